@@ -1,0 +1,26 @@
+//! WSLAP+ free-form strong-lensing mass reconstruction (Sendra, Diego, Broadhurst & Lazkoz).
+//!
+//! The modules follow the pipeline: cosmology → mass components → maps and critical curves →
+//! rendering and file formats. Angles are arcsec in the tangent-plane frame of METHOD.md
+//! (+x West, +y North); every stored deflection, convergence and shear is for `D_ls/D_s = 1`.
+//! The wasm boundary (`wasm.rs`) and the CLI (`main.rs`) are thin shells around this library.
+
+pub mod cosmology;
+pub mod curves;
+pub mod demo;
+pub mod ds9;
+pub mod fits;
+pub mod grid;
+pub mod maps;
+pub mod model;
+pub mod profiles;
+pub mod render;
+pub mod units;
+
+#[cfg(target_arch = "wasm32")]
+mod wasm;
+
+pub use cosmology::{Cosmology, CosmologyError, LensPlane};
+pub use curves::CriticalCurves;
+pub use grid::{Map, MapGeometry};
+pub use profiles::{Lens, MassComponent};

@@ -1,0 +1,1 @@
+//! The one place that talks to JavaScript (compiled for wasm32 only).
