@@ -17,7 +17,9 @@ pub enum CosmologyError {
         value: f64,
         reason: &'static str,
     },
-    #[error("source redshift z_s = {z_source} must be greater than the lens redshift z_l = {z_lens}")]
+    #[error(
+        "source redshift z_s = {z_source} must be greater than the lens redshift z_l = {z_lens}"
+    )]
     SourceNotBehindLens { z_lens: f64, z_source: f64 },
 }
 

@@ -5,6 +5,29 @@
 
 use glam::DVec2;
 
+mod error;
+mod gaussian;
+mod nfw;
+mod nfw_ellipse;
+mod nfw_math;
+mod point;
+mod sis;
+mod tnfw;
+
+pub use error::ProfileError;
+pub use gaussian::{
+    gaussian_unit_deflection, gaussian_unit_hessian, gaussian_unit_kappa, Gaussian,
+};
+pub use nfw::{nfw_deflection, nfw_hessian, nfw_kappa, nfw_mass_cylinder_msun, Nfw};
+pub use nfw_ellipse::{NfwEllipse, CSE_TERMS};
+pub use nfw_math::{nfw_terms, NfwTerms, X_FLOOR as NFW_X_FLOOR};
+pub use point::PointMass;
+pub use sis::{sis_theta_e_arcsec, Sis};
+pub use tnfw::{
+    far_field_coefficients as tnfw_far_field_coefficients, tnfw_mass_and_kappa_unit,
+    tnfw_total_mass_unit, TruncatedNfw,
+};
+
 /// One lensing mass distribution on the lens plane.
 pub trait MassComponent: Send + Sync + std::fmt::Debug {
     /// Convergence `kappa_ref = Sigma / Sigma_cr_ref` at `p` (arcsec).
@@ -14,6 +37,11 @@ pub trait MassComponent: Send + Sync + std::fmt::Debug {
     /// Hessian of the lensing potential at `p`: `[psi_xx, psi_xy, psi_yy]` (dimensionless).
     /// `kappa = (psi_xx + psi_yy)/2`, `gamma1 = (psi_xx - psi_yy)/2`, `gamma2 = psi_xy`.
     fn hessian(&self, p: DVec2) -> [f64; 3];
+    /// Deflection and Hessian together; profiles that share work between the two override it
+    /// (map making calls this once per pixel and component).
+    fn deflection_hessian(&self, p: DVec2) -> (DVec2, [f64; 3]) {
+        (self.deflection(p), self.hessian(p))
+    }
 }
 
 /// A lens made of several components; its fields are the sums of theirs.
@@ -40,5 +68,13 @@ impl MassComponent for Lens {
             let h = c.hessian(p);
             [acc[0] + h[0], acc[1] + h[1], acc[2] + h[2]]
         })
+    }
+    fn deflection_hessian(&self, p: DVec2) -> (DVec2, [f64; 3]) {
+        self.components
+            .iter()
+            .fold((DVec2::ZERO, [0.0; 3]), |(a, h), c| {
+                let (da, dh) = c.deflection_hessian(p);
+                (a + da, [h[0] + dh[0], h[1] + dh[1], h[2] + dh[2]])
+            })
     }
 }
