@@ -1,7 +1,22 @@
 //! Critical curves and caustics (METHOD.md section 6).
+//!
+//! Critical curves are the zero contours of the Jacobian eigenvalues `lambda_t`, `lambda_r`
+//! ([`LensMaps::eigen_maps`]), traced by marching squares between pixel centres with linear
+//! sub-pixel interpolation. Each crossed cell edge carries one contour vertex, and every segment
+//! is oriented with the side `lambda >= 0` on its left, so each vertex has at most one successor:
+//! the segments join into polylines after one sort (one scan of the map, then `O(S log S)` in the
+//! number of segments `S`). A curve that leaves the map is an open
+//! polyline that starts and ends on the map's border; every other curve is a closed loop.
+//! Saddle cells (diagonal corners of equal sign) are resolved by the value at the cell centre
+//! (mean of the four corners): the corners on the centre's side are joined through the cell.
 
 use glam::DVec2;
 use serde::{Deserialize, Serialize};
+
+use crate::cosmology::{CosmologyError, LensPlane};
+use crate::grid::{Map, MapGeometry};
+use crate::maps::LensMaps;
+use crate::profiles::MassComponent;
 
 /// A polyline in arcsec; closed curves repeat no point (the last joins the first).
 pub type Polyline = Vec<DVec2>;
@@ -22,4 +37,308 @@ pub struct CriticalCurves {
 pub struct Caustics {
     pub tangential: Vec<Polyline>,
     pub radial: Vec<Polyline>,
+}
+
+/// One zero contour of a map: vertices in arcsec, with the side `value >= 0` on the left.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Contour {
+    pub points: Polyline,
+    /// True for a loop (last vertex joins the first); false for a curve cut by the map border.
+    pub closed: bool,
+}
+
+/// Vertices closer than this (in pixels) are merged, e.g. where a contour passes exactly
+/// through a pixel centre and two cell edges give the same point.
+const DUPLICATE_PIXELS: f64 = 1.0e-9;
+
+/// Critical curves and caustics for a source with `f = D_ls/D_s` at `z_source`.
+///
+/// Tangential curves are the zero contours of `lambda_t = 1 - f (kappa + |gamma|)`, radial
+/// curves those of `lambda_r = 1 - f (kappa - |gamma|)`. Caustics map every vertex through
+/// `beta = theta - f alpha(theta)` (arcsec), with `alpha` from `lens` when given, else by
+/// bilinear interpolation of the deflection maps; a caustic keeps the vertex count of its
+/// critical curve (the SIS caustic is many copies of one point).
+///
+/// The effective Einstein radius is `sqrt(A / pi)` (arcsec), where `A` is the area where
+/// `lambda_t < 0` enclosed by the closed tangential loops: the sum of the loops' shoelace areas,
+/// each signed by its orientation, so a loop nested inside another (around an island with
+/// `lambda_t > 0`) counts as a hole. Curves open at the map border do not count: enlarge the
+/// map if the tangential curve leaves it. Maps whose `kappa`/`gamma` do not fill their geometry
+/// (only possible when built by hand) give no curves.
+pub fn critical_curves(
+    maps: &LensMaps,
+    f: f64,
+    z_source: f64,
+    lens: Option<&dyn MassComponent>,
+) -> CriticalCurves {
+    // The eigenvalues are evaluated on the fly (no full-size temporary maps).
+    let geometry = maps.geometry();
+    let n = geometry.pixels;
+    let fields = [&maps.kappa, &maps.gamma1, &maps.gamma2];
+    let consistent = fields
+        .iter()
+        .all(|m| m.geometry == geometry && m.data.len() == n * n);
+    let (k, g1, g2) = (&maps.kappa.data, &maps.gamma1.data, &maps.gamma2.data);
+    let shear = |i: usize| (g1[i] * g1[i] + g2[i] * g2[i]).sqrt();
+    let (tangential, radial) = if consistent {
+        (
+            contours_of(geometry, |i| 1.0 - f * (k[i] + shear(i))),
+            contours_of(geometry, |i| 1.0 - f * (k[i] - shear(i))),
+        )
+    } else {
+        (Vec::new(), Vec::new())
+    };
+    // Tangential loops run clockwise around their lambda_t < 0 interior (negative area).
+    let area: f64 = -tangential
+        .iter()
+        .filter(|c| c.closed)
+        .map(|c| signed_area_arcsec2(&c.points))
+        .sum::<f64>();
+    let einstein_radius_arcsec = (area.max(0.0) / std::f64::consts::PI).sqrt();
+    let to_source = |curves: &[Contour]| -> Vec<Polyline> {
+        curves
+            .iter()
+            .map(|c| {
+                c.points
+                    .iter()
+                    .map(|&p| source_position(maps, f, lens, p))
+                    .collect()
+            })
+            .collect()
+    };
+    let caustics = Caustics {
+        tangential: to_source(&tangential),
+        radial: to_source(&radial),
+    };
+    let points = |curves: Vec<Contour>| curves.into_iter().map(|c| c.points).collect();
+    CriticalCurves {
+        z_source,
+        einstein_radius_arcsec,
+        tangential: points(tangential),
+        radial: points(radial),
+        caustics,
+    }
+}
+
+/// The effective Einstein radius in arcsec of `lens` for a source at `z_source`, from the
+/// tangential critical curves on a map of `geometry` (see [`critical_curves`]); 0 when no closed
+/// tangential curve lies inside the map.
+pub fn einstein_radius_for(
+    lens: &dyn MassComponent,
+    geometry: MapGeometry,
+    plane: &LensPlane,
+    z_source: f64,
+) -> Result<f64, CosmologyError> {
+    let f = plane.distance_ratio(z_source)?;
+    let maps = LensMaps::from_lens(lens, geometry);
+    Ok(critical_curves(&maps, f, z_source, Some(lens)).einstein_radius_arcsec)
+}
+
+/// Source-plane position `beta = theta - f alpha(theta)` in arcsec.
+fn source_position(maps: &LensMaps, f: f64, lens: Option<&dyn MassComponent>, p: DVec2) -> DVec2 {
+    let alpha = match lens {
+        Some(l) => l.deflection(p),
+        None => DVec2::new(maps.alpha_x.sample(p), maps.alpha_y.sample(p)),
+    };
+    p - f * alpha
+}
+
+/// Shoelace area of a closed polygon in arcsec^2: positive when counter-clockwise.
+pub fn signed_area_arcsec2(points: &[DVec2]) -> f64 {
+    let Some(&last) = points.last() else {
+        return 0.0;
+    };
+    let mut prev = last;
+    let mut twice = 0.0;
+    for &p in points {
+        twice += prev.perp_dot(p);
+        prev = p;
+    }
+    0.5 * twice
+}
+
+/// The zero contours of `field`, traced between pixel centres by marching squares (see the
+/// module doc). A map with fewer than 2 pixels a side, or whose data do not fill it, has none.
+/// Non-finite values count as negative.
+pub fn zero_contours(field: &Map) -> Vec<Contour> {
+    let n = field.geometry.pixels;
+    if field.data.len() != n * n {
+        return Vec::new();
+    }
+    contours_of(field.geometry, |k| field.data[k])
+}
+
+/// The zero contours of the field whose value at pixel `k = j n + i` is `value(k)`.
+fn contours_of(geometry: MapGeometry, value: impl Fn(usize) -> f64) -> Vec<Contour> {
+    let n = geometry.pixels;
+    if n < 2 {
+        return Vec::new();
+    }
+    let grid = EdgeGrid { n, value };
+    grid.join(grid.link_segments())
+        .into_iter()
+        .map(|(edges, closed)| {
+            let points = edges
+                .into_iter()
+                .map(|p| geometry.pixel_to_arcsec(p.x, p.y))
+                .collect();
+            Contour { points, closed }
+        })
+        .collect()
+}
+
+/// The nodes (pixel centres) and cell edges of an `n x n` map. Edge ids: horizontal edge from
+/// node `(i, j)` to `(i+1, j)` is `j (n-1) + i`; vertical edge from `(i, j)` to `(i, j+1)` is
+/// `n (n-1) + j n + i`.
+struct EdgeGrid<F> {
+    n: usize,
+    /// The field at node `k = j n + i`.
+    value: F,
+}
+
+impl<F: Fn(usize) -> f64> EdgeGrid<F> {
+    fn horizontal(&self, i: usize, j: usize) -> usize {
+        j * (self.n - 1) + i
+    }
+
+    fn vertical(&self, i: usize, j: usize) -> usize {
+        self.n * (self.n - 1) + j * self.n + i
+    }
+
+    /// The contour vertex on edge `e` in fractional pixel coordinates: linear interpolation of
+    /// the zero between the edge's two nodes.
+    fn vertex(&self, e: usize) -> DVec2 {
+        let n = self.n;
+        let h = n * (n - 1);
+        let (a, b) = if e < h {
+            let (i, j) = (e % (n - 1), e / (n - 1));
+            ((i, j), (i + 1, j))
+        } else {
+            let (i, j) = ((e - h) % n, (e - h) / n);
+            ((i, j), (i, j + 1))
+        };
+        let (va, vb) = ((self.value)(a.1 * n + a.0), (self.value)(b.1 * n + b.0));
+        let t = va / (va - vb);
+        let t = if t.is_finite() {
+            t.clamp(0.0, 1.0)
+        } else {
+            0.5
+        };
+        let pa = DVec2::new(a.0 as f64, a.1 as f64);
+        let pb = DVec2::new(b.0 as f64, b.1 as f64);
+        pa + t * (pb - pa)
+    }
+
+    /// One pass over the cells: the oriented segments `(from edge, to edge)` of the contour.
+    fn link_segments(&self) -> Vec<(usize, usize)> {
+        let n = self.n;
+        let mut segments = Vec::new();
+        // Two rows of node values, each node evaluated once.
+        let mut row0: Vec<f64> = (0..n).map(|i| (self.value)(i)).collect();
+        let mut row1 = vec![0.0; n];
+        for j in 0..n - 1 {
+            for (i, v) in row1.iter_mut().enumerate() {
+                *v = (self.value)((j + 1) * n + i);
+            }
+            for i in 0..n - 1 {
+                // Corners counter-clockwise from the bottom left; edge k runs corner k -> k+1.
+                let v = [row0[i], row0[i + 1], row1[i + 1], row1[i]];
+                let pos = v.map(|x| x >= 0.0);
+                let case = pos
+                    .iter()
+                    .enumerate()
+                    .fold(0u8, |c, (k, &p)| c | (u8::from(p) << k));
+                if case == 0 || case == 15 {
+                    continue;
+                }
+                let edges = [
+                    self.horizontal(i, j),
+                    self.vertical(i + 1, j),
+                    self.horizontal(i, j + 1),
+                    self.vertical(i, j),
+                ];
+                // An exit edge goes from a positive to a negative corner; the segment runs from
+                // an exit edge to an entry edge, which keeps the positive side on its left.
+                let is_exit = |k: usize| pos[k] && !pos[(k + 1) % 4];
+                let is_entry = |k: usize| !pos[k] && pos[(k + 1) % 4];
+                let mut link = |from: usize, to: usize| segments.push((edges[from], edges[to]));
+                if case == 0b0101 || case == 0b1010 {
+                    // Saddle: entries and exits alternate. A positive centre joins the positive
+                    // corners (exit -> next edge); a negative one separates them
+                    // (exit -> previous edge).
+                    let centre_positive = v.iter().sum::<f64>() >= 0.0;
+                    let step = if centre_positive { 1 } else { 3 };
+                    for k in (0..4).filter(|&k| is_exit(k)) {
+                        link(k, (k + step) % 4);
+                    }
+                } else {
+                    let from = (0..4).find(|&k| is_exit(k));
+                    let to = (0..4).find(|&k| is_entry(k));
+                    if let (Some(from), Some(to)) = (from, to) {
+                        link(from, to);
+                    }
+                }
+            }
+            std::mem::swap(&mut row0, &mut row1);
+        }
+        segments
+    }
+
+    /// Joins the segments into curves: first the open chains (from border edges that no segment
+    /// enters), then the loops. Every crossed edge starts at most one segment and ends at most
+    /// one, so after sorting by start edge each successor is one binary search away
+    /// (`O(S log S)` for `S` segments). Returns each curve's vertices (fractional pixels) and
+    /// whether it is closed; duplicate consecutive vertices are merged, and degenerate curves
+    /// (fewer than 2 vertices, or 3 for a loop) dropped.
+    fn join(&self, mut segments: Vec<(usize, usize)>) -> Vec<(Vec<DVec2>, bool)> {
+        segments.sort_unstable();
+        let mut ends: Vec<usize> = segments.iter().map(|s| s.1).collect();
+        ends.sort_unstable();
+        let successor = |e: usize| segments.binary_search_by_key(&e, |s| s.0).ok();
+        let mut used = vec![false; segments.len()];
+        let mut curves = Vec::new();
+        for closed in [false, true] {
+            for first in 0..segments.len() {
+                let start = segments[first].0;
+                if used[first] || (!closed && ends.binary_search(&start).is_ok()) {
+                    continue;
+                }
+                let mut points = vec![self.vertex(start)];
+                let mut k = first;
+                loop {
+                    used[k] = true;
+                    let to = segments[k].1;
+                    if to == start {
+                        break;
+                    }
+                    push_distinct(&mut points, self.vertex(to));
+                    match successor(to) {
+                        Some(next) if !used[next] => k = next,
+                        _ => break,
+                    }
+                }
+                if closed {
+                    while points.len() > 1
+                        && points[0].distance(points[points.len() - 1]) < DUPLICATE_PIXELS
+                    {
+                        points.pop();
+                    }
+                }
+                if points.len() >= if closed { 3 } else { 2 } {
+                    curves.push((points, closed));
+                }
+            }
+        }
+        curves
+    }
+}
+
+/// Appends `p` unless it repeats the last vertex.
+fn push_distinct(points: &mut Vec<DVec2>, p: DVec2) {
+    if points
+        .last()
+        .map_or(true, |q| q.distance(p) >= DUPLICATE_PIXELS)
+    {
+        points.push(p);
+    }
 }
