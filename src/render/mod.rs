@@ -1,1 +1,145 @@
-//! (being written)
+//! Figures of maps with tiny-skia: the convergence map colour-mapped, with axes in arcsec, a
+//! colour bar, critical curves, point overlays and a legend (METHOD.md section 6).
+//!
+//! Orientation: pixel `i` of the map (+x, West for HFF maps with `CDELT1 < 0`) grows to the
+//! right and row `j` (+y, North) grows upward, as DS9 shows the FITS file; so East is to the
+//! left, as on the sky. Rendering is deterministic (no system fonts; a built-in bitmap font).
+
+use glam::DVec2;
+use serde::{Deserialize, Serialize};
+use thiserror::Error;
+
+use crate::curves::CriticalCurves;
+use crate::grid::Map;
+
+mod axes;
+mod colormap;
+mod colormap_tables;
+mod figure;
+mod font;
+mod overlay;
+
+pub use colormap::{
+    color_limits, render_colormap_rgba, value_rgb, ColorScale, Colormap, LOG_RANGE, NO_DATA_RGB,
+};
+pub use figure::{kappa_figure_frame, render_kappa_png, FigureFrame};
+pub use overlay::{CAUSTIC_RGB, RADIAL_RGB, TANGENTIAL_RGB};
+
+/// What prevents a figure from being drawn.
+#[derive(Debug, Error, Clone, PartialEq)]
+pub enum RenderError {
+    #[error("render option {name} = {value}: {reason}")]
+    BadOption {
+        name: &'static str,
+        value: String,
+        reason: &'static str,
+    },
+    #[error("the map has {len} values but its geometry needs {pixels} x {pixels}")]
+    BadMap { len: usize, pixels: usize },
+    #[error("the map has no finite values to set the colour scale from")]
+    NoFiniteValues,
+    #[error("log10 colour scale: the map has no positive values; give vmin and vmax")]
+    NoPositiveValues,
+    #[error("PNG encoding failed: {0}")]
+    Png(String),
+}
+
+/// Checks that the map's data fill its geometry and the geometry is usable.
+pub(crate) fn check_map(map: &Map) -> Result<(), RenderError> {
+    let n = map.geometry.pixels;
+    let size = map.geometry.size_arcsec;
+    if n == 0 || map.data.len() != n * n {
+        return Err(RenderError::BadMap {
+            len: map.data.len(),
+            pixels: n,
+        });
+    }
+    if !(size.is_finite() && size > 0.0 && map.geometry.center.is_finite()) {
+        let value = format!("{size} arcsec at {}", map.geometry.center);
+        return Err(RenderError::BadOption {
+            name: "geometry",
+            value,
+            reason: "size must be positive and finite",
+        });
+    }
+    Ok(())
+}
+
+/// Marker drawn at each position of an [`OverlayPoints`] set.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Marker {
+    #[default]
+    Circle,
+    Cross,
+    Plus,
+    Square,
+}
+
+/// A labelled set of positions (arcsec, frame of METHOD.md section 1), e.g. observed images.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct OverlayPoints {
+    pub label: String,
+    /// sRGB colour.
+    pub color: [u8; 3],
+    pub positions_arcsec: Vec<DVec2>,
+    pub marker: Marker,
+}
+
+/// What is drawn over the map: critical curves (tangential red, radial cyan; the caustics
+/// white and dashed if [`KappaPlotOptions::show_caustics`]) and point sets, clipped to the map.
+#[derive(Debug, Clone, Default)]
+pub struct Overlay<'a> {
+    pub curves: Option<&'a CriticalCurves>,
+    pub points: Vec<OverlayPoints>,
+}
+
+/// Options of [`render_kappa_png`]; `Default` gives a 512-pixel viridis map, linear scale,
+/// limits from the data.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(default)]
+pub struct KappaPlotOptions {
+    pub scale: ColorScale,
+    /// Lower colour limit in data units (None: from the data, see [`color_limits`]).
+    pub vmin: Option<f64>,
+    /// Upper colour limit in data units (None: the data maximum).
+    pub vmax: Option<f64>,
+    pub colormap: Colormap,
+    /// Side of the map on screen in pixels, 64 to 4096 (default 512). Text scales with it.
+    pub map_pixels_on_screen: u32,
+    /// Title above the map.
+    pub title: Option<String>,
+    /// Colour-bar label; default "kappa" or "log10 kappa".
+    pub colorbar_label: Option<String>,
+    /// Also draw the caustics of [`Overlay::curves`] (default false).
+    pub show_caustics: bool,
+}
+
+impl Default for KappaPlotOptions {
+    fn default() -> Self {
+        Self {
+            scale: ColorScale::Linear,
+            vmin: None,
+            vmax: None,
+            colormap: Colormap::Viridis,
+            map_pixels_on_screen: 512,
+            title: None,
+            colorbar_label: None,
+            show_caustics: false,
+        }
+    }
+}
+
+impl KappaPlotOptions {
+    /// Checks the screen size (the colour limits are checked by [`color_limits`]).
+    pub fn validate(&self) -> Result<(), RenderError> {
+        if !(64..=4096).contains(&self.map_pixels_on_screen) {
+            return Err(RenderError::BadOption {
+                name: "map_pixels_on_screen",
+                value: self.map_pixels_on_screen.to_string(),
+                reason: "must be 64 to 4096",
+            });
+        }
+        Ok(())
+    }
+}
