@@ -82,7 +82,10 @@ impl Map {
         let q = self.geometry.arcsec_to_pixel(p);
         let max = (n - 1) as f64;
         let (x, y) = (q.x.clamp(0.0, max), q.y.clamp(0.0, max));
-        let (i0, j0) = ((x.floor() as usize).min(n.saturating_sub(2)), (y.floor() as usize).min(n.saturating_sub(2)));
+        let (i0, j0) = (
+            (x.floor() as usize).min(n.saturating_sub(2)),
+            (y.floor() as usize).min(n.saturating_sub(2)),
+        );
         if n < 2 {
             return self.data[0];
         }
@@ -97,6 +100,8 @@ impl Map {
         self.data
             .iter()
             .filter(|v| v.is_finite())
-            .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), &v| (lo.min(v), hi.max(v)))
+            .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), &v| {
+                (lo.min(v), hi.max(v))
+            })
     }
 }

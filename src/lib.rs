@@ -13,8 +13,11 @@ pub mod fits;
 pub mod grid;
 pub mod maps;
 pub mod model;
+pub mod products;
 pub mod profiles;
+pub mod radial;
 pub mod render;
+pub mod sky;
 pub mod units;
 
 #[cfg(target_arch = "wasm32")]

@@ -1,27 +1,38 @@
-//! Command-line parsing and the subcommands.
+//! Command-line parsing and the subcommands (native only).
+
+mod maps;
 
 use std::process::ExitCode;
 
 use clap::{Parser, Subcommand};
 
 /// WSLAP+ free-form strong-lensing mass reconstruction.
+///
+/// Angles are arcsec in the tangent-plane frame of the reference point (+x West, +y North);
+/// maps of kappa, shear and deflection are for D_ls/D_s = 1 (the HFF convention).
 #[derive(Debug, Parser)]
-#[command(name = "wslap", version, about, long_about = None)]
+#[command(name = "wslap", version, about, long_about)]
 struct Cli {
     #[command(subcommand)]
-    command: Option<Command>,
+    command: Command,
 }
 
 #[derive(Debug, Subcommand)]
-enum Command {}
+enum Command {
+    Maps(maps::MapsArgs),
+}
 
+/// Parses the arguments, runs the subcommand, prints any error with its context.
 pub fn run() -> ExitCode {
     let cli = Cli::parse();
-    match cli.command {
-        None => {
-            use clap::CommandFactory;
-            let _ = Cli::command().print_help();
-            ExitCode::SUCCESS
+    let result = match cli.command {
+        Command::Maps(args) => maps::run(&args),
+    };
+    match result {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(message) => {
+            eprintln!("error: {message}");
+            ExitCode::FAILURE
         }
     }
 }

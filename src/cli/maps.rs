@@ -1,0 +1,133 @@
+//! `wslap maps`: the map products of a model file, or of published HFF deflection maps.
+
+use std::fs;
+use std::path::{Path, PathBuf};
+
+use clap::Args;
+use wslap::fits::read_image;
+use wslap::model::ModelFile;
+use wslap::products::{ProductOptions, Products};
+use wslap::render::ColorScale;
+use wslap::{Cosmology, LensPlane};
+
+/// Maps, critical curves, caustics and figures of a lens.
+///
+/// Writes into DIR: kappa.fits, gamma1.fits, gamma2.fits, x-arcsec-deflect.fits,
+/// y-arcsec-deflect.fits (all for D_ls/D_s = 1), magnif.fits (at --z-source, header ZSOURCE),
+/// critical-curves.json, critical-curves.reg (DS9), kappa.png and summary.json.
+#[derive(Debug, Args)]
+#[command(group(clap::ArgGroup::new("lens").required(true).args(["model", "deflection"])))]
+pub struct MapsArgs {
+    /// Model file (JSON) of a parametric lens.
+    #[arg(long, value_name = "MODEL.json")]
+    model: Option<PathBuf>,
+    /// Published deflection maps (HFF x- and y-arcsec-deflect FITS, D_ls/D_s = 1).
+    #[arg(long, num_args = 2, value_names = ["X.fits", "Y.fits"], requires = "z_lens")]
+    deflection: Option<Vec<PathBuf>>,
+    /// Lens redshift (with --deflection; a model file has its own).
+    #[arg(long)]
+    z_lens: Option<f64>,
+    /// H0 in km/s/Mpc (with --deflection).
+    #[arg(long, default_value_t = 70.0)]
+    h0: f64,
+    /// Omega_m of flat LCDM (with --deflection).
+    #[arg(long, default_value_t = 0.3)]
+    omega_m: f64,
+    /// Output folder (created if missing).
+    #[arg(long, value_name = "DIR")]
+    out: PathBuf,
+    /// Source redshift of the magnification map and the critical curves.
+    #[arg(long, default_value_t = 2.0)]
+    z_source: f64,
+    /// Map width in arcsec, centred on (0, 0) (model files only).
+    #[arg(long, default_value_t = 200.0)]
+    size: f64,
+    /// Pixels on a side (model files only).
+    #[arg(long, default_value_t = 512)]
+    pixels: usize,
+    /// Colour scale of kappa.png.
+    #[arg(long, value_enum, default_value_t = Scale::Log)]
+    scale: Scale,
+}
+
+#[derive(Debug, Clone, Copy, clap::ValueEnum)]
+enum Scale {
+    Log,
+    Linear,
+}
+
+impl From<Scale> for ColorScale {
+    fn from(s: Scale) -> Self {
+        match s {
+            Scale::Log => ColorScale::Log,
+            Scale::Linear => ColorScale::Linear,
+        }
+    }
+}
+
+pub fn run(args: &MapsArgs) -> Result<(), String> {
+    let products = if let Some(path) = &args.model {
+        let text = read_text(path)?;
+        let model = ModelFile::from_json_str(&text, &path.display().to_string())
+            .map_err(|e| e.to_string())?;
+        let opts = ProductOptions {
+            z_source: args.z_source,
+            size_arcsec: args.size,
+            pixels: args.pixels,
+            scale: args.scale.into(),
+        };
+        Products::from_model(&model, &opts).map_err(|e| e.to_string())?
+    } else {
+        let paths = args.deflection.as_deref().unwrap_or_default();
+        let (ax, ay) = (read_map(&paths[0])?, read_map(&paths[1])?);
+        let z_lens = args.z_lens.ok_or("--deflection needs --z-lens")?;
+        let cosmology = Cosmology::new(args.h0, args.omega_m).map_err(|e| e.to_string())?;
+        let plane = LensPlane::new(cosmology, z_lens).map_err(|e| e.to_string())?;
+        Products::from_deflection(ax.0, ay.0, plane, ax.1, args.z_source)
+            .map_err(|e| e.to_string())?
+    };
+    write_products(&products, args.scale.into(), &args.out)?;
+    let s = products.summary();
+    println!(
+        "wrote {} (Einstein radius at z_s = {}: {:.2} arcsec; {} tangential, {} radial critical curves)",
+        args.out.display(),
+        s.z_source,
+        s.einstein_radius_arcsec,
+        s.tangential_curves,
+        s.radial_curves
+    );
+    Ok(())
+}
+
+fn read_text(path: &Path) -> Result<String, String> {
+    fs::read_to_string(path).map_err(|e| format!("{}: {e}", path.display()))
+}
+
+fn read_map(path: &Path) -> Result<(wslap::Map, Option<wslap::sky::SkyReference>), String> {
+    let bytes = fs::read(path).map_err(|e| format!("{}: {e}", path.display()))?;
+    let image = read_image(&bytes, &path.display().to_string()).map_err(|e| e.to_string())?;
+    let (_, reference) = image.geometry().map_err(|e| e.to_string())?;
+    let map = image.to_map().map_err(|e| e.to_string())?;
+    Ok((map, reference))
+}
+
+/// Writes every product file into `dir`.
+pub fn write_products(products: &Products, scale: ColorScale, dir: &Path) -> Result<(), String> {
+    fs::create_dir_all(dir).map_err(|e| format!("{}: {e}", dir.display()))?;
+    let write = |name: &str, bytes: &[u8]| -> Result<(), String> {
+        let path = dir.join(name);
+        fs::write(&path, bytes).map_err(|e| format!("{}: {e}", path.display()))
+    };
+    for (name, bytes) in products.fits_files().map_err(|e| e.to_string())? {
+        write(name, &bytes)?;
+    }
+    write("critical-curves.json", products.curves_json().as_bytes())?;
+    write("critical-curves.reg", products.regions().as_bytes())?;
+    write(
+        "kappa.png",
+        &products.kappa_png(scale).map_err(|e| e.to_string())?,
+    )?;
+    let summary = serde_json::to_string_pretty(&products.summary()).map_err(|e| e.to_string())?;
+    write("summary.json", summary.as_bytes())?;
+    Ok(())
+}

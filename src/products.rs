@@ -1,0 +1,360 @@
+//! The map product set of METHOD.md section 6 for one lens, as `wslap maps` writes it and the
+//! app shows it: reference-normalised maps, magnification, critical curves and caustics at one
+//! source redshift, the radial profile, and the files (FITS, DS9, PNG, JSON).
+
+use glam::DVec2;
+use serde::{Deserialize, Serialize};
+use thiserror::Error;
+
+use crate::cosmology::{CosmologyError, LensPlane};
+use crate::curves::{critical_curves, CriticalCurves};
+use crate::ds9::write_regions;
+use crate::fits::{write_image, Card, FitsError, FitsWriteOptions};
+use crate::grid::{Map, MapGeometry};
+use crate::maps::{LensMaps, MapsError};
+use crate::model::{ModelError, ModelFile};
+use crate::profiles::MassComponent;
+use crate::radial::{radial_profile, RadialBins, RadialError, RadialProfile};
+use crate::render::{render_kappa_png, ColorScale, KappaPlotOptions, Overlay, RenderError};
+use crate::sky::SkyReference;
+
+/// Largest map side in pixels (a 8192^2 map of five float64 quantities is 2.7 GB).
+pub const MAX_PIXELS: usize = 8192;
+
+/// What went wrong while making the products.
+#[derive(Debug, Error)]
+pub enum ProductsError {
+    #[error(transparent)]
+    Model(#[from] ModelError),
+    #[error(transparent)]
+    Cosmology(#[from] CosmologyError),
+    #[error("{field} = {value} is not allowed ({reason})")]
+    BadOption {
+        field: &'static str,
+        value: f64,
+        reason: &'static str,
+    },
+    #[error(transparent)]
+    Maps(#[from] MapsError),
+    #[error(transparent)]
+    Fits(#[from] FitsError),
+    #[error(transparent)]
+    Radial(#[from] RadialError),
+    #[error(transparent)]
+    Render(#[from] RenderError),
+}
+
+/// Settings of one product run; every field has a documented default.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct ProductOptions {
+    /// Source redshift of the magnification map and the critical curves (default 2).
+    pub z_source: f64,
+    /// Width of the square map in arcsec, centred on (0, 0) (default 200).
+    pub size_arcsec: f64,
+    /// Pixels on a side (default 512).
+    pub pixels: usize,
+    /// Colour scale of the kappa figure (default log).
+    pub scale: ColorScale,
+}
+
+impl Default for ProductOptions {
+    fn default() -> Self {
+        Self {
+            z_source: 2.0,
+            size_arcsec: 200.0,
+            pixels: 512,
+            scale: ColorScale::Log,
+        }
+    }
+}
+
+impl ProductOptions {
+    /// Checks the ranges: `size_arcsec` in (0, 36000], `pixels` in [16, MAX_PIXELS].
+    pub fn validate(&self) -> Result<(), ProductsError> {
+        if !(self.size_arcsec.is_finite() && self.size_arcsec > 0.0 && self.size_arcsec <= 36_000.0)
+        {
+            return Err(ProductsError::BadOption {
+                field: "size",
+                value: self.size_arcsec,
+                reason: "the map width in arcsec must be in (0, 36000]",
+            });
+        }
+        if !(16..=MAX_PIXELS).contains(&self.pixels) {
+            return Err(ProductsError::BadOption {
+                field: "pixels",
+                value: self.pixels as f64,
+                reason: "the map side must be 16 to 8192 pixels",
+            });
+        }
+        if !self.z_source.is_finite() {
+            return Err(ProductsError::BadOption {
+                field: "z_source",
+                value: self.z_source,
+                reason: "the source redshift must be a number",
+            });
+        }
+        Ok(())
+    }
+}
+
+/// Wall-clock time of each stage in milliseconds.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Serialize, Deserialize)]
+pub struct Timings {
+    pub maps_ms: f64,
+    pub curves_ms: f64,
+    pub profile_ms: f64,
+}
+
+/// Everything derived from one lens at one source redshift.
+#[derive(Debug, Clone)]
+pub struct Products {
+    pub plane: LensPlane,
+    pub reference: Option<SkyReference>,
+    /// `f(z_s) = D_ls/D_s`.
+    pub distance_ratio: f64,
+    pub maps: LensMaps,
+    pub magnification: Map,
+    pub curves: CriticalCurves,
+    pub profile: RadialProfile,
+    pub timings: Timings,
+}
+
+/// A short account of the products (`summary.json`).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Summary {
+    pub z_lens: f64,
+    pub z_source: f64,
+    pub distance_ratio: f64,
+    pub d_l_mpc: f64,
+    pub sigma_cr_ref_msun_per_arcsec2: f64,
+    pub map_size_arcsec: f64,
+    pub map_pixels: usize,
+    pub einstein_radius_arcsec: f64,
+    pub tangential_curves: usize,
+    pub radial_curves: usize,
+    pub kappa_max: f64,
+    /// Projected mass inside 10, 20 and 50 arcsec of (0, 0), Msun (`null` where the circle
+    /// leaves the map).
+    pub mass_within_arcsec: Vec<(f64, Option<f64>)>,
+    pub timings_ms: Timings,
+}
+
+/// Radii of the enclosed masses reported in the summary, arcsec.
+const SUMMARY_RADII_ARCSEC: [f64; 3] = [10.0, 20.0, 50.0];
+
+impl Products {
+    /// Products of a parametric model file.
+    pub fn from_model(model: &ModelFile, opts: &ProductOptions) -> Result<Self, ProductsError> {
+        opts.validate()?;
+        let plane = model.lens_plane()?;
+        let f = plane.distance_ratio(opts.z_source)?;
+        let lens = model.build_lens()?;
+        let geometry = MapGeometry::centered(opts.size_arcsec, opts.pixels);
+        let t = Clock::start();
+        let maps = LensMaps::from_lens(&lens, geometry);
+        let maps_ms = t.ms();
+        Self::finish(
+            maps,
+            plane,
+            model.reference,
+            f,
+            opts.z_source,
+            Some(&lens),
+            maps_ms,
+        )
+    }
+
+    /// Products of published deflection maps (HFF convention, `D_ls/D_s = 1`, arcsec).
+    pub fn from_deflection(
+        alpha_x: Map,
+        alpha_y: Map,
+        plane: LensPlane,
+        reference: Option<SkyReference>,
+        z_source: f64,
+    ) -> Result<Self, ProductsError> {
+        let f = plane.distance_ratio(z_source)?;
+        let t = Clock::start();
+        let maps = LensMaps::from_deflection(alpha_x, alpha_y)?;
+        let maps_ms = t.ms();
+        Self::finish(maps, plane, reference, f, z_source, None, maps_ms)
+    }
+
+    fn finish(
+        maps: LensMaps,
+        plane: LensPlane,
+        reference: Option<SkyReference>,
+        f: f64,
+        z_source: f64,
+        lens: Option<&dyn MassComponent>,
+        maps_ms: f64,
+    ) -> Result<Self, ProductsError> {
+        let t = Clock::start();
+        let magnification = maps.magnification(f);
+        let curves = critical_curves(&maps, f, z_source, lens);
+        let curves_ms = t.ms();
+        let t = Clock::start();
+        let geometry = maps.geometry();
+        let r_max = 0.5 * geometry.size_arcsec - geometry.center.length();
+        let bins = RadialBins::Linear {
+            r_min_arcsec: 0.0,
+            r_max_arcsec: r_max.max(geometry.pixel_arcsec()),
+            count: (geometry.pixels / 4).clamp(4, 200),
+        };
+        let profile = radial_profile(&maps.kappa, DVec2::ZERO, &bins, &plane)?;
+        let profile_ms = t.ms();
+        Ok(Self {
+            plane,
+            reference,
+            distance_ratio: f,
+            maps,
+            magnification,
+            curves,
+            profile,
+            timings: Timings {
+                maps_ms,
+                curves_ms,
+                profile_ms,
+            },
+        })
+    }
+
+    /// The summary written as `summary.json`.
+    pub fn summary(&self) -> Summary {
+        let g = self.maps.geometry();
+        let profile_mass_at = |r: f64| -> Option<f64> {
+            let edges = &self.profile.r_edges_arcsec;
+            let k = edges.iter().position(|&e| e >= r)?;
+            if k == 0 {
+                return Some(0.0);
+            }
+            // Linear interpolation between the bracketing edges (r^2 would be exact for a sheet).
+            let (r0, r1) = (edges[k - 1], edges[k]);
+            let (m0, m1) = (
+                self.profile.enclosed_mass_msun[k - 1],
+                self.profile.enclosed_mass_msun[k],
+            );
+            Some(m0 + (m1 - m0) * (r * r - r0 * r0) / (r1 * r1 - r0 * r0))
+        };
+        Summary {
+            z_lens: self.plane.z_lens,
+            z_source: self.curves.z_source,
+            distance_ratio: self.distance_ratio,
+            d_l_mpc: self.plane.d_l_mpc,
+            sigma_cr_ref_msun_per_arcsec2: self.plane.sigma_cr_ref_msun_per_arcsec2,
+            map_size_arcsec: g.size_arcsec,
+            map_pixels: g.pixels,
+            einstein_radius_arcsec: self.curves.einstein_radius_arcsec,
+            tangential_curves: self.curves.tangential.len(),
+            radial_curves: self.curves.radial.len(),
+            kappa_max: self.maps.kappa.min_max().1,
+            mass_within_arcsec: SUMMARY_RADII_ARCSEC
+                .iter()
+                .map(|&r| (r, profile_mass_at(r)))
+                .collect(),
+            timings_ms: self.timings,
+        }
+    }
+
+    /// The kappa figure (PNG) with the critical curves on top.
+    pub fn kappa_png(&self, scale: ColorScale) -> Result<Vec<u8>, ProductsError> {
+        let overlay = Overlay {
+            curves: Some(&self.curves),
+            points: Vec::new(),
+        };
+        let opts = KappaPlotOptions {
+            scale,
+            title: Some(format!(
+                "z_l = {}, critical curves at z_s = {}",
+                self.plane.z_lens, self.curves.z_source
+            )),
+            ..KappaPlotOptions::default()
+        };
+        Ok(render_kappa_png(&self.maps.kappa, &overlay, &opts)?)
+    }
+
+    /// The HFF-style FITS maps: `(file name, bytes)` for kappa, gamma1, gamma2, the two
+    /// deflections (all at `D_ls/D_s = 1`) and the magnification at `z_s` (header `ZSOURCE`).
+    pub fn fits_files(&self) -> Result<Vec<(&'static str, Vec<u8>)>, ProductsError> {
+        let z = self.curves.z_source;
+        let base = |bunit: &str, what: &str| FitsWriteOptions {
+            bunit: bunit.to_string(),
+            comments: vec![
+                format!("{what}, written by wslap {}", env!("CARGO_PKG_VERSION")),
+                "Normalised to D_ls/D_s = 1 (HFF convention) unless stated.".to_string(),
+            ],
+            reference: self.reference,
+            extra_cards: vec![Card::real("ZLENS", self.plane.z_lens, "lens redshift")],
+        };
+        let m = &self.maps;
+        let mut magnif = base("", "Magnification");
+        magnif
+            .extra_cards
+            .push(Card::real("ZSOURCE", z, "source redshift of this map"));
+        Ok(vec![
+            (
+                "kappa.fits",
+                write_image(&m.kappa, &base("", "Convergence"))?,
+            ),
+            (
+                "gamma1.fits",
+                write_image(&m.gamma1, &base("", "Shear component 1"))?,
+            ),
+            (
+                "gamma2.fits",
+                write_image(&m.gamma2, &base("", "Shear component 2"))?,
+            ),
+            (
+                "x-arcsec-deflect.fits",
+                write_image(
+                    &m.alpha_x,
+                    &base("arcsec", "Deflection along x (pixel axis 1)"),
+                )?,
+            ),
+            (
+                "y-arcsec-deflect.fits",
+                write_image(
+                    &m.alpha_y,
+                    &base("arcsec", "Deflection along y (pixel axis 2)"),
+                )?,
+            ),
+            ("magnif.fits", write_image(&self.magnification, &magnif)?),
+        ])
+    }
+
+    /// `critical-curves.json`: curves and caustics in arcsec.
+    pub fn curves_json(&self) -> String {
+        serde_json::to_string(&self.curves).expect("curves serialise")
+    }
+
+    /// `critical-curves.reg`: DS9 regions (fk5 when the sky reference is known).
+    pub fn regions(&self) -> String {
+        write_regions(&self.curves, self.reference, &self.maps.geometry())
+    }
+}
+
+/// Wall-clock timer that also works in a browser worker (where `std::time::Instant` panics).
+struct Clock(f64);
+
+impl Clock {
+    fn start() -> Self {
+        Self(now_ms())
+    }
+    fn ms(&self) -> f64 {
+        now_ms() - self.0
+    }
+}
+
+#[cfg(not(target_arch = "wasm32"))]
+fn now_ms() -> f64 {
+    use std::time::{SystemTime, UNIX_EPOCH};
+    SystemTime::now()
+        .duration_since(UNIX_EPOCH)
+        .map(|d| d.as_secs_f64() * 1e3)
+        .unwrap_or(0.0)
+}
+
+#[cfg(target_arch = "wasm32")]
+fn now_ms() -> f64 {
+    js_sys::Date::now()
+}
