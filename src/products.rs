@@ -146,21 +146,31 @@ const SUMMARY_RADII_ARCSEC: [f64; 3] = [10.0, 20.0, 50.0];
 impl Products {
     /// Products of a parametric model file.
     pub fn from_model(model: &ModelFile, opts: &ProductOptions) -> Result<Self, ProductsError> {
-        opts.validate()?;
         let plane = model.lens_plane()?;
-        let f = plane.distance_ratio(opts.z_source)?;
         let lens = model.build_lens()?;
+        Self::from_lens(&lens, plane, model.reference, opts)
+    }
+
+    /// Products of any lens (a parametric model, or a reconstruction) on the map of `opts`.
+    pub fn from_lens(
+        lens: &dyn MassComponent,
+        plane: LensPlane,
+        reference: Option<SkyReference>,
+        opts: &ProductOptions,
+    ) -> Result<Self, ProductsError> {
+        opts.validate()?;
+        let f = plane.distance_ratio(opts.z_source)?;
         let geometry = MapGeometry::centered(opts.size_arcsec, opts.pixels);
         let t = Clock::start();
-        let maps = LensMaps::from_lens(&lens, geometry);
+        let maps = LensMaps::from_lens(lens, geometry);
         let maps_ms = t.ms();
         Self::finish(
             maps,
             plane,
-            model.reference,
+            reference,
             f,
             opts.z_source,
-            Some(&lens),
+            Some(lens),
             maps_ms,
         )
     }
