@@ -1,0 +1,129 @@
+//! What can go wrong reading a catalogue, and what is only worth a warning.
+//!
+//! Every message starts with the file name given by the caller and names the line, and where
+//! one value is at fault its 1-based column, the column's name and the text as written.
+
+use std::fmt;
+
+use serde::{Deserialize, Serialize};
+use thiserror::Error;
+
+/// A catalogue that cannot be used as written.
+#[derive(Debug, Error, Clone, PartialEq)]
+pub enum CatalogError {
+    /// No data rows: an empty file, or only blank and comment lines.
+    #[error(
+        "{source_name}: no catalogue rows in {lines} line(s) (only blank lines and # comments)"
+    )]
+    Empty { source_name: String, lines: usize },
+
+    /// A row with fewer columns than the format needs.
+    #[error(
+        "{source_name}: line {line}: {found} column(s) found, at least {needed} needed \
+         ({expected})"
+    )]
+    MissingColumns {
+        source_name: String,
+        line: usize,
+        found: usize,
+        needed: usize,
+        /// The column layout, e.g. `"id x y a b theta z [mag]"`.
+        expected: &'static str,
+    },
+
+    /// One field that is not a usable value: not a number, NaN/inf, out of range, a bad id.
+    #[error("{source_name}: line {line}, column {column} ({column_name}): '{value}' {reason}")]
+    BadValue {
+        source_name: String,
+        line: usize,
+        /// 1-based column number.
+        column: usize,
+        column_name: &'static str,
+        /// The field as written.
+        value: String,
+        /// Why it is rejected, e.g. `"is not a number"`.
+        reason: String,
+    },
+
+    /// The same image id on two rows.
+    #[error("{source_name}: line {line}: image id '{id}' is already used on line {first_line}")]
+    DuplicateId {
+        source_name: String,
+        id: String,
+        first_line: usize,
+        line: usize,
+    },
+
+    /// Two images of one system whose redshifts differ by more than the agreement tolerance.
+    #[error(
+        "{source_name}: system '{system}': line {line_a} gives z = {z_a} but line {line_b} gives \
+         z = {z_b}; images of one source must agree within {tolerance} (1 + z)"
+    )]
+    InconsistentRedshift {
+        source_name: String,
+        system: String,
+        line_a: usize,
+        z_a: f64,
+        line_b: usize,
+        z_b: f64,
+        /// The relative tolerance on `Δz / (1 + z)`.
+        tolerance: f64,
+    },
+
+    /// A `#REFERENCE` header that cannot be read.
+    #[error("{source_name}: line {line}: bad header '{text}': {reason}")]
+    BadReference {
+        source_name: String,
+        line: usize,
+        text: String,
+        reason: String,
+    },
+
+    /// A `#REFERENCE` mode this reader does not convert.
+    #[error("{source_name}: line {line}: unsupported REFERENCE mode {mode}: {reason}")]
+    UnsupportedReference {
+        source_name: String,
+        line: usize,
+        mode: String,
+        reason: String,
+    },
+
+    /// The sky reference asked for by the caller cannot define a frame.
+    #[error(
+        "{source_name}: requested sky reference (RA {ra_deg} deg, Dec {dec_deg} deg) is not \
+         usable: RA and Dec must be finite and |Dec| < 90 deg"
+    )]
+    InvalidReference {
+        source_name: String,
+        ra_deg: f64,
+        dec_deg: f64,
+    },
+
+    /// A catalogue without a sky reference cannot be moved to another frame.
+    #[error("{source_name}: the catalogue has no sky reference, so it cannot change frame")]
+    NoReference { source_name: String },
+
+    /// A default source redshift that is not finite and positive.
+    #[error("{source_name}: default source redshift {z} must be finite and > 0")]
+    BadDefaultRedshift { source_name: String, z: f64 },
+}
+
+/// Something legal but worth telling the user (the caller decides what to do with it).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct CatalogWarning {
+    /// File name, as given by the caller.
+    pub source_name: String,
+    /// 1-based line the warning is about (the first one, when it concerns several).
+    pub line: usize,
+    pub message: String,
+}
+
+impl fmt::Display for CatalogWarning {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(
+            f,
+            "{}: line {}: {}",
+            self.source_name, self.line, self.message
+        )
+    }
+}

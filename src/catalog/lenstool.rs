@@ -1,0 +1,257 @@
+//! Parsers for Lenstool multiple-image and member (potfile) catalogues (METHOD.md section 7),
+//! as people have them: any whitespace (tabs, runs of spaces, trailing spaces, CRLF), `#`
+//! comment lines anywhere (also indented), an optional `#REFERENCE` header before the rows
+//! (see [`super::frame`]), and no header meaning absolute degrees.
+
+use std::collections::HashMap;
+
+use glam::DVec2;
+
+use super::frame;
+use super::rows::{read_table, warn_extra_columns, Fields};
+use super::{
+    CatalogError, CatalogWarning, Image, ImageCatalog, ImageSystem, Member, MemberCatalog,
+};
+use crate::sky::SkyReference;
+
+/// Images of one source agree in redshift when `(z_max - z_min) / (1 + z_min)` is at most this.
+/// 1e-3 is a velocity difference of 300 km/s: the spread of redshifts measured from different
+/// lines or spectra of one galaxy (e.g. 1.1781 and 1.1783 for system 32 of MACS J1931).
+pub const Z_AGREEMENT_TOL: f64 = 1e-3;
+
+const IMAGE_LAYOUT: &str = "id x y a b theta z [mag]";
+const MEMBER_LAYOUT: &str = "id x y a b theta mag [lum]";
+
+/// Parses a Lenstool multiple-image catalogue: rows `id x y a b theta z [mag]`.
+///
+/// Positions end in the arcsec frame (+x West, +y North) of `reference` when given; otherwise
+/// of the header's `#REFERENCE` position; otherwise (absolute degrees without one) of the mean
+/// image position. With `RA0, Dec0` the frame origin, `x = -(RA - RA0) cos(Dec0) 3600` and
+/// `y = (Dec - Dec0) 3600` arcsec; relative catalogues in another frame are re-projected
+/// through (RA, Dec). `a`, `b` are arcsec (>= 0), `theta` degrees, `mag` 0 when missing.
+///
+/// Ids are `system.image`: the system is the text before the first '.' (`4.2a` and `14c.1`
+/// are systems `4` and `14c`). `z = 0` means unknown (`None`); images of one system must agree
+/// within [`Z_AGREEMENT_TOL`] (their mean is used, with a warning when they differ or some are
+/// unknown). Warnings: single-image systems, extra columns (ignored).
+pub fn parse_image_catalog(
+    text: &str,
+    source_name: &str,
+    reference: Option<SkyReference>,
+) -> Result<(ImageCatalog, Vec<CatalogWarning>), CatalogError> {
+    let requested = frame::check_requested(reference, source_name)?;
+    let table = read_table(text, source_name)?;
+    let [c0, c1] = table.coords.column_names();
+    let names = ["id", c0, c1, "a", "b", "theta", "z", "mag"];
+    let mut warnings = Vec::new();
+    let mut extra_lines = Vec::new();
+    let mut seen: HashMap<&str, usize> = HashMap::new();
+    let mut parsed = Vec::with_capacity(table.rows.len());
+    for row in &table.rows {
+        let f = Fields {
+            row,
+            names: &names,
+            source_name,
+        };
+        f.require(IMAGE_LAYOUT, &mut extra_lines)?;
+        let id = row.fields[0];
+        let system = f.system_id()?;
+        if let Some(&first_line) = seen.get(id) {
+            return Err(CatalogError::DuplicateId {
+                source_name: source_name.into(),
+                id: id.into(),
+                first_line,
+                line: row.line,
+            });
+        }
+        seen.insert(id, row.line);
+        let shape = f.shape(table.coords)?;
+        let z = f.redshift(6)?;
+        let mag = f.optional(7)?;
+        let image = Image {
+            id: id.into(),
+            position: shape.raw,
+            a_arcsec: shape.a,
+            b_arcsec: shape.b,
+            theta_deg: shape.theta,
+            mag,
+            line: row.line,
+        };
+        parsed.push((system, z, image));
+    }
+    warn_extra_columns(&extra_lines, source_name, &mut warnings);
+    let raw: Vec<DVec2> = parsed.iter().map(|(_, _, im)| im.position).collect();
+    let (frame_ref, positions) = table.coords.into_frame(&raw, requested);
+    for ((_, _, image), p) in parsed.iter_mut().zip(positions) {
+        image.position = p;
+    }
+    let systems = group_systems(parsed, source_name, &mut warnings)?;
+    let catalog = ImageCatalog {
+        source_name: source_name.into(),
+        reference: Some(frame_ref),
+        systems,
+    };
+    Ok((catalog, warnings))
+}
+
+/// Parses a Lenstool member catalogue (potfile): rows `id x y a b theta mag [lum]`.
+///
+/// Same `#REFERENCE` rules and frame as [`parse_image_catalog`]; `a`, `b` arcsec (>= 0),
+/// `theta` degrees, `mag` required, `lum` 0 when missing (kept as written, not interpreted).
+/// Ids are free text; a repeated id is only a warning.
+pub fn parse_member_catalog(
+    text: &str,
+    source_name: &str,
+    reference: Option<SkyReference>,
+) -> Result<(MemberCatalog, Vec<CatalogWarning>), CatalogError> {
+    let requested = frame::check_requested(reference, source_name)?;
+    let table = read_table(text, source_name)?;
+    let [c0, c1] = table.coords.column_names();
+    let names = ["id", c0, c1, "a", "b", "theta", "mag", "lum"];
+    let mut warnings = Vec::new();
+    let mut extra_lines = Vec::new();
+    let mut seen: HashMap<&str, usize> = HashMap::new();
+    let mut members = Vec::with_capacity(table.rows.len());
+    for row in &table.rows {
+        let f = Fields {
+            row,
+            names: &names,
+            source_name,
+        };
+        f.require(MEMBER_LAYOUT, &mut extra_lines)?;
+        let id = row.fields[0];
+        if let Some(&first_line) = seen.get(id) {
+            warnings.push(CatalogWarning {
+                source_name: source_name.into(),
+                line: row.line,
+                message: format!("member id '{id}' is already used on line {first_line}"),
+            });
+        }
+        seen.insert(id, row.line);
+        let shape = f.shape(table.coords)?;
+        members.push(Member {
+            id: id.into(),
+            position: shape.raw,
+            a_arcsec: shape.a,
+            b_arcsec: shape.b,
+            theta_deg: shape.theta,
+            mag: f.number(6)?,
+            lum: f.optional(7)?,
+            line: row.line,
+        });
+    }
+    warn_extra_columns(&extra_lines, source_name, &mut warnings);
+    let raw: Vec<DVec2> = members.iter().map(|m| m.position).collect();
+    let (frame_ref, positions) = table.coords.into_frame(&raw, requested);
+    for (m, p) in members.iter_mut().zip(positions) {
+        m.position = p;
+    }
+    let catalog = MemberCatalog {
+        source_name: source_name.into(),
+        reference: Some(frame_ref),
+        members,
+    };
+    Ok((catalog, warnings))
+}
+
+/// The images of one system while grouping, with each image's `(line, z)` as written.
+struct Group {
+    id: String,
+    zs: Vec<(usize, Option<f64>)>,
+    images: Vec<Image>,
+}
+
+/// Groups images by system in order of first appearance and settles each system's redshift.
+fn group_systems(
+    parsed: Vec<(String, Option<f64>, Image)>,
+    source_name: &str,
+    warnings: &mut Vec<CatalogWarning>,
+) -> Result<Vec<ImageSystem>, CatalogError> {
+    let mut index: HashMap<String, usize> = HashMap::new();
+    let mut groups: Vec<Group> = Vec::new();
+    for (system, z, image) in parsed {
+        let k = *index.entry(system.clone()).or_insert_with(|| {
+            groups.push(Group {
+                id: system,
+                zs: Vec::new(),
+                images: Vec::new(),
+            });
+            groups.len() - 1
+        });
+        groups[k].zs.push((image.line, z));
+        groups[k].images.push(image);
+    }
+    let mut systems = Vec::with_capacity(groups.len());
+    for Group { id, zs, images } in groups {
+        let z = system_redshift(&id, &zs, source_name, warnings)?;
+        if images.len() == 1 {
+            warnings.push(CatalogWarning {
+                source_name: source_name.into(),
+                line: images[0].line,
+                message: format!(
+                    "system '{id}' has a single image ('{}'): it constrains nothing by itself",
+                    images[0].id
+                ),
+            });
+        }
+        systems.push(ImageSystem { id, z, images });
+    }
+    Ok(systems)
+}
+
+/// The redshift of one system from its images' `(line, z)`: `None` when all are unknown,
+/// otherwise the mean of the known ones, which must agree within [`Z_AGREEMENT_TOL`].
+fn system_redshift(
+    id: &str,
+    zs: &[(usize, Option<f64>)],
+    source_name: &str,
+    warnings: &mut Vec<CatalogWarning>,
+) -> Result<Option<f64>, CatalogError> {
+    let known: Vec<(usize, f64)> = zs.iter().filter_map(|&(l, z)| z.map(|z| (l, z))).collect();
+    let by_z = |a: &&(usize, f64), b: &&(usize, f64)| a.1.total_cmp(&b.1);
+    let (Some(&lo), Some(&hi)) = (known.iter().min_by(by_z), known.iter().rev().max_by(by_z))
+    else {
+        return Ok(None);
+    };
+    let mut warn = |line: usize, message: String| {
+        warnings.push(CatalogWarning {
+            source_name: source_name.into(),
+            line,
+            message,
+        });
+    };
+    let (first, second) = if lo.0 < hi.0 { (lo, hi) } else { (hi, lo) };
+    if hi.1 - lo.1 > Z_AGREEMENT_TOL * (1.0 + lo.1) {
+        return Err(CatalogError::InconsistentRedshift {
+            source_name: source_name.into(),
+            system: id.into(),
+            line_a: first.0,
+            z_a: first.1,
+            line_b: second.0,
+            z_b: second.1,
+            tolerance: Z_AGREEMENT_TOL,
+        });
+    }
+    let z = known.iter().map(|k| k.1).sum::<f64>() / known.len() as f64;
+    if hi.1 > lo.1 {
+        warn(
+            first.0,
+            format!(
+                "system '{id}': line {} gives z = {} and line {} gives z = {} (within the \
+                 tolerance); using their mean z = {z}",
+                first.0, first.1, second.0, second.1
+            ),
+        );
+    }
+    if let Some(&(unknown_line, _)) = zs.iter().find(|(_, z)| z.is_none()) {
+        warn(
+            unknown_line,
+            format!(
+                "system '{id}': z = 0 (unknown) here but line {} gives z = {}; using z = {z} \
+                 for the whole system",
+                known[0].0, known[0].1
+            ),
+        );
+    }
+    Ok(Some(z))
+}

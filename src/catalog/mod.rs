@@ -1,0 +1,177 @@
+//! Lenstool catalogues: multiple images and cluster members (METHOD.md section 7).
+//!
+//! Positions are brought into the arcsec frame of one sky reference (+x West, +y North).
+//! [`parse_image_catalog`] and [`parse_member_catalog`] read Lenstool's text formats; the
+//! caller passes the frame it wants (e.g. the members' reference) so that every catalogue of a
+//! run shares one frame.
+
+use glam::DVec2;
+use serde::{Deserialize, Serialize};
+
+use crate::sky::SkyReference;
+
+mod error;
+mod frame;
+mod lenstool;
+mod rows;
+
+pub use error::{CatalogError, CatalogWarning};
+pub use lenstool::{parse_image_catalog, parse_member_catalog, Z_AGREEMENT_TOL};
+
+/// One observed image of a multiply-lensed source.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Image {
+    /// The catalogue id, e.g. `"4.2"`.
+    pub id: String,
+    /// Position in arcsec in the catalogue's frame.
+    pub position: DVec2,
+    /// Ellipse semi-axes in arcsec (Lenstool `a`, `b`) and position angle in degrees
+    /// counter-clockwise from +x (Lenstool `theta`).
+    pub a_arcsec: f64,
+    pub b_arcsec: f64,
+    pub theta_deg: f64,
+    /// Magnitude column (0 when unknown).
+    pub mag: f64,
+    /// 1-based line of the catalogue it came from (for messages).
+    pub line: usize,
+}
+
+/// The images of one source: the part of the id before the first '.'.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct ImageSystem {
+    /// System id, e.g. `"4"`.
+    pub id: String,
+    /// Source redshift (`None` when the catalogue says 0: unknown).
+    pub z: Option<f64>,
+    pub images: Vec<Image>,
+}
+
+/// A parsed multiple-image catalogue.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct ImageCatalog {
+    /// File name, for messages.
+    pub source_name: String,
+    /// The frame's sky origin: the reference the caller asked for, else the `#REFERENCE`
+    /// position, else (absolute degrees without one) the mean image position.
+    pub reference: Option<SkyReference>,
+    /// Systems in the order of first appearance.
+    pub systems: Vec<ImageSystem>,
+}
+
+/// One cluster member galaxy of a Lenstool potfile.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Member {
+    pub id: String,
+    pub position: DVec2,
+    pub a_arcsec: f64,
+    pub b_arcsec: f64,
+    pub theta_deg: f64,
+    /// Magnitude (the mass-to-light scaling uses it).
+    pub mag: f64,
+    /// The 8th column as written (luminosity, or in some files a redshift); not interpreted.
+    pub lum: f64,
+    pub line: usize,
+}
+
+/// A parsed member (potfile) catalogue.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct MemberCatalog {
+    pub source_name: String,
+    pub reference: Option<SkyReference>,
+    pub members: Vec<Member>,
+}
+
+impl ImageCatalog {
+    /// Systems whose source redshift is known (`z` is `Some`), in catalogue order.
+    pub fn systems_with_redshift(&self) -> impl Iterator<Item = &ImageSystem> + '_ {
+        self.systems.iter().filter(|s| s.z.is_some())
+    }
+
+    /// Systems whose source redshift is unknown (`z = 0` in the file), in catalogue order.
+    pub fn unknown_redshift_systems(&self) -> impl Iterator<Item = &ImageSystem> + '_ {
+        self.systems.iter().filter(|s| s.z.is_none())
+    }
+
+    /// The catalogue with `z` given to every system of unknown redshift (known ones are kept).
+    /// `z` must be finite and > 0.
+    pub fn with_default_z(mut self, z: f64) -> Result<Self, CatalogError> {
+        if !(z.is_finite() && z > 0.0) {
+            return Err(CatalogError::BadDefaultRedshift {
+                source_name: self.source_name,
+                z,
+            });
+        }
+        for s in &mut self.systems {
+            s.z.get_or_insert(z);
+        }
+        Ok(self)
+    }
+
+    /// Every image, system by system.
+    pub fn images(&self) -> impl Iterator<Item = &Image> + '_ {
+        self.systems.iter().flat_map(|s| s.images.iter())
+    }
+
+    /// Number of images over all systems.
+    pub fn image_count(&self) -> usize {
+        self.systems.iter().map(|s| s.images.len()).sum()
+    }
+
+    /// `(min, max)` corners in arcsec of the box holding every image position;
+    /// `(0, 0)`, `(0, 0)` for a catalogue without images.
+    pub fn bounding_box_arcsec(&self) -> (DVec2, DVec2) {
+        bounding_box(self.images().map(|im| im.position))
+    }
+
+    /// The catalogue in the arcsec frame of `to`: every position goes through its sky position,
+    /// `p' = to.to_offset_arcsec(from.offset_to_radec(p))`. Fails without a reference or with an
+    /// unusable `to` (non-finite, `|Dec| >= 90`).
+    pub fn reframed(mut self, to: SkyReference) -> Result<Self, CatalogError> {
+        let (from, to) = reframe_pair(self.reference, to, &self.source_name)?;
+        for s in &mut self.systems {
+            for im in &mut s.images {
+                im.position = frame::reframe(im.position, from, to);
+            }
+        }
+        self.reference = Some(to);
+        Ok(self)
+    }
+}
+
+impl MemberCatalog {
+    /// The catalogue in the arcsec frame of `to` (see [`ImageCatalog::reframed`]).
+    pub fn reframed(mut self, to: SkyReference) -> Result<Self, CatalogError> {
+        let (from, to) = reframe_pair(self.reference, to, &self.source_name)?;
+        for m in &mut self.members {
+            m.position = frame::reframe(m.position, from, to);
+        }
+        self.reference = Some(to);
+        Ok(self)
+    }
+
+    /// `(min, max)` corners in arcsec of the box holding every member position;
+    /// `(0, 0)`, `(0, 0)` for a catalogue without members.
+    pub fn bounding_box_arcsec(&self) -> (DVec2, DVec2) {
+        bounding_box(self.members.iter().map(|m| m.position))
+    }
+}
+
+fn reframe_pair(
+    from: Option<SkyReference>,
+    to: SkyReference,
+    source_name: &str,
+) -> Result<(SkyReference, SkyReference), CatalogError> {
+    let from = from.ok_or_else(|| CatalogError::NoReference {
+        source_name: source_name.into(),
+    })?;
+    let to = frame::check_requested(Some(to), source_name)?.unwrap_or(to);
+    Ok((from, to))
+}
+
+fn bounding_box(points: impl Iterator<Item = DVec2>) -> (DVec2, DVec2) {
+    points
+        .fold(None, |acc: Option<(DVec2, DVec2)>, p| {
+            Some(acc.map_or((p, p), |(lo, hi)| (lo.min(p), hi.max(p))))
+        })
+        .unwrap_or((DVec2::ZERO, DVec2::ZERO))
+}

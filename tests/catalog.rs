@@ -1,0 +1,578 @@
+//! Lenstool catalogues (METHOD.md section 7): the real AS1063 and MACS1931 inputs in
+//! ../shared/data (native only), the formats' variants and frame changes, and one test per bad
+//! input, each expecting its specific error text.
+
+mod common;
+
+use common::assert_abs;
+use glam::DVec2;
+use wslap::catalog::{
+    parse_image_catalog, parse_member_catalog, CatalogError, ImageCatalog, Z_AGREEMENT_TOL,
+};
+use wslap::sky::SkyReference;
+
+/// Positions computed by the same formula in another order: rounding of `RA - RA0` (~1e-13 deg)
+/// times 3600 arcsec/deg.
+const POSITION_ATOL_ARCSEC: f64 = 1e-8;
+/// Round trip through (RA, Dec) and back: double rounding of degrees near 342 (~6e-14 deg).
+const ROUND_TRIP_ATOL_ARCSEC: f64 = 1e-9;
+
+/// The AS1063 members' frame (`#REFERENCE 3 342.1832200 -44.5308890`).
+const AS1063_RA0: f64 = 342.18322;
+const AS1063_DEC0: f64 = -44.530889;
+
+fn as1063_reference() -> SkyReference {
+    SkyReference::new(AS1063_RA0, AS1063_DEC0).unwrap()
+}
+
+/// `x = -(RA - RA0) cos(Dec0) 3600`, `y = (Dec - Dec0) 3600` (METHOD.md section 1).
+fn lenstool_offset(ra: f64, dec: f64, ra0: f64, dec0: f64) -> DVec2 {
+    DVec2::new(
+        -(ra - ra0) * dec0.to_radians().cos() * 3600.0,
+        (dec - dec0) * 3600.0,
+    )
+}
+
+fn image_err(text: &str) -> String {
+    let err = parse_image_catalog(text, "bad.cat", None).expect_err("must be rejected");
+    err.to_string()
+}
+
+#[track_caller]
+fn assert_contains(message: &str, parts: &[&str]) {
+    for p in parts {
+        assert!(message.contains(p), "'{p}' missing from: {message}");
+    }
+}
+
+#[cfg(not(target_arch = "wasm32"))]
+mod real_files {
+    use super::*;
+
+    fn read(rel: &str) -> String {
+        let path = format!("{}/../shared/data/{rel}", env!("CARGO_MANIFEST_DIR"));
+        std::fs::read_to_string(&path).unwrap_or_else(|e| panic!("{path}: {e}"))
+    }
+
+    fn images(rel: &str, reference: Option<SkyReference>) -> ImageCatalog {
+        let (cat, warnings) = parse_image_catalog(&read(rel), rel, reference).unwrap();
+        assert!(
+            warnings.is_empty(),
+            "{rel}: unexpected warnings {warnings:?}"
+        );
+        cat
+    }
+
+    fn unknown_z_images(cat: &ImageCatalog) -> usize {
+        cat.unknown_redshift_systems().map(|s| s.images.len()).sum()
+    }
+
+    #[test]
+    fn as1063_gold_images() {
+        let cat = images("AS1063/lenstool_cats/cats_gold_mul_gold.cat", None);
+        assert_eq!(cat.image_count(), 50);
+        assert_eq!(cat.systems.len(), 19);
+        assert_eq!(cat.systems_with_redshift().count(), 19);
+        assert_eq!(cat.unknown_redshift_systems().count(), 0);
+        let s12 = cat.systems.iter().find(|s| s.id == "12").unwrap();
+        assert_eq!((s12.images.len(), s12.z), (5, Some(6.107)));
+        // Without a requested frame: the mean image position, so the mean offset is zero.
+        let mean = cat.images().map(|im| im.position).sum::<DVec2>() / 50.0;
+        assert!(mean.length() < POSITION_ATOL_ARCSEC, "mean offset {mean}");
+        let (lo, hi) = cat.bounding_box_arcsec();
+        assert!(
+            lo.x < -30.0 && hi.x > 40.0 && lo.y < -35.0 && hi.y > 40.0,
+            "{lo} {hi}"
+        );
+    }
+
+    #[test]
+    fn as1063_gold_images_in_members_frame() {
+        let cat = images(
+            "AS1063/lenstool_cats/cats_gold_mul_gold.cat",
+            Some(as1063_reference()),
+        );
+        assert_eq!(cat.reference, Some(as1063_reference()));
+        let im = &cat.systems[0].images[0];
+        assert_eq!((im.id.as_str(), im.line), ("1.1", 1));
+        let expected = lenstool_offset(342.1945, -44.526998, AS1063_RA0, AS1063_DEC0);
+        assert_abs(
+            "image 1.1 x",
+            im.position.x,
+            expected.x,
+            POSITION_ATOL_ARCSEC,
+        );
+        assert_abs(
+            "image 1.1 y",
+            im.position.y,
+            expected.y,
+            POSITION_ATOL_ARCSEC,
+        );
+        assert_abs("image 1.1 x (approx.)", im.position.x, -28.948, 1e-3);
+        assert_abs("image 1.1 y (approx.)", im.position.y, 14.0076, 1e-3);
+    }
+
+    #[test]
+    fn as1063_silver_images_and_default_z() {
+        let cat = images("AS1063/lenstool_cats/cats_silver_mul_silver.cat", None);
+        assert_eq!((cat.image_count(), cat.systems.len()), (72, 27));
+        let unknown: Vec<&str> = cat
+            .unknown_redshift_systems()
+            .map(|s| s.id.as_str())
+            .collect();
+        assert_eq!(unknown, ["3", "8", "9", "43", "141", "142", "143", "144"]);
+        assert_eq!(unknown_z_images(&cat), 22);
+        let filled = cat.clone().with_default_z(2.0).unwrap();
+        assert_eq!(filled.unknown_redshift_systems().count(), 0);
+        for (a, b) in cat.systems.iter().zip(&filled.systems) {
+            assert_eq!(b.z, Some(a.z.unwrap_or(2.0)), "system {}", a.id);
+        }
+    }
+
+    #[test]
+    fn as1063_members() {
+        let rel = "AS1063/lenstool_cats/cats_gold_ref_potential_w_clumpNE.cat";
+        let (cat, warnings) = parse_member_catalog(&read(rel), rel, None).unwrap();
+        assert!(warnings.is_empty(), "{warnings:?}");
+        assert_eq!(cat.members.len(), 260);
+        assert_eq!(cat.reference, Some(as1063_reference()));
+        let m = &cat.members[0];
+        assert_eq!((m.id.as_str(), m.line), ("13475", 2));
+        assert_eq!(
+            (m.position, m.mag, m.lum),
+            (DVec2::new(79.7384, 33.1776), 18.3953, 0.0)
+        );
+        assert_eq!((m.a_arcsec, m.theta_deg), (1.23055596, 38.85));
+        let mag_range = cat
+            .members
+            .iter()
+            .fold((f64::MAX, f64::MIN), |(lo, hi), m| {
+                (lo.min(m.mag), hi.max(m.mag))
+            });
+        assert_eq!(mag_range, (18.2961, 25.099));
+    }
+
+    #[test]
+    fn macs1931_images() {
+        let rel = "MACS1931/lenstool_cats/immul_ongoing.cat";
+        let (cat, warnings) = parse_image_catalog(&read(rel), rel, None).unwrap();
+        assert_eq!((cat.image_count(), cat.systems.len()), (28, 10));
+        assert_eq!(unknown_z_images(&cat), 11);
+        assert_eq!(cat.unknown_redshift_systems().count(), 4);
+        // System 32: z = 1.1781 (line 9), 1.1783 (lines 13, 15): within the tolerance, averaged,
+        // with one warning naming both lines.
+        let s32 = cat.systems.iter().find(|s| s.id == "32").unwrap();
+        assert_abs(
+            "z of system 32",
+            s32.z.unwrap(),
+            (1.1781 + 2.0 * 1.1783) / 3.0,
+            1e-12,
+        );
+        assert_eq!(warnings.len(), 1, "{warnings:?}");
+        assert_eq!(warnings[0].line, 9);
+        assert_contains(
+            &warnings[0].to_string(),
+            &[rel, "system '32'", "line 13", "1.1783"],
+        );
+        let ids: Vec<&str> = cat.systems.iter().map(|s| s.id.as_str()).collect();
+        assert_eq!(
+            ids,
+            ["1", "954", "32", "23", "26", "27", "2", "4", "6", "5"]
+        );
+    }
+
+    #[test]
+    fn macs1931_members_and_images_share_a_frame() {
+        let rel = "MACS1931/lenstool_cats/m1931.cat";
+        let (members, warnings) = parse_member_catalog(&read(rel), rel, None).unwrap();
+        assert!(warnings.is_empty(), "{warnings:?}");
+        assert_eq!(members.members.len(), 198);
+        assert_eq!(members.reference, SkyReference::new(292.95682, -26.575718));
+        // The 8th column of this file holds redshifts, kept as written.
+        assert!(members.members.iter().all(|m| (0.2..0.5).contains(&m.lum)));
+        let rel = "MACS1931/lenstool_cats/immul_ongoing.cat";
+        let (cat, _) = parse_image_catalog(&read(rel), rel, members.reference).unwrap();
+        let (lo, hi) = members.bounding_box_arcsec();
+        for im in cat.images() {
+            let p = im.position;
+            assert!(
+                p.cmpge(lo).all() && p.cmple(hi).all(),
+                "image {} at {p}",
+                im.id
+            );
+        }
+        let im = &cat.systems[0].images[0];
+        let expected = lenstool_offset(292.96063, -26.569172, 292.95682, -26.575718);
+        assert!(
+            (im.position - expected).length() < POSITION_ATOL_ARCSEC,
+            "{}",
+            im.position
+        );
+    }
+}
+
+// ---------------------------------------------------------------- formats and frames
+
+const MEMBERS_REL: &str = "#REFERENCE 3 342.18322 -44.530889\n\
+    1 79.7384 33.1776 1.2 1.1 38.85 18.39 0.0\n\
+    2 -59.1622 67.7765 1.1 0.9 -29.98 18.46 0.0\n\
+    3 -300.5 -250.25 0.5 0.4 10.0 22.1 0.0\n";
+
+#[cfg_attr(not(target_arch = "wasm32"), test)]
+#[cfg_attr(target_arch = "wasm32", wasm_bindgen_test::wasm_bindgen_test)]
+fn relative_catalogue_reprojects_and_back() {
+    let other = SkyReference::new(342.21, -44.49).unwrap();
+    let (native, _) = parse_member_catalog(MEMBERS_REL, "m.cat", None).unwrap();
+    let (moved, _) = parse_member_catalog(MEMBERS_REL, "m.cat", Some(other)).unwrap();
+    assert_eq!(moved.reference, Some(other));
+    // The moved positions are the same sky positions.
+    let m = &moved.members[0];
+    let (ra, dec) = as1063_reference().offset_to_radec(native.members[0].position);
+    let expected = lenstool_offset(ra, dec, other.ra_deg, other.dec_deg);
+    assert!(
+        (m.position - expected).length() < POSITION_ATOL_ARCSEC,
+        "{}",
+        m.position
+    );
+    assert!((m.position - native.members[0].position).length() > 100.0);
+    let back = moved.reframed(as1063_reference()).unwrap();
+    for (a, b) in back.members.iter().zip(&native.members) {
+        assert!(
+            (a.position - b.position).length() < ROUND_TRIP_ATOL_ARCSEC,
+            "member {}: {} vs {}",
+            a.id,
+            a.position,
+            b.position
+        );
+    }
+}
+
+#[cfg_attr(not(target_arch = "wasm32"), test)]
+#[cfg_attr(target_arch = "wasm32", wasm_bindgen_test::wasm_bindgen_test)]
+fn whitespace_comments_and_ids_as_people_write_them() {
+    let text = "\u{feff}# gold list\r\n\
+        \t4.2a\t342.1945   -44.526998\t0.1 0.1 0.0 1.5 24.0   \r\n\
+        \r\n\
+        \x20  #4.9 342.19 -44.52 0.1 0.1 0 1.5 0  (commented out)\r\n\
+        4.1 342.1959 -44.528965 0.1 0.1 0.0 1.5\r\n\
+        14c.1 342.18645 -44.521197 0.2 0.1 30 0 0\r\n\
+        14c.2 342.1927 -44.531135 0.2 0.1 30 0 0 99 extra\r\n";
+    let (cat, warnings) = parse_image_catalog(text, "w.cat", None).unwrap();
+    let ids: Vec<(&str, usize)> = cat
+        .systems
+        .iter()
+        .map(|s| (s.id.as_str(), s.images.len()))
+        .collect();
+    assert_eq!(ids, [("4", 2), ("14c", 2)]);
+    assert_eq!((cat.systems[0].z, cat.systems[1].z), (Some(1.5), None));
+    let first = &cat.systems[0].images[0];
+    assert_eq!(
+        (first.id.as_str(), first.line, first.mag),
+        ("4.2a", 2, 24.0)
+    );
+    assert_eq!(cat.systems[0].images[1].mag, 0.0, "missing mag is 0");
+    assert_eq!(cat.systems[1].images[0].theta_deg, 30.0);
+    assert_eq!(warnings.len(), 1, "{warnings:?}");
+    assert_eq!(
+        warnings[0].to_string(),
+        "w.cat: line 7: 1 row(s) have more than 8 columns; the extra columns are ignored"
+    );
+}
+
+#[cfg_attr(not(target_arch = "wasm32"), test)]
+#[cfg_attr(target_arch = "wasm32", wasm_bindgen_test::wasm_bindgen_test)]
+fn single_images_and_partly_unknown_redshifts_warn() {
+    let text = "1.1 10 20 0.1 0.1 0 0 0\n\
+                1.2 10.001 20 0.1 0.1 0 2.5 0\n\
+                7.1 10.002 20 0.1 0.1 0 3.0 0\n";
+    let (cat, warnings) = parse_image_catalog(text, "w.cat", None).unwrap();
+    assert_eq!(
+        cat.systems[0].z,
+        Some(2.5),
+        "unknown z = 0 does not contradict 2.5"
+    );
+    let messages: Vec<String> = warnings.iter().map(ToString::to_string).collect();
+    assert_eq!(messages.len(), 2, "{messages:?}");
+    assert_contains(
+        &messages[0],
+        &["w.cat: line 1:", "system '1'", "line 2 gives z = 2.5"],
+    );
+    assert_contains(
+        &messages[1],
+        &["w.cat: line 3:", "system '7' has a single image ('7.1')"],
+    );
+}
+
+#[cfg_attr(not(target_arch = "wasm32"), test)]
+#[cfg_attr(target_arch = "wasm32", wasm_bindgen_test::wasm_bindgen_test)]
+fn reference_modes_0_1_3_agree() {
+    let (ra, dec) = as1063_reference().offset_to_radec(DVec2::new(-28.5, 14.25));
+    let abs0 = format!("#REFERENCE 0 342.18322 -44.530889\n1.1 {ra:.12} {dec:.12} 0 0 0 2 0\n");
+    let rel1 = "#REFERENCE 1 22:48:43.9728 -44:31:51.2004\n1.1 -28.5 14.25 0 0 0 2 0\n";
+    let rel3 = "#REFERENCE 3 342.18322 -44.530889\n1.1 -28.5 14.25 0 0 0 2 0\n";
+    for text in [abs0.as_str(), rel1, rel3] {
+        let (cat, _) = parse_image_catalog(text, "r.cat", None).unwrap();
+        let r = cat.reference.unwrap();
+        assert_abs("ra0", r.ra_deg, AS1063_RA0, 1e-10);
+        assert_abs("dec0", r.dec_deg, AS1063_DEC0, 1e-10);
+        let p = cat.systems[0].images[0].position;
+        assert!(
+            (p - DVec2::new(-28.5, 14.25)).length() < 1e-6,
+            "{text}: {p}"
+        );
+    }
+}
+
+#[cfg_attr(not(target_arch = "wasm32"), test)]
+#[cfg_attr(target_arch = "wasm32", wasm_bindgen_test::wasm_bindgen_test)]
+fn members_without_lum_and_absolute_members() {
+    let text = "a 342.19 -44.52 0.5 0.4 10 19.5\nb 342.17 -44.54 0.5 0.4 10 20.5 1e11\n";
+    let (cat, warnings) = parse_member_catalog(text, "m.cat", Some(as1063_reference())).unwrap();
+    assert!(warnings.is_empty());
+    assert_eq!((cat.members[0].lum, cat.members[1].lum), (0.0, 1e11));
+    let expected = lenstool_offset(342.17, -44.54, AS1063_RA0, AS1063_DEC0);
+    assert!((cat.members[1].position - expected).length() < POSITION_ATOL_ARCSEC);
+    let (lo, hi) = cat.bounding_box_arcsec();
+    assert!(lo.x < hi.x && lo.y < hi.y);
+}
+
+#[cfg_attr(not(target_arch = "wasm32"), test)]
+#[cfg_attr(target_arch = "wasm32", wasm_bindgen_test::wasm_bindgen_test)]
+fn image_catalog_helpers() {
+    let text = "#REFERENCE 3 10 20\n\
+                1.1 -3 4 0 0 0 1.5\n1.2 5 -6 0 0 0 1.5\n2.1 1 1 0 0 0 0\n2.2 0 9 0 0 0 0\n";
+    let (cat, _) = parse_image_catalog(text, "h.cat", None).unwrap();
+    assert_eq!(cat.image_count(), 4);
+    assert_eq!(
+        cat.bounding_box_arcsec(),
+        (DVec2::new(-3.0, -6.0), DVec2::new(5.0, 9.0))
+    );
+    assert_eq!(
+        cat.systems_with_redshift()
+            .map(|s| &s.id)
+            .collect::<Vec<_>>(),
+        ["1"]
+    );
+    assert_eq!(
+        cat.unknown_redshift_systems()
+            .map(|s| &s.id)
+            .collect::<Vec<_>>(),
+        ["2"]
+    );
+    let filled = cat.clone().with_default_z(3.0).unwrap();
+    assert_eq!(
+        (filled.systems[0].z, filled.systems[1].z),
+        (Some(1.5), Some(3.0))
+    );
+    let err = cat.with_default_z(f64::NAN).unwrap_err().to_string();
+    assert_eq!(
+        err,
+        "h.cat: default source redshift NaN must be finite and > 0"
+    );
+    let empty = ImageCatalog {
+        source_name: "e".into(),
+        reference: None,
+        systems: vec![],
+    };
+    assert_eq!(empty.bounding_box_arcsec(), (DVec2::ZERO, DVec2::ZERO));
+    assert!(matches!(
+        empty.reframed(as1063_reference()),
+        Err(CatalogError::NoReference { .. })
+    ));
+}
+
+// ---------------------------------------------------------------- bad inputs
+
+#[cfg_attr(not(target_arch = "wasm32"), test)]
+#[cfg_attr(target_arch = "wasm32", wasm_bindgen_test::wasm_bindgen_test)]
+fn missing_columns() {
+    let err = image_err("1.1 342.1 -44.5 0.1 0.1 0 1.2\n1.2 342.2 -44.5 0.1 0.1\n");
+    assert_eq!(
+        err,
+        "bad.cat: line 2: 5 column(s) found, at least 7 needed (id x y a b theta z [mag])"
+    );
+}
+
+#[cfg_attr(not(target_arch = "wasm32"), test)]
+#[cfg_attr(target_arch = "wasm32", wasm_bindgen_test::wasm_bindgen_test)]
+fn nan_value() {
+    let err = image_err("# list\n1.1 342.1 -44.5 0.1 0.1 NaN 1.2 0\n");
+    assert_eq!(
+        err,
+        "bad.cat: line 2, column 6 (theta): 'NaN' is not a finite number"
+    );
+}
+
+#[cfg_attr(not(target_arch = "wasm32"), test)]
+#[cfg_attr(target_arch = "wasm32", wasm_bindgen_test::wasm_bindgen_test)]
+fn non_numeric_value() {
+    let err = image_err("1.1 342.1 -44.5 0.1 0.1 0 1.2 0\n\n1.2 342.2 -44.5 0.1 0.1 0 abc 0\n");
+    assert_eq!(err, "bad.cat: line 3, column 7 (z): 'abc' is not a number");
+}
+
+#[cfg_attr(not(target_arch = "wasm32"), test)]
+#[cfg_attr(target_arch = "wasm32", wasm_bindgen_test::wasm_bindgen_test)]
+fn duplicate_image_ids() {
+    let err = image_err(
+        "1.1 342.1 -44.5 0 0 0 1.2 0\n1.2 342.2 -44.5 0 0 0 1.2 0\n1.1 342.3 -44.5 0 0 0 1.2 0\n",
+    );
+    assert_eq!(
+        err,
+        "bad.cat: line 3: image id '1.1' is already used on line 1"
+    );
+}
+
+#[cfg_attr(not(target_arch = "wasm32"), test)]
+#[cfg_attr(target_arch = "wasm32", wasm_bindgen_test::wasm_bindgen_test)]
+fn id_without_dot() {
+    let err = image_err("1.1 342.1 -44.5 0 0 0 1.2 0\n12 342.2 -44.5 0 0 0 1.2 0\n");
+    assert_contains(
+        &err,
+        &[
+            "bad.cat: line 2, column 1 (id): '12'",
+            "system.image",
+            "no '.'",
+        ],
+    );
+}
+
+#[cfg_attr(not(target_arch = "wasm32"), test)]
+#[cfg_attr(target_arch = "wasm32", wasm_bindgen_test::wasm_bindgen_test)]
+fn inconsistent_redshift_in_a_system() {
+    let err = image_err(
+        "5.1 342.1 -44.5 0 0 0 1.39 0\n6.1 342.2 -44.5 0 0 0 2 0\n5.2 342.3 -44.5 0 0 0 1.42 0\n",
+    );
+    assert_eq!(
+        err,
+        format!(
+            "bad.cat: system '5': line 1 gives z = 1.39 but line 3 gives z = 1.42; images of \
+             one source must agree within {Z_AGREEMENT_TOL} (1 + z)"
+        )
+    );
+}
+
+#[cfg_attr(not(target_arch = "wasm32"), test)]
+#[cfg_attr(target_arch = "wasm32", wasm_bindgen_test::wasm_bindgen_test)]
+fn empty_file() {
+    assert_eq!(
+        image_err(""),
+        "bad.cat: no catalogue rows in 0 line(s) (only blank lines and # comments)"
+    );
+}
+
+#[cfg_attr(not(target_arch = "wasm32"), test)]
+#[cfg_attr(target_arch = "wasm32", wasm_bindgen_test::wasm_bindgen_test)]
+fn only_comments() {
+    let err = parse_member_catalog(
+        "#REFERENCE 3 10 20\n# id x y\n\n  #1 0 0 1 1 0 20 0\n",
+        "m.cat",
+        None,
+    )
+    .unwrap_err();
+    assert_eq!(
+        err,
+        CatalogError::Empty {
+            source_name: "m.cat".into(),
+            lines: 4
+        }
+    );
+    assert_eq!(
+        err.to_string(),
+        "m.cat: no catalogue rows in 4 line(s) (only blank lines and # comments)"
+    );
+}
+
+#[cfg_attr(not(target_arch = "wasm32"), test)]
+#[cfg_attr(target_arch = "wasm32", wasm_bindgen_test::wasm_bindgen_test)]
+fn unsupported_reference_mode() {
+    let err = image_err("# pixels\n#REFERENCE 2 2048 2048\n1.1 100 200 0 0 0 1.2 0\n");
+    assert_contains(
+        &err,
+        &[
+            "bad.cat: line 2: unsupported REFERENCE mode 2:",
+            "pixels",
+            "#REFERENCE 3 ra0 dec0",
+        ],
+    );
+    let err = image_err("#REFERENCE 7 10 20\n1.1 100 200 0 0 0 1.2 0\n");
+    assert_contains(&err, &["bad.cat: line 1: unsupported REFERENCE mode 7"]);
+}
+
+#[cfg_attr(not(target_arch = "wasm32"), test)]
+#[cfg_attr(target_arch = "wasm32", wasm_bindgen_test::wasm_bindgen_test)]
+fn negative_semi_axis() {
+    let err = image_err("1.1 342.1 -44.5 -0.1 0.1 0 1.2 0\n");
+    assert_eq!(
+        err,
+        "bad.cat: line 1, column 4 (a): '-0.1' is negative: ellipse semi-axes must be >= 0 arcsec"
+    );
+    let err = parse_member_catalog("#REFERENCE 3 10 20\nm1 1 2 0.5 -1 0 20\n", "m.cat", None)
+        .unwrap_err()
+        .to_string();
+    assert_contains(&err, &["m.cat: line 2, column 5 (b): '-1' is negative"]);
+}
+
+#[cfg_attr(not(target_arch = "wasm32"), test)]
+#[cfg_attr(target_arch = "wasm32", wasm_bindgen_test::wasm_bindgen_test)]
+fn negative_redshift() {
+    let err = image_err("1.1 342.1 -44.5 0 0 0 -1.2 0\n");
+    assert_contains(
+        &err,
+        &[
+            "bad.cat: line 1, column 7 (z): '-1.2' is negative",
+            "exactly 0",
+        ],
+    );
+}
+
+#[cfg_attr(not(target_arch = "wasm32"), test)]
+#[cfg_attr(target_arch = "wasm32", wasm_bindgen_test::wasm_bindgen_test)]
+fn relative_positions_without_header() {
+    // An arcsec catalogue that lost its '#REFERENCE 3' line reads as degrees: RA -28.9 fails.
+    let err = image_err("1.1 -28.9 14.0 0 0 0 1.2 0\n");
+    assert_contains(
+        &err,
+        &[
+            "bad.cat: line 1, column 2 (ra): '-28.9'",
+            "#REFERENCE 3 ra0 dec0",
+        ],
+    );
+}
+
+#[cfg_attr(not(target_arch = "wasm32"), test)]
+#[cfg_attr(target_arch = "wasm32", wasm_bindgen_test::wasm_bindgen_test)]
+fn misplaced_or_malformed_reference() {
+    let err = image_err("1.1 342.1 -44.5 0 0 0 1.2 0\n#REFERENCE 3 342 -44\n");
+    assert_contains(
+        &err,
+        &[
+            "bad.cat: line 2: bad header",
+            "before the first row (line 1)",
+        ],
+    );
+    let err = image_err("#REFERENCE 3 342\n1.1 1 2 0 0 0 1.2 0\n");
+    assert_contains(
+        &err,
+        &[
+            "bad.cat: line 1: bad header '#REFERENCE 3 342'",
+            "needs ra0 and dec0",
+        ],
+    );
+    let err = image_err("#REFERENCE 3 342 -95\n1.1 1 2 0 0 0 1.2 0\n");
+    assert_contains(&err, &["bad.cat: line 1: bad header", "|Dec| < 90"]);
+}
+
+#[cfg_attr(not(target_arch = "wasm32"), test)]
+#[cfg_attr(target_arch = "wasm32", wasm_bindgen_test::wasm_bindgen_test)]
+fn unusable_requested_reference() {
+    let bad = SkyReference {
+        ra_deg: f64::NAN,
+        dec_deg: 0.0,
+    };
+    let err = parse_member_catalog(MEMBERS_REL, "m.cat", Some(bad)).unwrap_err();
+    assert!(
+        matches!(err, CatalogError::InvalidReference { .. }),
+        "{err}"
+    );
+    assert_contains(&err.to_string(), &["m.cat: requested sky reference"]);
+}
