@@ -5,15 +5,18 @@
 
 use glam::DVec2;
 
+mod dpie;
 mod error;
 mod gaussian;
 mod nfw;
 mod nfw_ellipse;
 mod nfw_math;
 mod point;
+mod shear;
 mod sis;
 mod tnfw;
 
+pub use dpie::{dpie_b0_arcsec, kk_epsilon, Dpie, CIRCULAR_EPSILON as DPIE_CIRCULAR_EPSILON};
 pub use error::ProfileError;
 pub use gaussian::{
     gaussian_unit_deflection, gaussian_unit_hessian, gaussian_unit_kappa, Gaussian,
@@ -22,6 +25,7 @@ pub use nfw::{nfw_deflection, nfw_hessian, nfw_kappa, nfw_mass_cylinder_msun, Nf
 pub use nfw_ellipse::{NfwEllipse, CSE_TERMS};
 pub use nfw_math::{nfw_terms, NfwTerms, X_FLOOR as NFW_X_FLOOR};
 pub use point::PointMass;
+pub use shear::ExternalShear;
 pub use sis::{sis_theta_e_arcsec, Sis};
 pub use tnfw::{
     far_field_coefficients as tnfw_far_field_coefficients, tnfw_mass_and_kappa_unit,

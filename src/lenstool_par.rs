@@ -1,0 +1,325 @@
+//! Lenstool parameter files (`.par`) of parametric cluster models, read far enough to evaluate
+//! the published models: `runmode` (`reference`), `potentiel` blocks of profile 81 (dPIE,
+//! [`Dpie`]) and 14 (external shear, [`ExternalShear`]), `potfile` blocks (cluster members
+//! from a catalogue, scaled with luminosity) and `cosmologie`. Every other block (`limit`,
+//! `image`, `grille`, `cline`, ...) is skipped: a model is evaluated with the values written in
+//! its `potentiel` blocks, which in a `bestopt.par` are the fitted ones.
+//!
+//! Conventions, from Lenstool's source (github.com/cerschae/Lenstool-HPC,
+//! ChiBenchmark/lenstoolchi/src: `r_potentiel.c`, `set_potfile.c`, `o_print_res.c`,
+//! `o_set_lens_bayes.c`):
+//! - A `potfile` keyword with a mode flag (`sigma 3 100.1 18.7`) is read as `(mode, v1, v2)`
+//!   and Lenstool evaluates the model at `v1`: mode 0 is a fixed value, 1 a uniform prior on
+//!   `[v1, v2]` (starting at `v1`), 3 a Gaussian prior of mean `v1` and width `v2`. A
+//!   `bestopt.par` from a Bayesian run (`inverse 3`) writes there the posterior median and
+//!   `limit * stddev`; the best sample's own value is not written, so the median is used.
+//! - Members (`filein 1` or `3`: rows `id x y a b theta mag lum`) are dPIEs of mass
+//!   ellipticity `(a^2 - b^2)/(a^2 + b^2)` at angle `theta`, scaled from the `L*` galaxy of
+//!   magnitude `mag0` with `L/L* = 10^(-0.4 (mag - mag0))`:
+//!   `sigma = sigma* (L/L*)^(1/vdslope)`, `r_cut = r_cut* (L/L*)^(2/slope)`,
+//!   `r_core = r_core* (L/L*)^(1/2)`.
+//! - Radii in kpc become arcsec with the lens plane's `mpc_per_arcsec`; in a `potentiel`
+//!   block the kpc value wins when both are given, in a `potfile` the arcsec one (as Lenstool).
+//! - The shear `gamma` is at `D_ls/D_s = 1` like every Lenstool deflection; its `kappa`
+//!   keyword is not read by Lenstool and must be 0 here.
+
+use glam::DVec2;
+use thiserror::Error;
+
+use crate::catalog::{CatalogError, Member, MemberCatalog};
+use crate::cosmology::{Cosmology, CosmologyError, LensPlane};
+use crate::profiles::{Dpie, ExternalShear, Lens, MassComponent, ProfileError};
+use crate::sky::SkyReference;
+
+mod read;
+
+pub use read::parse_par;
+
+/// Redshifts of the potentials that differ by more than this make a multi-plane model.
+pub(crate) const Z_MATCH_TOL: f64 = 1.0e-6;
+
+/// What is wrong with a `.par` file or the model it describes; every variant names the file.
+#[derive(Debug, Error)]
+pub enum ParError {
+    #[error("{file}: cannot read: {message}")]
+    Io { file: String, message: String },
+    #[error("{file}:{line}: {reason}")]
+    Syntax {
+        file: String,
+        line: usize,
+        reason: String,
+    },
+    #[error("{file}:{line}: `{keyword}` in block `{block}`: {reason} (got `{value}`)")]
+    BadValue {
+        file: String,
+        line: usize,
+        block: String,
+        keyword: &'static str,
+        value: String,
+        reason: &'static str,
+    },
+    #[error("{file}:{line}: block `{block}`: {reason}")]
+    Unsupported {
+        file: String,
+        line: usize,
+        block: String,
+        reason: String,
+    },
+    #[error("{file}:{line}: block `{block}` has no `{keyword}`")]
+    Missing {
+        file: String,
+        line: usize,
+        block: String,
+        keyword: &'static str,
+    },
+    #[error("{file}: {reason}")]
+    Model { file: String, reason: String },
+    #[error("{file}:{line}: block `{block}`: {source}")]
+    Profile {
+        file: String,
+        line: usize,
+        block: String,
+        #[source]
+        source: ProfileError,
+    },
+    #[error("{file}: cosmologie: {source}")]
+    Cosmology {
+        file: String,
+        #[source]
+        source: CosmologyError,
+    },
+    #[error(transparent)]
+    Catalog(Box<CatalogError>),
+    #[error("{catalog}:{line}: member `{id}`: {reason}")]
+    Member {
+        catalog: String,
+        line: usize,
+        id: String,
+        reason: String,
+    },
+}
+
+/// A radius as the file gives it.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Radius {
+    Arcsec(f64),
+    Kpc(f64),
+}
+
+impl Radius {
+    /// The radius in arcsec on `plane`.
+    pub fn arcsec(self, plane: &LensPlane) -> f64 {
+        match self {
+            Radius::Arcsec(r) => r,
+            Radius::Kpc(r) => r / (1.0e3 * plane.mpc_per_arcsec),
+        }
+    }
+}
+
+/// One mass component of a `potentiel` block (positions in arcsec, angles in degrees
+/// counter-clockwise from +x).
+#[derive(Debug, Clone, PartialEq)]
+pub enum ParComponent {
+    /// Profile 81; `sigma_v_km_s` is Lenstool's `v_disp`, `ellipticity` its `ellipticite`.
+    Dpie {
+        center_arcsec: DVec2,
+        sigma_v_km_s: f64,
+        r_core: Radius,
+        r_cut: Radius,
+        ellipticity: f64,
+        pa_deg: f64,
+    },
+    /// Profile 14.
+    Shear {
+        center_arcsec: DVec2,
+        gamma: f64,
+        pa_deg: f64,
+    },
+}
+
+/// A `potentiel` block: its header (e.g. `potentiel O1`), line and component.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ParPotential {
+    pub block: String,
+    pub line: usize,
+    pub component: ParComponent,
+}
+
+/// A `potfile` block: the member catalogue and the `L*` galaxy of the scaling relations.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ParPotfile {
+    pub block: String,
+    pub line: usize,
+    /// The `filein` path as written (relative to wherever Lenstool ran).
+    pub filein: String,
+    pub mag0: f64,
+    pub sigma_km_s: f64,
+    pub r_core: Radius,
+    pub r_cut: Radius,
+    pub slope: f64,
+    pub vdslope: f64,
+}
+
+impl ParPotfile {
+    /// Lenstool's scaling for a member of magnitude `mag`: `(sigma [km/s], r_core [arcsec],
+    /// r_cut [arcsec])` with `L/L* = 10^(-0.4 (mag - mag0))` (see the module documentation).
+    pub fn scaled(&self, mag: f64, plane: &LensPlane) -> (f64, f64, f64) {
+        let lum = 10f64.powf(0.4 * (self.mag0 - mag));
+        (
+            self.sigma_km_s * lum.powf(1.0 / self.vdslope),
+            self.r_core.arcsec(plane) * lum.sqrt(),
+            self.r_cut.arcsec(plane) * lum.powf(2.0 / self.slope),
+        )
+    }
+
+    /// The member `m` of `catalog` as a dPIE on `plane`.
+    fn member(&self, m: &Member, catalog: &str, plane: &LensPlane) -> Result<Dpie, ParError> {
+        let fail = |reason: String| ParError::Member {
+            catalog: catalog.to_string(),
+            line: m.line,
+            id: m.id.clone(),
+            reason,
+        };
+        let (a, b) = (m.a_arcsec, m.b_arcsec);
+        if !(a >= b && a > 0.0) {
+            return Err(fail(format!(
+                "needs a >= b and a > 0 for the ellipticity (a = {a}, b = {b}; Lenstool refuses it too)"
+            )));
+        }
+        if m.mag == 0.0 {
+            return Err(fail("magnitude 0 (Lenstool would give it no mass)".into()));
+        }
+        let (sigma, core, cut) = self.scaled(m.mag, plane);
+        let e = (a * a - b * b) / (a * a + b * b);
+        Dpie::new(m.position, sigma, core, cut, e, m.theta_deg)
+            .map_err(|e| fail(format!("{e} (potfile `{}`)", self.block)))
+    }
+}
+
+/// The model of a `.par` file, as written (no file read yet).
+#[derive(Debug, Clone, PartialEq)]
+pub struct LenstoolPar {
+    pub source_name: String,
+    /// `runmode reference 1|3 ra dec`; `None` without one.
+    pub reference: Option<SkyReference>,
+    pub cosmology: Cosmology,
+    /// The redshift shared by every potential.
+    pub z_lens: f64,
+    pub potentials: Vec<ParPotential>,
+    pub potfiles: Vec<ParPotfile>,
+}
+
+/// A model ready to evaluate: the lens (reference normalisation) and its plane.
+#[derive(Debug)]
+pub struct LenstoolModel {
+    pub lens: Lens,
+    pub plane: LensPlane,
+    pub reference: Option<SkyReference>,
+    /// Components from `potentiel` blocks, then members from the potfiles.
+    pub potentials: usize,
+    pub members: usize,
+}
+
+impl LenstoolPar {
+    /// The lens plane at [`Self::z_lens`] in the file's cosmology.
+    pub fn lens_plane(&self) -> Result<LensPlane, ParError> {
+        LensPlane::new(self.cosmology, self.z_lens).map_err(|source| ParError::Cosmology {
+            file: self.source_name.clone(),
+            source,
+        })
+    }
+
+    /// Builds the lens: one component per `potentiel` block, then one dPIE per member of
+    /// `member_catalogs[k]` for the `k`-th `potfile` block (read them with
+    /// [`crate::catalog::parse_member_catalog`] in the frame of [`Self::reference`]).
+    pub fn build(&self, member_catalogs: &[MemberCatalog]) -> Result<LenstoolModel, ParError> {
+        if member_catalogs.len() != self.potfiles.len() {
+            return Err(ParError::Model {
+                file: self.source_name.clone(),
+                reason: format!(
+                    "{} potfile block(s) but {} member catalogue(s) given",
+                    self.potfiles.len(),
+                    member_catalogs.len()
+                ),
+            });
+        }
+        let plane = self.lens_plane()?;
+        let mut components: Vec<Box<dyn MassComponent>> = Vec::new();
+        for p in &self.potentials {
+            let profile = |source| ParError::Profile {
+                file: self.source_name.clone(),
+                line: p.line,
+                block: p.block.clone(),
+                source,
+            };
+            match p.component {
+                ParComponent::Dpie {
+                    center_arcsec,
+                    sigma_v_km_s,
+                    r_core,
+                    r_cut,
+                    ellipticity,
+                    pa_deg,
+                } => {
+                    let (core, cut) = (r_core.arcsec(&plane), r_cut.arcsec(&plane));
+                    let d = Dpie::new(center_arcsec, sigma_v_km_s, core, cut, ellipticity, pa_deg);
+                    components.push(Box::new(d.map_err(profile)?));
+                }
+                ParComponent::Shear {
+                    center_arcsec,
+                    gamma,
+                    pa_deg,
+                } => {
+                    let s = ExternalShear::new(center_arcsec, gamma, pa_deg);
+                    components.push(Box::new(s.map_err(profile)?));
+                }
+            }
+        }
+        let potentials = components.len();
+        for (pf, cat) in self.potfiles.iter().zip(member_catalogs) {
+            for m in &cat.members {
+                components.push(Box::new(pf.member(m, &cat.source_name, &plane)?));
+            }
+        }
+        let members = components.len() - potentials;
+        Ok(LenstoolModel {
+            lens: Lens::new(components),
+            plane,
+            reference: self.reference,
+            potentials,
+            members,
+        })
+    }
+}
+
+/// Reads `par_path` and its member catalogues and builds the model. `member_paths` gives one
+/// catalogue per `potfile` block in order; when empty, each `filein` is taken relative to the
+/// directory of `par_path`.
+#[cfg(not(target_arch = "wasm32"))]
+pub fn load_lenstool_model(
+    par_path: &std::path::Path,
+    member_paths: &[&std::path::Path],
+) -> Result<LenstoolModel, ParError> {
+    let read = |path: &std::path::Path| {
+        std::fs::read_to_string(path).map_err(|e| ParError::Io {
+            file: path.display().to_string(),
+            message: e.to_string(),
+        })
+    };
+    let par = parse_par(&read(par_path)?, &par_path.display().to_string())?;
+    let dir = par_path.parent().unwrap_or(std::path::Path::new("."));
+    let paths: Vec<std::path::PathBuf> = if member_paths.is_empty() {
+        par.potfiles.iter().map(|p| dir.join(&p.filein)).collect()
+    } else {
+        member_paths.iter().map(|p| p.to_path_buf()).collect()
+    };
+    let mut catalogs = Vec::with_capacity(paths.len());
+    for path in &paths {
+        let name = path.display().to_string();
+        let (cat, _warnings) =
+            crate::catalog::parse_member_catalog(&read(path)?, &name, par.reference)
+                .map_err(|e| ParError::Catalog(Box::new(e)))?;
+        catalogs.push(cat);
+    }
+    par.build(&catalogs)
+}
