@@ -1,0 +1,600 @@
+//! Constraint pixels: the positions `theta_i` of the rows of the linear system (METHOD.md
+//! section 3).
+//!
+//! Each image of a multiple-image system becomes pixels in one of three modes:
+//! - `point`: its catalogue position;
+//! - `ellipse` (default): the centres of a square lattice of pitch `pixel_arcsec` (default
+//!   0.2 arcsec, an HST drizzled pixel scale) centred on the image that fall inside its
+//!   catalogue ellipse (`a`, `b` semi-axes in arcsec, `theta` degrees counter-clockwise from
+//!   +x), about `pi a b / pixel^2` of them and always at least the centre;
+//! - `arcs`: pixels given explicitly in an arc file (see [`parse_arcs`]).
+//!
+//! Weights (the diagonal of `W`, in 1/arcsec^2) are `w / sigma_pos^2` with `w` from the
+//! weighting scheme: `equal_per_image` (default) gives each image a total `w` of 1 shared by
+//! its pixels, so a large arc counts as much as a compact image and `point` mode gets `w = 1`
+//! everywhere; `equal_per_pixel` gives every pixel `w = 1`; `equal_per_system` gives each
+//! system a total of 1. `sigma_pos_arcsec` (default 0.5, a common image-plane position error)
+//! scales all weights alike, which changes chi^2 but not the solution.
+//!
+//! Systems without a redshift are left out unless `default_z` is given; systems with a single
+//! image and held-out systems are left out too; each is listed in
+//! [`ConstraintSet::excluded`].
+
+use glam::DVec2;
+use serde::{Deserialize, Serialize};
+use thiserror::Error;
+
+use crate::catalog::ImageCatalog;
+
+/// What can be wrong with constraint settings or inputs.
+#[derive(Debug, Error, Clone, PartialEq)]
+pub enum ConstraintError {
+    #[error("constraints: {field} = {value} is not allowed ({reason})")]
+    BadParameter {
+        field: &'static str,
+        value: f64,
+        reason: &'static str,
+    },
+    #[error("constraints: mode \"{mode}\" cannot use {given}")]
+    ModeMismatch {
+        mode: &'static str,
+        given: &'static str,
+    },
+    #[error("{source_name}: line {line}, column {column}: {message}")]
+    ArcsSyntax {
+        source_name: String,
+        line: usize,
+        column: usize,
+        message: String,
+    },
+    #[error("{source_name}: system {system}: {reason}")]
+    ArcsSystem {
+        source_name: String,
+        system: String,
+        reason: String,
+    },
+    #[error("{source_name}: line {line}: image {id}: {field} = {value} is not allowed ({reason})")]
+    BadImage {
+        source_name: String,
+        line: usize,
+        id: String,
+        field: &'static str,
+        value: f64,
+        reason: &'static str,
+    },
+    #[error("{source_name}: image {id}: its ellipse holds about {pixels} pixels, more than max_pixels_per_image = {max}")]
+    TooManyPixels {
+        source_name: String,
+        id: String,
+        pixels: f64,
+        max: usize,
+    },
+    #[error("constraints: hold-out system \"{id}\" is not in {source_name}")]
+    UnknownHoldOut { source_name: String, id: String },
+    #[error("{source_name}: no system is left to constrain the model (excluded: {excluded})")]
+    NoSystems {
+        source_name: String,
+        excluded: String,
+    },
+}
+
+/// How images become pixels.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum ConstraintMode {
+    Point,
+    Ellipse,
+    Arcs,
+}
+
+impl ConstraintMode {
+    fn name(self) -> &'static str {
+        match self {
+            Self::Point => "point",
+            Self::Ellipse => "ellipse",
+            Self::Arcs => "arcs",
+        }
+    }
+}
+
+/// How the rows of pixels are weighted against each other (see the module documentation).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Weighting {
+    EqualPerPixel,
+    EqualPerImage,
+    EqualPerSystem,
+}
+
+/// Constraint settings (the `constraints` block of an inversion configuration).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct ConstraintConfig {
+    /// "point", "ellipse" (default) or "arcs".
+    pub mode: ConstraintMode,
+    /// Lattice pitch of `ellipse` mode in arcsec (default 0.2). Allowed [1e-3, 10].
+    pub pixel_arcsec: f64,
+    /// "equal_per_image" (default), "equal_per_pixel" or "equal_per_system".
+    pub weighting: Weighting,
+    /// Image-plane position error in arcsec (default 0.5). Allowed [1e-4, 100].
+    pub sigma_pos_arcsec: f64,
+    /// Redshift given to systems whose redshift is unknown (default none: they are left out).
+    pub default_z: Option<f64>,
+    /// Largest number of pixels one ellipse may hold (default 10000). Allowed >= 1.
+    pub max_pixels_per_image: usize,
+}
+
+impl Default for ConstraintConfig {
+    fn default() -> Self {
+        Self {
+            mode: ConstraintMode::Ellipse,
+            pixel_arcsec: 0.2,
+            weighting: Weighting::EqualPerImage,
+            sigma_pos_arcsec: 0.5,
+            default_z: None,
+            max_pixels_per_image: 10_000,
+        }
+    }
+}
+
+impl ConstraintConfig {
+    /// Checks every field against the range in its documentation.
+    pub fn validate(&self) -> Result<(), ConstraintError> {
+        let bad = |field, value, reason| ConstraintError::BadParameter {
+            field,
+            value,
+            reason,
+        };
+        if !(self.pixel_arcsec.is_finite() && (1e-3..=10.0).contains(&self.pixel_arcsec)) {
+            return Err(bad(
+                "pixel_arcsec",
+                self.pixel_arcsec,
+                "must be in [1e-3, 10] arcsec",
+            ));
+        }
+        if !(self.sigma_pos_arcsec.is_finite() && (1e-4..=100.0).contains(&self.sigma_pos_arcsec)) {
+            return Err(bad(
+                "sigma_pos_arcsec",
+                self.sigma_pos_arcsec,
+                "must be in [1e-4, 100] arcsec",
+            ));
+        }
+        if let Some(z) = self.default_z {
+            if !(z.is_finite() && z > 0.0 && z < 20.0) {
+                return Err(bad("default_z", z, "a source redshift must be in (0, 20)"));
+            }
+        }
+        if self.max_pixels_per_image == 0 {
+            return Err(bad("max_pixels_per_image", 0.0, "must be at least 1"));
+        }
+        Ok(())
+    }
+}
+
+/// One constraint position: two rows (x and y) of the linear system.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct ConstraintPixel {
+    /// Index into [`ConstraintSet::systems`].
+    pub system: usize,
+    /// Index of the image within its system.
+    pub image: usize,
+    /// `theta` in arcsec.
+    pub position: DVec2,
+    /// Row weight in 1/arcsec^2 (both rows).
+    pub weight: f64,
+}
+
+/// One source system that is used.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct ConstraintSystem {
+    pub id: String,
+    /// Source redshift.
+    pub z: f64,
+    /// True when `z` is `default_z` (the catalogue did not know it).
+    pub z_assumed: bool,
+    /// Image ids, in order (`image` of a pixel indexes this).
+    pub images: Vec<String>,
+    pub n_pixels: usize,
+}
+
+/// Why a system was left out.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Exclusion {
+    UnknownRedshift,
+    SingleImage,
+    HeldOut,
+}
+
+/// A system left out, and why.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct ExcludedSystem {
+    pub id: String,
+    pub reason: Exclusion,
+}
+
+/// All constraint pixels, grouped by system (pixels of a system are contiguous, in system
+/// order).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct ConstraintSet {
+    pub systems: Vec<ConstraintSystem>,
+    pub pixels: Vec<ConstraintPixel>,
+    pub excluded: Vec<ExcludedSystem>,
+    pub warnings: Vec<String>,
+}
+
+/// Explicit arc pixels, from [`parse_arcs`].
+#[derive(Debug, Clone, PartialEq)]
+pub struct ArcCatalog {
+    pub source_name: String,
+    pub systems: Vec<ArcSystem>,
+}
+
+/// The pixels of one system of an arc file; a flat `pixels` list is one image.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ArcSystem {
+    pub id: String,
+    pub z: Option<f64>,
+    /// Pixel positions in arcsec, per image.
+    pub images: Vec<Vec<DVec2>>,
+}
+
+/// Where the constraints come from.
+#[derive(Debug, Clone, Copy)]
+pub enum ConstraintSource<'a> {
+    /// Catalogue images, as points or ellipses.
+    Catalog(&'a ImageCatalog),
+    /// Explicit arc pixels (mode `arcs`).
+    Arcs(&'a ArcCatalog),
+}
+
+#[derive(Deserialize)]
+#[serde(untagged)]
+enum IdJson {
+    Text(String),
+    Number(serde_json::Number),
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct ArcSystemJson {
+    id: IdJson,
+    #[serde(default)]
+    z: Option<f64>,
+    #[serde(default)]
+    pixels: Option<Vec<[f64; 2]>>,
+    #[serde(default)]
+    images: Option<Vec<Vec<[f64; 2]>>>,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct ArcsJson {
+    systems: Vec<ArcSystemJson>,
+}
+
+/// Parses an arc file (`source_name` names it in errors):
+///
+/// ```json
+/// {"systems": [
+///   {"id": "1", "z": 2.1, "pixels": [[x, y], ...]},
+///   {"id": "2", "z": null, "images": [[[x, y], ...], [[x, y], ...]]}]}
+/// ```
+///
+/// Positions in arcsec in the frame of METHOD.md section 1. Each system has either `pixels`
+/// (all its pixels, counted as one image) or `images` (one pixel list per image); `z` null,
+/// 0 or absent means unknown. Ids must be unique, pixel lists non-empty and finite.
+pub fn parse_arcs(text: &str, source_name: &str) -> Result<ArcCatalog, ConstraintError> {
+    let raw: ArcsJson = serde_json::from_str(text).map_err(|e| ConstraintError::ArcsSyntax {
+        source_name: source_name.to_string(),
+        line: e.line(),
+        column: e.column(),
+        message: e.to_string(),
+    })?;
+    let mut systems: Vec<ArcSystem> = Vec::with_capacity(raw.systems.len());
+    for s in raw.systems {
+        let id = match s.id {
+            IdJson::Text(t) => t,
+            IdJson::Number(n) => n.to_string(),
+        };
+        let fail = |reason: String| ConstraintError::ArcsSystem {
+            source_name: source_name.to_string(),
+            system: id.clone(),
+            reason,
+        };
+        if systems.iter().any(|o| o.id == id) {
+            return Err(fail("the id appears twice".into()));
+        }
+        let images: Vec<Vec<[f64; 2]>> = match (s.pixels, s.images) {
+            (Some(p), None) => vec![p],
+            (None, Some(i)) => i,
+            _ => return Err(fail("give exactly one of \"pixels\" and \"images\"".into())),
+        };
+        if images.is_empty() || images.iter().any(|i| i.is_empty()) {
+            return Err(fail("every pixel list must hold at least one pixel".into()));
+        }
+        if let Some(p) = images
+            .iter()
+            .flatten()
+            .find(|p| !(p[0].is_finite() && p[1].is_finite()))
+        {
+            return Err(fail(format!("pixel [{}, {}] is not finite", p[0], p[1])));
+        }
+        let z = match s.z {
+            Some(0.0) => None,
+            Some(z) if !(z.is_finite() && z > 0.0 && z < 20.0) => {
+                return Err(fail(format!(
+                    "z = {z} must be in (0, 20), or 0/null when unknown"
+                )));
+            }
+            z => z,
+        };
+        systems.push(ArcSystem {
+            id,
+            z,
+            images: images
+                .into_iter()
+                .map(|i| i.into_iter().map(|[x, y]| DVec2::new(x, y)).collect())
+                .collect(),
+        });
+    }
+    Ok(ArcCatalog {
+        source_name: source_name.to_string(),
+        systems,
+    })
+}
+
+/// Lattice points `center + (i, j) * pixel` (arcsec) inside the ellipse of semi-axes `a`, `b`
+/// (arcsec) with the `a` axis at `theta_deg` counter-clockwise from +x; the centre is always
+/// included. `a` or `b` <= 0 gives the centre alone. Each lattice row is scanned only over
+/// the chord of the ellipse, so the work is that of the pixels found.
+pub fn ellipse_pixels(center: DVec2, a: f64, b: f64, theta_deg: f64, pixel: f64) -> Vec<DVec2> {
+    if a <= 0.0 || b <= 0.0 {
+        return vec![center];
+    }
+    let (sin, cos) = theta_deg.to_radians().sin_cos();
+    let inside = |d: DVec2| {
+        let along = d.x * cos + d.y * sin;
+        let across = -d.x * sin + d.y * cos;
+        (along / a).powi(2) + (across / b).powi(2) <= 1.0
+    };
+    // The ellipse as q_xx x^2 + q_xy x y + q_yy y^2 <= 1.
+    let (ia2, ib2) = (1.0 / (a * a), 1.0 / (b * b));
+    let q_xx = cos * cos * ia2 + sin * sin * ib2;
+    let q_xy = 2.0 * cos * sin * (ia2 - ib2);
+    let q_yy = sin * sin * ia2 + cos * cos * ib2;
+    let half_height = (a * a * sin * sin + b * b * cos * cos).sqrt();
+    let rows = (half_height / pixel).ceil() as i64;
+    let mut out = Vec::new();
+    for j in -rows..=rows {
+        let y = j as f64 * pixel;
+        let disc = q_xy * q_xy * y * y - 4.0 * q_xx * (q_yy * y * y - 1.0);
+        if disc < 0.0 {
+            continue;
+        }
+        let root = disc.sqrt();
+        let lo = ((-q_xy * y - root) / (2.0 * q_xx * pixel)).floor() as i64 - 1;
+        let hi = ((-q_xy * y + root) / (2.0 * q_xx * pixel)).ceil() as i64 + 1;
+        for i in lo..=hi {
+            let d = DVec2::new(i as f64 * pixel, y);
+            if inside(d) {
+                out.push(center + d);
+            }
+        }
+    }
+    if out.is_empty() {
+        out.push(center);
+    }
+    out
+}
+
+/// A system on its way into the set: id, redshift, images as pixel lists, image ids.
+struct Candidate {
+    id: String,
+    z: Option<f64>,
+    image_ids: Vec<String>,
+    images: Vec<Vec<DVec2>>,
+    /// Whether a single pixel list is one image (catalogue: the system is left out) rather than
+    /// an arc whose pixels must all map to one source position (arc file: kept).
+    single_is_one_image: bool,
+}
+
+/// Catalogue images to candidate systems, as points or ellipse pixels.
+fn catalog_candidates(
+    catalog: &ImageCatalog,
+    config: &ConstraintConfig,
+) -> Result<Vec<Candidate>, ConstraintError> {
+    let mut out = Vec::with_capacity(catalog.systems.len());
+    for system in &catalog.systems {
+        let mut images = Vec::with_capacity(system.images.len());
+        for im in &system.images {
+            let bad =
+                |field: &'static str, value: f64, reason: &'static str| ConstraintError::BadImage {
+                    source_name: catalog.source_name.clone(),
+                    line: im.line,
+                    id: im.id.clone(),
+                    field,
+                    value,
+                    reason,
+                };
+            let fields = [
+                ("x", im.position.x),
+                ("y", im.position.y),
+                ("a", im.a_arcsec),
+                ("b", im.b_arcsec),
+                ("theta", im.theta_deg),
+            ];
+            if let Some((field, value)) = fields.iter().find(|(_, v)| !v.is_finite()) {
+                return Err(bad(field, *value, "must be finite"));
+            }
+            if let Some(z) = system.z {
+                if !(z.is_finite() && z > 0.0) {
+                    return Err(bad("z", z, "a source redshift must be positive"));
+                }
+            }
+            images.push(match config.mode {
+                ConstraintMode::Point => vec![im.position],
+                _ => {
+                    let estimate =
+                        std::f64::consts::PI * im.a_arcsec.max(0.0) * im.b_arcsec.max(0.0)
+                            / (config.pixel_arcsec * config.pixel_arcsec);
+                    if estimate > config.max_pixels_per_image as f64 {
+                        return Err(ConstraintError::TooManyPixels {
+                            source_name: catalog.source_name.clone(),
+                            id: im.id.clone(),
+                            pixels: estimate.round(),
+                            max: config.max_pixels_per_image,
+                        });
+                    }
+                    ellipse_pixels(
+                        im.position,
+                        im.a_arcsec,
+                        im.b_arcsec,
+                        im.theta_deg,
+                        config.pixel_arcsec,
+                    )
+                }
+            });
+        }
+        out.push(Candidate {
+            id: system.id.clone(),
+            z: system.z,
+            image_ids: system.images.iter().map(|i| i.id.clone()).collect(),
+            images,
+            single_is_one_image: true,
+        });
+    }
+    Ok(out)
+}
+
+/// Constraint pixels and weights from `source` (see the module documentation). Systems whose
+/// id is in `hold_out` are left out (every id must exist).
+pub fn build_constraints(
+    source: ConstraintSource<'_>,
+    config: &ConstraintConfig,
+    hold_out: &[String],
+) -> Result<ConstraintSet, ConstraintError> {
+    config.validate()?;
+    let (source_name, candidates) = match (source, config.mode) {
+        (ConstraintSource::Catalog(c), ConstraintMode::Point | ConstraintMode::Ellipse) => {
+            (c.source_name.clone(), catalog_candidates(c, config)?)
+        }
+        (ConstraintSource::Arcs(a), ConstraintMode::Arcs) => (
+            a.source_name.clone(),
+            a.systems
+                .iter()
+                .map(|s| Candidate {
+                    id: s.id.clone(),
+                    z: s.z,
+                    image_ids: (1..=s.images.len())
+                        .map(|k| format!("{}.{k}", s.id))
+                        .collect(),
+                    images: s.images.clone(),
+                    single_is_one_image: false,
+                })
+                .collect(),
+        ),
+        (ConstraintSource::Catalog(_), mode) => {
+            return Err(ConstraintError::ModeMismatch {
+                mode: mode.name(),
+                given: "an image catalogue (give an arc file)",
+            })
+        }
+        (ConstraintSource::Arcs(_), mode) => {
+            return Err(ConstraintError::ModeMismatch {
+                mode: mode.name(),
+                given: "an arc file (use mode \"arcs\")",
+            })
+        }
+    };
+    if let Some(id) = hold_out
+        .iter()
+        .find(|h| !candidates.iter().any(|c| &c.id == *h))
+    {
+        return Err(ConstraintError::UnknownHoldOut {
+            source_name,
+            id: id.clone(),
+        });
+    }
+    let mut set = ConstraintSet {
+        systems: Vec::new(),
+        pixels: Vec::new(),
+        excluded: Vec::new(),
+        warnings: Vec::new(),
+    };
+    for c in candidates {
+        let z = c.z.or(config.default_z);
+        let exclusion = if hold_out.contains(&c.id) {
+            Err(Exclusion::HeldOut)
+        } else if c.images.len() < 2 && c.single_is_one_image {
+            set.warnings.push(format!(
+                "{source_name}: system {} has a single image: not used",
+                c.id
+            ));
+            Err(Exclusion::SingleImage)
+        } else if let Some(z) = z {
+            Ok(z)
+        } else {
+            set.warnings.push(format!(
+                "{source_name}: system {} has no redshift and no default_z is set: not used",
+                c.id
+            ));
+            Err(Exclusion::UnknownRedshift)
+        };
+        match exclusion {
+            Ok(z) => add_system(&mut set, c, z, config),
+            Err(reason) => set.excluded.push(ExcludedSystem { id: c.id, reason }),
+        }
+    }
+    if set.systems.is_empty() {
+        let excluded: Vec<String> = set
+            .excluded
+            .iter()
+            .map(|e| format!("{} ({:?})", e.id, e.reason))
+            .collect();
+        return Err(ConstraintError::NoSystems {
+            source_name,
+            excluded: if excluded.is_empty() {
+                "none".into()
+            } else {
+                excluded.join(", ")
+            },
+        });
+    }
+    Ok(set)
+}
+
+/// Appends one system's pixels with their weights (module documentation).
+fn add_system(set: &mut ConstraintSet, c: Candidate, z: f64, config: &ConstraintConfig) {
+    let system = set.systems.len();
+    let n_pixels: usize = c.images.iter().map(Vec::len).sum();
+    let inv_var = 1.0 / (config.sigma_pos_arcsec * config.sigma_pos_arcsec);
+    for (image, pixels) in c.images.iter().enumerate() {
+        let w = match config.weighting {
+            Weighting::EqualPerPixel => 1.0,
+            Weighting::EqualPerImage => 1.0 / pixels.len() as f64,
+            Weighting::EqualPerSystem => 1.0 / n_pixels as f64,
+        };
+        set.pixels
+            .extend(pixels.iter().map(|&position| ConstraintPixel {
+                system,
+                image,
+                position,
+                weight: w * inv_var,
+            }));
+    }
+    let z_assumed = c.z.is_none();
+    if z_assumed {
+        set.warnings.push(format!(
+            "system {} has no redshift: default_z = {z} assumed",
+            c.id
+        ));
+    }
+    set.systems.push(ConstraintSystem {
+        id: c.id,
+        z,
+        z_assumed,
+        images: c.image_ids,
+        n_pixels,
+    });
+}

@@ -1,0 +1,517 @@
+//! Member galaxies: the WSLAP+ prior (METHOD.md section 4, paper section 3).
+//!
+//! Each member gets a luminosity `L/L* = 10^(-0.4 (mag - mag*))` and a halo mass
+//! `M = Upsilon L = Upsilon L* (L/L*)`. Defaults: `Upsilon = 20 Msun/Lsun` (the paper's
+//! "ratio ~20") and `L* = 5e10 Lsun`, so an `L*` galaxy has `M* = 1e12 Msun`, a typical
+//! total halo mass of an `L*` galaxy. `mag*` is the apparent magnitude of `L*`: given, or
+//! `M*_abs + 5 log10(D_L / 10 pc)` with `M*_abs = -21.5` (about `L*` in the r/i bands for
+//! H0 = 70, no K-correction) and `D_L = (1 + z_l)^2 D_l`.
+//!
+//! The halo is a truncated NFW (Baltz, Marshall & Oguri 2009) whose total mass is `M`
+//! (or, with `profile = "nfw"`, an NFW with `M200 = M`). Its scale and truncation radii grow
+//! self-similarly, `r_s = r_s* (M / M*)^e`, `r_t = r_t* (M / M*)^e` with `e = 1/3` (fixed mean
+//! density; tidal truncation at a given cluster-centric distance also gives `r_t ∝ M^(1/3)`).
+//! `r_t* = 40 kpc`: a truncated isothermal halo of `1e12 Msun` inside 40 kpc has
+//! `sigma ~ 210 km/s`, as an `L*` elliptical, and galaxy-galaxy lensing in cluster cores finds
+//! `r_t*` of 20-60 kpc (Limousin et al. 2007, Natarajan et al. 2009). `r_s* = 10 kpc`: then an
+//! `L*` halo deflects by 1.1 arcsec at 5 kpc (`D_ls/D_s = 1`), as an SIS of 200 km/s
+//! (1.15 arcsec) does; a field concentration (`c200 ~ 5`, `r_s ~ 70 kpc`) would give 0.3
+//! arcsec, far too little for a galaxy whose centre is dominated by its stars. The parent NFW's
+//! `rho_s` follows from `M = 4 pi rho_s r_s^3 m_tot(r_t / r_s)` and its `c200` from
+//! `rho_s = (200/3) rho_crit c^3 / (ln(1 + c) - c/(1 + c))`.
+//!
+//! Members are grouped into layers, each one column `C_l` of the linear system whose fiducial
+//! deflection is the sum of its galaxies' (`C_l = 1`: the catalogue masses are right).
+
+use std::fmt;
+use std::str::FromStr;
+use std::sync::Arc;
+
+use glam::DVec2;
+use serde::{Deserialize, Serialize};
+use thiserror::Error;
+
+use super::grid::CellGrid;
+use crate::catalog::MemberCatalog;
+use crate::cosmology::LensPlane;
+use crate::profiles::{tnfw_total_mass_unit, Lens, MassComponent, Nfw, ProfileError, TruncatedNfw};
+
+/// What can be wrong with member settings or a member galaxy.
+#[derive(Debug, Error, Clone, PartialEq)]
+pub enum MembersError {
+    #[error("members: {field} = {value} is not allowed ({reason})")]
+    BadParameter {
+        field: &'static str,
+        value: f64,
+        reason: &'static str,
+    },
+    #[error("members: layers = \"{value}\" is not one of none, single, bcg, brightest:N (N >= 1)")]
+    BadLayers { value: String },
+    #[error(
+        "{source_name}: line {line}: member {id}: {field} = {value} is not allowed ({reason})"
+    )]
+    BadMember {
+        source_name: String,
+        line: usize,
+        id: String,
+        field: &'static str,
+        value: f64,
+        reason: &'static str,
+    },
+    #[error("{source_name}: line {line}: member {id}: its halo cannot be built: {source}")]
+    Halo {
+        source_name: String,
+        line: usize,
+        id: String,
+        #[source]
+        source: ProfileError,
+    },
+}
+
+/// How members are grouped into layers (one `C_l` column each). In JSON a string:
+/// `"none"`, `"single"`, `"bcg"` or `"brightest:N"`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(try_from = "String", into = "String")]
+pub enum LayerSplit {
+    /// No member layer (the original WSLAP; the paper's case i).
+    None,
+    /// All members in one layer (the paper).
+    Single,
+    /// The brightest member alone, the rest in a second layer.
+    Bcg,
+    /// Each of the N brightest alone, the rest in one more layer.
+    Brightest(usize),
+}
+
+impl FromStr for LayerSplit {
+    type Err = MembersError;
+    fn from_str(s: &str) -> Result<Self, Self::Err> {
+        let bad = || MembersError::BadLayers {
+            value: s.to_string(),
+        };
+        match s.trim() {
+            "none" => Ok(Self::None),
+            "single" => Ok(Self::Single),
+            "bcg" => Ok(Self::Bcg),
+            t => match t
+                .strip_prefix("brightest:")
+                .map(|n| n.trim().parse::<usize>())
+            {
+                Some(Ok(n)) if n >= 1 => Ok(Self::Brightest(n)),
+                _ => Err(bad()),
+            },
+        }
+    }
+}
+
+impl fmt::Display for LayerSplit {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            Self::None => write!(f, "none"),
+            Self::Single => write!(f, "single"),
+            Self::Bcg => write!(f, "bcg"),
+            Self::Brightest(n) => write!(f, "brightest:{n}"),
+        }
+    }
+}
+
+impl TryFrom<String> for LayerSplit {
+    type Error = MembersError;
+    fn try_from(s: String) -> Result<Self, Self::Error> {
+        s.parse()
+    }
+}
+
+impl From<LayerSplit> for String {
+    fn from(l: LayerSplit) -> String {
+        l.to_string()
+    }
+}
+
+/// The halo profile given to each member.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum HaloProfile {
+    /// Truncated NFW whose total mass is the catalogue mass (default).
+    Tnfw,
+    /// Untruncated NFW with `M200` = the catalogue mass.
+    Nfw,
+}
+
+/// Member-galaxy settings (the `members` block of an inversion configuration).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct MemberConfig {
+    /// Layer split: "none", "single" (default, the paper), "bcg" or "brightest:N".
+    pub layers: LayerSplit,
+    /// Apparent magnitude of an `L*` galaxy (default: from `abs_mag_star` and `D_L(z_l)`).
+    pub mag_star: Option<f64>,
+    /// Absolute magnitude of `L*` (default -21.5), used when `mag_star` is not given.
+    pub abs_mag_star: f64,
+    /// Mass-to-light ratio `Upsilon` in Msun/Lsun (default 20, the paper). Allowed (0, 1e4].
+    pub mass_to_light: f64,
+    /// `L*` in Lsun (default 5e10). Allowed (0, 1e13].
+    pub l_star_lsun: f64,
+    /// Halo profile (default "tnfw").
+    pub profile: HaloProfile,
+    /// Truncation radius of an `M*` halo in kpc (default 40). Allowed (0, 1e4].
+    pub r_trunc_lstar_kpc: f64,
+    /// Scale radius of an `M*` halo in kpc (default 10). Allowed (0, 1e4].
+    pub r_s_lstar_kpc: f64,
+    /// `r_s, r_t ∝ M^size_exponent` (default 1/3: self-similar). Allowed [0, 2].
+    pub size_exponent: f64,
+    /// Members farther than this fraction of the field width outside the grid are dropped
+    /// with a warning (default 0.1). Allowed [0, 10].
+    pub outside_margin_fraction: f64,
+}
+
+/// Bisection steps for the parent concentration (`log c` over [1e-3, 1e3]: 2^-100 of that
+/// interval is far below double precision).
+const C200_BISECTIONS: usize = 100;
+/// Concentrations the NFW profiles accept.
+const C200_RANGE: (f64, f64) = (1.0e-3, 1.0e3);
+
+impl Default for MemberConfig {
+    fn default() -> Self {
+        Self {
+            layers: LayerSplit::Single,
+            mag_star: None,
+            abs_mag_star: -21.5,
+            mass_to_light: 20.0,
+            l_star_lsun: 5.0e10,
+            profile: HaloProfile::Tnfw,
+            r_trunc_lstar_kpc: 40.0,
+            r_s_lstar_kpc: 10.0,
+            size_exponent: 1.0 / 3.0,
+            outside_margin_fraction: 0.1,
+        }
+    }
+}
+
+fn check(field: &'static str, v: f64, lo: f64, hi: f64, lo_open: bool) -> Result<(), MembersError> {
+    let ok = v.is_finite() && v <= hi && if lo_open { v > lo } else { v >= lo };
+    if ok {
+        Ok(())
+    } else {
+        Err(MembersError::BadParameter {
+            field,
+            value: v,
+            reason: "outside the range given in its documentation",
+        })
+    }
+}
+
+impl MemberConfig {
+    /// Checks every field against the range in its documentation.
+    pub fn validate(&self) -> Result<(), MembersError> {
+        if let Some(m) = self.mag_star {
+            check("mag_star", m, -50.0, 50.0, false)?;
+        }
+        check("abs_mag_star", self.abs_mag_star, -50.0, 50.0, false)?;
+        check("mass_to_light", self.mass_to_light, 0.0, 1e4, true)?;
+        check("l_star_lsun", self.l_star_lsun, 0.0, 1e13, true)?;
+        check("r_trunc_lstar_kpc", self.r_trunc_lstar_kpc, 0.0, 1e4, true)?;
+        check("r_s_lstar_kpc", self.r_s_lstar_kpc, 0.0, 1e4, true)?;
+        check("size_exponent", self.size_exponent, 0.0, 2.0, false)?;
+        check(
+            "outside_margin_fraction",
+            self.outside_margin_fraction,
+            0.0,
+            10.0,
+            false,
+        )?;
+        if let LayerSplit::Brightest(0) = self.layers {
+            return Err(MembersError::BadLayers {
+                value: self.layers.to_string(),
+            });
+        }
+        Ok(())
+    }
+
+    /// Apparent magnitude of `L*` on `plane`: `mag_star`, or
+    /// `abs_mag_star + 5 log10(D_L / Mpc) + 25` with `D_L = (1 + z_l)^2 D_l`.
+    pub fn mag_star_on(&self, plane: &LensPlane) -> f64 {
+        self.mag_star.unwrap_or_else(|| {
+            let d_lum_mpc = (1.0 + plane.z_lens).powi(2) * plane.d_l_mpc;
+            self.abs_mag_star + 5.0 * d_lum_mpc.log10() + 25.0
+        })
+    }
+
+    /// Halo mass in Msun of a galaxy of apparent magnitude `mag`:
+    /// `Upsilon L* 10^(-0.4 (mag - mag*))`.
+    pub fn mass_msun(&self, mag: f64, mag_star: f64) -> f64 {
+        self.mass_to_light * self.l_star_lsun * 10f64.powf(-0.4 * (mag - mag_star))
+    }
+
+    /// Truncation radius in kpc of a halo of mass `mass_msun`: `r_t* (M / M*)^e`.
+    pub fn r_trunc_kpc(&self, mass_msun: f64) -> f64 {
+        self.r_trunc_lstar_kpc * self.size_scale(mass_msun)
+    }
+
+    /// Scale radius in kpc of a halo of mass `mass_msun`: `r_s* (M / M*)^e`.
+    pub fn r_s_kpc(&self, mass_msun: f64) -> f64 {
+        self.r_s_lstar_kpc * self.size_scale(mass_msun)
+    }
+
+    /// `(M / M*)^e` with `M* = Upsilon L*`.
+    fn size_scale(&self, mass_msun: f64) -> f64 {
+        (mass_msun / (self.mass_to_light * self.l_star_lsun)).powf(self.size_exponent)
+    }
+}
+
+/// One member's halo as built.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct MemberHalo {
+    /// Index into the member catalogue.
+    pub member: usize,
+    pub id: String,
+    /// Position in arcsec.
+    pub position: DVec2,
+    pub mag: f64,
+    /// `L / L*`.
+    pub luminosity_lstar: f64,
+    /// Catalogue mass `Upsilon L` in Msun (total mass of a truncated halo, M200 of an NFW).
+    pub mass_msun: f64,
+    /// M200 of the (parent) NFW in Msun.
+    pub m200_msun: f64,
+    /// Concentration of the (parent) NFW.
+    pub c200: f64,
+    /// Scale radius in arcsec.
+    pub r_s_arcsec: f64,
+    /// Truncation radius in arcsec (`None` for an untruncated NFW).
+    pub r_trunc_arcsec: Option<f64>,
+}
+
+/// One galaxy layer: a fiducial deflection field with its own `C_l`.
+#[derive(Debug, Clone)]
+pub struct Layer {
+    /// E.g. "members", "bcg", "member 12", "rest", or a name given to a true layer.
+    pub name: String,
+    /// Indices into the member catalogue (empty for a layer built from components).
+    pub members: Vec<usize>,
+    /// The summed halos at `D_ls/D_s = 1`, shared with reconstructed lenses.
+    pub lens: Arc<Lens>,
+}
+
+impl Layer {
+    /// A layer made directly from mass components (e.g. the true galaxies of a test).
+    pub fn from_components(name: &str, components: Vec<Box<dyn MassComponent>>) -> Self {
+        Self {
+            name: name.to_string(),
+            members: Vec::new(),
+            lens: Arc::new(Lens::new(components)),
+        }
+    }
+
+    /// Fiducial deflection `alpha_l` at `p` (arcsec), in arcsec, for `D_ls/D_s = 1`.
+    pub fn deflection(&self, p: DVec2) -> DVec2 {
+        self.lens.deflection(p)
+    }
+}
+
+/// The members' halos and layers, with warnings about members left out.
+#[derive(Debug, Clone)]
+pub struct MemberModel {
+    /// Halos of the members used, in catalogue order.
+    pub halos: Vec<MemberHalo>,
+    pub layers: Vec<Layer>,
+    pub warnings: Vec<String>,
+}
+
+/// `mu(c) = ln(1 + c) - c/(1 + c)` (dimensionless).
+fn nfw_mu(c: f64) -> f64 {
+    c.ln_1p() - c / (1.0 + c)
+}
+
+/// The `c200` whose NFW has characteristic density `rho_s` (Msun/Mpc^3) on `plane`:
+/// `(200/3) rho_crit c^3 / mu(c) = rho_s`, by bisection in `log c` (the left side grows with
+/// `c`); `None` outside [`C200_RANGE`].
+fn c200_for_rho_s(rho_s: f64, plane: &LensPlane) -> Option<f64> {
+    let g = |c: f64| 200.0 / 3.0 * plane.rho_crit_msun_per_mpc3 * c * c * c / nfw_mu(c) - rho_s;
+    let (mut lo, mut hi) = C200_RANGE;
+    if !(g(lo) <= 0.0 && g(hi) >= 0.0) {
+        return None;
+    }
+    for _ in 0..C200_BISECTIONS {
+        let mid = (lo * hi).sqrt();
+        if g(mid) > 0.0 {
+            hi = mid;
+        } else {
+            lo = mid;
+        }
+    }
+    Some((lo * hi).sqrt())
+}
+
+/// One member's halo component with its parent-NFW M200 (Msun), c200 and truncation radius
+/// (arcsec).
+type BuiltHalo = (Box<dyn MassComponent>, f64, f64, Option<f64>);
+
+/// Builds the halo of one member of catalogue mass `mass_msun` at `position` (module
+/// documentation): a truncated NFW of total mass `M`, or an NFW of `M200 = M`.
+fn member_halo(
+    config: &MemberConfig,
+    position: DVec2,
+    mass_msun: f64,
+    plane: &LensPlane,
+) -> Result<BuiltHalo, ProfileError> {
+    let r_s_mpc = config.r_s_kpc(mass_msun) * 1e-3;
+    let no_c200 = ProfileError::BadParameter {
+        component: "member halo",
+        field: "r_s",
+        value: r_s_mpc * 1e3,
+        reason: "r_s in kpc needs a concentration outside [1e-3, 1e3] for this mass",
+    };
+    match config.profile {
+        HaloProfile::Nfw => {
+            let r200_mpc = (3.0 * mass_msun
+                / (800.0 * std::f64::consts::PI * plane.rho_crit_msun_per_mpc3))
+                .cbrt();
+            let c = r200_mpc / r_s_mpc;
+            if !(C200_RANGE.0..=C200_RANGE.1).contains(&c) {
+                return Err(no_c200);
+            }
+            let nfw = Nfw::new(position, mass_msun, c, plane)?;
+            Ok((Box::new(nfw), mass_msun, c, None))
+        }
+        HaloProfile::Tnfw => {
+            let r_t_mpc = config.r_trunc_kpc(mass_msun) * 1e-3;
+            let tau = r_t_mpc / r_s_mpc;
+            let rho_s = mass_msun
+                / (4.0 * std::f64::consts::PI * r_s_mpc.powi(3) * tnfw_total_mass_unit(tau));
+            let c = c200_for_rho_s(rho_s, plane).ok_or(no_c200)?;
+            let m200 = 4.0 * std::f64::consts::PI * rho_s * r_s_mpc.powi(3) * nfw_mu(c);
+            let r_t_arcsec = r_t_mpc / plane.mpc_per_arcsec;
+            let tnfw = TruncatedNfw::new(position, m200, c, r_t_arcsec, plane)?;
+            Ok((Box::new(tnfw), m200, c, Some(r_t_arcsec)))
+        }
+    }
+}
+
+/// Halos (METHOD.md section 4) and layers of the members of `catalog` that lie inside the
+/// field of `grid` grown by `outside_margin_fraction` of its width; the others are left out
+/// with a warning each. Layers are split by brightness (lowest magnitude first, ties by
+/// catalogue order); empty layers are not made.
+pub fn build_member_layers(
+    catalog: &MemberCatalog,
+    config: &MemberConfig,
+    plane: &LensPlane,
+    grid: &CellGrid,
+) -> Result<MemberModel, MembersError> {
+    config.validate()?;
+    let mag_star = config.mag_star_on(plane);
+    let margin = config.outside_margin_fraction * grid.width_arcsec;
+    let mut warnings = Vec::new();
+    let mut halos = Vec::new();
+    let mut components: Vec<Box<dyn MassComponent>> = Vec::new();
+    for (index, m) in catalog.members.iter().enumerate() {
+        let bad_member =
+            |field: &'static str, value: f64, reason: &'static str| MembersError::BadMember {
+                source_name: catalog.source_name.clone(),
+                line: m.line,
+                id: m.id.clone(),
+                field,
+                value,
+                reason,
+            };
+        for (field, v) in [("x", m.position.x), ("y", m.position.y)] {
+            if !v.is_finite() {
+                return Err(bad_member(field, v, "a position in arcsec must be finite"));
+            }
+        }
+        if !(m.mag.is_finite() && (m.mag - mag_star).abs() <= 20.0) {
+            return Err(bad_member(
+                "mag",
+                m.mag,
+                "must be within 20 magnitudes of mag_star",
+            ));
+        }
+        if !grid.contains(m.position, margin) {
+            warnings.push(format!(
+                "{}: line {}: member {} at ({:.2}, {:.2}) arcsec lies outside the field \
+                 (grid of {:.1} arcsec plus {:.1} arcsec margin): not used",
+                catalog.source_name,
+                m.line,
+                m.id,
+                m.position.x,
+                m.position.y,
+                grid.width_arcsec,
+                margin
+            ));
+            continue;
+        }
+        let mass_msun = config.mass_msun(m.mag, mag_star);
+        let (component, m200_msun, c200, r_trunc_arcsec) =
+            member_halo(config, m.position, mass_msun, plane).map_err(|source| {
+                MembersError::Halo {
+                    source_name: catalog.source_name.clone(),
+                    line: m.line,
+                    id: m.id.clone(),
+                    source,
+                }
+            })?;
+        components.push(component);
+        halos.push(MemberHalo {
+            member: index,
+            id: m.id.clone(),
+            position: m.position,
+            mag: m.mag,
+            luminosity_lstar: mass_msun / (config.mass_to_light * config.l_star_lsun),
+            mass_msun,
+            m200_msun,
+            c200,
+            r_s_arcsec: config.r_s_kpc(mass_msun) * 1e-3 / plane.mpc_per_arcsec,
+            r_trunc_arcsec,
+        });
+    }
+    let layers = split_layers(config.layers, &halos, components);
+    Ok(MemberModel {
+        halos,
+        layers,
+        warnings,
+    })
+}
+
+/// Groups the halos (with their components, in the same order) into layers.
+fn split_layers(
+    split: LayerSplit,
+    halos: &[MemberHalo],
+    components: Vec<Box<dyn MassComponent>>,
+) -> Vec<Layer> {
+    let n_alone = match split {
+        LayerSplit::None => return Vec::new(),
+        LayerSplit::Single => 0,
+        LayerSplit::Bcg => 1,
+        LayerSplit::Brightest(n) => n,
+    }
+    .min(halos.len());
+    let mut order: Vec<usize> = (0..halos.len()).collect();
+    order.sort_by(|&i, &j| halos[i].mag.total_cmp(&halos[j].mag).then(i.cmp(&j)));
+    let mut slots: Vec<Option<Box<dyn MassComponent>>> = components.into_iter().map(Some).collect();
+    let mut layers = Vec::new();
+    for (rank, &k) in order[..n_alone].iter().enumerate() {
+        let name = if split == LayerSplit::Bcg {
+            "bcg".to_string()
+        } else {
+            format!("member {} (rank {})", halos[k].id, rank + 1)
+        };
+        layers.push(Layer {
+            name,
+            members: vec![halos[k].member],
+            lens: Arc::new(Lens::new(slots[k].take().into_iter().collect())),
+        });
+    }
+    let mut rest: Vec<usize> = order[n_alone..].to_vec();
+    rest.sort_unstable();
+    if !rest.is_empty() {
+        let name = if n_alone == 0 { "members" } else { "rest" };
+        layers.push(Layer {
+            name: name.to_string(),
+            members: rest.iter().map(|&k| halos[k].member).collect(),
+            lens: Arc::new(Lens::new(
+                rest.iter().filter_map(|&k| slots[k].take()).collect(),
+            )),
+        });
+    }
+    layers
+}

@@ -1,0 +1,22 @@
+//! The WSLAP+ inversion between the catalogues and the solver (METHOD.md sections 3 and 4):
+//! the cell grid, the member-galaxy layers, the constraint pixels and the linear system
+//! `Theta = Gamma X` with its normal equations.
+
+mod constraints;
+mod grid;
+mod members;
+mod npy;
+mod system;
+
+pub use constraints::{
+    build_constraints, ellipse_pixels, parse_arcs, ArcCatalog, ArcSystem, ConstraintConfig,
+    ConstraintError, ConstraintMode, ConstraintPixel, ConstraintSet, ConstraintSource,
+    ConstraintSystem, ExcludedSystem, Exclusion, Weighting,
+};
+pub use grid::{cell_unit_deflection, Cell, CellGrid, GridConfig, GridError, GridMass};
+pub use members::{
+    build_member_layers, HaloProfile, Layer, LayerSplit, MemberConfig, MemberHalo, MemberModel,
+    MembersError,
+};
+pub use npy::{export_system, npy_header, write_f64s, write_npy, NpyError};
+pub use system::{ColumnInfo, LinearSystem, RowBlock, ScaledLens, SystemConfig, SystemError};

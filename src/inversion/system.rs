@@ -1,0 +1,542 @@
+//! The linear system `Theta = Gamma X` of WSLAP+ (METHOD.md section 3, paper eqs. 4-7) and
+//! its normal equations `A = Gamma^T W Gamma`, `b = -Gamma^T W Theta` (section 5).
+//!
+//! Unknowns `X = (m_1..m_Nc, C_1..C_L, beta_x,1..beta_x,Ns, beta_y,1..beta_y,Ns)`. Pixel `i`
+//! of system `s` gives two rows, `2i` (x) and `2i + 1` (y):
+//!
+//! ```text
+//! theta_x,i + S = f(z_s) [ sum_j Ux_ij m_j + sum_l C_l ax_l(theta_i) ] + beta'_x,s
+//! theta_y,i + S = f(z_s) [ sum_j Uy_ij m_j + sum_l C_l ay_l(theta_i) ] + beta'_y,s
+//! ```
+//!
+//! - `U_ij` = deflection (arcsec) at pixel `i` of cell `j` holding one mass unit:
+//!   `K mu / D_l` times the unit Gaussian deflection, with the mass unit `mu` (default
+//!   1e12 Msun: a 1e15 Msun cluster on a 32 x 32 grid has cells of ~1e12) so that the cell
+//!   unknowns are O(1); the mass of cell `j` is `X_j mu`.
+//! - `a_l` = fiducial deflection of galaxy layer `l` (arcsec, `D_ls/D_s = 1`).
+//! - `S` = frame shift (arcsec) added to every row so that every `beta' = beta + S` is
+//!   positive for the non-negative solver; the source position is `beta = X_beta - S`.
+//!   Default `S = max_i max(|theta_x,i|, |theta_y,i|) + field width`, rounded up to an arcsec:
+//!   `|beta| <= |theta| + |alpha|` and no deflection in the field exceeds its width.
+//!
+//! `Gamma` is never held whole: rows are made in blocks of at most `block_mbytes` and fed to
+//! the normal-equation accumulator; cell columns are filled by all threads natively.
+
+use std::ops::Range;
+use std::sync::Arc;
+
+use glam::DVec2;
+use serde::{Deserialize, Serialize};
+use thiserror::Error;
+
+use super::constraints::ConstraintSet;
+use super::grid::{cell_unit_deflection, CellGrid, GridError, GridMass};
+use super::members::Layer;
+use crate::cosmology::{CosmologyError, LensPlane};
+use crate::profiles::{Lens, MassComponent};
+use crate::solver::{NormalEquations, SolverError};
+use crate::units::point_mass_deflection_arcsec2;
+
+/// What can go wrong building or using the linear system.
+#[derive(Debug, Error, Clone, PartialEq)]
+pub enum SystemError {
+    #[error("system: {field} = {value} is not allowed ({reason})")]
+    BadParameter {
+        field: &'static str,
+        value: f64,
+        reason: &'static str,
+    },
+    #[error("system {system}: {source}")]
+    Redshift {
+        system: String,
+        #[source]
+        source: CosmologyError,
+    },
+    #[error("layer \"{layer}\": its deflection at ({x}, {y}) arcsec is not finite")]
+    LayerNotFinite { layer: String, x: f64, y: f64 },
+    #[error("{what} has {got} values, expected {expected}")]
+    Length {
+        what: &'static str,
+        expected: usize,
+        got: usize,
+    },
+    #[error("normal equations: {0}")]
+    Accumulate(#[from] SolverError),
+    #[error(transparent)]
+    Grid(#[from] GridError),
+}
+
+/// Settings of the linear system (the `system` block of an inversion configuration).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct SystemConfig {
+    /// Mass unit of the cell unknowns in Msun (default 1e12). Allowed [1e3, 1e18].
+    pub mass_unit_msun: f64,
+    /// Frame shift `S` in arcsec (default: automatic, see the module documentation).
+    /// Allowed [0, 1e6].
+    pub theta_shift_arcsec: Option<f64>,
+    /// Largest block of `Gamma` rows held at once, in MB (default 64). Allowed [0.001, 1e5].
+    pub block_mbytes: f64,
+    /// Threads for filling rows; 0 (default) = all available (always 1 on wasm32).
+    pub threads: usize,
+}
+
+impl Default for SystemConfig {
+    fn default() -> Self {
+        Self {
+            mass_unit_msun: 1.0e12,
+            theta_shift_arcsec: None,
+            block_mbytes: 64.0,
+            threads: 0,
+        }
+    }
+}
+
+impl SystemConfig {
+    /// Checks every field against the range in its documentation.
+    pub fn validate(&self) -> Result<(), SystemError> {
+        let bad = |field, value, reason| SystemError::BadParameter {
+            field,
+            value,
+            reason,
+        };
+        let m = self.mass_unit_msun;
+        if !(m.is_finite() && (1e3..=1e18).contains(&m)) {
+            return Err(bad("mass_unit_msun", m, "must be in [1e3, 1e18] Msun"));
+        }
+        if let Some(s) = self.theta_shift_arcsec {
+            if !(s.is_finite() && (0.0..=1e6).contains(&s)) {
+                return Err(bad("theta_shift_arcsec", s, "must be in [0, 1e6] arcsec"));
+            }
+        }
+        let mb = self.block_mbytes;
+        if !(mb.is_finite() && (1e-3..=1e5).contains(&mb)) {
+            return Err(bad("block_mbytes", mb, "must be in [0.001, 1e5] MB"));
+        }
+        Ok(())
+    }
+}
+
+/// What one column of `Gamma` (one unknown) is. In JSON tagged by `"kind"`.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(tag = "kind", rename_all = "snake_case")]
+pub enum ColumnInfo {
+    /// Mass of grid cell `index`, in units of `mass_unit_msun`.
+    Cell {
+        index: usize,
+        center: DVec2,
+        size_arcsec: f64,
+        sigma_arcsec: f64,
+    },
+    /// Scale `C_l` of galaxy layer `index` (dimensionless).
+    Layer { index: usize, name: String },
+    /// `beta'_x` (arcsec, shifted) of system `system`.
+    BetaX { system: usize, id: String },
+    /// `beta'_y` (arcsec, shifted) of system `system`.
+    BetaY { system: usize, id: String },
+}
+
+/// Rows of `Gamma` for a range of pixels: `gamma` row-major (`2 n_pixels x n_columns`),
+/// `theta` the shifted positions and `weights` the row weights (1/arcsec^2).
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct RowBlock {
+    pub gamma: Vec<f64>,
+    pub theta: Vec<f64>,
+    pub weights: Vec<f64>,
+}
+
+/// The assembled system: column layout, normal equations and what is needed to make rows and
+/// the reconstructed lens again.
+#[derive(Debug, Clone)]
+pub struct LinearSystem {
+    pub columns: Vec<ColumnInfo>,
+    /// `2 x` number of pixels.
+    pub n_rows: usize,
+    /// Frame shift `S` in arcsec.
+    pub theta_shift_arcsec: f64,
+    /// Mass unit of the cell unknowns in Msun.
+    pub mass_unit_msun: f64,
+    /// `A = Gamma^T W Gamma`, row-major `n x n` (`n = columns.len()`).
+    pub a: Vec<f64>,
+    /// `b = -Gamma^T W Theta`.
+    pub b: Vec<f64>,
+    /// `Theta^T W Theta`: `chi^2(X) = 2 phi(X) + Theta^T W Theta`.
+    pub theta_w_theta: f64,
+    pub grid: CellGrid,
+    pub layers: Vec<Layer>,
+    pub constraints: ConstraintSet,
+    /// `f(z_s) = D_ls / D_s` per system.
+    pub distance_ratios: Vec<f64>,
+    /// `D_l` in Mpc.
+    pub d_l_mpc: f64,
+    /// `a_l(theta_i)` for pixel `i`, layer `l` at `[i * L + l]`.
+    layer_deflections: Vec<DVec2>,
+    threads: usize,
+    rows_per_block: usize,
+}
+
+/// Threads to use: `requested`, or all available when 0; always 1 on wasm32.
+fn thread_count(requested: usize) -> usize {
+    if cfg!(target_arch = "wasm32") {
+        return 1;
+    }
+    if requested > 0 {
+        requested
+    } else {
+        std::thread::available_parallelism().map_or(1, |n| n.get())
+    }
+}
+
+/// Calls `fill(first_item, chunk)` on consecutive chunks of `out` (`stride` values per item),
+/// split over `threads` threads (in this thread when 1).
+fn parallel_fill<F>(out: &mut [f64], stride: usize, threads: usize, fill: F)
+where
+    F: Fn(usize, &mut [f64]) + Sync,
+{
+    let items = out.len() / stride.max(1);
+    if threads <= 1 || items < 2 {
+        fill(0, out);
+        return;
+    }
+    let per = items.div_ceil(threads);
+    std::thread::scope(|scope| {
+        for (k, chunk) in out.chunks_mut(per * stride).enumerate() {
+            let fill = &fill;
+            scope.spawn(move || fill(k * per, chunk));
+        }
+    });
+}
+
+impl LinearSystem {
+    /// Builds the system of METHOD.md section 3 for `grid`, `layers` and `constraints` on
+    /// `plane` and accumulates its normal equations block by block.
+    pub fn build(
+        grid: &CellGrid,
+        layers: &[Layer],
+        constraints: &ConstraintSet,
+        plane: &LensPlane,
+        config: &SystemConfig,
+    ) -> Result<Self, SystemError> {
+        config.validate()?;
+        let distance_ratios = constraints
+            .systems
+            .iter()
+            .map(|s| {
+                plane
+                    .distance_ratio(s.z)
+                    .map_err(|source| SystemError::Redshift {
+                        system: s.id.clone(),
+                        source,
+                    })
+            })
+            .collect::<Result<Vec<f64>, _>>()?;
+        let columns = column_layout(grid, layers, constraints);
+        let n_cols = columns.len();
+        let theta_shift_arcsec = config.theta_shift_arcsec.unwrap_or_else(|| {
+            let reach = constraints
+                .pixels
+                .iter()
+                .map(|p| p.position.abs().max_element())
+                .fold(0.0, f64::max);
+            (reach + grid.width_arcsec).ceil()
+        });
+        let threads = thread_count(config.threads);
+        let layer_deflections = layer_deflections(layers, constraints, threads)?;
+        let bytes_per_pixel = 2.0 * n_cols as f64 * 8.0;
+        let rows_per_block =
+            ((config.block_mbytes * 1e6 / bytes_per_pixel).floor() as usize).max(1);
+        let mut system = Self {
+            columns,
+            n_rows: 2 * constraints.pixels.len(),
+            theta_shift_arcsec,
+            mass_unit_msun: config.mass_unit_msun,
+            a: Vec::new(),
+            b: Vec::new(),
+            theta_w_theta: 0.0,
+            grid: grid.clone(),
+            layers: layers.to_vec(),
+            constraints: constraints.clone(),
+            distance_ratios,
+            d_l_mpc: plane.d_l_mpc,
+            layer_deflections,
+            threads,
+            rows_per_block,
+        };
+        system.accumulate_normal()?;
+        Ok(system)
+    }
+
+    /// Number of unknowns.
+    pub fn n_columns(&self) -> usize {
+        self.columns.len()
+    }
+
+    /// Columns of the cell masses.
+    pub fn cell_columns(&self) -> Range<usize> {
+        0..self.grid.len()
+    }
+
+    /// Columns of the layer scales `C_l`.
+    pub fn layer_columns(&self) -> Range<usize> {
+        let start = self.grid.len();
+        start..start + self.layers.len()
+    }
+
+    /// Columns of `beta'_x` (then `beta'_y` follow in [`Self::beta_y_columns`]).
+    pub fn beta_x_columns(&self) -> Range<usize> {
+        let start = self.grid.len() + self.layers.len();
+        start..start + self.constraints.systems.len()
+    }
+
+    /// Columns of `beta'_y`.
+    pub fn beta_y_columns(&self) -> Range<usize> {
+        let start = self.beta_x_columns().end;
+        start..start + self.constraints.systems.len()
+    }
+
+    /// Pixels per block of rows (each pixel is two rows).
+    pub fn pixels_per_block(&self) -> usize {
+        self.rows_per_block
+    }
+
+    /// `K mu f / D_l`: the deflection (arcsec) per unit Gaussian deflection and per cell
+    /// unknown, for a source with distance ratio `f`.
+    fn cell_scale(&self, f: f64) -> f64 {
+        point_mass_deflection_arcsec2() * self.mass_unit_msun / self.d_l_mpc * f
+    }
+
+    /// Rows `2 p0 .. 2 p1` of `Gamma`, `Theta` and `W` for pixels `p0..p1` into `out`
+    /// (resized; see [`RowBlock`]).
+    pub fn rows(&self, pixels: Range<usize>, out: &mut RowBlock) -> Result<(), SystemError> {
+        let n_pix = self.constraints.pixels.len();
+        if pixels.start > pixels.end || pixels.end > n_pix {
+            return Err(SystemError::Length {
+                what: "pixel range end",
+                expected: n_pix,
+                got: pixels.end,
+            });
+        }
+        let n_cols = self.n_columns();
+        let count = pixels.len();
+        out.gamma.clear();
+        out.gamma.resize(2 * count * n_cols, 0.0);
+        out.theta.clear();
+        out.weights.clear();
+        let centers_x: Vec<f64> = self.grid.cells.iter().map(|c| c.center.x).collect();
+        let centers_y: Vec<f64> = self.grid.cells.iter().map(|c| c.center.y).collect();
+        let inv_2s2: Vec<f64> = self
+            .grid
+            .cells
+            .iter()
+            .map(|c| 0.5 / (c.sigma_arcsec * c.sigma_arcsec))
+            .collect();
+        let (n_cells, n_layers) = (self.grid.len(), self.layers.len());
+        let (bx, by) = (self.beta_x_columns().start, self.beta_y_columns().start);
+        let first = pixels.start;
+        parallel_fill(&mut out.gamma, 2 * n_cols, self.threads, |k0, chunk| {
+            for (k, two_rows) in chunk.chunks_exact_mut(2 * n_cols).enumerate() {
+                let i = first + k0 + k;
+                let pixel = &self.constraints.pixels[i];
+                let f = self.distance_ratios[pixel.system];
+                let scale = self.cell_scale(f);
+                let (row_x, row_y) = two_rows.split_at_mut(n_cols);
+                let p = pixel.position;
+                for j in 0..n_cells {
+                    let (gx, gy) =
+                        cell_unit_deflection(p.x - centers_x[j], p.y - centers_y[j], inv_2s2[j]);
+                    row_x[j] = scale * gx;
+                    row_y[j] = scale * gy;
+                }
+                for l in 0..n_layers {
+                    let a = self.layer_deflections[i * n_layers + l];
+                    row_x[n_cells + l] = f * a.x;
+                    row_y[n_cells + l] = f * a.y;
+                }
+                row_x[bx + pixel.system] = 1.0;
+                row_y[by + pixel.system] = 1.0;
+            }
+        });
+        for pixel in &self.constraints.pixels[pixels] {
+            out.theta.push(pixel.position.x + self.theta_shift_arcsec);
+            out.theta.push(pixel.position.y + self.theta_shift_arcsec);
+            out.weights.push(pixel.weight);
+            out.weights.push(pixel.weight);
+        }
+        Ok(())
+    }
+
+    /// Fills `a`, `b` and `theta_w_theta` from blocks of rows.
+    fn accumulate_normal(&mut self) -> Result<(), SystemError> {
+        let n = self.n_columns();
+        let mut acc = NormalEquations::new(n)?;
+        let mut theta_w_theta = 0.0;
+        let mut block = RowBlock::default();
+        let n_pix = self.constraints.pixels.len();
+        let mut start = 0;
+        while start < n_pix {
+            let end = (start + self.rows_per_block).min(n_pix);
+            self.rows(start..end, &mut block)?;
+            acc.add_rows(&block.gamma, &block.weights, &block.theta)?;
+            theta_w_theta += block
+                .theta
+                .iter()
+                .zip(&block.weights)
+                .map(|(t, w)| w * t * t)
+                .sum::<f64>();
+            start = end;
+        }
+        let (a, b) = acc.finish();
+        self.a = a;
+        self.b = b;
+        self.theta_w_theta = theta_w_theta;
+        Ok(())
+    }
+
+    /// Checks that `x` has one value per column.
+    fn check_x(&self, x: &[f64]) -> Result<(), SystemError> {
+        if x.len() != self.n_columns() {
+            return Err(SystemError::Length {
+                what: "solution X",
+                expected: self.n_columns(),
+                got: x.len(),
+            });
+        }
+        Ok(())
+    }
+
+    /// Cell masses in Msun: `X_j mu`.
+    pub fn cell_masses_msun(&self, x: &[f64]) -> Result<Vec<f64>, SystemError> {
+        self.check_x(x)?;
+        Ok(x[self.cell_columns()]
+            .iter()
+            .map(|m| m * self.mass_unit_msun)
+            .collect())
+    }
+
+    /// Source positions `beta = X_beta' - S` in arcsec, per system.
+    pub fn betas_arcsec(&self, x: &[f64]) -> Result<Vec<DVec2>, SystemError> {
+        self.check_x(x)?;
+        let (bx, by) = (self.beta_x_columns(), self.beta_y_columns());
+        Ok(x[bx]
+            .iter()
+            .zip(&x[by])
+            .map(|(&u, &v)| DVec2::new(u, v) - DVec2::splat(self.theta_shift_arcsec))
+            .collect())
+    }
+
+    /// The mass model of solution `x` at `D_ls/D_s = 1`: the cells as Gaussians of mass
+    /// `X_j mu` and each layer scaled by `C_l` (layers with `C_l = 0` left out).
+    pub fn reconstructed_lens(&self, x: &[f64]) -> Result<Lens, SystemError> {
+        self.check_x(x)?;
+        let k = point_mass_deflection_arcsec2() * self.mass_unit_msun / self.d_l_mpc;
+        let b2 = x[self.cell_columns()].iter().map(|m| k * m).collect();
+        let grid = GridMass::new(&self.grid, b2)?;
+        let mut components: Vec<Box<dyn MassComponent>> = vec![Box::new(grid)];
+        for (layer, &c) in self.layers.iter().zip(&x[self.layer_columns()]) {
+            if c != 0.0 {
+                components.push(Box::new(ScaledLens {
+                    factor: c,
+                    lens: Arc::clone(&layer.lens),
+                }));
+            }
+        }
+        Ok(Lens::new(components))
+    }
+}
+
+/// A shared lens scaled by a constant (a galaxy layer times its `C_l`).
+#[derive(Debug, Clone)]
+pub struct ScaledLens {
+    pub factor: f64,
+    pub lens: Arc<Lens>,
+}
+
+impl MassComponent for ScaledLens {
+    fn kappa(&self, p: DVec2) -> f64 {
+        self.factor * self.lens.kappa(p)
+    }
+    fn deflection(&self, p: DVec2) -> DVec2 {
+        self.factor * self.lens.deflection(p)
+    }
+    fn hessian(&self, p: DVec2) -> [f64; 3] {
+        self.lens.hessian(p).map(|h| self.factor * h)
+    }
+    fn deflection_hessian(&self, p: DVec2) -> (DVec2, [f64; 3]) {
+        let (a, h) = self.lens.deflection_hessian(p);
+        (self.factor * a, h.map(|v| self.factor * v))
+    }
+}
+
+/// Column layout: cells, layers, `beta'_x` per system, `beta'_y` per system.
+fn column_layout(
+    grid: &CellGrid,
+    layers: &[Layer],
+    constraints: &ConstraintSet,
+) -> Vec<ColumnInfo> {
+    let mut columns: Vec<ColumnInfo> = grid
+        .cells
+        .iter()
+        .enumerate()
+        .map(|(index, c)| ColumnInfo::Cell {
+            index,
+            center: c.center,
+            size_arcsec: c.size_arcsec,
+            sigma_arcsec: c.sigma_arcsec,
+        })
+        .collect();
+    columns.extend(
+        layers
+            .iter()
+            .enumerate()
+            .map(|(index, l)| ColumnInfo::Layer {
+                index,
+                name: l.name.clone(),
+            }),
+    );
+    let systems = constraints.systems.iter().enumerate();
+    columns.extend(systems.clone().map(|(system, s)| ColumnInfo::BetaX {
+        system,
+        id: s.id.clone(),
+    }));
+    columns.extend(systems.map(|(system, s)| ColumnInfo::BetaY {
+        system,
+        id: s.id.clone(),
+    }));
+    columns
+}
+
+/// `a_l(theta_i)` for every pixel and layer (`[i * L + l]`), checked finite.
+fn layer_deflections(
+    layers: &[Layer],
+    constraints: &ConstraintSet,
+    threads: usize,
+) -> Result<Vec<DVec2>, SystemError> {
+    let n_layers = layers.len();
+    let n_pix = constraints.pixels.len();
+    let mut flat = vec![0.0; 2 * n_layers * n_pix];
+    if n_layers > 0 {
+        parallel_fill(&mut flat, 2 * n_layers, threads, |i0, chunk| {
+            for (k, out) in chunk.chunks_exact_mut(2 * n_layers).enumerate() {
+                let p = constraints.pixels[i0 + k].position;
+                for (l, layer) in layers.iter().enumerate() {
+                    let a = layer.deflection(p);
+                    out[2 * l] = a.x;
+                    out[2 * l + 1] = a.y;
+                }
+            }
+        });
+    }
+    let out: Vec<DVec2> = flat
+        .chunks_exact(2)
+        .map(|v| DVec2::new(v[0], v[1]))
+        .collect();
+    if let Some(k) = out.iter().position(|a| !a.is_finite()) {
+        let p = constraints.pixels[k / n_layers].position;
+        return Err(SystemError::LayerNotFinite {
+            layer: layers[k % n_layers].name.clone(),
+            x: p.x,
+            y: p.y,
+        });
+    }
+    Ok(out)
+}
