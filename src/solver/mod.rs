@@ -1,0 +1,173 @@
+//! Non-negative quadratic programming for the WSLAP+ linear system (METHOD.md section 5).
+//!
+//! The inversion minimises `phi(X) = 1/2 X^T A X + b^T X` subject to `X >= 0`, with
+//! `A = Gamma^T W Gamma` (symmetric positive semi-definite, dense) and `b = -Gamma^T W Theta`.
+//!
+//! - [`NormalEquations`] accumulates `A` and `b` from blocks of rows of `Gamma` (blocked,
+//!   multi-threaded natively), [`gram_weighted`] does it in one call.
+//! - [`QadpProblem`] runs the multiplicative update of Sha, Saul & Lee (2002) (QADP), the
+//!   paper's solver; the number of iterations is the regulariser.
+//! - [`nnqp_exact`] is an exact active-set solver (Lawson–Hanson in QP form) for small problems,
+//!   the reference the tests compare QADP with.
+//!
+//! All matrices are dense, row-major `&[f64]` of `n * n` values.
+
+mod gram;
+mod kernel;
+mod nnls;
+mod qadp;
+mod sweep;
+
+use thiserror::Error;
+
+pub use gram::{gram_weighted, NormalEquations};
+pub use nnls::{nnqp_exact, NNQP_EXACT_MAX_UNKNOWNS};
+pub use qadp::{Control, Progress, QadpProblem, QadpSettings, SolveOutcome, SolveStatus};
+
+/// What can be wrong with a quadratic program, its start or the solver settings.
+#[derive(Debug, Error, Clone, PartialEq)]
+pub enum SolverError {
+    #[error("solver: the problem has no unknowns (n = 0)")]
+    Empty,
+    #[error("solver: {what} has {got} values, expected {expected}")]
+    DimensionMismatch {
+        what: &'static str,
+        expected: usize,
+        got: usize,
+    },
+    #[error("solver: {what}[{index}] = {value} is not finite")]
+    NonFinite {
+        what: &'static str,
+        index: usize,
+        value: f64,
+    },
+    #[error("solver: A is not symmetric: A[{row}][{col}] = {a_row_col:e} but A[{col}][{row}] = {a_col_row:e}")]
+    NotSymmetric {
+        row: usize,
+        col: usize,
+        a_row_col: f64,
+        a_col_row: f64,
+    },
+    #[error("solver: A is not positive semi-definite: {reason} (row {row}, column {col}, value {value:e})")]
+    NotPositiveSemidefinite {
+        row: usize,
+        col: usize,
+        value: f64,
+        reason: &'static str,
+    },
+    #[error("solver: the objective is unbounded below along unknown {index}: its row of A is zero and b[{index}] = {b:e} < 0")]
+    Unbounded { index: usize, b: f64 },
+    #[error("solver: start x0[{index}] = {value} is negative (every start value must be >= 0)")]
+    NegativeStart { index: usize, value: f64 },
+    #[error("solver: {what}[{index}] = {value} must be >= 0")]
+    NegativeWeight {
+        what: &'static str,
+        index: usize,
+        value: f64,
+    },
+    #[error("solver: setting {name} = {value} is not allowed ({reason})")]
+    BadSetting {
+        name: &'static str,
+        value: usize,
+        reason: &'static str,
+    },
+    #[error("solver: the exact solver handles at most {max} unknowns, got {n}")]
+    TooLarge { n: usize, max: usize },
+    #[error("solver: the exact solver met a singular subproblem when freeing unknown {index} (pivot {pivot:e}); A must be positive definite on the free set")]
+    Singular { index: usize, pivot: f64 },
+    #[error("solver: the exact solver did not converge in {iterations} active-set changes")]
+    NotConverged { iterations: usize },
+}
+
+/// Relative tolerance of the symmetry check: `|A_ij - A_ji| <= SYMMETRY_RTOL * sqrt(A_ii A_jj)`.
+/// Matrices formed as `G^T W G` in floating point are symmetric to ~1e-15; 1e-9 leaves room for
+/// matrices assembled in other orders while catching transposition mistakes.
+const SYMMETRY_RTOL: f64 = 1e-9;
+
+/// Checks sizes, finiteness, symmetry and the cheap necessary conditions for `A` to be positive
+/// semi-definite (`A_ii >= 0`; every 2x2 principal minor `A_ii A_jj - A_ij^2 >= 0`, so a zero
+/// diagonal entry needs a zero row), and that no zero row has `b_i < 0` (unbounded objective).
+/// A full PSD test would cost a Cholesky factorisation (`n^3 / 3`) and is not done.
+pub(crate) fn validate_system(a: &[f64], b: &[f64], n: usize) -> Result<(), SolverError> {
+    if n == 0 {
+        return Err(SolverError::Empty);
+    }
+    let expected = n.checked_mul(n).ok_or(SolverError::DimensionMismatch {
+        what: "A",
+        expected: usize::MAX,
+        got: a.len(),
+    })?;
+    check_len("A", a, expected)?;
+    check_len("b", b, n)?;
+    check_finite("A", a)?;
+    check_finite("b", b)?;
+    for i in 0..n {
+        let a_ii = a[i * n + i];
+        if a_ii < 0.0 {
+            return Err(SolverError::NotPositiveSemidefinite {
+                row: i,
+                col: i,
+                value: a_ii,
+                reason: "negative diagonal entry",
+            });
+        }
+        for j in (i + 1)..n {
+            let (a_ij, a_ji) = (a[i * n + j], a[j * n + i]);
+            let bound = (a_ii * a[j * n + j]).sqrt();
+            if (a_ij - a_ji).abs() > SYMMETRY_RTOL * bound {
+                return Err(SolverError::NotSymmetric {
+                    row: i,
+                    col: j,
+                    a_row_col: a_ij,
+                    a_col_row: a_ji,
+                });
+            }
+            if a_ij.abs() > bound * (1.0 + SYMMETRY_RTOL) {
+                return Err(SolverError::NotPositiveSemidefinite {
+                    row: i,
+                    col: j,
+                    value: a_ij,
+                    reason: "|A_ij| > sqrt(A_ii A_jj)",
+                });
+            }
+        }
+        if a_ii == 0.0 && b[i] < 0.0 {
+            return Err(SolverError::Unbounded { index: i, b: b[i] });
+        }
+    }
+    Ok(())
+}
+
+pub(crate) fn check_len(what: &'static str, v: &[f64], expected: usize) -> Result<(), SolverError> {
+    if v.len() != expected {
+        return Err(SolverError::DimensionMismatch {
+            what,
+            expected,
+            got: v.len(),
+        });
+    }
+    Ok(())
+}
+
+pub(crate) fn check_finite(what: &'static str, v: &[f64]) -> Result<(), SolverError> {
+    match v.iter().position(|x| !x.is_finite()) {
+        Some(index) => Err(SolverError::NonFinite {
+            what,
+            index,
+            value: v[index],
+        }),
+        None => Ok(()),
+    }
+}
+
+/// `phi(X) = 1/2 X^T A X + b^T X` in f64 (row-major `A`, `n * n`); for tests and reports.
+pub fn objective(a: &[f64], b: &[f64], x: &[f64]) -> f64 {
+    let n = b.len();
+    let mut phi = 0.0;
+    for i in 0..n {
+        let row = &a[i * n..(i + 1) * n];
+        let ax_i: f64 = row.iter().zip(x).map(|(a_ij, x_j)| a_ij * x_j).sum();
+        phi += x[i] * (0.5 * ax_i + b[i]);
+    }
+    phi
+}

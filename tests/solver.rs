@@ -1,0 +1,493 @@
+//! The solvers: QADP against the exact active-set solver on random problems, analytic
+//! non-negative quadratic programs, the run protocol (reports, cancel, positivity, monotone
+//! objective), the normal-equations accumulator against a naive product, and bad inputs.
+
+mod common;
+
+use common::assert_rel;
+use wslap::solver::{
+    gram_weighted, nnqp_exact, objective, Control, NormalEquations, Progress, QadpProblem,
+    QadpSettings, SolveStatus, SolverError, NNQP_EXACT_MAX_UNKNOWNS,
+};
+
+/// QADP after enough iterations against the exact optimum: `phi - phi* <= 1e-6 |phi*|` is the
+/// requirement of the solver (the f32 pass limits it to ~1e-9 here).
+const QADP_OBJECTIVE_RTOL: f64 = 1e-6;
+/// The exact solver on problems with a closed-form optimum: rounding only.
+const EXACT_RTOL: f64 = 1e-12;
+/// The objective reported during a run comes from the f32 pass: ~1e-7 of `x^T |A| x`, which
+/// here is about `|phi|` (measured: <= 2e-8).
+const REPORTED_OBJECTIVE_RTOL: f64 = 1e-7;
+/// QADP is monotone: the f64 objective of the reported iterates may rise only by the rounding
+/// of its own sum (measured: <= 1.2e-15).
+const MONOTONE_RTOL: f64 = 1e-13;
+/// Bands of rows change how the f32 column sums are grouped: runs with different thread counts
+/// agree to the f32 rounding of the sums (measured: ~1e-9 of max x after 700 iterations).
+const THREADS_RTOL: f64 = 1e-6;
+/// `G^T W G` blocked and threaded vs a naive triple loop (different summation order).
+const GRAM_RTOL: f64 = 1e-12;
+
+/// splitmix64 with a fixed seed per test.
+struct Rng(u64);
+
+impl Rng {
+    fn next_u64(&mut self) -> u64 {
+        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
+        let mut z = self.0;
+        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+        z ^ (z >> 31)
+    }
+    fn uniform(&mut self) -> f64 {
+        (self.next_u64() >> 11) as f64 / (1u64 << 53) as f64
+    }
+    fn normal(&mut self) -> f64 {
+        let u = 1.0 - self.uniform();
+        (-2.0 * u.ln()).sqrt() * (2.0 * std::f64::consts::PI * self.uniform()).cos()
+    }
+}
+
+/// `A = G^T G`, `b = -G^T y` with `G` (2n x n) Gaussian and `y = G x_true + noise`, where
+/// about a third of `x_true` is negative, so that the optimum has components at 0.
+fn random_problem(rng: &mut Rng, n: usize) -> (Vec<f64>, Vec<f64>) {
+    let m = 2 * n;
+    let g: Vec<f64> = (0..m * n).map(|_| rng.normal()).collect();
+    let x_true: Vec<f64> = (0..n).map(|_| rng.uniform() * 3.0 - 1.0).collect();
+    let y: Vec<f64> = (0..m)
+        .map(|r| (0..n).map(|j| g[r * n + j] * x_true[j]).sum::<f64>() + 0.1 * rng.normal())
+        .collect();
+    gram_weighted(&g, m, n, &vec![1.0; m], &y).expect("valid random system")
+}
+
+/// One report: iteration, reported objective, f64 objective of the reported x, min x.
+type Report = (usize, f64, f64, f64);
+
+/// Runs QADP on `(a, b)` and returns the outcome and every report.
+fn run_recorded(
+    (a, b): (&[f64], &[f64]),
+    problem: &QadpProblem,
+    x0: &[f64],
+    settings: &QadpSettings,
+) -> (wslap::solver::SolveOutcome, Vec<Report>) {
+    let mut reports = Vec::new();
+    let outcome = problem
+        .run(x0, settings, &mut |p| {
+            assert!(
+                p.x.iter().all(|v| v.is_finite()),
+                "x finite at {}",
+                p.iteration
+            );
+            let min_x = p.x.iter().fold(f64::INFINITY, |m, &v| m.min(v));
+            reports.push((p.iteration, p.objective, objective(a, b, p.x), min_x));
+            Control::Continue
+        })
+        .expect("valid run");
+    (outcome, reports)
+}
+
+#[cfg_attr(not(target_arch = "wasm32"), test)]
+#[cfg_attr(target_arch = "wasm32", wasm_bindgen_test::wasm_bindgen_test)]
+fn qadp_matches_exact_on_random_problems() {
+    let mut rng = Rng(20020);
+    for case in 0..20 {
+        let n = 5 + case * 55 / 19;
+        let (a, b) = random_problem(&mut rng, n);
+        let exact = nnqp_exact(&a, &b, n).expect("exact solver");
+        let phi_star = objective(&a, &b, &exact);
+        assert!(exact.contains(&0.0), "case {case}: some optimal x_i = 0");
+        let problem = QadpProblem::new(&a, &b, n).expect("valid problem");
+        let settings = QadpSettings {
+            iterations: 6000,
+            report_every: 200,
+            threads: 0,
+        };
+        let (outcome, reports) = run_recorded((&a, &b), &problem, &vec![0.1; n], &settings);
+        assert_eq!(outcome.status, SolveStatus::Completed);
+        assert_eq!(outcome.iterations, 6000);
+        let phi = objective(&a, &b, &outcome.x);
+        assert!(
+            phi - phi_star <= QADP_OBJECTIVE_RTOL * phi_star.abs(),
+            "case {case} (n = {n}): QADP phi = {phi:e}, exact phi* = {phi_star:e}"
+        );
+        for &(t, reported, exact, min_x) in &reports {
+            assert!(min_x >= 0.0, "case {case}: x >= 0 at iteration {t}");
+            assert_rel(
+                "reported objective",
+                reported,
+                exact,
+                REPORTED_OBJECTIVE_RTOL,
+            );
+        }
+        for pair in reports.windows(2) {
+            let ((_, _, phi0, _), (t1, _, phi1, _)) = (pair[0], pair[1]);
+            assert!(
+                phi1 <= phi0 + MONOTONE_RTOL * phi0.abs(),
+                "case {case}: objective rose from {phi0:e} to {phi1:e} at iteration {t1}"
+            );
+        }
+    }
+}
+
+#[cfg_attr(not(target_arch = "wasm32"), test)]
+#[cfg_attr(target_arch = "wasm32", wasm_bindgen_test::wasm_bindgen_test)]
+fn diagonal_problem_has_closed_form_optimum() {
+    // min sum_i (d_i x_i^2 / 2 + b_i x_i), x >= 0: x_i = max(-b_i / d_i, 0).
+    let d: [f64; 5] = [2.0, 0.5, 4.0, 1.0, 3.0];
+    let b = [-1.0, 2.0, -8.0, 0.5, -0.3];
+    let n = d.len();
+    let mut a = vec![0.0; n * n];
+    for i in 0..n {
+        a[i * n + i] = d[i];
+    }
+    let expected: Vec<f64> = (0..n).map(|i| (-b[i] / d[i]).max(0.0)).collect();
+    let exact = nnqp_exact(&a, &b, n).expect("exact solver");
+    let problem = QadpProblem::new(&a, &b, n).expect("valid problem");
+    let settings = QadpSettings {
+        iterations: 50,
+        ..QadpSettings::default()
+    };
+    let outcome = problem
+        .run(&[1.0; 5], &settings, &mut |_| Control::Continue)
+        .expect("valid run");
+    for i in 0..n {
+        common::assert_abs("exact x_i", exact[i], expected[i], EXACT_RTOL);
+        common::assert_abs("QADP x_i", outcome.x[i], expected[i], 1e-12);
+    }
+}
+
+#[cfg_attr(not(target_arch = "wasm32"), test)]
+#[cfg_attr(target_arch = "wasm32", wasm_bindgen_test::wasm_bindgen_test)]
+fn two_by_two_with_active_bound() {
+    // A = [[2, 1], [1, 2]], b = (-1, 1): the unconstrained optimum (1, -1) is infeasible; the
+    // constrained one is (1/2, 0) with phi = -1/4 (gradient of x_2 there: 1/2 + 1 > 0).
+    let a = [2.0, 1.0, 1.0, 2.0];
+    let b = [-1.0, 1.0];
+    let exact = nnqp_exact(&a, &b, 2).expect("exact solver");
+    common::assert_abs("exact x_1", exact[0], 0.5, EXACT_RTOL);
+    common::assert_abs("exact x_2", exact[1], 0.0, EXACT_RTOL);
+    let problem = QadpProblem::new(&a, &b, 2).expect("valid problem");
+    let outcome = problem
+        .run(&[1.0, 1.0], &QadpSettings::default(), &mut |_| {
+            Control::Continue
+        })
+        .expect("valid run");
+    assert_rel("QADP phi", outcome.objective, -0.25, 1e-9);
+    common::assert_abs("QADP x_1", outcome.x[0], 0.5, 1e-6);
+    common::assert_abs("QADP x_2", outcome.x[1], 0.0, 1e-6);
+}
+
+#[cfg_attr(not(target_arch = "wasm32"), test)]
+#[cfg_attr(target_arch = "wasm32", wasm_bindgen_test::wasm_bindgen_test)]
+fn cancel_stops_at_the_reported_state() {
+    let (a, b) = random_problem(&mut Rng(7), 30);
+    let problem = QadpProblem::new(&a, &b, 30).expect("valid problem");
+    let mut seen = Vec::new();
+    let outcome = problem
+        .run(&[0.1; 30], &QadpSettings::default(), &mut |p| {
+            seen.push(p.iteration);
+            if p.iteration == 300 {
+                assert_rel(
+                    "objective shown",
+                    p.objective,
+                    objective(&a, &b, p.x),
+                    REPORTED_OBJECTIVE_RTOL,
+                );
+                Control::Cancel
+            } else {
+                Control::Continue
+            }
+        })
+        .expect("valid run");
+    assert_eq!(outcome.status, SolveStatus::Cancelled);
+    assert_eq!(outcome.iterations, 300);
+    assert_eq!(seen, vec![0, 100, 200, 300]);
+    let exact = objective(&a, &b, &outcome.x);
+    assert_rel(
+        "objective",
+        outcome.objective,
+        exact,
+        REPORTED_OBJECTIVE_RTOL,
+    );
+}
+
+#[cfg_attr(not(target_arch = "wasm32"), test)]
+#[cfg_attr(target_arch = "wasm32", wasm_bindgen_test::wasm_bindgen_test)]
+fn reports_at_start_every_k_and_at_the_end() {
+    let (a, b) = random_problem(&mut Rng(8), 12);
+    let problem = QadpProblem::new(&a, &b, 12).expect("valid problem");
+    let settings = QadpSettings {
+        iterations: 250,
+        report_every: 100,
+        threads: 0,
+    };
+    let (outcome, reports) = run_recorded((&a, &b), &problem, &[0.1; 12], &settings);
+    let iterations: Vec<usize> = reports.iter().map(|r| r.0).collect();
+    assert_eq!(iterations, vec![0, 100, 200, 250]);
+    assert_eq!(outcome.iterations, 250);
+    let none = QadpSettings {
+        iterations: 0,
+        ..settings
+    };
+    let (outcome, reports) = run_recorded((&a, &b), &problem, &[0.1; 12], &none);
+    assert_eq!((outcome.iterations, reports.len()), (0, 1));
+    assert_eq!(outcome.x, vec![0.1; 12]);
+}
+
+#[cfg_attr(not(target_arch = "wasm32"), test)]
+#[cfg_attr(target_arch = "wasm32", wasm_bindgen_test::wasm_bindgen_test)]
+fn zero_start_component_stays_zero() {
+    let n = 20;
+    let (a, b) = random_problem(&mut Rng(9), n);
+    let exact = nnqp_exact(&a, &b, n).expect("exact solver");
+    let k = exact
+        .iter()
+        .position(|&v| v > 0.1)
+        .expect("a clearly positive optimal component");
+    let mut x0 = vec![0.1; n];
+    x0[k] = 0.0;
+    let problem = QadpProblem::new(&a, &b, n).expect("valid problem");
+    let outcome = problem
+        .run(&x0, &QadpSettings::default(), &mut |p| {
+            assert_eq!(p.x[k], 0.0, "x_{k} at iteration {}", p.iteration);
+            Control::Continue
+        })
+        .expect("valid run");
+    assert_eq!(outcome.x[k], 0.0);
+}
+
+#[cfg_attr(not(target_arch = "wasm32"), test)]
+#[cfg_attr(target_arch = "wasm32", wasm_bindgen_test::wasm_bindgen_test)]
+fn zero_rows_go_to_zero_or_stay() {
+    // Unknown 1 has a zero row: b_1 > 0 sends it to 0; unknown 3 (zero row, b_3 = 0) keeps
+    // its start. The others solve the 2x2 problem of `two_by_two_with_active_bound`.
+    let n = 4;
+    let mut a = vec![0.0; n * n];
+    a[0] = 2.0;
+    a[2] = 1.0;
+    a[2 * n] = 1.0;
+    a[2 * n + 2] = 2.0;
+    let b = [-1.0, 3.0, 1.0, 0.0];
+    let problem = QadpProblem::new(&a, &b, n).expect("valid problem");
+    let outcome = problem
+        .run(&[1.0, 1.0, 1.0, 0.7], &QadpSettings::default(), &mut |_| {
+            Control::Continue
+        })
+        .expect("valid run");
+    common::assert_abs("x_0", outcome.x[0], 0.5, 1e-6);
+    assert_eq!(outcome.x[1], 0.0);
+    assert_eq!(outcome.x[3], 0.7);
+}
+
+#[cfg_attr(not(target_arch = "wasm32"), test)]
+#[cfg_attr(target_arch = "wasm32", wasm_bindgen_test::wasm_bindgen_test)]
+fn units_do_not_matter() {
+    // phi scaled by s: same minimiser. Extreme s checks that the f32 copy is rescaled.
+    let n = 15;
+    let (a, b) = random_problem(&mut Rng(10), n);
+    let settings = QadpSettings {
+        iterations: 500,
+        ..QadpSettings::default()
+    };
+    let base = QadpProblem::new(&a, &b, n)
+        .expect("valid problem")
+        .run(&[0.1; 15], &settings, &mut |_| Control::Continue)
+        .expect("valid run");
+    for s in [1e-30, 1e30] {
+        let a_s: Vec<f64> = a.iter().map(|v| v * s).collect();
+        let b_s: Vec<f64> = b.iter().map(|v| v * s).collect();
+        let scaled = QadpProblem::new(&a_s, &b_s, n)
+            .expect("valid problem")
+            .run(&[0.1; 15], &settings, &mut |_| Control::Continue)
+            .expect("valid run");
+        for (x, x_ref) in scaled.x.iter().zip(&base.x) {
+            common::assert_abs("x scaled problem", *x, *x_ref, 1e-12 * (1.0 + x_ref));
+        }
+        assert_rel("objective", scaled.objective, base.objective * s, 1e-12);
+    }
+}
+
+#[cfg_attr(not(target_arch = "wasm32"), test)]
+#[cfg_attr(target_arch = "wasm32", wasm_bindgen_test::wasm_bindgen_test)]
+fn threads_agree_to_rounding() {
+    // Odd: the last band ends with a lone row.
+    let n = 61;
+    let (a, b) = random_problem(&mut Rng(11), n);
+    let problem = QadpProblem::new(&a, &b, n).expect("valid problem");
+    let run = |threads| {
+        let settings = QadpSettings {
+            iterations: 700,
+            report_every: 100,
+            threads,
+        };
+        problem
+            .run(&[0.1; 61], &settings, &mut |_| Control::Continue)
+            .expect("valid run")
+    };
+    let serial = run(1);
+    let x_max = serial.x.iter().fold(0.0f64, |m, &v| m.max(v));
+    for threads in [2, 3] {
+        let parallel = run(threads);
+        for (x, x_ref) in parallel.x.iter().zip(&serial.x) {
+            common::assert_abs("x with threads", *x, *x_ref, THREADS_RTOL * x_max);
+        }
+        assert_rel(
+            "objective",
+            parallel.objective,
+            serial.objective,
+            THREADS_RTOL,
+        );
+    }
+}
+
+#[cfg_attr(not(target_arch = "wasm32"), test)]
+#[cfg_attr(target_arch = "wasm32", wasm_bindgen_test::wasm_bindgen_test)]
+fn normal_equations_match_naive_product() {
+    let mut rng = Rng(12);
+    // 37 unknowns: not a multiple of the tile sizes; 300: large enough to be threaded.
+    for (n, n_rows) in [(37, 300), (300, 40)] {
+        let g: Vec<f64> = (0..n_rows * n).map(|_| rng.normal()).collect();
+        let w: Vec<f64> = (0..n_rows).map(|_| rng.uniform() * 2.0).collect();
+        let theta: Vec<f64> = (0..n_rows).map(|_| rng.normal() * 50.0).collect();
+        let mut normal = NormalEquations::new(n).expect("n > 0");
+        // Uneven blocks, one longer than the internal block of rows.
+        let cuts = [0, n_rows / 3, n_rows / 3 + 1, n_rows];
+        for pair in cuts.windows(2) {
+            let (r0, r1) = (pair[0], pair[1]);
+            normal
+                .add_rows(&g[r0 * n..r1 * n], &w[r0..r1], &theta[r0..r1])
+                .expect("valid rows");
+        }
+        assert_eq!(normal.rows_added(), n_rows);
+        let (a, b) = normal.finish();
+        for i in 0..n {
+            let b_ref: f64 = (0..n_rows).map(|r| -w[r] * theta[r] * g[r * n + i]).sum();
+            let scale_b: f64 = (0..n_rows)
+                .map(|r| (w[r] * theta[r] * g[r * n + i]).abs())
+                .sum();
+            common::assert_abs("b_i", b[i], b_ref, GRAM_RTOL * scale_b);
+            for j in 0..n {
+                let terms = (0..n_rows).map(|r| w[r] * g[r * n + i] * g[r * n + j]);
+                let a_ref: f64 = terms.clone().sum();
+                let scale: f64 = terms.map(f64::abs).sum();
+                common::assert_abs("A_ij", a[i * n + j], a_ref, GRAM_RTOL * scale);
+            }
+        }
+    }
+}
+
+#[cfg_attr(not(target_arch = "wasm32"), test)]
+#[cfg_attr(target_arch = "wasm32", wasm_bindgen_test::wasm_bindgen_test)]
+fn bad_inputs_are_named() {
+    let a = [2.0, 1.0, 1.0, 2.0];
+    let b = [-1.0, 1.0];
+    let new = |a: &[f64], b: &[f64], n| QadpProblem::new(a, b, n).map(|_| ());
+    assert_eq!(new(&[], &[], 0), Err(SolverError::Empty));
+    assert!(matches!(
+        new(&a[..3], &b, 2),
+        Err(SolverError::DimensionMismatch {
+            what: "A",
+            expected: 4,
+            got: 3
+        })
+    ));
+    assert!(matches!(
+        new(&a, &[1.0], 2),
+        Err(SolverError::DimensionMismatch { what: "b", .. })
+    ));
+    assert!(matches!(
+        new(&[2.0, f64::NAN, 1.0, 2.0], &b, 2),
+        Err(SolverError::NonFinite {
+            what: "A",
+            index: 1,
+            ..
+        })
+    ));
+    assert!(matches!(
+        new(&a, &[f64::INFINITY, 0.0], 2),
+        Err(SolverError::NonFinite {
+            what: "b",
+            index: 0,
+            ..
+        })
+    ));
+    assert!(matches!(
+        new(&[2.0, 1.0, 0.5, 2.0], &b, 2),
+        Err(SolverError::NotSymmetric { row: 0, col: 1, .. })
+    ));
+    assert!(matches!(
+        new(&[-1.0, 0.0, 0.0, 2.0], &b, 2),
+        Err(SolverError::NotPositiveSemidefinite { row: 0, col: 0, .. })
+    ));
+    assert!(matches!(
+        new(&[1.0, 3.0, 3.0, 1.0], &b, 2),
+        Err(SolverError::NotPositiveSemidefinite { row: 0, col: 1, .. })
+    ));
+    assert_eq!(
+        new(&[2.0, 0.0, 0.0, 0.0], &[1.0, -2.0], 2),
+        Err(SolverError::Unbounded { index: 1, b: -2.0 })
+    );
+
+    let problem = QadpProblem::new(&a, &b, 2).expect("valid problem");
+    let settings = QadpSettings::default();
+    let mut go = |_: &Progress| Control::Continue;
+    assert!(matches!(
+        problem.run(&[1.0], &settings, &mut go),
+        Err(SolverError::DimensionMismatch { what: "x0", .. })
+    ));
+    assert!(matches!(
+        problem.run(&[1.0, f64::NAN], &settings, &mut go),
+        Err(SolverError::NonFinite {
+            what: "x0",
+            index: 1,
+            ..
+        })
+    ));
+    assert_eq!(
+        problem.run(&[1.0, -0.5], &settings, &mut go),
+        Err(SolverError::NegativeStart {
+            index: 1,
+            value: -0.5
+        })
+    );
+    let no_reports = QadpSettings {
+        report_every: 0,
+        ..settings
+    };
+    assert!(matches!(
+        problem.run(&[1.0, 1.0], &no_reports, &mut go),
+        Err(SolverError::BadSetting {
+            name: "report_every",
+            ..
+        })
+    ));
+
+    let big = NNQP_EXACT_MAX_UNKNOWNS + 1;
+    let mut identity = vec![0.0; big * big];
+    for i in 0..big {
+        identity[i * big + i] = 1.0;
+    }
+    assert!(matches!(
+        nnqp_exact(&identity, &vec![-1.0; big], big),
+        Err(SolverError::TooLarge { .. })
+    ));
+
+    let mut normal = NormalEquations::new(2).expect("n > 0");
+    assert_eq!(NormalEquations::new(0).err(), Some(SolverError::Empty));
+    assert!(matches!(
+        normal.add_rows(&[1.0, 2.0, 3.0], &[1.0], &[0.0]),
+        Err(SolverError::DimensionMismatch { what: "rows", .. })
+    ));
+    assert!(matches!(
+        normal.add_rows(&[1.0, 2.0], &[-1.0], &[0.0]),
+        Err(SolverError::NegativeWeight { index: 0, .. })
+    ));
+    assert!(matches!(
+        normal.add_rows(&[1.0, 2.0], &[1.0], &[f64::NAN]),
+        Err(SolverError::NonFinite { what: "theta", .. })
+    ));
+    assert!(matches!(
+        gram_weighted(&[1.0, 2.0], 1, 2, &[], &[0.0]),
+        Err(SolverError::DimensionMismatch { what: "w", .. })
+    ));
+    assert_eq!(normal.rows_added(), 0, "failed calls add nothing");
+}
