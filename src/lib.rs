@@ -5,19 +5,25 @@
 //! (+x West, +y North); every stored deflection, convergence and shear is for `D_ls/D_s = 1`.
 //! The wasm boundary (`wasm.rs`) and the CLI (`main.rs`) are thin shells around this library.
 
+pub mod catalog;
 pub mod cosmology;
 pub mod curves;
 pub mod demo;
 pub mod ds9;
 pub mod fits;
 pub mod grid;
+pub mod images;
+pub mod inversion;
+pub mod lenstool_par;
 pub mod maps;
 pub mod model;
 pub mod products;
 pub mod profiles;
 pub mod radial;
+pub mod reconstruct;
 pub mod render;
 pub mod sky;
+pub mod solver;
 pub mod units;
 
 #[cfg(target_arch = "wasm32")]

@@ -344,13 +344,13 @@ impl Products {
 }
 
 /// Wall-clock timer that also works in a browser worker (where `std::time::Instant` panics).
-struct Clock(f64);
+pub(crate) struct Clock(f64);
 
 impl Clock {
-    fn start() -> Self {
+    pub(crate) fn start() -> Self {
         Self(now_ms())
     }
-    fn ms(&self) -> f64 {
+    pub(crate) fn ms(&self) -> f64 {
         now_ms() - self.0
     }
 }

@@ -1,6 +1,7 @@
 //! Command-line parsing and the subcommands (native only).
 
 mod maps;
+mod reconstruct;
 
 use std::process::ExitCode;
 
@@ -20,6 +21,7 @@ struct Cli {
 #[derive(Debug, Subcommand)]
 enum Command {
     Maps(maps::MapsArgs),
+    Reconstruct(reconstruct::ReconstructArgs),
 }
 
 /// Parses the arguments, runs the subcommand, prints any error with its context.
@@ -27,6 +29,7 @@ pub fn run() -> ExitCode {
     let cli = Cli::parse();
     let result = match cli.command {
         Command::Maps(args) => maps::run(&args),
+        Command::Reconstruct(args) => reconstruct::run(&args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

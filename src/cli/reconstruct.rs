@@ -1,0 +1,229 @@
+//! `wslap reconstruct`: the WSLAP+ inversion of a Lenstool image catalogue.
+
+use std::fs;
+use std::path::{Path, PathBuf};
+
+use clap::Args;
+use serde::Serialize;
+use wslap::catalog::{parse_image_catalog, parse_member_catalog};
+use wslap::inversion::{export_system, ConstraintSource, LinearSystem};
+use wslap::reconstruct::{
+    reconstruct, ConvergenceRecord, Inputs, LayerSource, ReconstructConfig, Reconstruction,
+};
+use wslap::render::ColorScale;
+use wslap::solver::Control;
+use wslap::{Cosmology, LensPlane};
+
+use super::maps::write_products;
+
+/// Free-form mass reconstruction (WSLAP+) from multiple images and member galaxies.
+///
+/// Writes into DIR the map files of `wslap maps` (kappa.fits, ..., kappa.png) for the
+/// reconstructed lens, plus sources.json (per system: z, beta, scatter, observed and predicted
+/// images, offsets; held-out systems marked), convergence.json (objective, grid mass and C per
+/// report) and summary.json (settings, C per layer, grid mass, enclosed masses, Einstein
+/// radius, image-plane rms, timings).
+#[derive(Debug, Args)]
+pub struct ReconstructArgs {
+    /// Lenstool multiple-image catalogue (id x y a b theta z mag).
+    #[arg(long, value_name = "IMAGES.cat")]
+    images: PathBuf,
+    /// Lenstool member catalogue (potfile: id x y a b theta mag lum).
+    #[arg(long, value_name = "MEMBERS.cat")]
+    members: Option<PathBuf>,
+    /// Lens redshift.
+    #[arg(long)]
+    z_lens: f64,
+    /// Settings (JSON); every field is optional, see README.md.
+    #[arg(long, value_name = "CONFIG.json")]
+    config: Option<PathBuf>,
+    /// Systems to leave out of the fit and predict, e.g. 3,7.
+    #[arg(long, value_delimiter = ',', value_name = "IDS")]
+    holdout: Vec<String>,
+    /// Redshift for systems whose catalogue redshift is 0 (unknown); without it they are left out.
+    #[arg(long)]
+    default_z: Option<f64>,
+    /// QADP iterations (overrides the configuration).
+    #[arg(long)]
+    iterations: Option<usize>,
+    /// H0 in km/s/Mpc.
+    #[arg(long, default_value_t = 70.0)]
+    h0: f64,
+    /// Omega_m of flat LCDM.
+    #[arg(long, default_value_t = 0.3)]
+    omega_m: f64,
+    /// Also write the linear system (gamma.npy, theta.npy, weights.npy, columns.json) here.
+    #[arg(long, value_name = "DIR")]
+    export_system: Option<PathBuf>,
+    /// Output folder (created if missing).
+    #[arg(long, value_name = "DIR")]
+    out: PathBuf,
+}
+
+pub fn run(args: &ReconstructArgs) -> Result<(), String> {
+    let mut config = match &args.config {
+        Some(path) => {
+            ReconstructConfig::from_json_str(&read_text(path)?, &path.display().to_string())
+                .map_err(|e| e.to_string())?
+        }
+        None => ReconstructConfig::default(),
+    };
+    if let Some(n) = args.iterations {
+        config.solver.iterations = n;
+    }
+    if args.default_z.is_some() {
+        config.constraints.default_z = args.default_z;
+    }
+    let cosmology = Cosmology::new(args.h0, args.omega_m).map_err(|e| e.to_string())?;
+    let plane = LensPlane::new(cosmology, args.z_lens).map_err(|e| e.to_string())?;
+    let (catalog, mut warnings) =
+        parse_image_catalog(&read_text(&args.images)?, &name(&args.images), None)
+            .map_err(|e| e.to_string())?;
+    let members = match &args.members {
+        Some(path) => {
+            let (m, w) = parse_member_catalog(&read_text(path)?, &name(path), catalog.reference)
+                .map_err(|e| e.to_string())?;
+            warnings.extend(w);
+            Some(m)
+        }
+        None => None,
+    };
+    for w in &warnings {
+        eprintln!("warning: {w}");
+    }
+    let inputs = Inputs {
+        images: ConstraintSource::Catalog(&catalog),
+        layers: members
+            .as_ref()
+            .map_or(LayerSource::None, LayerSource::Members),
+        plane,
+        reference: catalog.reference,
+        holdout: &args.holdout,
+        catalog: Some(&catalog),
+    };
+    let total = config.solver.iterations;
+    let mut progress = |r: &ConvergenceRecord| {
+        if r.iteration % 1000 == 0 || r.iteration == total {
+            eprintln!(
+                "level {} iteration {:>6}/{total}: objective {:.6e}, grid mass {:.4e} Msun, C = {:?}",
+                r.level, r.iteration, r.objective, r.grid_mass_msun, r.c
+            );
+        }
+        Control::Continue
+    };
+    let result = reconstruct(&inputs, &config, &mut progress).map_err(|e| e.to_string())?;
+    for w in &result.warnings {
+        eprintln!("warning: {w}");
+    }
+    if let Some(dir) = &args.export_system {
+        export_system(&result.system, dir).map_err(|e| e.to_string())?;
+    }
+    write_reconstruction(&result, &args.out)?;
+    println!("{}", one_line(&result, &args.out));
+    Ok(())
+}
+
+fn read_text(path: &Path) -> Result<String, String> {
+    fs::read_to_string(path).map_err(|e| format!("{}: {e}", path.display()))
+}
+
+fn name(path: &Path) -> String {
+    path.display().to_string()
+}
+
+/// `summary.json` of a reconstruction.
+#[derive(Debug, Serialize)]
+struct ReconstructSummary<'a> {
+    settings: &'a ReconstructConfig,
+    status: String,
+    iterations: usize,
+    constraint_pixels: usize,
+    systems_fitted: Vec<&'a str>,
+    systems_excluded: Vec<String>,
+    layers: Vec<&'a str>,
+    c_per_layer: Vec<f64>,
+    grid_mass_msun: f64,
+    grid_cells: usize,
+    field_center_arcsec: [f64; 2],
+    field_width_arcsec: f64,
+    theta_shift_arcsec: f64,
+    einstein_radius_arcsec: f64,
+    einstein_radius_z_source: f64,
+    mass_within_arcsec: Vec<(f64, Option<f64>)>,
+    image_plane_rms_arcsec: Option<f64>,
+    holdout_image_plane_rms_arcsec: Option<f64>,
+    warnings: &'a [String],
+    maps: wslap::products::Summary,
+    timings_ms: wslap::reconstruct::StageTimings,
+}
+
+fn summary(r: &Reconstruction) -> ReconstructSummary<'_> {
+    let s: &LinearSystem = &r.system;
+    let maps = r.products.summary();
+    ReconstructSummary {
+        settings: &r.config,
+        status: format!("{:?}", r.status),
+        iterations: r.iterations,
+        constraint_pixels: s.constraints.pixels.len(),
+        systems_fitted: s
+            .constraints
+            .systems
+            .iter()
+            .map(|x| x.id.as_str())
+            .collect(),
+        systems_excluded: s
+            .constraints
+            .excluded
+            .iter()
+            .map(|e| format!("{} ({:?})", e.id, e.reason))
+            .collect(),
+        layers: s.layers.iter().map(|l| l.name.as_str()).collect(),
+        c_per_layer: r.layer_factors(),
+        grid_mass_msun: r.grid_mass_msun(),
+        grid_cells: s.grid.cells.len(),
+        field_center_arcsec: s.grid.center.to_array(),
+        field_width_arcsec: s.grid.width_arcsec,
+        theta_shift_arcsec: s.theta_shift_arcsec,
+        einstein_radius_arcsec: maps.einstein_radius_arcsec,
+        einstein_radius_z_source: maps.z_source,
+        mass_within_arcsec: maps.mass_within_arcsec.clone(),
+        image_plane_rms_arcsec: r.image_plane_rms_arcsec(false),
+        holdout_image_plane_rms_arcsec: r.image_plane_rms_arcsec(true),
+        warnings: &r.warnings,
+        maps,
+        timings_ms: r.timings,
+    }
+}
+
+/// Writes the map files, sources.json, convergence.json and summary.json into `dir`.
+fn write_reconstruction(r: &Reconstruction, dir: &Path) -> Result<(), String> {
+    write_products(&r.products, ColorScale::Log, dir)?;
+    let write = |file: &str, text: String| -> Result<(), String> {
+        let path = dir.join(file);
+        fs::write(&path, text).map_err(|e| format!("{}: {e}", path.display()))
+    };
+    write("sources.json", json(&r.sources)?)?;
+    write("convergence.json", json(&r.convergence)?)?;
+    write("summary.json", json(&summary(r))?)?;
+    Ok(())
+}
+
+fn one_line(r: &Reconstruction, out: &Path) -> String {
+    format!(
+        "wrote {} ({} systems, {} constraint pixels, {} iterations; C = {:?}; grid mass {:.3e} Msun; Einstein radius at z_s = {}: {:.2} arcsec; image-plane rms {})",
+        out.display(),
+        r.system.constraints.systems.len(),
+        r.system.constraints.pixels.len(),
+        r.iterations,
+        r.layer_factors(),
+        r.grid_mass_msun(),
+        r.config.products.z_source,
+        r.products.curves.einstein_radius_arcsec,
+        r.image_plane_rms_arcsec(false).map_or("n/a".to_string(), |v| format!("{v:.2} arcsec")),
+    )
+}
+
+/// Pretty JSON of a result file.
+fn json<T: Serialize>(value: &T) -> Result<String, String> {
+    serde_json::to_string_pretty(value).map_err(|e| e.to_string())
+}

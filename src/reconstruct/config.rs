@@ -1,0 +1,140 @@
+//! The settings of a reconstruction (`CONFIG.json` of `wslap reconstruct`): one struct per
+//! stage, every field with a documented default.
+
+use serde::{Deserialize, Serialize};
+
+use crate::inversion::{ConstraintConfig, GridConfig, MemberConfig, SystemConfig};
+use crate::solver::QadpSettings;
+
+use super::ReconstructError;
+
+/// Every setting of a reconstruction. Missing blocks and fields take their defaults; unknown
+/// fields are errors.
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct ReconstructConfig {
+    /// The cell grid (default 32 x 32 over the images' extent with a margin).
+    pub grid: GridConfig,
+    /// Member galaxies: masses from magnitudes and the layers (default one layer, the paper).
+    pub members: MemberConfig,
+    /// Constraints from the images (default: the pixels inside each catalogue ellipse).
+    pub constraints: ConstraintConfig,
+    /// The linear system (mass unit, frame shift, block size).
+    pub system: SystemConfig,
+    /// The QADP iteration.
+    pub solver: SolverConfig,
+    /// The maps and curves of the result.
+    pub products: ProductConfig,
+}
+
+/// The QADP settings and its start (the paper's "reasonable" start: small masses and small C).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct SolverConfig {
+    /// QADP iterations: the regulariser (default 8000, the paper's best; 50000 over-fits).
+    pub iterations: usize,
+    /// Report objective, grid mass and C every this many iterations (default 100).
+    pub report_every: usize,
+    /// Start mass of every cell in Msun (default 1e10: small against a cluster's ~1e12 per
+    /// cell, as the paper's "reasonable" start).
+    pub start_cell_mass_msun: f64,
+    /// Start value of every layer factor C_l (default 0.1).
+    pub start_c: f64,
+}
+
+impl Default for SolverConfig {
+    fn default() -> Self {
+        Self {
+            iterations: 8000,
+            report_every: 100,
+            start_cell_mass_msun: 1e10,
+            start_c: 0.1,
+        }
+    }
+}
+
+/// Which maps and curves are made of the result.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct ProductConfig {
+    /// Source redshift of the magnification map and critical curves (default 2).
+    pub z_source: f64,
+    /// Map side in pixels (default 512).
+    pub pixels: usize,
+    /// Map width in arcsec (default: the grid's field).
+    pub size_arcsec: Option<f64>,
+}
+
+impl Default for ProductConfig {
+    fn default() -> Self {
+        Self {
+            z_source: 2.0,
+            pixels: 512,
+            size_arcsec: None,
+        }
+    }
+}
+
+impl ReconstructConfig {
+    /// Parses a configuration file; errors name the file, line and column.
+    pub fn from_json_str(text: &str, source_name: &str) -> Result<Self, ReconstructError> {
+        let config: Self = serde_json::from_str(text).map_err(|e| ReconstructError::Config {
+            source_name: source_name.to_string(),
+            message: format!("line {}, column {}: {e}", e.line(), e.column()),
+        })?;
+        config.validate().map_err(|e| ReconstructError::Config {
+            source_name: source_name.to_string(),
+            message: e.to_string(),
+        })?;
+        Ok(config)
+    }
+
+    /// Checks every block.
+    pub fn validate(&self) -> Result<(), ReconstructError> {
+        self.grid.validate()?;
+        self.members.validate()?;
+        self.constraints.validate()?;
+        self.system.validate()?;
+        self.solver_settings().validate()?;
+        let s = &self.solver;
+        if !(s.start_cell_mass_msun.is_finite() && s.start_cell_mass_msun > 0.0) {
+            return Err(ReconstructError::BadSetting {
+                field: "solver.start_cell_mass_msun",
+                value: s.start_cell_mass_msun,
+                reason: "the start mass must be positive: a cell that starts at 0 stays at 0",
+            });
+        }
+        if !(s.start_c.is_finite() && s.start_c > 0.0) {
+            return Err(ReconstructError::BadSetting {
+                field: "solver.start_c",
+                value: s.start_c,
+                reason: "the start C must be positive: a factor that starts at 0 stays at 0",
+            });
+        }
+        let p = &self.products;
+        if !(p.z_source.is_finite() && p.z_source > 0.0) {
+            return Err(ReconstructError::BadSetting {
+                field: "products.z_source",
+                value: p.z_source,
+                reason: "must be a positive redshift",
+            });
+        }
+        if !(16..=crate::products::MAX_PIXELS).contains(&p.pixels) {
+            return Err(ReconstructError::BadSetting {
+                field: "products.pixels",
+                value: p.pixels as f64,
+                reason: "the map side must be 16 to 8192 pixels",
+            });
+        }
+        Ok(())
+    }
+
+    /// The QADP settings of this configuration.
+    pub fn solver_settings(&self) -> QadpSettings {
+        QadpSettings {
+            iterations: self.solver.iterations,
+            report_every: self.solver.report_every,
+            ..QadpSettings::default()
+        }
+    }
+}

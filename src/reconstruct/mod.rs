@@ -1,0 +1,285 @@
+//! The WSLAP+ reconstruction, end to end: constraints from the images, the cell grid and the
+//! member-galaxy layers, the linear system, QADP, and the products of the solution (maps,
+//! curves, per-system source positions, predicted images and their offsets, hold-out tests).
+//!
+//! The pipeline of the paper (Sendra et al., section 2) and METHOD.md sections 3 to 6.
+
+mod config;
+mod sources;
+
+use glam::DVec2;
+use serde::{Deserialize, Serialize};
+use thiserror::Error;
+
+pub use config::{ProductConfig, ReconstructConfig, SolverConfig};
+pub use sources::{ImageReport, SourceReport};
+
+use crate::catalog::{ImageCatalog, MemberCatalog};
+use crate::cosmology::LensPlane;
+use crate::images::ImageError;
+use crate::inversion::{
+    build_constraints, build_member_layers, CellGrid, ConstraintError, ConstraintSet,
+    ConstraintSource, GridError, Layer, LinearSystem, MembersError, SystemError,
+};
+use crate::products::{ProductOptions, Products, ProductsError};
+use crate::profiles::Lens;
+use crate::sky::SkyReference;
+use crate::solver::{Control, QadpProblem, SolveStatus, SolverError};
+
+/// What can stop a reconstruction.
+#[derive(Debug, Error)]
+pub enum ReconstructError {
+    #[error("{source_name}: {message}")]
+    Config {
+        source_name: String,
+        message: String,
+    },
+    #[error("{field} = {value} is not allowed ({reason})")]
+    BadSetting {
+        field: &'static str,
+        value: f64,
+        reason: &'static str,
+    },
+    #[error(transparent)]
+    Constraints(#[from] ConstraintError),
+    #[error(transparent)]
+    Grid(#[from] GridError),
+    #[error(transparent)]
+    Members(#[from] MembersError),
+    #[error(transparent)]
+    System(#[from] SystemError),
+    #[error(transparent)]
+    Solver(#[from] SolverError),
+    #[error(transparent)]
+    Images(#[from] ImageError),
+    #[error(transparent)]
+    Products(#[from] ProductsError),
+    #[error("no system is left to constrain the lens ({0})")]
+    NoConstraints(String),
+}
+
+/// Where the member-galaxy layers come from.
+#[derive(Debug, Clone, Copy)]
+pub enum LayerSource<'a> {
+    /// No galaxies: the grid alone (the paper's case (i)).
+    None,
+    /// Layers built from a member catalogue with the `members` settings.
+    Members(&'a MemberCatalog),
+    /// Layers given directly (e.g. the true galaxies of a simulation).
+    Given(&'a [Layer]),
+}
+
+/// The data of one reconstruction.
+#[derive(Debug, Clone, Copy)]
+pub struct Inputs<'a> {
+    pub images: ConstraintSource<'a>,
+    pub layers: LayerSource<'a>,
+    pub plane: LensPlane,
+    pub reference: Option<SkyReference>,
+    /// Ids of systems left out of the fit and predicted afterwards.
+    pub holdout: &'a [String],
+    /// The image catalogue, for per-image offsets and hold-out predictions (`None` for arcs).
+    pub catalog: Option<&'a ImageCatalog>,
+}
+
+/// One report of the QADP iteration (`convergence.json`).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct ConvergenceRecord {
+    /// Refinement level (0 = the regular grid).
+    pub level: usize,
+    pub iteration: usize,
+    pub objective: f64,
+    pub grid_mass_msun: f64,
+    /// `C_l` per layer.
+    pub c: Vec<f64>,
+}
+
+/// Wall-clock time of each stage in milliseconds.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Serialize, Deserialize)]
+pub struct StageTimings {
+    pub system_ms: f64,
+    pub solve_ms: f64,
+    pub products_ms: f64,
+    pub sources_ms: f64,
+}
+
+/// The result of a reconstruction.
+#[derive(Debug)]
+pub struct Reconstruction {
+    pub config: ReconstructConfig,
+    pub system: LinearSystem,
+    /// The solution `X` (cell masses in `system.mass_unit_msun`, C per layer, shifted betas).
+    pub x: Vec<f64>,
+    pub status: SolveStatus,
+    pub iterations: usize,
+    pub convergence: Vec<ConvergenceRecord>,
+    pub lens: Lens,
+    pub products: Products,
+    pub sources: Vec<SourceReport>,
+    pub warnings: Vec<String>,
+    pub timings: StageTimings,
+}
+
+impl Reconstruction {
+    /// `C_l` per layer.
+    pub fn layer_factors(&self) -> Vec<f64> {
+        self.x[self.system.layer_columns()].to_vec()
+    }
+
+    /// Total mass of the grid cells in Msun.
+    pub fn grid_mass_msun(&self) -> f64 {
+        self.x[self.system.cell_columns()].iter().sum::<f64>() * self.system.mass_unit_msun
+    }
+
+    /// Root mean square of the offsets between observed and predicted images, arcsec, over the
+    /// fitted (not held-out) systems; `None` when no image was matched.
+    pub fn image_plane_rms_arcsec(&self, held_out: bool) -> Option<f64> {
+        let offsets: Vec<f64> = self
+            .sources
+            .iter()
+            .filter(|s| s.held_out == held_out)
+            .flat_map(|s| s.observed.iter().filter_map(|i| i.offset_arcsec))
+            .collect();
+        (!offsets.is_empty())
+            .then(|| (offsets.iter().map(|o| o * o).sum::<f64>() / offsets.len() as f64).sqrt())
+    }
+}
+
+/// Runs the reconstruction. `progress` sees every QADP report and may cancel; a cancelled run
+/// still returns the products of the last iterate (its status says `Cancelled`).
+pub fn reconstruct(
+    inputs: &Inputs<'_>,
+    config: &ReconstructConfig,
+    progress: &mut dyn FnMut(&ConvergenceRecord) -> Control,
+) -> Result<Reconstruction, ReconstructError> {
+    config.validate()?;
+    let constraints = build_constraints(inputs.images, &config.constraints, inputs.holdout)?;
+    if constraints.systems.is_empty() {
+        return Err(ReconstructError::NoConstraints(describe_excluded(
+            &constraints,
+        )));
+    }
+    let mut warnings = constraints.warnings.clone();
+    let positions: Vec<DVec2> = constraints.pixels.iter().map(|p| p.position).collect();
+    let mut grid = CellGrid::from_config(&config.grid, &positions)?;
+    let layers: Vec<Layer> = match inputs.layers {
+        LayerSource::None => Vec::new(),
+        LayerSource::Given(layers) => layers.to_vec(),
+        LayerSource::Members(catalog) => {
+            let model = build_member_layers(catalog, &config.members, &inputs.plane, &grid)?;
+            warnings.extend(model.warnings);
+            model.layers
+        }
+    };
+    let settings = config.solver_settings();
+    let mut convergence = Vec::new();
+    let mut timings = StageTimings::default();
+    let mut level = 0;
+    let (system, x, status, iterations) = loop {
+        let t = crate::products::Clock::start();
+        let system =
+            LinearSystem::build(&grid, &layers, &constraints, &inputs.plane, &config.system)?;
+        timings.system_ms += t.ms();
+        let t = crate::products::Clock::start();
+        let x0 = start_values(&system, &config.solver);
+        let problem = QadpProblem::new(&system.a, &system.b, system.n_columns())?;
+        let cells = system.cell_columns();
+        let layer_cols = system.layer_columns();
+        let unit = system.mass_unit_msun;
+        let mut callback = |p: &crate::solver::Progress| {
+            let record = ConvergenceRecord {
+                level,
+                iteration: p.iteration,
+                objective: p.objective,
+                grid_mass_msun: p.x[cells.clone()].iter().sum::<f64>() * unit,
+                c: p.x[layer_cols.clone()].to_vec(),
+            };
+            let control = progress(&record);
+            convergence.push(record);
+            control
+        };
+        let outcome = problem.run(&x0, &settings, &mut callback)?;
+        timings.solve_ms += t.ms();
+        if level < config.grid.refinements && outcome.status == SolveStatus::Completed {
+            let masses = system.cell_masses_msun(&outcome.x)?;
+            grid = grid.refine(&masses, config.grid.refine_fraction)?;
+            level += 1;
+            continue;
+        }
+        break (system, outcome.x, outcome.status, outcome.iterations);
+    };
+    let lens = system.reconstructed_lens(&x)?;
+    let t = crate::products::Clock::start();
+    let opts = ProductOptions {
+        z_source: config.products.z_source,
+        size_arcsec: config
+            .products
+            .size_arcsec
+            .unwrap_or(system.grid.width_arcsec),
+        pixels: config.products.pixels,
+        ..ProductOptions::default()
+    };
+    let products = Products::from_lens(&lens, inputs.plane, inputs.reference, &opts)?;
+    timings.products_ms = t.ms();
+    let t = crate::products::Clock::start();
+    let sources = sources::report(
+        &system,
+        &x,
+        &lens,
+        &products,
+        inputs,
+        config.constraints.default_z,
+    )?;
+    timings.sources_ms = t.ms();
+    Ok(Reconstruction {
+        config: config.clone(),
+        system,
+        x,
+        status,
+        iterations,
+        convergence,
+        lens,
+        products,
+        sources,
+        warnings,
+        timings,
+    })
+}
+
+/// The paper's "reasonable" start: small cell masses, small C, and each beta at the mean
+/// position of its system's constraint pixels (shifted into the positive frame).
+fn start_values(system: &LinearSystem, solver: &SolverConfig) -> Vec<f64> {
+    let mut x = vec![0.0; system.n_columns()];
+    let cell = solver.start_cell_mass_msun / system.mass_unit_msun;
+    x[system.cell_columns()].iter_mut().for_each(|v| *v = cell);
+    x[system.layer_columns()]
+        .iter_mut()
+        .for_each(|v| *v = solver.start_c);
+    let ns = system.constraints.systems.len();
+    let mut sum = vec![DVec2::ZERO; ns];
+    let mut count = vec![0usize; ns];
+    for p in &system.constraints.pixels {
+        sum[p.system] += p.position;
+        count[p.system] += 1;
+    }
+    let shift = system.theta_shift_arcsec;
+    let (bx, by) = (system.beta_x_columns(), system.beta_y_columns());
+    for s in 0..ns {
+        let mean = sum[s] / count[s].max(1) as f64;
+        x[bx.start + s] = (mean.x + shift).max(1e-3);
+        x[by.start + s] = (mean.y + shift).max(1e-3);
+    }
+    x
+}
+
+fn describe_excluded(constraints: &ConstraintSet) -> String {
+    if constraints.excluded.is_empty() {
+        return "the catalogue holds no system".to_string();
+    }
+    let list: Vec<String> = constraints
+        .excluded
+        .iter()
+        .map(|e| format!("{}: {:?}", e.id, e.reason))
+        .collect();
+    format!("left out: {}", list.join(", "))
+}
