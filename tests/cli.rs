@@ -243,3 +243,144 @@ fn bad_inputs_give_clear_errors() {
         "nothing is written when the input is bad"
     );
 }
+
+fn shared(path: &str) -> String {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../shared/data")
+        .join(path)
+        .display()
+        .to_string()
+}
+
+#[test]
+fn reconstruct_writes_every_product_and_marks_held_out_systems() {
+    let dir = temp_dir("reconstruct");
+    let config = dir.join("config.json");
+    fs::write(
+        &config,
+        r#"{"grid": {"cells": 12}, "products": {"pixels": 64}}"#,
+    )
+    .unwrap();
+    let out_dir = dir.join("out");
+    let system_dir = dir.join("system");
+    let out = wslap(&[
+        "reconstruct",
+        "--images",
+        &shared("AS1063/lenstool_cats/cats_gold_mul_gold.cat"),
+        "--members",
+        &shared("AS1063/lenstool_cats/cats_gold_ref_potential_w_clumpNE.cat"),
+        "--z-lens",
+        "0.348",
+        "--config",
+        config.to_str().unwrap(),
+        "--iterations",
+        "300",
+        "--holdout",
+        "2,7",
+        "--export-system",
+        system_dir.to_str().unwrap(),
+        "--out",
+        out_dir.to_str().unwrap(),
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    for name in PRODUCT_FILES
+        .iter()
+        .chain(&["sources.json", "convergence.json"])
+    {
+        assert!(out_dir.join(name).exists(), "{name} missing");
+    }
+    for name in ["gamma.npy", "theta.npy", "weights.npy", "columns.json"] {
+        assert!(system_dir.join(name).exists(), "{name} missing");
+    }
+    let sources: serde_json::Value =
+        serde_json::from_str(&fs::read_to_string(out_dir.join("sources.json")).unwrap()).unwrap();
+    let held: Vec<&str> = sources
+        .as_array()
+        .unwrap()
+        .iter()
+        .filter(|s| s["held_out"] == true)
+        .map(|s| s["id"].as_str().unwrap())
+        .collect();
+    assert_eq!(held, ["2", "7"]);
+    let s = summary(&out_dir);
+    assert_eq!(s["systems_fitted"].as_array().unwrap().len(), 17);
+    assert_eq!(s["c_per_layer"].as_array().unwrap().len(), 1);
+    let convergence: serde_json::Value =
+        serde_json::from_str(&fs::read_to_string(out_dir.join("convergence.json")).unwrap())
+            .unwrap();
+    assert_eq!(
+        convergence.as_array().unwrap().last().unwrap()["iteration"],
+        300
+    );
+}
+
+#[test]
+fn reconstruct_bad_inputs_name_the_problem() {
+    let dir = temp_dir("reconstruct-bad");
+    let images = shared("AS1063/lenstool_cats/cats_gold_mul_gold.cat");
+    // A lens behind the sources.
+    let out = wslap(&[
+        "reconstruct",
+        "--images",
+        &images,
+        "--z-lens",
+        "1.5",
+        "--out",
+        dir.join("a").to_str().unwrap(),
+    ]);
+    assert!(!out.status.success());
+    assert!(String::from_utf8_lossy(&out.stderr).contains("z_l = 1.5"));
+    // A malformed catalogue row.
+    let bad = dir.join("bad.cat");
+    fs::write(
+        &bad,
+        "1.1 342.19 -44.52 0.1 0.1 0 1.2 0\n1.2 342.19 nan 0.1 0.1 0 1.2 0\n",
+    )
+    .unwrap();
+    let out = wslap(&[
+        "reconstruct",
+        "--images",
+        bad.to_str().unwrap(),
+        "--z-lens",
+        "0.3",
+        "--out",
+        dir.join("b").to_str().unwrap(),
+    ]);
+    assert!(!out.status.success());
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(err.contains("bad.cat") && err.contains("line 2"), "{err}");
+    // A bad setting in the configuration.
+    let config = dir.join("config.json");
+    fs::write(&config, r#"{"solver": {"start_c": 0}}"#).unwrap();
+    let out = wslap(&[
+        "reconstruct",
+        "--images",
+        &images,
+        "--z-lens",
+        "0.348",
+        "--config",
+        config.to_str().unwrap(),
+        "--out",
+        dir.join("c").to_str().unwrap(),
+    ]);
+    assert!(!out.status.success());
+    assert!(String::from_utf8_lossy(&out.stderr).contains("start_c"));
+    // An unknown hold-out id.
+    let out = wslap(&[
+        "reconstruct",
+        "--images",
+        &images,
+        "--z-lens",
+        "0.348",
+        "--holdout",
+        "999",
+        "--out",
+        dir.join("d").to_str().unwrap(),
+    ]);
+    assert!(!out.status.success());
+    assert!(String::from_utf8_lossy(&out.stderr).contains("999"));
+}
