@@ -384,3 +384,50 @@ fn reconstruct_bad_inputs_name_the_problem() {
     assert!(!out.status.success());
     assert!(String::from_utf8_lossy(&out.stderr).contains("999"));
 }
+
+#[test]
+fn reconstruct_from_arc_pixels() {
+    let dir = temp_dir("arcs");
+    let arcs = dir.join("arcs.json");
+    fs::write(
+        &arcs,
+        r#"{"systems": [
+            {"id": "a", "z": 2.0, "images": [[[20.0, 1.0], [20.1, 1.5], [20.0, 2.0]], [[-18.0, -2.0], [-18.1, -2.4]]]},
+            {"id": "b", "z": 3.0, "images": [[[3.0, 24.0], [3.5, 24.1]], [[-2.0, -22.0], [-2.4, -22.1]], [[0.5, 0.8]]]}
+        ]}"#,
+    )
+    .unwrap();
+    let out_dir = dir.join("out");
+    let out = wslap(&[
+        "reconstruct",
+        "--arcs",
+        arcs.to_str().unwrap(),
+        "--z-lens",
+        "0.3",
+        "--iterations",
+        "100",
+        "--out",
+        out_dir.to_str().unwrap(),
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let s = summary(&out_dir);
+    assert_eq!(s["constraint_pixels"], 10);
+    assert_eq!(s["settings"]["constraints"]["mode"], "arcs");
+    // Images and arcs together are refused: one source of constraints at a time.
+    let out = wslap(&[
+        "reconstruct",
+        "--arcs",
+        arcs.to_str().unwrap(),
+        "--images",
+        arcs.to_str().unwrap(),
+        "--z-lens",
+        "0.3",
+        "--out",
+        out_dir.to_str().unwrap(),
+    ]);
+    assert!(!out.status.success());
+}

@@ -6,7 +6,7 @@ use std::path::{Path, PathBuf};
 use clap::Args;
 use serde::Serialize;
 use wslap::catalog::{parse_image_catalog, parse_member_catalog};
-use wslap::inversion::{export_system, ConstraintSource, LinearSystem};
+use wslap::inversion::{export_system, parse_arcs, ConstraintMode, ConstraintSource, LinearSystem};
 use wslap::reconstruct::{
     reconstruct, ConvergenceRecord, Inputs, LayerSource, ReconstructConfig, Reconstruction,
 };
@@ -24,10 +24,15 @@ use super::maps::write_products;
 /// report) and summary.json (settings, C per layer, grid mass, enclosed masses, Einstein
 /// radius, image-plane rms, timings).
 #[derive(Debug, Args)]
+#[command(group(clap::ArgGroup::new("constraints").required(true).args(["images", "arcs"])))]
 pub struct ReconstructArgs {
     /// Lenstool multiple-image catalogue (id x y a b theta z mag).
     #[arg(long, value_name = "IMAGES.cat")]
-    images: PathBuf,
+    images: Option<PathBuf>,
+    /// Arc pixels instead of a catalogue (JSON: {"systems": [{"id", "z", "images": [[[x, y], ...], ...]}]},
+    /// arcsec); sets the constraint mode to "arcs".
+    #[arg(long, value_name = "ARCS.json")]
+    arcs: Option<PathBuf>,
     /// Lenstool member catalogue (potfile: id x y a b theta mag lum).
     #[arg(long, value_name = "MEMBERS.cat")]
     members: Option<PathBuf>,
@@ -76,12 +81,23 @@ pub fn run(args: &ReconstructArgs) -> Result<(), String> {
     }
     let cosmology = Cosmology::new(args.h0, args.omega_m).map_err(|e| e.to_string())?;
     let plane = LensPlane::new(cosmology, args.z_lens).map_err(|e| e.to_string())?;
-    let (catalog, mut warnings) =
-        parse_image_catalog(&read_text(&args.images)?, &name(&args.images), None)
-            .map_err(|e| e.to_string())?;
+    let (catalog, arcs, mut warnings) = match (&args.images, &args.arcs) {
+        (Some(path), _) => {
+            let (c, w) = parse_image_catalog(&read_text(path)?, &name(path), None)
+                .map_err(|e| e.to_string())?;
+            (Some(c), None, w)
+        }
+        (None, Some(path)) => {
+            config.constraints.mode = ConstraintMode::Arcs;
+            let a = parse_arcs(&read_text(path)?, &name(path)).map_err(|e| e.to_string())?;
+            (None, Some(a), Vec::new())
+        }
+        (None, None) => return Err("give --images or --arcs".to_string()),
+    };
+    let reference = catalog.as_ref().and_then(|c| c.reference);
     let members = match &args.members {
         Some(path) => {
-            let (m, w) = parse_member_catalog(&read_text(path)?, &name(path), catalog.reference)
+            let (m, w) = parse_member_catalog(&read_text(path)?, &name(path), reference)
                 .map_err(|e| e.to_string())?;
             warnings.extend(w);
             Some(m)
@@ -91,15 +107,20 @@ pub fn run(args: &ReconstructArgs) -> Result<(), String> {
     for w in &warnings {
         eprintln!("warning: {w}");
     }
+    let images = match (&catalog, &arcs) {
+        (Some(c), _) => ConstraintSource::Catalog(c),
+        (None, Some(a)) => ConstraintSource::Arcs(a),
+        (None, None) => unreachable!("one of them was read above"),
+    };
     let inputs = Inputs {
-        images: ConstraintSource::Catalog(&catalog),
+        images,
         layers: members
             .as_ref()
             .map_or(LayerSource::None, LayerSource::Members),
         plane,
-        reference: catalog.reference,
+        reference: reference.or(members.as_ref().and_then(|m| m.reference)),
         holdout: &args.holdout,
-        catalog: Some(&catalog),
+        catalog: catalog.as_ref(),
     };
     let total = config.solver.iterations;
     let mut progress = |r: &ConvergenceRecord| {

@@ -7,10 +7,40 @@ use serde::{Deserialize, Serialize};
 
 use crate::images::{find_images, source_position, ImageSearch, SearchGrid};
 use crate::inversion::LinearSystem;
+use crate::maps::LensMaps;
 use crate::products::Products;
-use crate::profiles::Lens;
+use crate::profiles::{Lens, MassComponent};
 
 use super::{Inputs, ReconstructError};
+
+/// Predicted images solve the lens equation on the interpolated maps to this accuracy (arcsec);
+/// the maps themselves are good to a fraction of their pixel.
+const MAP_IMAGE_TOLERANCE_ARCSEC: f64 = 1e-3;
+
+/// The lens as its product maps, bilinearly interpolated (deflection from the alpha maps, the
+/// Hessian from kappa and gamma).
+#[derive(Debug)]
+struct InterpolatedLens<'a>(&'a LensMaps);
+
+impl MassComponent for InterpolatedLens<'_> {
+    fn kappa(&self, p: DVec2) -> f64 {
+        self.0.kappa.sample(p)
+    }
+    fn deflection(&self, p: DVec2) -> DVec2 {
+        DVec2::new(self.0.alpha_x.sample(p), self.0.alpha_y.sample(p))
+    }
+    fn hessian(&self, p: DVec2) -> [f64; 3] {
+        let (k, g1, g2) = (
+            self.0.kappa.sample(p),
+            self.0.gamma1.sample(p),
+            self.0.gamma2.sample(p),
+        );
+        [k + g1, g2, k - g1]
+    }
+}
+
+/// Most constraint pixels of one system back-projected for its scatter.
+const SCATTER_SAMPLE: usize = 500;
 
 /// One observed image and the model's prediction next to it.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -65,27 +95,48 @@ pub(super) fn report(
     default_z: Option<f64>,
 ) -> Result<Vec<SourceReport>, ReconstructError> {
     let betas = system.betas_arcsec(x)?;
-    let search = ImageSearch::default();
+    // Images are found on the product maps, interpolated: the exact lens sums every cell and
+    // galaxy at each Newton step, which for a 64 x 64 grid costs minutes per system.
+    let search = ImageSearch {
+        tolerance_arcsec: MAP_IMAGE_TOLERANCE_ARCSEC,
+        ..ImageSearch::default()
+    };
+    let map_lens = InterpolatedLens(&products.maps);
     let predict = |f: f64, beta: DVec2| -> Result<Vec<PredictedImage>, ReconstructError> {
-        Ok(
-            find_images(lens, SearchGrid::Maps(&products.maps), f, beta, &search)?
-                .into_iter()
-                .map(|i| PredictedImage {
-                    position_arcsec: i.position,
-                    magnification: i.magnification,
-                })
-                .collect(),
-        )
+        Ok(find_images(
+            &map_lens,
+            SearchGrid::Maps(&products.maps),
+            f,
+            beta,
+            &search,
+        )?
+        .into_iter()
+        .map(|i| PredictedImage {
+            position_arcsec: i.position,
+            magnification: i.magnification,
+        })
+        .collect())
     };
     let mut reports = Vec::new();
     for (s, sys) in system.constraints.systems.iter().enumerate() {
         let f = system.distance_ratios[s];
         let beta = betas[s];
-        // Every constraint pixel of the system, back-projected.
-        let mut d2 = Vec::new();
+        // The system's constraint pixels back-projected (at most SCATTER_SAMPLE of them, evenly
+        // spread: a big arc would otherwise cost a full lens evaluation per pixel).
+        let pixels: Vec<_> = system
+            .constraints
+            .pixels
+            .iter()
+            .filter(|p| p.system == s)
+            .collect();
+        let stride = pixels.len().div_ceil(SCATTER_SAMPLE).max(1);
+        let d2: Vec<f64> = pixels
+            .iter()
+            .step_by(stride)
+            .map(|p| source_position(lens, f, p.position).distance_squared(beta))
+            .collect();
         let mut per_image = vec![(DVec2::ZERO, 0usize); sys.images.len()];
-        for p in system.constraints.pixels.iter().filter(|p| p.system == s) {
-            d2.push(source_position(lens, f, p.position).distance_squared(beta));
+        for p in &pixels {
             per_image[p.image].0 += p.position;
             per_image[p.image].1 += 1;
         }
