@@ -12,27 +12,9 @@ use std::time::Instant;
 
 use wslap::solver::{gram_weighted, Control, QadpProblem, QadpSettings};
 
-/// splitmix64: a small, fixed-seed generator (quality is irrelevant here).
-struct Rng(u64);
-
-impl Rng {
-    fn next_u64(&mut self) -> u64 {
-        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
-        let mut z = self.0;
-        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-        z ^ (z >> 31)
-    }
-    /// Uniform in [0, 1).
-    fn uniform(&mut self) -> f64 {
-        (self.next_u64() >> 11) as f64 / (1u64 << 53) as f64
-    }
-    /// Standard normal (Box–Muller).
-    fn normal(&mut self) -> f64 {
-        let u = 1.0 - self.uniform();
-        (-2.0 * u.ln()).sqrt() * (2.0 * std::f64::consts::PI * self.uniform()).cos()
-    }
-}
+#[path = "../tests/common/rng.rs"]
+mod rng;
+use rng::Rng;
 
 /// `(Gamma, Theta, W)` as in `synthetic()` of qadp_numpy.py (fov 200 arcsec, Gaussian-smoothed
 /// point-mass deflection per cell, pixels uniform in +-60 arcsec, 30 sources).

@@ -27,25 +27,7 @@ const THREADS_RTOL: f64 = 1e-6;
 /// `G^T W G` blocked and threaded vs a naive triple loop (different summation order).
 const GRAM_RTOL: f64 = 1e-12;
 
-/// splitmix64 with a fixed seed per test.
-struct Rng(u64);
-
-impl Rng {
-    fn next_u64(&mut self) -> u64 {
-        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
-        let mut z = self.0;
-        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-        z ^ (z >> 31)
-    }
-    fn uniform(&mut self) -> f64 {
-        (self.next_u64() >> 11) as f64 / (1u64 << 53) as f64
-    }
-    fn normal(&mut self) -> f64 {
-        let u = 1.0 - self.uniform();
-        (-2.0 * u.ln()).sqrt() * (2.0 * std::f64::consts::PI * self.uniform()).cos()
-    }
-}
+use common::rng::Rng;
 
 /// `A = G^T G`, `b = -G^T y` with `G` (2n x n) Gaussian and `y = G x_true + noise`, where
 /// about a third of `x_true` is negative, so that the optimum has components at 0.

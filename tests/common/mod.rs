@@ -12,6 +12,8 @@
 //! Reference data are read with `include_str!` so that the browser build has them too.
 #![allow(dead_code)] // each test binary uses a different part of this module
 
+pub mod rng;
+
 #[cfg(target_arch = "wasm32")]
 wasm_bindgen_test::wasm_bindgen_test_configure!(run_in_dedicated_worker);
 
