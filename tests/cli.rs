@@ -333,7 +333,14 @@ fn reconstruct_bad_inputs_name_the_problem() {
         dir.join("a").to_str().unwrap(),
     ]);
     assert!(!out.status.success());
-    assert!(String::from_utf8_lossy(&out.stderr).contains("z_l = 1.5"));
+    let err = String::from_utf8_lossy(&out.stderr);
+    // The first system in front of the lens, named by file and line, with its redshift.
+    assert!(
+        err.contains("cats_gold_mul_gold.cat: line ")
+            && err.contains("z_s = ")
+            && err.contains("z_lens = 1.5"),
+        "{err}"
+    );
     // A malformed catalogue row.
     let bad = dir.join("bad.cat");
     fs::write(

@@ -217,7 +217,7 @@ fn summary(r: &Reconstruction) -> ReconstructSummary<'_> {
 }
 
 /// Writes the map files, sources.json, convergence.json and summary.json into `dir`.
-fn write_reconstruction(r: &Reconstruction, dir: &Path) -> Result<(), String> {
+pub(super) fn write_reconstruction(r: &Reconstruction, dir: &Path) -> Result<(), String> {
     write_products(&r.products, ColorScale::Log, dir)?;
     let write = |file: &str, text: String| -> Result<(), String> {
         let path = dir.join(file);

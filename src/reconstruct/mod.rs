@@ -92,6 +92,9 @@ pub struct ConvergenceRecord {
     pub grid_mass_msun: f64,
     /// `C_l` per layer.
     pub c: Vec<f64>,
+    /// Source position `beta` of each fitted system at this iteration, arcsec (frame shift
+    /// removed), in the order of the constraint systems.
+    pub beta_arcsec: Vec<DVec2>,
 }
 
 /// Wall-clock time of each stage in milliseconds.
@@ -153,6 +156,7 @@ pub fn reconstruct(
     progress: &mut dyn FnMut(&ConvergenceRecord) -> Control,
 ) -> Result<Reconstruction, ReconstructError> {
     config.validate()?;
+    check_source_redshifts(inputs, config)?;
     let constraints = build_constraints(inputs.images, &config.constraints, inputs.holdout)?;
     if constraints.systems.is_empty() {
         return Err(ReconstructError::NoConstraints(describe_excluded(
@@ -186,6 +190,8 @@ pub fn reconstruct(
         let cells = system.cell_columns();
         let layer_cols = system.layer_columns();
         let unit = system.mass_unit_msun;
+        let (bx, by) = (system.beta_x_columns(), system.beta_y_columns());
+        let shift = system.theta_shift_arcsec;
         let mut callback = |p: &crate::solver::Progress| {
             let record = ConvergenceRecord {
                 level,
@@ -193,6 +199,11 @@ pub fn reconstruct(
                 objective: p.objective,
                 grid_mass_msun: p.x[cells.clone()].iter().sum::<f64>() * unit,
                 c: p.x[layer_cols.clone()].to_vec(),
+                beta_arcsec: bx
+                    .clone()
+                    .zip(by.clone())
+                    .map(|(i, j)| DVec2::new(p.x[i] - shift, p.x[j] - shift))
+                    .collect(),
             };
             let control = progress(&record);
             convergence.push(record);
@@ -270,6 +281,54 @@ fn start_values(system: &LinearSystem, solver: &SolverConfig) -> Vec<f64> {
         x[by.start + s] = (mean.y + shift).max(1e-3);
     }
     x
+}
+
+/// Every source must lie behind the lens: the first system at `z_s <= z_l` is an error naming
+/// the file, the line (catalogues) or system, and the value.
+fn check_source_redshifts(
+    inputs: &Inputs<'_>,
+    config: &ReconstructConfig,
+) -> Result<(), ReconstructError> {
+    let z_lens = inputs.plane.z_lens;
+    let behind = |z: f64| z > z_lens;
+    if let Some(z) = config.constraints.default_z {
+        if !behind(z) {
+            return Err(ReconstructError::Config {
+                source_name: "constraints.default_z".to_string(),
+                message: format!(
+                    "z = {z} is not behind the lens (z_lens = {z_lens}): a source must have z_s > z_l"
+                ),
+            });
+        }
+    }
+    let bad = |source_name: &str, place: String, z: f64| ReconstructError::Config {
+        source_name: source_name.to_string(),
+        message: format!(
+            "{place}: z_s = {z} is not behind the lens (z_lens = {z_lens}): a source must have z_s > z_l"
+        ),
+    };
+    match inputs.images {
+        ConstraintSource::Catalog(cat) => {
+            for s in &cat.systems {
+                if let Some(z) = s.z.filter(|&z| !behind(z)) {
+                    let line = s.images.first().map_or(0, |i| i.line);
+                    return Err(bad(
+                        &cat.source_name,
+                        format!("line {line} (system {})", s.id),
+                        z,
+                    ));
+                }
+            }
+        }
+        ConstraintSource::Arcs(arcs) => {
+            for s in &arcs.systems {
+                if let Some(z) = s.z.filter(|&z| !behind(z)) {
+                    return Err(bad(&arcs.source_name, format!("system {}", s.id), z));
+                }
+            }
+        }
+    }
+    Ok(())
 }
 
 fn describe_excluded(constraints: &ConstraintSet) -> String {
