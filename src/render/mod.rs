@@ -15,15 +15,25 @@ use crate::grid::Map;
 mod axes;
 mod colormap;
 mod colormap_tables;
+mod compose;
 mod figure;
 mod font;
 mod overlay;
+mod plot;
 
 pub use colormap::{
     color_limits, render_colormap_rgba, value_rgb, ColorScale, Colormap, LOG_RANGE, NO_DATA_RGB,
 };
+pub use compose::{
+    compose_grid, compose_png_grid, grid_offsets, GridLayout, MAX_COMPOSED_PIXELS,
+    MAX_COMPOSED_SIDE_PX,
+};
 pub use figure::{kappa_figure_frame, render_kappa_png, FigureFrame};
 pub use overlay::{CAUSTIC_RGB, RADIAL_RGB, TANGENTIAL_RGB};
+pub use plot::{
+    Axis, AxisScale, LinePlot, LineStyle, PlotFrame, Reference, Series, MAX_LINE_WIDTH_PX, PALETTE,
+    PLOT_SIDE_PX,
+};
 
 /// What prevents a figure from being drawn.
 #[derive(Debug, Error, Clone, PartialEq)]
