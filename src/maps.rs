@@ -60,39 +60,93 @@ pub struct LensMaps {
 /// The five output rows of one map row: `[kappa, gamma1, gamma2, alpha_x, alpha_y]`.
 type RowSlices<'a> = [&'a mut [f64]; 5];
 
-/// Fills whole rows `first_row..` of the five maps from the lens at the pixel centres.
-fn fill_rows(lens: &dyn MassComponent, geometry: &MapGeometry, first_row: usize, out: RowSlices) {
+/// Adds, to whole rows `first_row..` of the five maps, the sum of the `parts` at the pixel
+/// centres (summed in order at each pixel, as [`crate::profiles::Lens`] does).
+fn fill_rows(
+    parts: &[&dyn MassComponent],
+    geometry: &MapGeometry,
+    first_row: usize,
+    out: RowSlices,
+) {
     let n = geometry.pixels;
     let [kappa, gamma1, gamma2, alpha_x, alpha_y] = out;
     for (k, kap) in kappa.iter_mut().enumerate() {
         let p = geometry.pixel_center(k % n, first_row + k / n);
-        let (a, [xx, xy, yy]) = lens.deflection_hessian(p);
-        *kap = 0.5 * (xx + yy);
-        gamma1[k] = 0.5 * (xx - yy);
-        gamma2[k] = xy;
-        alpha_x[k] = a.x;
-        alpha_y[k] = a.y;
+        let (a, [xx, xy, yy]) = parts
+            .iter()
+            .fold((glam::DVec2::ZERO, [0.0; 3]), |(a, h), c| {
+                let (da, dh) = c.deflection_hessian(p);
+                (a + da, [h[0] + dh[0], h[1] + dh[1], h[2] + dh[2]])
+            });
+        *kap += 0.5 * (xx + yy);
+        gamma1[k] += 0.5 * (xx - yy);
+        gamma2[k] += xy;
+        alpha_x[k] += a.x;
+        alpha_y[k] += a.y;
     }
 }
 
+/// Adds the sum of `parts` to every pixel of `maps`, evaluating
+/// [`MassComponent::deflection_hessian`] at each pixel centre: `kappa = (psi_xx + psi_yy)/2`,
+/// `gamma1 = (psi_xx - psi_yy)/2`, `gamma2 = psi_xy`, `alpha` in arcsec. Natively the rows are
+/// split over all available threads; on wasm32 it runs serially.
+pub fn add_pixelwise(parts: &[&dyn MassComponent], maps: &mut LensMaps) {
+    let geometry = maps.geometry();
+    let LensMaps {
+        kappa,
+        gamma1,
+        gamma2,
+        alpha_x,
+        alpha_y,
+    } = maps;
+    fill_parallel(
+        parts,
+        &geometry,
+        [
+            &mut kappa.data,
+            &mut gamma1.data,
+            &mut gamma2.data,
+            &mut alpha_x.data,
+            &mut alpha_y.data,
+        ],
+    );
+}
+
 impl LensMaps {
-    /// Evaluates the lens at every pixel centre: `alpha` from `deflection`, and
+    /// The lens fields at every pixel centre: `alpha` from `deflection`, and
     /// `kappa = (psi_xx + psi_yy)/2`, `gamma1 = (psi_xx - psi_yy)/2`, `gamma2 = psi_xy` from the
-    /// Hessian. Natively the rows are split over all available threads; on wasm32 it runs serially.
+    /// Hessian. Components with a whole-map method ([`MassComponent::add_to_maps`], e.g. the
+    /// FFT convolution of a regular grid of cells) use it; the others are evaluated pixel by
+    /// pixel as in [`Self::from_lens_pixelwise`].
     pub fn from_lens(lens: &dyn MassComponent, geometry: MapGeometry) -> LensMaps {
-        let n = geometry.pixels;
-        let mut fields: [Vec<f64>; 5] = std::array::from_fn(|_| vec![0.0; n * n]);
-        {
-            let [k, g1, g2, ax, ay] = &mut fields;
-            fill_parallel(lens, &geometry, [k, g1, g2, ax, ay]);
+        let mut maps = Self::zeros(geometry);
+        if !lens.add_to_maps(&mut maps) {
+            add_pixelwise(&[lens], &mut maps);
         }
-        let [kappa, gamma1, gamma2, alpha_x, alpha_y] = fields.map(|data| Map { geometry, data });
+        maps
+    }
+
+    /// The reference path: [`MassComponent::deflection_hessian`] of the whole lens at every pixel
+    /// centre (see [`add_pixelwise`]), with no whole-map shortcut.
+    pub fn from_lens_pixelwise(lens: &dyn MassComponent, geometry: MapGeometry) -> LensMaps {
+        let mut maps = Self::zeros(geometry);
+        add_pixelwise(&[lens], &mut maps);
+        maps
+    }
+
+    /// Five maps of zeros on `geometry`.
+    pub fn zeros(geometry: MapGeometry) -> LensMaps {
+        let n = geometry.pixels;
+        let zero = || Map {
+            geometry,
+            data: vec![0.0; n * n],
+        };
         LensMaps {
-            kappa,
-            gamma1,
-            gamma2,
-            alpha_x,
-            alpha_y,
+            kappa: zero(),
+            gamma1: zero(),
+            gamma2: zero(),
+            alpha_x: zero(),
+            alpha_y: zero(),
         }
     }
 
@@ -252,7 +306,7 @@ fn gradient(map: &Map, i: usize, j: usize, h: f64) -> (f64, f64) {
 
 /// Splits the rows of the five output maps into one band per thread.
 #[cfg(not(target_arch = "wasm32"))]
-fn fill_parallel(lens: &dyn MassComponent, geometry: &MapGeometry, out: RowSlices) {
+fn fill_parallel(parts: &[&dyn MassComponent], geometry: &MapGeometry, out: RowSlices) {
     let n = geometry.pixels;
     if n == 0 {
         return;
@@ -274,7 +328,7 @@ fn fill_parallel(lens: &dyn MassComponent, geometry: &MapGeometry, out: RowSlice
         .collect();
     if threads == 1 {
         for (row, slices) in work {
-            fill_rows(lens, geometry, row, slices);
+            fill_rows(parts, geometry, row, slices);
         }
         return;
     }
@@ -287,7 +341,7 @@ fn fill_parallel(lens: &dyn MassComponent, geometry: &MapGeometry, out: RowSlice
         for jobs in per_thread {
             s.spawn(move || {
                 for (row, slices) in jobs {
-                    fill_rows(lens, geometry, row, slices);
+                    fill_rows(parts, geometry, row, slices);
                 }
             });
         }
@@ -296,6 +350,6 @@ fn fill_parallel(lens: &dyn MassComponent, geometry: &MapGeometry, out: RowSlice
 
 /// wasm32 has no threads here: fill every row in turn.
 #[cfg(target_arch = "wasm32")]
-fn fill_parallel(lens: &dyn MassComponent, geometry: &MapGeometry, out: RowSlices) {
-    fill_rows(lens, geometry, 0, out);
+fn fill_parallel(parts: &[&dyn MassComponent], geometry: &MapGeometry, out: RowSlices) {
+    fill_rows(parts, geometry, 0, out);
 }

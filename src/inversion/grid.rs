@@ -15,6 +15,10 @@ use glam::DVec2;
 use serde::{Deserialize, Serialize};
 use thiserror::Error;
 
+use super::grid_fft::{self, MapPlan};
+use crate::grid::MapGeometry;
+use crate::maps::LensMaps;
+
 /// What can be wrong with a grid setting or a refinement request.
 #[derive(Debug, Error, Clone, PartialEq)]
 pub enum GridError {
@@ -382,6 +386,29 @@ impl GridMass {
             b2_arcsec2,
         })
     }
+
+    /// How [`crate::profiles::MassComponent::add_to_maps`] would make the maps of `geometry`:
+    /// which cells go to the FFT convolution (groups of equal width on a sub-lattice of the
+    /// pixel lattice, see `grid_fft`) and which to the direct per-pixel sum.
+    pub fn map_plan(&self, geometry: &MapGeometry) -> MapPlan {
+        let (groups, direct) = grid_fft::plan(
+            &self.centers,
+            &self.sigmas_arcsec,
+            &self.b2_arcsec2,
+            geometry,
+        );
+        grid_fft::summarize(&groups, &direct)
+    }
+
+    /// The cells `indices` alone.
+    fn subset(&self, indices: &[usize]) -> GridMass {
+        GridMass {
+            centers: indices.iter().map(|&j| self.centers[j]).collect(),
+            sigmas_arcsec: indices.iter().map(|&j| self.sigmas_arcsec[j]).collect(),
+            inv_2s2: indices.iter().map(|&j| self.inv_2s2[j]).collect(),
+            b2_arcsec2: indices.iter().map(|&j| self.b2_arcsec2[j]).collect(),
+        }
+    }
 }
 
 impl crate::profiles::MassComponent for GridMass {
@@ -414,5 +441,41 @@ impl crate::profiles::MassComponent for GridMass {
             }
         }
         h
+    }
+    /// Exact maps by FFT convolution for the cells on the pixel lattice (see
+    /// [`GridMass::map_plan`]), the direct sum for the others; declines (returns false, adds
+    /// nothing) when no cell group gains from the FFT.
+    fn add_to_maps(&self, maps: &mut LensMaps) -> bool {
+        let geometry = maps.geometry();
+        let n2 = geometry.pixels * geometry.pixels;
+        let fields = [
+            &maps.kappa,
+            &maps.gamma1,
+            &maps.gamma2,
+            &maps.alpha_x,
+            &maps.alpha_y,
+        ];
+        if fields
+            .iter()
+            .any(|m| m.geometry != geometry || m.data.len() != n2)
+        {
+            return false;
+        }
+        let (groups, direct) = grid_fft::plan(
+            &self.centers,
+            &self.sigmas_arcsec,
+            &self.b2_arcsec2,
+            &geometry,
+        );
+        if groups.is_empty() {
+            return false;
+        }
+        for group in &groups {
+            grid_fft::add_group(group, maps);
+        }
+        if !direct.is_empty() {
+            crate::maps::add_pixelwise(&[&self.subset(&direct)], maps);
+        }
+        true
     }
 }

@@ -4,6 +4,7 @@
 
 mod constraints;
 mod grid;
+mod grid_fft;
 mod members;
 mod npy;
 mod system;
@@ -14,6 +15,7 @@ pub use constraints::{
     ConstraintSystem, ExcludedSystem, Exclusion, Weighting,
 };
 pub use grid::{cell_unit_deflection, Cell, CellGrid, GridConfig, GridError, GridMass};
+pub use grid_fft::MapPlan;
 pub use members::{
     build_member_layers, HaloProfile, Layer, LayerSplit, MemberConfig, MemberHalo, MemberModel,
     MembersError,

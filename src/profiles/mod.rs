@@ -5,6 +5,8 @@
 
 use glam::DVec2;
 
+use crate::maps::LensMaps;
+
 mod dpie;
 mod error;
 mod gaussian;
@@ -46,6 +48,15 @@ pub trait MassComponent: Send + Sync + std::fmt::Debug {
     fn deflection_hessian(&self, p: DVec2) -> (DVec2, [f64; 3]) {
         (self.deflection(p), self.hessian(p))
     }
+    /// Adds this component's `kappa`, `gamma1`, `gamma2` and `alpha` (arcsec), all at
+    /// `D_ls/D_s = 1`, to every pixel of `maps` by a faster whole-map method and returns true,
+    /// or returns false and leaves `maps` untouched: the caller then evaluates
+    /// [`Self::deflection_hessian`] pixel by pixel ([`crate::maps::LensMaps::from_lens`]).
+    /// The default declines; a grid of Gaussian cells convolves by FFT.
+    fn add_to_maps(&self, maps: &mut LensMaps) -> bool {
+        let _ = maps;
+        false
+    }
 }
 
 /// A lens made of several components; its fields are the sums of theirs.
@@ -80,5 +91,22 @@ impl MassComponent for Lens {
                 let (da, dh) = c.deflection_hessian(p);
                 (a + da, [h[0] + dh[0], h[1] + dh[1], h[2] + dh[2]])
             })
+    }
+    /// Lets every component add its maps; the components that decline are then summed pixel by
+    /// pixel together. Declines when all of them do (so the caller's path is unchanged).
+    fn add_to_maps(&self, maps: &mut LensMaps) -> bool {
+        let declined: Vec<&dyn MassComponent> = self
+            .components
+            .iter()
+            .filter(|c| !c.add_to_maps(maps))
+            .map(|c| c.as_ref())
+            .collect();
+        if declined.len() == self.components.len() {
+            return false;
+        }
+        if !declined.is_empty() {
+            crate::maps::add_pixelwise(&declined, maps);
+        }
+        true
     }
 }
