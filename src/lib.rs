@@ -22,6 +22,7 @@ pub mod profiles;
 pub mod radial;
 pub mod reconstruct;
 pub mod render;
+pub mod simulate;
 pub mod sky;
 pub mod solver;
 pub mod units;

@@ -2,6 +2,7 @@
 
 mod maps;
 mod reconstruct;
+mod simulate;
 
 use std::process::ExitCode;
 
@@ -22,6 +23,7 @@ struct Cli {
 enum Command {
     Maps(maps::MapsArgs),
     Reconstruct(reconstruct::ReconstructArgs),
+    Simulate(simulate::SimulateArgs),
 }
 
 /// Parses the arguments, runs the subcommand, prints any error with its context.
@@ -30,6 +32,7 @@ pub fn run() -> ExitCode {
     let result = match cli.command {
         Command::Maps(args) => maps::run(&args),
         Command::Reconstruct(args) => reconstruct::run(&args),
+        Command::Simulate(args) => simulate::run(&args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,
