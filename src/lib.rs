@@ -5,6 +5,7 @@
 //! (+x West, +y North); every stored deflection, convergence and shear is for `D_ls/D_s = 1`.
 //! The wasm boundary (`wasm.rs`) and the CLI (`main.rs`) are thin shells around this library.
 
+pub mod app;
 pub mod catalog;
 pub mod cosmology;
 pub mod curves;

@@ -1,95 +1,246 @@
-// Page wiring: DOM references first, then the worker client, then event handlers.
+// Page wiring: the worker client, the session's life cycle (example, files, project, runs,
+// cancel, persistence) and the panels of js/*.js.
 
 import { LensClient } from './lens-client.js';
+import { loadProject, saveProject } from './js/store.js';
+import { buildFileRows, setFileStatus, ROLES } from './js/files.js';
+import { buildSettings, showSettings } from './js/settings.js';
+import { wireViews, showPng, showSystems, viewOptions, currentView } from './js/views.js';
+import { showDownloads } from './js/downloads.js';
 
-const statusEl = document.getElementById('status');
-const errorEl = document.getElementById('error');
-const mapImg = document.getElementById('kappa-map');
-const summaryEl = document.getElementById('summary');
-const modelFileInput = document.getElementById('model-file');
-const modelFileStatus = document.getElementById('model-file-status');
-const zSourceInput = document.getElementById('z-source');
-const scaleSelect = document.getElementById('scale');
-const runButton = document.getElementById('run');
-const exampleButton = document.getElementById('example');
+const $ = (id) => document.getElementById(id);
+let examples = [];
+let resultKind = null; // kind of the shown result, null before any
+let lastProject = null; // the worker's project.json after the last change (restored on cancel)
+let settings = null;
 
-// The model text currently loaded; null means the built-in example.
-let modelText = null;
-let modelName = 'built-in example';
-let mapUrl = null;
+const client = new LensClient({ onCrash: (m) => showError(m) });
+const ask = (type, payload = {}, onProgress) => client.request(type, payload, onProgress);
 
-const client = new LensClient({
-  onReady: (msg) => setStatus(`Worker ready (wslap ${msg.version}).`),
-  onCrash: (message) => showError(message),
-});
+function setStatus(text) { $('status').textContent = text; }
+function showError(text) { $('error').textContent = text; $('error').hidden = false; }
+function clearError() { $('error').hidden = true; $('error').textContent = ''; }
 
-function setStatus(text) {
-  statusEl.textContent = text;
+async function persist() {
+  lastProject = await ask('textFile', { name: 'project.json' });
+  const problem = await saveProject(lastProject);
+  if (problem) setStatus(problem);
 }
 
-function showError(text) {
-  errorEl.textContent = text;
-  errorEl.hidden = false;
+async function refreshLoaded() {
+  const loaded = await ask('loaded');
+  $('reconstruct').disabled = !(loaded.images || loaded.arcs);
+  $('forward').disabled = !loaded.model;
+  $('lookup').disabled = !(loaded.deflection_x && loaded.deflection_y);
+  return loaded;
 }
 
-function clearError() {
-  errorEl.hidden = true;
-  errorEl.textContent = '';
+function describe(name, text) {
+  $('project-name').textContent = name;
+  $('project-description').textContent = text;
 }
 
-function options() {
-  return { z_source: Number(zSourceInput.value), scale: scaleSelect.value };
-}
-
-async function compute() {
-  clearError();
-  runButton.disabled = true;
-  exampleButton.disabled = true;
+async function render() {
+  const view = currentView();
   try {
-    const result = await client.request('forward', { model: modelText, options: options() },
-      (p) => setStatus(p.message));
-    if (mapUrl) URL.revokeObjectURL(mapUrl);
-    mapUrl = URL.createObjectURL(new Blob([result.png], { type: 'image/png' }));
-    mapImg.src = mapUrl;
-    mapImg.hidden = false;
-    const s = result.summary;
-    summaryEl.textContent = `${modelName}: z_lens = ${s.z_lens}, z_s = ${s.z_source}, ` +
-      `Einstein radius ${s.einstein_radius_arcsec.toFixed(1)}″, ` +
-      `${s.tangential_curves} tangential and ${s.radial_curves} radial critical curves.`;
-    setStatus(`Done in ${(result.elapsedMs / 1000).toFixed(2)} s.`);
+    if (view === 'systems') {
+      showSystems(resultKind ? await ask('sources') : []);
+      return;
+    }
+    const name = resultKind ? view : 'data';
+    if (!resultKind && view !== 'kappa') {
+      $('summary').textContent = 'Reconstruct (or run a forward model) to see this view.';
+      $('view-image').hidden = true;
+      return;
+    }
+    const { png } = await ask('view', { name, options: viewOptions() });
+    showPng(name, png);
   } catch (err) {
+    $('view-image').hidden = true;
+    $('summary').textContent = err.message;
+  }
+}
+
+function caption(info) {
+  const s = info.summary.maps ?? info.summary;
+  const status = info.status ? `${info.status}, ${info.iterations} iterations; ` : '';
+  $('summary').textContent = `${status}Einstein radius ${s.einstein_radius_arcsec.toFixed(1)}″ at ` +
+    `z_s = ${s.z_source}; ${s.tangential_curves} tangential and ${s.radial_curves} radial critical curves.`;
+}
+
+async function showResult(info) {
+  resultKind = info.kind;
+  caption(info);
+  showDownloads(info.kind, app);
+}
+
+function showProgress(on) {
+  $('progress-box').hidden = !on;
+  $('cancel').hidden = !on;
+  for (const id of ['reconstruct', 'forward', 'lookup']) $(id).disabled = on || $(id).disabled;
+}
+
+async function run(kind) {
+  clearError();
+  const total = settings?.reconstruct?.solver?.iterations ?? 1;
+  showProgress(true);
+  $('progress').value = 0;
+  $('progress-text').textContent = 'Building the linear system…';
+  setStatus(kind === 'reconstruct' ? 'Reconstructing…' : 'Computing…');
+  try {
+    const info = await ask('run', { kind }, (p) => {
+      const frac = Math.min(1, p.iteration / total);
+      const left = frac > 0 ? (p.elapsed_ms / frac - p.elapsed_ms) / 1000 : NaN;
+      $('progress').value = frac;
+      $('progress-text').textContent = `iteration ${p.iteration} / ${total}, objective ` +
+        `${p.objective.toExponential(4)}, about ${Number.isFinite(left) ? left.toFixed(0) : '?'} s left`;
+    });
+    setStatus(`Done in ${(info.elapsed_ms / 1000).toFixed(2)} s.`);
+    await showResult(info);
+    await persist();
+    await render();
+  } catch (err) {
+    if (err.cancelled) return;
     setStatus('Failed.');
     showError(err.message);
   } finally {
-    runButton.disabled = false;
-    exampleButton.disabled = false;
+    showProgress(false);
+    await refreshLoaded().catch(() => {});
   }
 }
 
-modelFileInput.addEventListener('change', async () => {
-  const file = modelFileInput.files[0];
-  if (!file) return;
-  const text = await file.text();
-  try {
-    // Validate in the worker before replacing what is loaded: a bad file loses nothing.
-    await client.request('validateModel', { model: text, name: file.name });
-    modelText = text;
-    modelName = file.name;
-    modelFileStatus.textContent = `Loaded ${file.name}.`;
-    modelFileStatus.classList.remove('bad');
-    compute();
-  } catch (err) {
-    modelFileStatus.textContent = err.message;
-    modelFileStatus.classList.add('bad');
+async function cancel() {
+  client.cancel();
+  showProgress(false);
+  setStatus('Cancelled; restoring the session…');
+  await client.ready;
+  if (lastProject) await openProject(lastProject, 'the session', true);
+  setStatus('Cancelled. The loaded data and the previous result are kept.');
+}
+
+async function afterOpen(report) {
+  settings = await ask('settings');
+  showSettings(settings);
+  $('z-curves').value = settings.reconstruct.products.z_source;
+  const loaded = await refreshLoaded();
+  for (const { role } of ROLES) setFileStatus(role, loaded[role] ? `${loaded[role]}: loaded` : '');
+  resultKind = null;
+  if (report?.result === 'restored' || report?.result === 'recomputed') await showResult(await ask('resultInfo'));
+  else $('summary').textContent = '';
+  await render();
+}
+
+async function openProject(text, name, quiet = false) {
+  const report = await ask('openProject', { text, name });
+  if (!quiet) describe(report.name || name, `Project: ${report.message}.`);
+  await afterOpen(report);
+  lastProject = text;
+  return report;
+}
+
+async function loadExample(ex) {
+  clearError();
+  await ask('reset');
+  await ask('setName', { name: ex.name });
+  await ask('setField', { path: 'z_lens', value: ex.z_lens });
+  for (const [path, value] of Object.entries(ex.settings ?? {})) await ask('setField', { path, value });
+  for (const f of ex.files) {
+    const text = await (await fetch(`examples/${f.path}`)).text();
+    await ask('loadText', { role: f.role, name: f.path.split('/').pop(), text });
   }
-});
+  describe(ex.name, ex.description);
+  await afterOpen(null);
+  await persist();
+  setStatus('Ready: press Reconstruct.');
+}
 
-runButton.addEventListener('click', compute);
-exampleButton.addEventListener('click', () => {
-  modelText = null;
-  modelName = 'built-in example';
-  modelFileStatus.textContent = '';
-  compute();
-});
+async function onFile(role, file) {
+  clearError();
+  try {
+    let report;
+    if (role === 'project') {
+      report = await openProject(await file.text(), file.name);
+      setFileStatus(role, `${file.name}: ${report.message}`);
+      await persist();
+      return;
+    }
+    if (role.startsWith('deflection')) {
+      const bytes = await file.arrayBuffer();
+      report = await ask('loadFits', { axis: role.endsWith('x') ? 0 : 1, name: file.name, bytes });
+    } else {
+      report = await ask('loadText', { role, name: file.name, text: await file.text() });
+    }
+    const warn = report.warnings.length ? ` (${report.warnings.length} warnings: ${report.warnings.join('; ')})` : '';
+    setFileStatus(role, `${report.name}: ${report.summary}${warn}`);
+    await refreshLoaded();
+    await persist();
+    if (!resultKind) await render();
+  } catch (err) {
+    setFileStatus(role, err.message, true);
+  }
+}
 
-compute();
+async function applySetting(path, value) {
+  if (path === 'reconstruct.products.z_source') return setZ(value);
+  settings = await ask('setField', { path, value });
+  await persist();
+  return settings;
+}
+
+async function setZ(z) {
+  settings = await ask('setZSource', { z });
+  $('z-curves').value = z;
+  showSettings(settings);
+  if (resultKind) {
+    caption(await ask('resultInfo'));
+    await render();
+  }
+  await persist();
+  return settings;
+}
+
+const app = {
+  render,
+  hover: (x, y) => ask('hover', { options: viewOptions(), x, y }),
+  textFile: (name) => ask('textFile', { name }),
+  fitsFile: async (name) => (await ask('fitsFiles')).find((f) => f.name === name).bytes,
+  viewPng: async (name) => (await ask('view', { name, options: viewOptions() })).png,
+  showError,
+};
+
+async function start() {
+  buildFileRows($('file-rows'), $('drop-zone'), onFile);
+  buildSettings($('settings-form'), applySetting);
+  wireViews(app);
+  $('reconstruct').addEventListener('click', () => run('reconstruct'));
+  $('forward').addEventListener('click', () => run('forward'));
+  $('lookup').addEventListener('click', () => run('lookup'));
+  $('cancel').addEventListener('click', cancel);
+  $('scale').addEventListener('change', render);
+  $('z-curves').addEventListener('change', async () => {
+    try { await setZ(Number($('z-curves').value)); $('z-curves-error').textContent = ''; } catch (err) {
+      $('z-curves-error').textContent = err.message;
+      $('z-curves').value = settings?.reconstruct?.products?.z_source ?? 2;
+    }
+  });
+  try {
+    examples = (await (await fetch('examples/index.json')).json()).examples;
+  } catch (err) {
+    showError(`could not read the examples: ${err.message}`);
+  }
+  $('example-select').innerHTML = examples.map((e, k) => `<option value="${k}">${e.name}</option>`).join('');
+  $('example-select').addEventListener('change', () => loadExample(examples[$('example-select').value]));
+  const version = (await client.ready).version;
+  setStatus(`Worker ready (wslap ${version}).`);
+  const saved = await loadProject();
+  if (saved) {
+    try {
+      await openProject(saved, 'saved project');
+      setStatus('Restored your project from this browser.');
+      return;
+    } catch { /* fall back to the example */ }
+  }
+  if (examples.length) await loadExample(examples[0]);
+}
+
+start().catch((err) => showError(err.message));

@@ -1,51 +1,82 @@
-// End-to-end: the page loads, the worker answers, the kappa map with critical curves appears.
+// End-to-end: the app opens on the built-in example, reconstructs it in the worker and shows a
+// mass map with critical curves; hover, z_s redraw, FITS download, reload restore, phone width.
 import { test } from 'node:test';
 import assert from 'node:assert/strict';
 import { join } from 'node:path';
-import { writeFile, mkdtemp } from 'node:fs/promises';
-import { tmpdir } from 'node:os';
-import { openApp, imageStats, ARTIFACTS } from './browser.mjs';
+import { readFile } from 'node:fs/promises';
+import { openApp, imageStats, ARTIFACTS, setField, waitStatus, fitsAxes } from './browser.mjs';
 
-test('the built-in example renders a kappa map with critical curves', async () => {
+/** Iterations of the quick test runs (the example's own setting is 3000). */
+const QUICK_ITERATIONS = 600;
+
+test('the built-in example reconstructs and shows a map with critical curves', async () => {
   const app = await openApp();
   try {
     const { page } = app;
-    await page.waitForSelector('#kappa-map:not([hidden])', { timeout: 60_000 });
-    await page.waitForFunction(() => document.getElementById('status').textContent.startsWith('Done'));
-    const stats = await imageStats(page, '#kappa-map');
+    await waitStatus(page, /^Ready/);
+    assert.match(await page.textContent('#project-name'), /Teaching/);
+    // The data are shown before anything is computed.
+    await page.waitForSelector('#view-image:not([hidden])');
+    const data = await imageStats(page, '#view-image');
+    assert.ok(data.magenta > 20, `observed images not drawn (${data.magenta} magenta pixels)`);
+    await page.screenshot({ path: join(ARTIFACTS, 'app-data.png'), fullPage: true });
+
+    await setField(page, '#set-reconstruct-solver-iterations', QUICK_ITERATIONS);
+    await page.click('#reconstruct');
+    await waitStatus(page, /^Done in/);
+    await page.waitForFunction(() => document.getElementById('view-image').dataset.view === 'kappa');
+    const stats = await imageStats(page, '#view-image');
     assert.ok(stats.width >= 400 && stats.height >= 400, `figure is ${stats.width}x${stats.height}`);
-    // A colour-mapped field has many colours; a blank or flat image has a handful.
     assert.ok(stats.distinctColours > 200, `only ${stats.distinctColours} distinct colours`);
-    // Tangential critical curves are drawn in red.
     assert.ok(stats.reddish > 50, `only ${stats.reddish} red curve pixels`);
-    const summary = await page.textContent('#summary');
-    assert.match(summary, /Einstein radius \d+\.\d″/);
-    assert.equal(await page.isHidden('#error'), true);
+    const before = await page.textContent('#summary');
+    const r2 = Number(before.match(/Einstein radius (\d+\.\d)″/)[1]);
+    assert.ok(r2 > 3, before);
     await page.screenshot({ path: join(ARTIFACTS, 'app-example.png'), fullPage: true });
+
+    // Hover read-out in the middle of the map.
+    const box = await (await page.$('#view-image')).boundingBox();
+    await page.mouse.move(box.x + box.width * 0.45, box.y + box.height * 0.5);
+    await page.waitForFunction(() => /κ = /.test(document.getElementById('readout').textContent));
+
+    // A higher z_s redraws larger curves without solving again.
+    await setField(page, '#z-curves', 5);
+    await page.waitForFunction((r) => {
+      const m = document.getElementById('summary').textContent.match(/Einstein radius (\d+\.\d)″ at z_s = 5/);
+      return m && Number(m[1]) > r;
+    }, r2);
+
+    // Every view renders.
+    for (const tab of ['source', 'radial', 'convergence']) {
+      await page.click(`#tab-${tab}`);
+      await page.waitForFunction((t) => document.getElementById('view-image').dataset.view === t, tab);
+      const s = await imageStats(page, '#view-image');
+      assert.ok(s.distinctColours > 20, `${tab}: ${s.distinctColours} colours`);
+      await page.screenshot({ path: join(ARTIFACTS, `app-view-${tab}.png`), fullPage: true });
+    }
+    await page.click('#tab-systems');
+    await page.waitForSelector('#systems table');
+    assert.equal(await page.locator('#systems tbody tr').count(), 4);
+    await page.click('#tab-kappa');
+
+    // The FITS download parses with the map size.
+    await page.click('#downloads-panel summary');
+    const [download] = await Promise.all([page.waitForEvent('download'), page.click('#dl-kappa-fits')]);
+    const bytes = await readFile(await download.path());
+    assert.deepEqual(fitsAxes(bytes), [256, 256]);
+    const [dl2] = await Promise.all([page.waitForEvent('download'), page.click('#dl-summary-json')]);
+    const summary = JSON.parse(await readFile(await dl2.path(), 'utf8'));
+    assert.equal(summary.settings.solver.iterations, QUICK_ITERATIONS);
+
+    // Reload: the project comes back from IndexedDB without solving again.
+    await page.reload();
+    await waitStatus(page, /^Restored/);
+    await page.waitForFunction(() => document.getElementById('view-image').dataset.view === 'kappa');
+    const again = await imageStats(page, '#view-image');
+    assert.ok(again.reddish > 50, `after reload only ${again.reddish} red curve pixels`);
+    assert.match(await page.textContent('#summary'), /Restored/);
     assert.deepEqual(app.consoleErrors, []);
     assert.deepEqual(app.foreignRequests, []);
-  } finally {
-    await app.close();
-  }
-});
-
-test('a malformed model file shows its error and keeps the current map', async () => {
-  const app = await openApp();
-  try {
-    const { page } = app;
-    await page.waitForSelector('#kappa-map:not([hidden])', { timeout: 60_000 });
-    const before = await page.getAttribute('#kappa-map', 'src');
-    const dir = await mkdtemp(join(tmpdir(), 'wslap-e2e-'));
-    const bad = join(dir, 'bad-model.json');
-    await writeFile(bad, '{\n  "z_lens": 0.3,\n  "components": [\n    {"type": "sis", "x": 0, "y": 0, "sigma_v": -5}\n  ]\n}\n');
-    await page.setInputFiles('#model-file', bad);
-    await page.waitForSelector('#model-file-status.bad');
-    const message = await page.textContent('#model-file-status');
-    assert.match(message, /bad-model\.json/);
-    assert.match(message, /sigma_v/);
-    assert.equal(await page.getAttribute('#kappa-map', 'src'), before);
-    await page.screenshot({ path: join(ARTIFACTS, 'app-bad-file.png'), fullPage: true });
-    assert.deepEqual(app.consoleErrors, []);
   } finally {
     await app.close();
   }
@@ -55,7 +86,11 @@ test('the page fits a phone-width screen', async () => {
   const app = await openApp({ width: 390, height: 844 });
   try {
     const { page } = app;
-    await page.waitForSelector('#kappa-map:not([hidden])', { timeout: 60_000 });
+    await waitStatus(page, /^Ready/);
+    await setField(page, '#set-reconstruct-solver-iterations', 200);
+    await page.click('#reconstruct');
+    await waitStatus(page, /^Done in/);
+    await page.waitForFunction(() => document.getElementById('view-image').dataset.view === 'kappa');
     const overflow = await page.evaluate(() => document.documentElement.scrollWidth - window.innerWidth);
     assert.ok(overflow <= 0, `page is ${overflow}px wider than the screen`);
     await page.screenshot({ path: join(ARTIFACTS, 'app-phone.png'), fullPage: true });

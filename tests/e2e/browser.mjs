@@ -6,7 +6,7 @@ import { fileURLToPath } from 'node:url';
 import { chromium } from 'playwright-core';
 import { serve } from '../../.ci/serve.mjs';
 
-const ROOT = join(dirname(fileURLToPath(import.meta.url)), '..', '..');
+export const ROOT = join(dirname(fileURLToPath(import.meta.url)), '..', '..');
 export const ARTIFACTS = join(ROOT, 'test-artifacts');
 
 const CHROMIUM_FLAGS = [
@@ -51,11 +51,50 @@ export async function imageStats(page, selector) {
     const { data } = ctx.getImageData(0, 0, c.width, c.height);
     const colours = new Set();
     let reddish = 0;
+    let magenta = 0;
+    let white = 0;
     for (let k = 0; k < data.length; k += 4) {
       const [r, g, b] = [data[k], data[k + 1], data[k + 2]];
       colours.add((r >> 3) << 10 | (g >> 3) << 5 | (b >> 3));
       if (r > 200 && g < 80 && b < 80) reddish += 1;
+      if (r > 220 && g < 100 && b > 220) magenta += 1;
+      if (r > 250 && g > 250 && b > 250) white += 1;
     }
-    return { width: c.width, height: c.height, distinctColours: colours.size, reddish };
+    return { width: c.width, height: c.height, distinctColours: colours.size, reddish, magenta, white };
   });
+}
+
+/** Types `value` into the input `selector` and commits it (a change event). */
+export async function setField(page, selector, value) {
+  await page.$eval(selector, (el) => { const d = el.closest('details'); if (d) d.open = true; });
+  await page.locator(selector).fill(String(value));
+  await page.locator(selector).dispatchEvent('change');
+  // Settings inputs remember the last accepted value in data-good; wait for it (or an error).
+  const isSetting = await page.$eval(selector, (el) => el.id.startsWith('set-'));
+  if (!isSetting) return;
+  await page.waitForFunction(([sel, v]) => {
+    const el = document.querySelector(sel);
+    const err = document.getElementById(`${el.id}-error`);
+    if (err && err.textContent) throw new Error(`${sel}: ${err.textContent}`);
+    return el.dataset.good === v;
+  }, [selector, String(value)]);
+}
+
+/** Waits until the status line matches `pattern` (fails with the error shown, if any). */
+export async function waitStatus(page, pattern, timeout = 60_000) {
+  try {
+    await page.waitForFunction((src) => new RegExp(src).test(document.getElementById('status').textContent),
+      pattern.source, { timeout });
+  } catch (err) {
+    const status = await page.textContent('#status');
+    const error = await page.textContent('#error');
+    throw new Error(`status '${status}' (error: '${error}') never matched ${pattern}: ${err.message}`);
+  }
+}
+
+/** [NAXIS1, NAXIS2] of a FITS file's primary header. */
+export function fitsAxes(bytes) {
+  const header = bytes.subarray(0, 2880 * 4).toString('latin1');
+  const card = (key) => Number(header.match(new RegExp(`${key} *= *(\\d+)`))[1]);
+  return [card('NAXIS1'), card('NAXIS2')];
 }

@@ -7,6 +7,8 @@
 use serde::Serialize;
 use wasm_bindgen::prelude::*;
 
+mod session;
+
 use crate::demo::CLUSTER_MODEL_JSON;
 use crate::model::ModelFile;
 use crate::products::{ProductOptions, Products};

@@ -1,0 +1,245 @@
+//! The files of a session: kept as texts (a project stores them) and checked when loaded, so a
+//! bad file is refused with its line and reason and never replaces a good one.
+
+use glam::DVec2;
+use serde::{Deserialize, Serialize};
+
+use crate::catalog::{parse_image_catalog, parse_member_catalog, ImageCatalog, MemberCatalog};
+use crate::fits::read_image;
+use crate::grid::Map;
+use crate::inversion::{parse_arcs, ArcCatalog};
+use crate::model::ModelFile;
+use crate::sky::SkyReference;
+
+use super::AppError;
+
+/// What a loaded file is.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum DataRole {
+    /// Lenstool multiple-image catalogue (`id x y a b theta z mag`).
+    Images,
+    /// Lenstool member catalogue (`id x y a b theta mag lum`).
+    Members,
+    /// Arc pixels, JSON (see [`parse_arcs`]).
+    Arcs,
+    /// Parametric model file (forward mode).
+    Model,
+}
+
+impl DataRole {
+    /// Parses `images`, `members`, `arcs` or `model`.
+    pub fn parse(s: &str) -> Result<Self, AppError> {
+        match s {
+            "images" => Ok(Self::Images),
+            "members" => Ok(Self::Members),
+            "arcs" => Ok(Self::Arcs),
+            "model" => Ok(Self::Model),
+            other => Err(AppError::File(format!(
+                "unknown file role '{other}' (images, members, arcs or model)"
+            ))),
+        }
+    }
+}
+
+/// A file as loaded: its name and text.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct NamedText {
+    pub name: String,
+    pub text: String,
+}
+
+/// A deflection map (HFF convention, arcsec at `D_ls/D_s = 1`) read from FITS.
+#[derive(Debug, Clone)]
+pub struct NamedMap {
+    pub name: String,
+    pub map: Map,
+    pub reference: Option<SkyReference>,
+}
+
+/// What loading a file found, for the line next to it.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct LoadReport {
+    pub role: String,
+    pub name: String,
+    /// E.g. "19 systems, 50 images".
+    pub summary: String,
+    pub warnings: Vec<String>,
+}
+
+/// Every file of a session.
+#[derive(Debug, Clone, Default)]
+pub struct LoadedData {
+    pub images: Option<NamedText>,
+    pub members: Option<NamedText>,
+    pub arcs: Option<NamedText>,
+    pub model: Option<NamedText>,
+    /// Deflection maps along x and y (look-up mode).
+    pub deflection: [Option<NamedMap>; 2],
+}
+
+/// The catalogues of a session in one frame, the way `wslap reconstruct` reads them: images
+/// first, members in the images' frame.
+#[derive(Debug, Clone, Default)]
+pub struct ParsedData {
+    pub images: Option<ImageCatalog>,
+    pub arcs: Option<ArcCatalog>,
+    pub members: Option<MemberCatalog>,
+    pub warnings: Vec<String>,
+}
+
+impl ParsedData {
+    /// The frame's sky reference (images first, else members).
+    pub fn reference(&self) -> Option<SkyReference> {
+        let images = self.images.as_ref().and_then(|c| c.reference);
+        images.or(self.members.as_ref().and_then(|m| m.reference))
+    }
+
+    /// Observed image positions (catalogue positions, or every arc pixel), arcsec.
+    pub fn observed_arcsec(&self) -> Vec<DVec2> {
+        if let Some(c) = &self.images {
+            return c.images().map(|i| i.position).collect();
+        }
+        let arcs = self.arcs.iter().flat_map(|a| a.systems.iter());
+        arcs.flat_map(|s| s.images.iter().flatten().copied())
+            .collect()
+    }
+
+    /// Member positions, arcsec.
+    pub fn members_arcsec(&self) -> Vec<DVec2> {
+        let members = self.members.iter().flat_map(|m| m.members.iter());
+        members.map(|m| m.position).collect()
+    }
+}
+
+fn describe_images(c: &ImageCatalog) -> String {
+    format!("{} systems, {} images", c.systems.len(), c.image_count())
+}
+
+impl LoadedData {
+    /// Checks `text` as a file of `role` and keeps it; an error leaves everything as it was.
+    pub fn load_text(
+        &mut self,
+        role: DataRole,
+        name: &str,
+        text: &str,
+    ) -> Result<LoadReport, AppError> {
+        let file = |e: &dyn std::fmt::Display| AppError::File(e.to_string());
+        let (summary, warnings) = match role {
+            DataRole::Images => {
+                let (c, w) = parse_image_catalog(text, name, None).map_err(|e| file(&e))?;
+                (
+                    describe_images(&c),
+                    w.iter().map(|w| w.to_string()).collect(),
+                )
+            }
+            DataRole::Members => {
+                let (c, w) = parse_member_catalog(text, name, None).map_err(|e| file(&e))?;
+                let n = c.members.len();
+                (
+                    format!("{n} members"),
+                    w.iter().map(|w| w.to_string()).collect(),
+                )
+            }
+            DataRole::Arcs => {
+                let a = parse_arcs(text, name).map_err(|e| file(&e))?;
+                let pixels: usize = a.systems.iter().flat_map(|s| &s.images).map(Vec::len).sum();
+                let n = a.systems.len();
+                (format!("{n} systems, {pixels} arc pixels"), Vec::new())
+            }
+            DataRole::Model => {
+                let m = ModelFile::from_json_str(text, name).map_err(|e| file(&e))?;
+                let n = m.components.len();
+                (
+                    format!("{n} components at z_lens = {}", m.z_lens),
+                    Vec::new(),
+                )
+            }
+        };
+        let slot = match role {
+            DataRole::Images => &mut self.images,
+            DataRole::Members => &mut self.members,
+            DataRole::Arcs => &mut self.arcs,
+            DataRole::Model => &mut self.model,
+        };
+        *slot = Some(NamedText {
+            name: name.to_string(),
+            text: text.to_string(),
+        });
+        Ok(LoadReport {
+            role: format!("{role:?}").to_lowercase(),
+            name: name.to_string(),
+            summary,
+            warnings,
+        })
+    }
+
+    /// Forgets the file of `role`.
+    pub fn clear(&mut self, role: DataRole) {
+        match role {
+            DataRole::Images => self.images = None,
+            DataRole::Members => self.members = None,
+            DataRole::Arcs => self.arcs = None,
+            DataRole::Model => self.model = None,
+        }
+    }
+
+    /// Reads a deflection FITS map for axis 0 (x) or 1 (y); an error changes nothing.
+    pub fn load_fits(
+        &mut self,
+        axis: usize,
+        name: &str,
+        bytes: &[u8],
+    ) -> Result<LoadReport, AppError> {
+        if axis > 1 {
+            return Err(AppError::File(format!(
+                "{name}: axis {axis} is not 0 (x) or 1 (y)"
+            )));
+        }
+        let file = |e: &dyn std::fmt::Display| AppError::File(e.to_string());
+        let image = read_image(bytes, name).map_err(|e| file(&e))?;
+        let (_, reference) = image.geometry().map_err(|e| file(&e))?;
+        let (map, blanks) = image.to_map_filled(0.0).map_err(|e| file(&e))?;
+        let n = map.geometry.pixels;
+        let mut warnings = Vec::new();
+        if blanks > 0 {
+            warnings.push(format!("{name}: {blanks} blank pixels set to 0"));
+        }
+        let summary = format!(
+            "{n} x {n} pixels, {:.1} arcsec wide",
+            map.geometry.size_arcsec
+        );
+        self.deflection[axis] = Some(NamedMap {
+            name: name.to_string(),
+            map,
+            reference,
+        });
+        Ok(LoadReport {
+            role: ["deflection_x", "deflection_y"][axis].to_string(),
+            name: name.to_string(),
+            summary,
+            warnings,
+        })
+    }
+
+    /// The catalogues parsed into one frame (images first, members in their frame).
+    pub fn parse(&self) -> Result<ParsedData, AppError> {
+        let file = |e: &dyn std::fmt::Display| AppError::File(e.to_string());
+        let mut out = ParsedData::default();
+        if let Some(f) = &self.images {
+            let (c, w) = parse_image_catalog(&f.text, &f.name, None).map_err(|e| file(&e))?;
+            out.warnings.extend(w.iter().map(|w| w.to_string()));
+            out.images = Some(c);
+        }
+        if let Some(f) = &self.arcs {
+            out.arcs = Some(parse_arcs(&f.text, &f.name).map_err(|e| file(&e))?);
+        }
+        if let Some(f) = &self.members {
+            let frame = out.images.as_ref().and_then(|c| c.reference);
+            let (m, w) = parse_member_catalog(&f.text, &f.name, frame).map_err(|e| file(&e))?;
+            out.warnings.extend(w.iter().map(|w| w.to_string()));
+            out.members = Some(m);
+        }
+        Ok(out)
+    }
+}

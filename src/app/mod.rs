@@ -1,0 +1,91 @@
+//! The browser app's core, free of JavaScript: a [`Session`] holds the loaded data (as texts, so
+//! a project file can store them), the settings and the last result; it loads files without
+//! losing what was loaded before, runs a reconstruction, a forward model or a look-up of
+//! deflection maps, redraws curves at another source redshift from the stored maps, renders
+//! the views and answers hover read-outs. `wasm.rs` is a thin shell around it.
+
+mod data;
+pub mod examples;
+mod outputs;
+mod plots;
+mod project;
+mod run;
+mod settings;
+mod source_plane;
+mod views;
+
+use thiserror::Error;
+
+pub use data::{DataRole, LoadReport, LoadedData, NamedText};
+pub use outputs::ReconstructSummary;
+pub use project::{Project, ProjectResult, PROJECT_FORMAT, PROJECT_VERSION};
+pub use run::{RunKind, SessionResult};
+pub use settings::{AppSettings, APP_MAP_PIXELS};
+pub use views::{HoverReadout, ViewOptions, ViewPng};
+
+/// What the app reports to the user; every message names the file, line or setting.
+#[derive(Debug, Error)]
+pub enum AppError {
+    /// A file that could not be read (the message names the file and line).
+    #[error("{0}")]
+    File(String),
+    /// A setting that is not allowed (the message names the field).
+    #[error("{0}")]
+    Setting(String),
+    /// Nothing to run, or a view asked for before any result.
+    #[error("{0}")]
+    Missing(String),
+    /// The computation failed (the core's message).
+    #[error("{0}")]
+    Run(String),
+}
+
+/// Loaded data, settings and the last result of one app session.
+#[derive(Debug, Default)]
+pub struct Session {
+    pub data: LoadedData,
+    pub settings: AppSettings,
+    pub result: Option<SessionResult>,
+    /// The example or project name shown by the app.
+    pub name: String,
+}
+
+impl Session {
+    /// An empty session with default settings.
+    pub fn new() -> Self {
+        Self::default()
+    }
+
+    /// Loads one text file in `role`; on an error nothing that was loaded changes.
+    pub fn load_text(
+        &mut self,
+        role: DataRole,
+        name: &str,
+        text: &str,
+    ) -> Result<LoadReport, AppError> {
+        self.data.load_text(role, name, text)
+    }
+
+    /// Loads one deflection FITS map (`axis` 0 for x, 1 for y); nothing changes on an error.
+    pub fn load_fits(
+        &mut self,
+        axis: usize,
+        name: &str,
+        bytes: &[u8],
+    ) -> Result<LoadReport, AppError> {
+        self.data.load_fits(axis, name, bytes)
+    }
+
+    /// Sets one setting (see [`AppSettings::with_field`]); the old value stays on an error.
+    pub fn set_field(&mut self, path: &str, value: serde_json::Value) -> Result<(), AppError> {
+        self.settings = self.settings.with_field(path, value)?;
+        Ok(())
+    }
+
+    /// The last result, or an error saying that nothing was computed yet.
+    pub fn result(&self) -> Result<&SessionResult, AppError> {
+        self.result
+            .as_ref()
+            .ok_or_else(|| AppError::Missing("nothing has been computed yet".to_string()))
+    }
+}

@@ -1,0 +1,190 @@
+//! The project file: one JSON document with the data texts, the settings and the result
+//! (summary, per-system reports, convergence and the solution vector `X`), so that reloading
+//! a project rebuilds the maps from `X` without iterating again.
+//!
+//! ```json
+//! {"format": "wslap-project", "version": 1, "name": "...",
+//!  "data": {"images": {"name": "...", "text": "..."}, "members": null, "arcs": null, "model": null},
+//!  "settings": {...AppSettings...},
+//!  "result": {"kind": "reconstruct", "summary": {...}, "x": [...], "iterations": 8000,
+//!             "sources": [...], "convergence": [...]}}
+//! ```
+//! Deflection FITS maps are not stored (they are large binaries): load them again.
+
+use serde::{Deserialize, Serialize};
+
+use crate::reconstruct::{ConvergenceRecord, SourceReport};
+
+use super::data::NamedText;
+use super::outputs::pretty;
+use super::run::RunKind;
+use super::{AppError, AppSettings, Session};
+
+/// The `format` field of every project file.
+pub const PROJECT_FORMAT: &str = "wslap-project";
+/// The version this code writes and reads.
+pub const PROJECT_VERSION: u32 = 1;
+
+/// The data texts of a project.
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
+#[serde(default)]
+pub struct ProjectData {
+    pub images: Option<NamedText>,
+    pub members: Option<NamedText>,
+    pub arcs: Option<NamedText>,
+    pub model: Option<NamedText>,
+}
+
+/// The stored result.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct ProjectResult {
+    pub kind: RunKind,
+    /// `summary.json` of the result.
+    pub summary: serde_json::Value,
+    /// The solution vector `X` of a reconstruction.
+    #[serde(default)]
+    pub x: Option<Vec<f64>>,
+    #[serde(default)]
+    pub iterations: usize,
+    #[serde(default)]
+    pub sources: Vec<SourceReport>,
+    #[serde(default)]
+    pub convergence: Vec<ConvergenceRecord>,
+}
+
+/// A saved session.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Project {
+    pub format: String,
+    pub version: u32,
+    #[serde(default)]
+    pub name: String,
+    #[serde(default)]
+    pub data: ProjectData,
+    #[serde(default)]
+    pub settings: AppSettings,
+    #[serde(default)]
+    pub result: Option<ProjectResult>,
+}
+
+/// What reopening a project did.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct ReopenReport {
+    pub name: String,
+    /// "restored" (maps rebuilt from X), "recomputed" (a forward model or look-up was rerun),
+    /// "solve_needed" (a reconstruction without a usable X: solve again) or "none".
+    pub result: String,
+    pub message: String,
+}
+
+impl Session {
+    /// The project of this session (pretty JSON).
+    pub fn project_json(&self) -> Result<String, AppError> {
+        let d = &self.data;
+        let result = match &self.result {
+            None => None,
+            Some(r) => Some(ProjectResult {
+                kind: r.kind,
+                summary: serde_json::from_str(&r.summary_json()?)
+                    .map_err(|e| AppError::Run(e.to_string()))?,
+                x: r.reconstruction.as_ref().map(|x| x.x.clone()),
+                iterations: r.reconstruction.as_ref().map_or(0, |x| x.iterations),
+                sources: r
+                    .reconstruction
+                    .as_ref()
+                    .map(|x| x.sources.clone())
+                    .unwrap_or_default(),
+                convergence: r
+                    .reconstruction
+                    .as_ref()
+                    .map(|x| x.convergence.clone())
+                    .unwrap_or_default(),
+            }),
+        };
+        pretty(&Project {
+            format: PROJECT_FORMAT.to_string(),
+            version: PROJECT_VERSION,
+            name: self.name.clone(),
+            data: ProjectData {
+                images: d.images.clone(),
+                members: d.members.clone(),
+                arcs: d.arcs.clone(),
+                model: d.model.clone(),
+            },
+            settings: self.settings.clone(),
+            result,
+        })
+    }
+
+    /// Replaces the session by the project in `text` (`source_name` names it in errors). The
+    /// session changes only if the whole project reads: format, version, every data file and
+    /// the settings. A stored reconstruction is rebuilt from its `X` (no iterations); a forward
+    /// model is recomputed.
+    pub fn open_project(
+        &mut self,
+        text: &str,
+        source_name: &str,
+    ) -> Result<ReopenReport, AppError> {
+        let p: Project = serde_json::from_str(text).map_err(|e| {
+            AppError::File(format!(
+                "{source_name}: line {}, column {}: {e}",
+                e.line(),
+                e.column()
+            ))
+        })?;
+        if p.format != PROJECT_FORMAT || p.version != PROJECT_VERSION {
+            return Err(AppError::File(format!(
+                "{source_name}: format '{}' version {} is not a {PROJECT_FORMAT} version {PROJECT_VERSION} file",
+                p.format, p.version
+            )));
+        }
+        p.settings
+            .validate()
+            .map_err(|e| AppError::File(format!("{source_name}: settings: {e}")))?;
+        let mut next = Session {
+            settings: p.settings,
+            name: p.name.clone(),
+            ..Session::default()
+        };
+        use super::DataRole as R;
+        for (role, file) in [
+            (R::Images, &p.data.images),
+            (R::Members, &p.data.members),
+            (R::Arcs, &p.data.arcs),
+            (R::Model, &p.data.model),
+        ] {
+            if let Some(f) = file {
+                next.load_text(role, &f.name, &f.text)
+                    .map_err(|e| AppError::File(format!("{source_name}: {e}")))?;
+            }
+        }
+        let (result, message) = match p.result {
+            None => ("none", "project opened".to_string()),
+            Some(r) => match (r.kind, r.x) {
+                (RunKind::Reconstruct, Some(x)) => {
+                    match next.restore_reconstruction(x, r.iterations, r.convergence, r.sources) {
+                        Ok(()) => ("restored", "maps rebuilt from the stored solution X".into()),
+                        Err(e) => (
+                            "solve_needed",
+                            format!("the stored solution was not used ({e}): reconstruct again"),
+                        ),
+                    }
+                }
+                (RunKind::Reconstruct, None) => (
+                    "solve_needed",
+                    "no stored solution: reconstruct again".to_string(),
+                ),
+                (kind, _) => match next.run(kind, &mut |_| crate::solver::Control::Continue) {
+                    Ok(()) => ("recomputed", "maps computed again".to_string()),
+                    Err(e) => ("solve_needed", format!("could not recompute: {e}")),
+                },
+            },
+        };
+        *self = next;
+        Ok(ReopenReport {
+            name: p.name,
+            result: result.to_string(),
+            message,
+        })
+    }
+}

@@ -1,0 +1,310 @@
+//! Running a session: a WSLAP+ reconstruction, a forward model or a look-up of deflection
+//! maps; the result keeps the maps, so curves at another source redshift need no new solve.
+
+use glam::DVec2;
+use serde::{Deserialize, Serialize};
+
+use crate::curves::critical_curves;
+use crate::inversion::{
+    build_constraints, build_member_layers, CellGrid, ConstraintMode, ConstraintSource, Layer,
+    LinearSystem,
+};
+use crate::model::ModelFile;
+use crate::products::{ProductOptions, Products};
+use crate::profiles::Lens;
+use crate::reconstruct::{
+    reconstruct, ConvergenceRecord, Inputs, LayerSource, ReconstructConfig, SourceReport,
+    StageTimings,
+};
+use crate::solver::Control;
+
+use super::data::ParsedData;
+use super::{AppError, Session};
+
+/// Map width of a forward model without a `products.size_arcsec` setting (arcsec).
+const FORWARD_SIZE_ARCSEC: f64 = 200.0;
+
+/// What a run computes.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum RunKind {
+    /// WSLAP+ from the image catalogue or arcs (and members).
+    Reconstruct,
+    /// Maps and curves of the model file.
+    Forward,
+    /// Maps and curves of the deflection FITS pair.
+    Lookup,
+}
+
+/// What a reconstruction adds to the maps.
+#[derive(Debug)]
+pub struct ReconstructionResult {
+    pub config: ReconstructConfig,
+    pub system: LinearSystem,
+    /// The solution vector `X` (see [`crate::reconstruct::Reconstruction::x`]).
+    pub x: Vec<f64>,
+    /// "Completed", "Cancelled", "Diverged" or "Restored" (rebuilt from a stored `X`).
+    pub status: String,
+    pub iterations: usize,
+    pub convergence: Vec<ConvergenceRecord>,
+    pub sources: Vec<SourceReport>,
+    pub warnings: Vec<String>,
+    pub timings: StageTimings,
+    pub lens: Lens,
+}
+
+/// The last result of a session.
+#[derive(Debug)]
+pub struct SessionResult {
+    pub kind: RunKind,
+    pub products: Products,
+    /// Observed images (arcsec), members (arcsec) of the data.
+    pub observed: Vec<DVec2>,
+    pub members: Vec<DVec2>,
+    pub reconstruction: Option<ReconstructionResult>,
+    /// Wall-clock time of the run in ms.
+    pub elapsed_ms: f64,
+}
+
+impl SessionResult {
+    /// Critical curves, caustics and magnification at `z_source` from the stored maps
+    /// (`f = D_ls/D_s(z_source)`), without solving again.
+    pub fn redraw(&mut self, z_source: f64) -> Result<(), AppError> {
+        let p = &mut self.products;
+        let f = p
+            .plane
+            .distance_ratio(z_source)
+            .map_err(|e| AppError::Setting(format!("z_source: {e}")))?;
+        p.distance_ratio = f;
+        p.magnification = p.maps.magnification(f);
+        p.curves = critical_curves(&p.maps, f, z_source, None);
+        Ok(())
+    }
+
+    /// Predicted image positions of every system (arcsec).
+    pub fn predicted(&self) -> Vec<DVec2> {
+        let sources = self.reconstruction.iter().flat_map(|r| r.sources.iter());
+        sources
+            .flat_map(|s| s.predicted.iter().map(|p| p.position_arcsec))
+            .collect()
+    }
+}
+
+/// The constraint source of the data with the configuration's mode (arcs force mode "arcs"
+/// when they are the only constraints, as in the CLI).
+fn constraint_source<'a>(
+    parsed: &'a ParsedData,
+    config: &mut ReconstructConfig,
+) -> Result<ConstraintSource<'a>, AppError> {
+    match (&parsed.images, &parsed.arcs) {
+        (Some(_), Some(a)) if config.constraints.mode == ConstraintMode::Arcs => {
+            Ok(ConstraintSource::Arcs(a))
+        }
+        (Some(c), _) => Ok(ConstraintSource::Catalog(c)),
+        (None, Some(a)) => {
+            config.constraints.mode = ConstraintMode::Arcs;
+            Ok(ConstraintSource::Arcs(a))
+        }
+        (None, None) => Err(AppError::Missing(
+            "load an image catalogue or an arcs file to reconstruct".to_string(),
+        )),
+    }
+}
+
+impl Session {
+    /// Runs `kind`; `progress` sees every QADP report (reconstruction only) and may cancel.
+    /// The previous result is replaced only on success.
+    pub fn run(
+        &mut self,
+        kind: RunKind,
+        progress: &mut dyn FnMut(&ConvergenceRecord) -> Control,
+    ) -> Result<(), AppError> {
+        let t = crate::products::Clock::start();
+        let mut result = match kind {
+            RunKind::Reconstruct => self.run_reconstruction(progress)?,
+            RunKind::Forward => self.run_forward()?,
+            RunKind::Lookup => self.run_lookup()?,
+        };
+        result.elapsed_ms = t.ms();
+        self.result = Some(result);
+        Ok(())
+    }
+
+    fn run_reconstruction(
+        &self,
+        progress: &mut dyn FnMut(&ConvergenceRecord) -> Control,
+    ) -> Result<SessionResult, AppError> {
+        let parsed = self.data.parse()?;
+        let plane = self.settings.lens_plane()?;
+        let mut config = self.settings.reconstruct.clone();
+        let images = constraint_source(&parsed, &mut config)?;
+        let inputs = Inputs {
+            images,
+            layers: parsed
+                .members
+                .as_ref()
+                .map_or(LayerSource::None, LayerSource::Members),
+            plane,
+            reference: parsed.reference(),
+            holdout: &[],
+            catalog: parsed.images.as_ref(),
+        };
+        let r =
+            reconstruct(&inputs, &config, progress).map_err(|e| AppError::Run(e.to_string()))?;
+        let mut warnings = parsed.warnings.clone();
+        warnings.extend(r.warnings);
+        Ok(SessionResult {
+            kind: RunKind::Reconstruct,
+            products: r.products,
+            observed: parsed.observed_arcsec(),
+            members: parsed.members_arcsec(),
+            reconstruction: Some(ReconstructionResult {
+                config: r.config,
+                system: r.system,
+                x: r.x,
+                status: format!("{:?}", r.status),
+                iterations: r.iterations,
+                convergence: r.convergence,
+                sources: r.sources,
+                warnings,
+                timings: r.timings,
+                lens: r.lens,
+            }),
+            elapsed_ms: 0.0,
+        })
+    }
+
+    /// Rebuilds a reconstruction from a stored solution `x` without iterating: the same
+    /// constraints, grid, layers and linear system as the run that found `x` (no grid
+    /// refinements), the lens of `x` and its products. Sources and convergence come from the
+    /// project.
+    pub fn restore_reconstruction(
+        &mut self,
+        x: Vec<f64>,
+        iterations: usize,
+        convergence: Vec<ConvergenceRecord>,
+        sources: Vec<SourceReport>,
+    ) -> Result<(), AppError> {
+        let t = crate::products::Clock::start();
+        let run = |e: &dyn std::fmt::Display| AppError::Run(e.to_string());
+        let parsed = self.data.parse()?;
+        let plane = self.settings.lens_plane()?;
+        let mut config = self.settings.reconstruct.clone();
+        if config.grid.refinements > 0 {
+            return Err(AppError::Missing(
+                "a refined grid cannot be rebuilt from X: solve again".to_string(),
+            ));
+        }
+        let source = constraint_source(&parsed, &mut config)?;
+        let constraints =
+            build_constraints(source, &config.constraints, &[]).map_err(|e| run(&e))?;
+        let positions: Vec<DVec2> = constraints.pixels.iter().map(|p| p.position).collect();
+        let grid = CellGrid::from_config(&config.grid, &positions).map_err(|e| run(&e))?;
+        let mut warnings = parsed.warnings.clone();
+        let layers: Vec<Layer> = match &parsed.members {
+            None => Vec::new(),
+            Some(m) => {
+                let model =
+                    build_member_layers(m, &config.members, &plane, &grid).map_err(|e| run(&e))?;
+                warnings.extend(model.warnings);
+                model.layers
+            }
+        };
+        let system = LinearSystem::build(&grid, &layers, &constraints, &plane, &config.system)
+            .map_err(|e| run(&e))?;
+        let lens = system.reconstructed_lens(&x).map_err(|e| run(&e))?;
+        let opts = ProductOptions {
+            z_source: config.products.z_source,
+            size_arcsec: config.products.size_arcsec.unwrap_or(grid.width_arcsec),
+            pixels: config.products.pixels,
+            ..ProductOptions::default()
+        };
+        let products =
+            Products::from_lens(&lens, plane, parsed.reference(), &opts).map_err(|e| run(&e))?;
+        self.result = Some(SessionResult {
+            kind: RunKind::Reconstruct,
+            products,
+            observed: parsed.observed_arcsec(),
+            members: parsed.members_arcsec(),
+            reconstruction: Some(ReconstructionResult {
+                config,
+                system,
+                x,
+                status: "Restored".to_string(),
+                iterations,
+                convergence,
+                sources,
+                warnings,
+                timings: StageTimings::default(),
+                lens,
+            }),
+            elapsed_ms: t.ms(),
+        });
+        Ok(())
+    }
+
+    fn run_forward(&self) -> Result<SessionResult, AppError> {
+        let file = self
+            .data
+            .model
+            .as_ref()
+            .ok_or_else(|| AppError::Missing("load a model file first".to_string()))?;
+        let model = ModelFile::from_json_str(&file.text, &file.name)
+            .map_err(|e| AppError::File(e.to_string()))?;
+        let p = &self.settings.reconstruct.products;
+        let opts = ProductOptions {
+            z_source: p.z_source,
+            size_arcsec: p.size_arcsec.unwrap_or(FORWARD_SIZE_ARCSEC),
+            pixels: p.pixels,
+            ..ProductOptions::default()
+        };
+        let products =
+            Products::from_model(&model, &opts).map_err(|e| AppError::Run(e.to_string()))?;
+        let parsed = self.data.parse().unwrap_or_default();
+        Ok(SessionResult {
+            kind: RunKind::Forward,
+            products,
+            observed: parsed.observed_arcsec(),
+            members: parsed.members_arcsec(),
+            reconstruction: None,
+            elapsed_ms: 0.0,
+        })
+    }
+
+    fn run_lookup(&self) -> Result<SessionResult, AppError> {
+        let [Some(ax), Some(ay)] = &self.data.deflection else {
+            return Err(AppError::Missing(
+                "load both deflection maps (x and y) first".to_string(),
+            ));
+        };
+        let plane = self.settings.lens_plane()?;
+        let products = Products::from_deflection(
+            ax.map.clone(),
+            ay.map.clone(),
+            plane,
+            ax.reference,
+            self.settings.reconstruct.products.z_source,
+        )
+        .map_err(|e| AppError::Run(format!("{} / {}: {e}", ax.name, ay.name)))?;
+        Ok(SessionResult {
+            kind: RunKind::Lookup,
+            products,
+            observed: Vec::new(),
+            members: Vec::new(),
+            reconstruction: None,
+            elapsed_ms: 0.0,
+        })
+    }
+
+    /// Sets `products.z_source` and redraws the curves of the last result from its maps.
+    pub fn set_z_source(&mut self, z_source: f64) -> Result<(), AppError> {
+        let next = self
+            .settings
+            .with_field("reconstruct.products.z_source", z_source.into())?;
+        if let Some(r) = &mut self.result {
+            r.redraw(z_source)?;
+        }
+        self.settings = next;
+        Ok(())
+    }
+}

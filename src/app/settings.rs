@@ -1,0 +1,87 @@
+//! The app's settings: the lens plane (z_lens, cosmology) and a [`ReconstructConfig`], edited
+//! one field at a time with validation, so that a bad value never replaces a good one.
+
+use serde::{Deserialize, Serialize};
+
+use crate::cosmology::{Cosmology, LensPlane};
+use crate::reconstruct::ReconstructConfig;
+
+use super::AppError;
+
+/// Map side in pixels the app uses by default (the CLI's default is 512).
+pub const APP_MAP_PIXELS: usize = 256;
+
+/// Every setting of a session.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct AppSettings {
+    /// Lens redshift (default 0.35).
+    pub z_lens: f64,
+    /// Hubble constant in km/s/Mpc (default 70).
+    pub h0: f64,
+    /// Omega_m of flat LCDM (default 0.3).
+    pub omega_m: f64,
+    /// The reconstruction settings (`CONFIG.json` of `wslap reconstruct`); the app's default
+    /// map side is [`APP_MAP_PIXELS`].
+    pub reconstruct: ReconstructConfig,
+}
+
+impl Default for AppSettings {
+    fn default() -> Self {
+        let mut reconstruct = ReconstructConfig::default();
+        reconstruct.products.pixels = APP_MAP_PIXELS;
+        Self {
+            z_lens: 0.35,
+            h0: 70.0,
+            omega_m: 0.3,
+            reconstruct,
+        }
+    }
+}
+
+impl AppSettings {
+    /// Checks the cosmology, the lens redshift and every block of the reconstruction settings.
+    pub fn validate(&self) -> Result<(), AppError> {
+        self.lens_plane()?;
+        self.reconstruct
+            .validate()
+            .map_err(|e| AppError::Setting(e.to_string()))
+    }
+
+    /// The lens plane at `z_lens` in flat LCDM with `h0`, `omega_m`.
+    pub fn lens_plane(&self) -> Result<LensPlane, AppError> {
+        let cosmology =
+            Cosmology::new(self.h0, self.omega_m).map_err(|e| AppError::Setting(e.to_string()))?;
+        LensPlane::new(cosmology, self.z_lens).map_err(|e| AppError::Setting(e.to_string()))
+    }
+
+    /// These settings with the field at `path` (dot-separated, e.g. `reconstruct.grid.cells`)
+    /// set to `value`; `null` clears an optional field. Fails, leaving `self` as it was, when
+    /// the path is unknown, the value has the wrong type, or the result does not validate.
+    pub fn with_field(&self, path: &str, value: serde_json::Value) -> Result<Self, AppError> {
+        let mut tree = serde_json::to_value(self).map_err(|e| AppError::Setting(e.to_string()))?;
+        let pointer = format!("/{}", path.replace('.', "/"));
+        let slot = tree
+            .pointer_mut(&pointer)
+            .ok_or_else(|| AppError::Setting(format!("{path}: no such setting")))?;
+        *slot = value;
+        let next: Self =
+            serde_json::from_value(tree).map_err(|e| AppError::Setting(format!("{path}: {e}")))?;
+        next.validate()
+            .map_err(|e| AppError::Setting(format!("{path}: {e}")))?;
+        Ok(next)
+    }
+
+    /// Parses settings JSON (missing fields take their defaults); errors name the line.
+    pub fn from_json_str(text: &str, source_name: &str) -> Result<Self, AppError> {
+        let s: Self = serde_json::from_str(text).map_err(|e| {
+            AppError::Setting(format!(
+                "{source_name}: line {}, column {}: {e}",
+                e.line(),
+                e.column()
+            ))
+        })?;
+        s.validate()?;
+        Ok(s)
+    }
+}

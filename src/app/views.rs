@@ -1,0 +1,157 @@
+//! The app's views, rendered with tiny-skia: the kappa map with curves and points, the source
+//! plane, the radial profile and the convergence plot; and the hover read-out of the kappa map.
+
+use glam::DVec2;
+use serde::{Deserialize, Serialize};
+
+use crate::render::{
+    kappa_figure_frame, render_kappa_png, ColorScale, FigureFrame, KappaPlotOptions, Marker,
+    Overlay, OverlayPoints,
+};
+
+use super::{AppError, Session};
+
+/// Observed images: magenta plus signs.
+pub const OBSERVED_RGB: [u8; 3] = [255, 60, 255];
+/// Predicted images: orange crosses.
+pub const PREDICTED_RGB: [u8; 3] = [255, 170, 0];
+/// Member galaxies: white circles.
+pub const MEMBER_RGB: [u8; 3] = [255, 255, 255];
+
+/// What to draw.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct ViewOptions {
+    /// Colour scale of the kappa map (default log).
+    pub scale: ColorScale,
+    pub show_members: bool,
+    pub show_observed: bool,
+    pub show_predicted: bool,
+    /// Map side on screen in pixels (default 512).
+    pub map_pixels_on_screen: u32,
+}
+
+impl Default for ViewOptions {
+    fn default() -> Self {
+        Self {
+            scale: ColorScale::Log,
+            show_members: true,
+            show_observed: true,
+            show_predicted: true,
+            map_pixels_on_screen: 512,
+        }
+    }
+}
+
+/// One rendered view.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ViewPng {
+    /// File name for downloads, e.g. `kappa.png`.
+    pub name: String,
+    pub png: Vec<u8>,
+}
+
+/// What is under the cursor on the kappa map.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct HoverReadout {
+    pub x_arcsec: f64,
+    pub y_arcsec: f64,
+    /// `kappa` at `D_ls/D_s = 1` (bilinear).
+    pub kappa: f64,
+    /// Magnification at the curves' source redshift (bilinear).
+    pub magnification: f64,
+    pub z_source: f64,
+}
+
+fn points(label: &str, rgb: [u8; 3], marker: Marker, p: Vec<DVec2>) -> OverlayPoints {
+    OverlayPoints {
+        label: label.to_string(),
+        color: rgb,
+        positions_arcsec: p,
+        marker,
+    }
+}
+
+fn render(e: impl std::fmt::Display) -> AppError {
+    AppError::Run(format!("rendering: {e}"))
+}
+
+impl Session {
+    fn kappa_options(&self, opts: &ViewOptions) -> Result<KappaPlotOptions, AppError> {
+        let r = self.result()?;
+        Ok(KappaPlotOptions {
+            scale: opts.scale,
+            map_pixels_on_screen: opts.map_pixels_on_screen,
+            title: Some(format!(
+                "kappa (z_l = {}), critical curves at z_s = {}",
+                r.products.plane.z_lens, r.products.curves.z_source
+            )),
+            ..KappaPlotOptions::default()
+        })
+    }
+
+    /// The kappa map (lin/log) with colour bar, arcsec axes, tangential (red) and radial (cyan)
+    /// critical curves, members, observed and predicted images.
+    pub fn kappa_view(&self, opts: &ViewOptions) -> Result<ViewPng, AppError> {
+        let r = self.result()?;
+        let mut overlay = Overlay {
+            curves: Some(&r.products.curves),
+            points: Vec::new(),
+        };
+        if opts.show_members {
+            let m = r.members.clone();
+            overlay
+                .points
+                .push(points("members", MEMBER_RGB, Marker::Circle, m));
+        }
+        if opts.show_observed {
+            let o = r.observed.clone();
+            overlay
+                .points
+                .push(points("observed", OBSERVED_RGB, Marker::Plus, o));
+        }
+        if opts.show_predicted {
+            let p = r.predicted();
+            overlay
+                .points
+                .push(points("predicted", PREDICTED_RGB, Marker::Cross, p));
+        }
+        let png = render_kappa_png(&r.products.maps.kappa, &overlay, &self.kappa_options(opts)?)
+            .map_err(render)?;
+        Ok(ViewPng {
+            name: "kappa.png".to_string(),
+            png,
+        })
+    }
+
+    /// Where the map lies in the kappa view drawn with `opts` (PNG pixels).
+    pub fn kappa_frame(&self, opts: &ViewOptions) -> Result<FigureFrame, AppError> {
+        let kappa = &self.result()?.products.maps.kappa;
+        kappa_figure_frame(kappa, &self.kappa_options(opts)?).map_err(render)
+    }
+
+    /// x, y (arcsec), kappa and magnification under the point `(px, py)` of the kappa view
+    /// drawn with `opts` (PNG pixels, origin top-left); `None` outside the map.
+    pub fn hover(
+        &self,
+        opts: &ViewOptions,
+        px: f32,
+        py: f32,
+    ) -> Result<Option<HoverReadout>, AppError> {
+        let r = self.result()?;
+        let kappa = &r.products.maps.kappa;
+        let frame = self.kappa_frame(opts)?;
+        let inside = |v: f32, lo: f32| v >= lo && v <= lo + frame.map_side;
+        if !(inside(px, frame.map_left) && inside(py, frame.map_top)) {
+            return Ok(None);
+        }
+        let p = frame.screen_to_arcsec(px, py);
+        Ok(Some(HoverReadout {
+            x_arcsec: p.x,
+            y_arcsec: p.y,
+            kappa: kappa.sample(p),
+            magnification: r.products.magnification.sample(p),
+            z_source: r.products.curves.z_source,
+        }))
+    }
+}

@@ -1,0 +1,217 @@
+//! `AppSession`: the app's [`Session`] as a JavaScript class living in the web worker.
+//! Every method is a thin conversion; the work and the error messages are the core's.
+
+use wasm_bindgen::prelude::*;
+
+use crate::app::{DataRole, RunKind, Session, ViewOptions};
+use crate::reconstruct::ConvergenceRecord;
+use crate::solver::Control;
+
+use super::{set, to_js};
+
+/// Least time between two progress messages, in ms.
+const PROGRESS_INTERVAL_MS: f64 = 100.0;
+
+fn err(e: impl std::fmt::Display) -> JsError {
+    JsError::new(&e.to_string())
+}
+
+fn view_options(options: JsValue) -> Result<ViewOptions, JsError> {
+    if options.is_undefined() || options.is_null() {
+        return Ok(ViewOptions::default());
+    }
+    serde_wasm_bindgen::from_value(options).map_err(|e| JsError::new(&format!("view options: {e}")))
+}
+
+fn bytes(png: &[u8]) -> JsValue {
+    js_sys::Uint8Array::from(png).into()
+}
+
+/// One session: loaded data, settings and the last result.
+#[wasm_bindgen]
+pub struct AppSession {
+    inner: Session,
+}
+
+impl Default for AppSession {
+    fn default() -> Self {
+        Self::new()
+    }
+}
+
+#[wasm_bindgen]
+impl AppSession {
+    /// An empty session with the app's default settings.
+    #[wasm_bindgen(constructor)]
+    pub fn new() -> AppSession {
+        AppSession {
+            inner: Session::new(),
+        }
+    }
+
+    /// Sets the name shown in titles (an example or project name).
+    pub fn set_name(&mut self, name: &str) {
+        self.inner.name = name.to_string();
+    }
+
+    /// Loads a text file as `role` (images, members, arcs, model); returns its `LoadReport`.
+    /// On an error (naming the file, line and reason) nothing loaded changes.
+    pub fn load_text(&mut self, role: &str, name: &str, text: &str) -> Result<JsValue, JsError> {
+        let role = DataRole::parse(role).map_err(err)?;
+        to_js(&self.inner.load_text(role, name, text).map_err(err)?)
+    }
+
+    /// Forgets the file of `role`.
+    pub fn clear(&mut self, role: &str) -> Result<(), JsError> {
+        self.inner.data.clear(DataRole::parse(role).map_err(err)?);
+        Ok(())
+    }
+
+    /// Loads a deflection FITS map for `axis` 0 (x) or 1 (y).
+    pub fn load_fits(&mut self, axis: usize, name: &str, data: &[u8]) -> Result<JsValue, JsError> {
+        to_js(&self.inner.load_fits(axis, name, data).map_err(err)?)
+    }
+
+    /// The settings (`AppSettings` as JSON-compatible object).
+    pub fn settings(&self) -> Result<JsValue, JsError> {
+        to_js(&self.inner.settings)
+    }
+
+    /// Sets the setting at `path` (e.g. `reconstruct.grid.cells`) to `value`; on an error the old
+    /// value stays. Returns the settings.
+    pub fn set_field(&mut self, path: &str, value: JsValue) -> Result<JsValue, JsError> {
+        let value: serde_json::Value = serde_wasm_bindgen::from_value(value)
+            .map_err(|e| JsError::new(&format!("{path}: {e}")))?;
+        self.inner.set_field(path, value).map_err(err)?;
+        self.settings()
+    }
+
+    /// Runs `kind` (reconstruct, forward, lookup). `progress` receives
+    /// `{level, iteration, objective, grid_mass_msun, c, elapsed_ms}` at most every 100 ms.
+    /// Returns `{kind, elapsed_ms, status, summary}`.
+    pub fn run(&mut self, kind: &str, progress: &js_sys::Function) -> Result<JsValue, JsError> {
+        let kind: RunKind = serde_json::from_value(serde_json::Value::String(kind.into()))
+            .map_err(|_| JsError::new(&format!("unknown run kind '{kind}'")))?;
+        let clock = crate::products::Clock::start();
+        let mut last = f64::NEG_INFINITY;
+        let mut report = |r: &ConvergenceRecord| {
+            let now = clock.ms();
+            if now - last >= PROGRESS_INTERVAL_MS {
+                last = now;
+                if let Ok(v) = to_js(r) {
+                    if let Some(obj) = v.dyn_ref::<js_sys::Object>() {
+                        let _ = set(obj, "elapsed_ms", &JsValue::from_f64(now));
+                    }
+                    let _ = progress.call1(&JsValue::NULL, &v);
+                }
+            }
+            Control::Continue
+        };
+        self.inner.run(kind, &mut report).map_err(err)?;
+        self.result_info()
+    }
+
+    /// `{kind, elapsed_ms, status, iterations, summary}` of the last result.
+    pub fn result_info(&self) -> Result<JsValue, JsError> {
+        let r = self.inner.result().map_err(err)?;
+        let summary: serde_json::Value =
+            serde_json::from_str(&r.summary_json().map_err(err)?).map_err(err)?;
+        let rec = r.reconstruction.as_ref();
+        to_js(&serde_json::json!({
+            "kind": r.kind,
+            "elapsed_ms": r.elapsed_ms,
+            "status": rec.map(|x| x.status.clone()),
+            "iterations": rec.map(|x| x.iterations),
+            "summary": summary,
+        }))
+    }
+
+    /// Sets the source redshift and redraws the curves from the stored maps (no new solve).
+    pub fn set_z_source(&mut self, z_source: f64) -> Result<JsValue, JsError> {
+        self.inner.set_z_source(z_source).map_err(err)?;
+        self.settings()
+    }
+
+    /// One view as PNG bytes: `kappa`, `source`, `data`, `radial` or `convergence`.
+    pub fn view(&self, name: &str, options: JsValue) -> Result<JsValue, JsError> {
+        let opts = view_options(options)?;
+        let s = &self.inner;
+        let v = match name {
+            "kappa" => s.kappa_view(&opts),
+            "source" => s.source_view(&opts),
+            "data" => s.data_view(&opts),
+            "radial" => s.radial_view(),
+            "convergence" => s.convergence_view(),
+            other => return Err(JsError::new(&format!("unknown view '{other}'"))),
+        }
+        .map_err(err)?;
+        Ok(bytes(&v.png))
+    }
+
+    /// x, y (arcsec), kappa and magnification under PNG pixel `(px, py)` of the kappa view, or
+    /// `null` outside the map.
+    pub fn hover(&self, options: JsValue, px: f32, py: f32) -> Result<JsValue, JsError> {
+        let opts = view_options(options)?;
+        match self.inner.hover(&opts, px, py).map_err(err)? {
+            Some(h) => to_js(&h),
+            None => Ok(JsValue::NULL),
+        }
+    }
+
+    /// Per-system reports (`sources.json` as objects).
+    pub fn sources(&self) -> Result<JsValue, JsError> {
+        let r = self.inner.result().map_err(err)?;
+        match &r.reconstruction {
+            Some(x) => to_js(&x.sources),
+            None => Ok(js_sys::Array::new().into()),
+        }
+    }
+
+    /// A download: `summary.json`, `sources.json`, `convergence.json`, `critical-curves.json`,
+    /// `critical-curves.reg` or `project.json` as text.
+    pub fn text_file(&self, name: &str) -> Result<String, JsError> {
+        if name == "project.json" {
+            return self.inner.project_json().map_err(err);
+        }
+        let r = self.inner.result().map_err(err)?;
+        match name {
+            "summary.json" => r.summary_json().map_err(err),
+            "sources.json" => r.sources_json().map_err(err),
+            "convergence.json" => r.convergence_json().map_err(err),
+            "critical-curves.json" => Ok(r.products.curves_json()),
+            "critical-curves.reg" => Ok(r.products.regions()),
+            other => Err(JsError::new(&format!("unknown file '{other}'"))),
+        }
+    }
+
+    /// The HFF-style FITS maps: an array of `{name, bytes}`.
+    pub fn fits_files(&self) -> Result<JsValue, JsError> {
+        let r = self.inner.result().map_err(err)?;
+        let files = r.products.fits_files().map_err(err)?;
+        let out = js_sys::Array::new();
+        for (name, data) in files {
+            let obj = js_sys::Object::new();
+            set(&obj, "name", &JsValue::from_str(name))?;
+            set(&obj, "bytes", &bytes(&data))?;
+            out.push(&obj);
+        }
+        Ok(out.into())
+    }
+
+    /// Replaces the session by a project file; returns `{name, result, message}`.
+    pub fn open_project(&mut self, text: &str, name: &str) -> Result<JsValue, JsError> {
+        to_js(&self.inner.open_project(text, name).map_err(err)?)
+    }
+
+    /// Which files are loaded: `{images, members, arcs, model, deflection_x, deflection_y}`
+    /// (names or null).
+    pub fn loaded(&self) -> Result<JsValue, JsError> {
+        let d = &self.inner.data;
+        let name = |t: &Option<crate::app::NamedText>| t.as_ref().map(|x| x.name.clone());
+        let fits = |k: usize| d.deflection[k].as_ref().map(|x| x.name.clone());
+        to_js(&serde_json::json!({
+            "images": name(&d.images), "members": name(&d.members), "arcs": name(&d.arcs),
+            "model": name(&d.model), "deflection_x": fits(0), "deflection_y": fits(1),
+        }))
+    }
+}

@@ -1,0 +1,271 @@
+//! The browser app's core (`wslap::app`): loading files without losing data, settings, the
+//! three run kinds, z_s redraws, views, hover read-outs, downloads and project files. These are
+//! the paths the web worker uses; they run natively and in a dedicated worker.
+
+mod common;
+
+use serde_json::json;
+use wslap::app::examples::{teaching_image_catalog, TEACHING_SOURCES};
+use wslap::app::{DataRole, RunKind, Session, ViewOptions};
+use wslap::demo::TEACHING_MODEL_JSON;
+use wslap::solver::Control;
+
+/// A quick reconstruction: 16 x 16 cells, 400 iterations, 64-pixel maps.
+fn teaching_session() -> Session {
+    let mut s = Session::new();
+    s.name = "teaching".into();
+    let cat = teaching_image_catalog().unwrap();
+    s.load_text(DataRole::Images, "images.cat", &cat).unwrap();
+    for (path, value) in [
+        ("z_lens", json!(0.3)),
+        ("reconstruct.grid.cells", json!(16)),
+        ("reconstruct.solver.iterations", json!(400)),
+        ("reconstruct.products.pixels", json!(64)),
+    ] {
+        s.set_field(path, value).unwrap();
+    }
+    s
+}
+
+fn solved() -> Session {
+    let mut s = teaching_session();
+    s.run(RunKind::Reconstruct, &mut |_| Control::Continue)
+        .unwrap();
+    s
+}
+
+const PNG_MAGIC: &[u8] = b"\x89PNG\r\n\x1a\n";
+
+#[cfg_attr(not(target_arch = "wasm32"), test)]
+#[cfg_attr(target_arch = "wasm32", wasm_bindgen_test::wasm_bindgen_test)]
+fn teaching_catalogue_has_multiple_images_of_every_source() {
+    let cat = teaching_image_catalog().unwrap();
+    for (id, _, _) in TEACHING_SOURCES {
+        let n = cat
+            .lines()
+            .filter(|l| l.starts_with(&format!("{id}.")))
+            .count();
+        assert!(n >= 2, "system {id} has {n} images:\n{cat}");
+    }
+}
+
+#[cfg(not(target_arch = "wasm32"))]
+#[test]
+fn committed_teaching_catalogue_is_up_to_date() {
+    let path =
+        std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("www/examples/teaching/images.cat");
+    let fresh = teaching_image_catalog().unwrap();
+    if std::env::var_os("WSLAP_REGENERATE").is_some() {
+        std::fs::write(&path, &fresh).unwrap();
+    }
+    let committed = std::fs::read_to_string(&path).unwrap_or_default();
+    assert_eq!(
+        committed,
+        fresh,
+        "run with WSLAP_REGENERATE=1 to rewrite {}",
+        path.display()
+    );
+}
+
+#[cfg_attr(not(target_arch = "wasm32"), test)]
+#[cfg_attr(target_arch = "wasm32", wasm_bindgen_test::wasm_bindgen_test)]
+fn a_bad_file_names_its_line_and_keeps_what_was_loaded() {
+    let mut s = teaching_session();
+    let before = s.data.images.clone();
+    let err = s
+        .load_text(
+            DataRole::Images,
+            "bad.cat",
+            "1.1 1.0 2.0 0.1 0.1 0 1.5\n1.2 x 2.0 0.1 0.1 0 1.5\n",
+        )
+        .unwrap_err()
+        .to_string();
+    assert!(err.contains("bad.cat") && err.contains("line 2"), "{err}");
+    assert_eq!(s.data.images, before);
+    let err = s
+        .load_text(DataRole::Arcs, "arcs.json", "{\n  \"systems\": [\n   oops")
+        .unwrap_err();
+    assert!(err.to_string().contains("line 3"), "{err}");
+    assert!(s.data.arcs.is_none());
+}
+
+#[cfg_attr(not(target_arch = "wasm32"), test)]
+#[cfg_attr(target_arch = "wasm32", wasm_bindgen_test::wasm_bindgen_test)]
+fn a_bad_setting_is_refused_and_the_old_value_kept() {
+    let mut s = Session::new();
+    let err = s
+        .set_field("reconstruct.grid.cells", json!(0))
+        .unwrap_err()
+        .to_string();
+    assert!(err.contains("cells"), "{err}");
+    assert_eq!(s.settings.reconstruct.grid.cells, 32);
+    assert!(s.set_field("z_lens", json!(-1.0)).is_err());
+    assert!(s.set_field("no.such.field", json!(1)).is_err());
+    assert!(s
+        .set_field("reconstruct.constraints.mode", json!("sideways"))
+        .is_err());
+    s.set_field("reconstruct.constraints.mode", json!("point"))
+        .unwrap();
+    s.set_field("reconstruct.grid.width_arcsec", json!(80.0))
+        .unwrap();
+    s.set_field("reconstruct.grid.width_arcsec", json!(null))
+        .unwrap();
+    assert_eq!(s.settings.reconstruct.grid.width_arcsec, None);
+    assert_eq!(
+        s.settings.reconstruct.products.pixels,
+        wslap::app::APP_MAP_PIXELS
+    );
+}
+
+#[cfg_attr(not(target_arch = "wasm32"), test)]
+#[cfg_attr(target_arch = "wasm32", wasm_bindgen_test::wasm_bindgen_test)]
+fn reconstruction_gives_curves_views_hover_and_the_cli_files() {
+    let mut reports = 0;
+    let mut s = teaching_session();
+    s.run(RunKind::Reconstruct, &mut |_| {
+        reports += 1;
+        Control::Continue
+    })
+    .unwrap();
+    assert!(reports >= 4, "{reports} progress reports");
+    let r = s.result().unwrap();
+    assert!(
+        !r.products.curves.tangential.is_empty(),
+        "no tangential curve"
+    );
+    let summary: serde_json::Value = serde_json::from_str(&r.summary_json().unwrap()).unwrap();
+    for key in [
+        "settings",
+        "c_per_layer",
+        "grid_mass_msun",
+        "einstein_radius_arcsec",
+        "maps",
+    ] {
+        assert!(summary.get(key).is_some(), "summary.json lacks {key}");
+    }
+    let sources: serde_json::Value = serde_json::from_str(&r.sources_json().unwrap()).unwrap();
+    assert_eq!(sources.as_array().unwrap().len(), TEACHING_SOURCES.len());
+    let opts = ViewOptions::default();
+    for view in [
+        s.kappa_view(&opts).unwrap(),
+        s.source_view(&opts).unwrap(),
+        s.data_view(&opts).unwrap(),
+    ] {
+        assert!(
+            view.png.starts_with(PNG_MAGIC) && view.png.len() > 2000,
+            "{}",
+            view.name
+        );
+    }
+    // The map's centre pixel of the kappa figure: kappa of a cluster core is large.
+    let frame = s.kappa_frame(&opts).unwrap();
+    let (cx, cy) = (
+        frame.map_left + frame.map_side / 2.0,
+        frame.map_top + frame.map_side / 2.0,
+    );
+    let inside = s.hover(&opts, cx, cy).unwrap().expect("inside the map");
+    assert!(inside.kappa.is_finite() && inside.magnification.is_finite());
+    assert!(s.hover(&opts, 1.0, 1.0).unwrap().is_none());
+    let fits = r.products.fits_files().unwrap();
+    assert_eq!(fits.len(), 6);
+    let header = String::from_utf8_lossy(&fits[0].1[..2880]).to_string();
+    assert!(
+        header.contains("NAXIS1  =                   64"),
+        "{header}"
+    );
+}
+
+#[cfg_attr(not(target_arch = "wasm32"), test)]
+#[cfg_attr(target_arch = "wasm32", wasm_bindgen_test::wasm_bindgen_test)]
+fn a_higher_source_redshift_redraws_a_larger_einstein_radius_without_solving() {
+    let mut s = solved();
+    let x = s
+        .result()
+        .unwrap()
+        .reconstruction
+        .as_ref()
+        .unwrap()
+        .x
+        .clone();
+    let r2 = s.result().unwrap().products.curves.einstein_radius_arcsec;
+    s.set_z_source(6.0).unwrap();
+    let r6 = s.result().unwrap().products.curves.einstein_radius_arcsec;
+    assert!(
+        r6 > r2 && r2 > 0.0,
+        "Einstein radius {r2} at z_s = 2, {r6} at z_s = 6"
+    );
+    assert_eq!(s.result().unwrap().reconstruction.as_ref().unwrap().x, x);
+    assert!(
+        s.set_z_source(0.1).is_err(),
+        "a source in front of the lens"
+    );
+    assert_eq!(s.settings.reconstruct.products.z_source, 6.0);
+}
+
+#[cfg_attr(not(target_arch = "wasm32"), test)]
+#[cfg_attr(target_arch = "wasm32", wasm_bindgen_test::wasm_bindgen_test)]
+fn a_project_reopens_with_the_maps_rebuilt_from_x() {
+    let s = solved();
+    let text = s.project_json().unwrap();
+    let mut t = Session::new();
+    let report = t.open_project(&text, "p.json").unwrap();
+    assert_eq!(report.result, "restored", "{}", report.message);
+    let (a, b) = (s.result().unwrap(), t.result().unwrap());
+    // serde_json's float parsing may differ from the written value in the last bit.
+    const KAPPA_RTOL: f64 = 1e-9;
+    let worst = a
+        .products
+        .maps
+        .kappa
+        .data
+        .iter()
+        .zip(&b.products.maps.kappa.data)
+        .map(|(p, q)| (p - q).abs() / p.abs().max(1e-12))
+        .fold(0.0, f64::max);
+    assert!(worst <= KAPPA_RTOL, "kappa differs by {worst:e} (relative)");
+    assert_eq!(t.settings, s.settings);
+    assert_eq!(t.data.images, s.data.images);
+    // A broken project changes nothing.
+    let err = t
+        .open_project("{\"format\": \"other\", \"version\": 1}", "q.json")
+        .unwrap_err();
+    assert!(err.to_string().contains("q.json"), "{err}");
+    assert!(t.result.is_some());
+}
+
+#[cfg_attr(not(target_arch = "wasm32"), test)]
+#[cfg_attr(target_arch = "wasm32", wasm_bindgen_test::wasm_bindgen_test)]
+fn forward_and_lookup_modes_agree_on_the_einstein_radius() {
+    /// Deflection maps differentiated by central differences vs the analytic Hessian: the
+    /// Einstein radius agrees to a fraction of the 1-arcsec pixel.
+    const RADIUS_ATOL_ARCSEC: f64 = 0.5;
+    let mut s = Session::new();
+    s.load_text(DataRole::Model, "model.json", TEACHING_MODEL_JSON)
+        .unwrap();
+    s.set_field("z_lens", json!(0.3)).unwrap();
+    s.set_field("reconstruct.products.size_arcsec", json!(64.0))
+        .unwrap();
+    s.set_field("reconstruct.products.pixels", json!(64))
+        .unwrap();
+    s.run(RunKind::Forward, &mut |_| Control::Continue).unwrap();
+    let forward = s.result().unwrap().products.curves.einstein_radius_arcsec;
+    let fits = s.result().unwrap().products.fits_files().unwrap();
+    let file = |name: &str| fits.iter().find(|(n, _)| *n == name).unwrap().1.clone();
+    s.load_fits(0, "x.fits", &file("x-arcsec-deflect.fits"))
+        .unwrap();
+    s.load_fits(1, "y.fits", &file("y-arcsec-deflect.fits"))
+        .unwrap();
+    assert!(s.load_fits(1, "bad.fits", b"SIMPLE = nonsense").is_err());
+    s.run(RunKind::Lookup, &mut |_| Control::Continue).unwrap();
+    let lookup = s.result().unwrap().products.curves.einstein_radius_arcsec;
+    common::assert_abs("Einstein radius", lookup, forward, RADIUS_ATOL_ARCSEC);
+}
+
+#[cfg(not(target_arch = "wasm32"))]
+#[test]
+fn committed_teaching_model_is_the_demo_model() {
+    let path =
+        std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("www/examples/teaching/model.json");
+    let committed = std::fs::read_to_string(&path).unwrap();
+    assert_eq!(committed.trim(), TEACHING_MODEL_JSON.trim());
+}

@@ -1,0 +1,96 @@
+// End-to-end with your own data: the AS1063 catalogues reconstruct; a malformed catalogue shows
+// its error with the line and keeps what was loaded; Cancel stops a run and the page still works.
+import { test } from 'node:test';
+import assert from 'node:assert/strict';
+import { join } from 'node:path';
+import { writeFile, mkdtemp } from 'node:fs/promises';
+import { tmpdir } from 'node:os';
+import { openApp, imageStats, ARTIFACTS, ROOT, setField, waitStatus } from './browser.mjs';
+
+const AS1063 = join(ROOT, '..', 'shared', 'data', 'AS1063', 'lenstool_cats');
+
+test('uploading the AS1063 catalogues reconstructs them', async () => {
+  const app = await openApp();
+  try {
+    const { page } = app;
+    await waitStatus(page, /^Ready/);
+    await page.setInputFiles('#file-images', join(AS1063, 'cats_gold_mul_gold.cat'));
+    await page.waitForFunction(() => /19 systems, 50 images/.test(document.getElementById('status-images').textContent));
+    await page.setInputFiles('#file-members', join(AS1063, 'cats_gold_ref_potential_w_clumpNE.cat'));
+    await page.waitForFunction(() => /members/.test(document.getElementById('status-members').textContent));
+    await setField(page, '#set-z_lens', 0.348);
+    await setField(page, '#set-reconstruct-solver-iterations', 300);
+    await setField(page, '#set-reconstruct-products-size_arcsec', '');
+    await page.click('#reconstruct');
+    await waitStatus(page, /^Done in/, 120_000);
+    await page.waitForFunction(() => document.getElementById('view-image').dataset.view === 'kappa');
+    const stats = await imageStats(page, '#view-image');
+    assert.ok(stats.distinctColours > 200, `only ${stats.distinctColours} distinct colours`);
+    assert.ok(stats.white > 100, `members not drawn (${stats.white} white pixels)`);
+    await page.screenshot({ path: join(ARTIFACTS, 'app-as1063.png'), fullPage: true });
+    await page.click('#tab-systems');
+    await page.waitForSelector('#systems table');
+    assert.ok(await page.locator('#systems tbody tr').count() >= 15);
+    assert.deepEqual(app.consoleErrors, []);
+  } finally {
+    await app.close();
+  }
+});
+
+test('a malformed catalogue shows its line and keeps the previous data', async () => {
+  const app = await openApp();
+  try {
+    const { page } = app;
+    await waitStatus(page, /^Ready/);
+    const before = await page.textContent('#status-images');
+    const dir = await mkdtemp(join(tmpdir(), 'wslap-e2e-'));
+    const bad = join(dir, 'bad-images.cat');
+    await writeFile(bad, '#REFERENCE 3 150 2.2\n1.1 1.0 2.0 0.1 0.1 0 1.5 0\n1.2 oops 2.0 0.1 0.1 0 1.5 0\n');
+    await page.setInputFiles('#file-images', bad);
+    await page.waitForSelector('#status-images.bad');
+    const message = await page.textContent('#status-images');
+    assert.match(message, /bad-images\.cat/);
+    assert.match(message, /line 3/);
+    await page.screenshot({ path: join(ARTIFACTS, 'app-bad-file.png'), fullPage: true });
+    // What was loaded is still there and still reconstructs.
+    assert.equal(await page.isDisabled('#reconstruct'), false);
+    await setField(page, '#set-reconstruct-solver-iterations', 100);
+    await page.click('#reconstruct');
+    await waitStatus(page, /^Done in/);
+    const summary = await page.textContent('#summary');
+    assert.match(summary, /Einstein radius/, `${before} / ${summary}`);
+  } finally {
+    await app.close();
+  }
+});
+
+test('Cancel stops a run at once and the page keeps working', async () => {
+  const app = await openApp();
+  try {
+    const { page } = app;
+    await waitStatus(page, /^Ready/);
+    await setField(page, '#set-reconstruct-solver-iterations', 1_000_000);
+    await page.click('#reconstruct');
+    await page.waitForFunction(() => /iteration \d+/.test(document.getElementById('progress-text').textContent));
+    // The main thread stays responsive while the worker iterates.
+    const lag = await page.evaluate(() => new Promise((resolve) => {
+      const t0 = performance.now();
+      setTimeout(() => resolve(performance.now() - t0), 0);
+    }));
+    assert.ok(lag < 50, `main thread blocked ${lag} ms`);
+    const t0 = Date.now();
+    await page.click('#cancel');
+    await waitStatus(page, /^Cancelled\./);
+    assert.ok(Date.now() - t0 < 5000, 'cancel took too long');
+    assert.equal(await page.isHidden('#progress-box'), true);
+    await setField(page, '#set-reconstruct-solver-iterations', 100);
+    await page.click('#reconstruct');
+    await waitStatus(page, /^Done in/);
+    await page.waitForFunction(() => document.getElementById('view-image').dataset.view === 'kappa');
+    const stats = await imageStats(page, '#view-image');
+    assert.ok(stats.reddish > 20, `only ${stats.reddish} red curve pixels after cancel`);
+    assert.deepEqual(app.consoleErrors, []);
+  } finally {
+    await app.close();
+  }
+});

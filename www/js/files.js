@@ -1,0 +1,58 @@
+// The "Your data" panel: one row per file role with a labelled file picker and a status line
+// (the parse error with its line, or what was loaded), and a drop zone that guesses roles.
+
+export const ROLES = [
+  { role: 'images', label: 'Image catalogue (Lenstool)', accept: '.cat,.txt,.dat' },
+  { role: 'members', label: 'Member catalogue (Lenstool)', accept: '.cat,.txt,.dat' },
+  { role: 'arcs', label: 'Arcs (JSON)', accept: '.json' },
+  { role: 'model', label: 'Model file (forward mode, JSON)', accept: '.json' },
+  { role: 'deflection_x', label: 'Deflection x (FITS)', accept: '.fits,.fit' },
+  { role: 'deflection_y', label: 'Deflection y (FITS)', accept: '.fits,.fit' },
+  { role: 'project', label: 'Project file (JSON)', accept: '.json' },
+];
+
+/** Guesses the role of a dropped file from its name and first bytes. */
+export async function guessRole(file) {
+  const name = file.name.toLowerCase();
+  if (/\.fits?$/.test(name)) return /(^|[-_.])y([-_.]|$)|y-arcsec|deflect_y|_y\./.test(name) ? 'deflection_y' : 'deflection_x';
+  const head = (await file.slice(0, 4000).text());
+  if (name.endsWith('.json')) {
+    if (head.includes('wslap-project')) return 'project';
+    if (head.includes('"components"')) return 'model';
+    return 'arcs';
+  }
+  if (/member|pot|gal|ref/.test(name)) return 'members';
+  return 'images';
+}
+
+/** Builds the rows; `onFile(role, file)` is called for every chosen file. */
+export function buildFileRows(container, dropZone, onFile) {
+  for (const { role, label, accept } of ROLES) {
+    const row = document.createElement('div');
+    row.className = 'field file-row';
+    row.innerHTML = `<label for="file-${role}">${label}</label>
+      <input id="file-${role}" type="file" accept="${accept}">
+      <p id="status-${role}" class="file-status" role="status"></p>`;
+    container.append(row);
+    const input = row.querySelector('input');
+    input.addEventListener('change', () => {
+      if (input.files[0]) onFile(role, input.files[0]);
+      input.value = '';
+    });
+  }
+  const over = (on) => (e) => { e.preventDefault(); dropZone.classList.toggle('over', on); };
+  dropZone.addEventListener('dragover', over(true));
+  dropZone.addEventListener('dragleave', over(false));
+  dropZone.addEventListener('drop', async (e) => {
+    over(false)(e);
+    for (const file of e.dataTransfer.files) onFile(await guessRole(file), file);
+  });
+}
+
+/** Shows `text` next to the file of `role` (`bad` for an error). */
+export function setFileStatus(role, text, bad = false) {
+  const el = document.getElementById(`status-${role}`);
+  if (!el) return;
+  el.textContent = text;
+  el.classList.toggle('bad', bad);
+}

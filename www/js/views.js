@@ -1,0 +1,95 @@
+// The result views: tabs, PNGs from the worker shown through blob URLs (decoded off the main
+// thread), the hover/click read-out on the mass map, and the per-system table.
+
+const img = () => document.getElementById('view-image');
+let current = 'kappa';
+let url = null;
+const pngs = {}; // view name -> Blob, for downloads
+
+export function viewOptions() {
+  return { scale: document.getElementById('scale').value };
+}
+
+export function currentView() { return current; }
+export function viewBlob(name) { return pngs[name] ?? null; }
+
+function selectTab(name) {
+  current = name;
+  for (const tab of document.querySelectorAll('[role=tab]')) {
+    tab.setAttribute('aria-selected', String(tab.dataset.view === name));
+    tab.tabIndex = tab.dataset.view === name ? 0 : -1;
+  }
+}
+
+/** Shows PNG `bytes` as the view `name`. */
+export function showPng(name, bytes) {
+  const blob = new Blob([bytes], { type: 'image/png' });
+  pngs[name] = blob;
+  if (url) URL.revokeObjectURL(url);
+  url = URL.createObjectURL(blob);
+  const el = img();
+  el.src = url;
+  el.alt = { kappa: 'Convergence map with critical curves', data: 'The loaded data',
+    source: 'Source plane with caustics', radial: 'Radial profile', convergence: 'Convergence plot' }[name] ?? name;
+  el.dataset.view = name;
+  el.hidden = false;
+  document.getElementById('systems').hidden = true;
+  document.getElementById('figure').hidden = false;
+}
+
+/** The per-system table (sources.json rows). */
+export function showSystems(sources) {
+  const box = document.getElementById('systems');
+  const f = (v, d = 2) => (v == null ? '–' : Number(v).toFixed(d));
+  const rows = sources.map((s) => `<tr><th scope="row">${s.id}${s.held_out ? ' (held out)' : ''}</th>
+    <td>${f(s.z, 3)}${s.z_assumed ? '*' : ''}</td><td>${f(s.beta_arcsec[0])}, ${f(s.beta_arcsec[1])}</td>
+    <td>${f(s.scatter_arcsec)}</td><td>${s.observed.length} / ${s.predicted.length}</td>
+    <td>${s.observed.map((o) => `${o.id}: ${f(o.offset_arcsec)}`).join('<br>')}</td>
+    <td>${f(s.image_plane_rms_arcsec)}</td></tr>`).join('');
+  box.innerHTML = sources.length === 0 ? '<p class="hint">No systems: not a reconstruction.</p>'
+    : `<div class="table-scroll"><table><caption>Per system: redshift, solved source position β, source-plane scatter, images observed / predicted, offsets of the observed images from the nearest predicted one (arcsec)</caption>
+    <thead><tr><th scope="col">system</th><th scope="col">z</th><th scope="col">β [″]</th><th scope="col">scatter [″]</th>
+    <th scope="col">images</th><th scope="col">offsets [″]</th><th scope="col">rms [″]</th></tr></thead><tbody>${rows}</tbody></table></div>`;
+  box.hidden = false;
+  document.getElementById('figure').hidden = true;
+}
+
+/** Wires the tabs (click and arrow keys) and the read-out. `app` renders views and hovers. */
+export function wireViews(app) {
+  const tabs = [...document.querySelectorAll('[role=tab]')];
+  tabs.forEach((tab, k) => {
+    tab.addEventListener('click', () => { selectTab(tab.dataset.view); app.render(); });
+    tab.addEventListener('keydown', (e) => {
+      const step = { ArrowRight: 1, ArrowLeft: -1 }[e.key];
+      if (!step) return;
+      const next = tabs[(k + step + tabs.length) % tabs.length];
+      next.focus();
+      next.click();
+    });
+  });
+  selectTab('kappa');
+  let busy = false;
+  let pending = null;
+  const readout = document.getElementById('readout');
+  const ask = async (e, pin) => {
+    const el = img();
+    if (el.dataset.view !== 'kappa' || !el.naturalWidth) return;
+    const r = el.getBoundingClientRect();
+    const x = (e.clientX - r.left) * el.naturalWidth / r.width;
+    const y = (e.clientY - r.top) * el.naturalHeight / r.height;
+    if (busy) { pending = [e, pin]; return; }
+    busy = true;
+    try {
+      const h = await app.hover(x, y);
+      if (h) {
+        const text = `x = ${h.x_arcsec.toFixed(2)}″, y = ${h.y_arcsec.toFixed(2)}″, κ = ${h.kappa.toFixed(3)}, ` +
+          `μ(z_s = ${h.z_source}) = ${h.magnification.toFixed(2)}`;
+        readout.textContent = pin ? `Clicked: ${text}` : text;
+      }
+    } catch { /* the worker is busy with a run or was restarted */ }
+    busy = false;
+    if (pending) { const [pe, pp] = pending; pending = null; ask(pe, pp); }
+  };
+  img().addEventListener('mousemove', (e) => ask(e, false));
+  img().addEventListener('click', (e) => ask(e, true));
+}
