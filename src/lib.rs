@@ -18,6 +18,7 @@ pub mod inversion;
 pub mod lenstool_par;
 pub mod maps;
 pub mod model;
+pub mod paper;
 pub mod products;
 pub mod profiles;
 pub mod radial;

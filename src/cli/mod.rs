@@ -1,6 +1,7 @@
 //! Command-line parsing and the subcommands (native only).
 
 mod maps;
+mod paper;
 mod reconstruct;
 mod simulate;
 
@@ -24,6 +25,7 @@ enum Command {
     Maps(maps::MapsArgs),
     Reconstruct(reconstruct::ReconstructArgs),
     Simulate(simulate::SimulateArgs),
+    Paper(paper::PaperArgs),
 }
 
 /// Parses the arguments, runs the subcommand, prints any error with its context.
@@ -33,6 +35,7 @@ pub fn run() -> ExitCode {
         Command::Maps(args) => maps::run(&args),
         Command::Reconstruct(args) => reconstruct::run(&args),
         Command::Simulate(args) => simulate::run(&args),
+        Command::Paper(args) => paper::run(&args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

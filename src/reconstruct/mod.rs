@@ -301,11 +301,13 @@ fn check_source_redshifts(
             });
         }
     }
-    let bad = |source_name: &str, place: String, z: f64| ReconstructError::Config {
+    let bad = |source_name: &str, place: String, z: f64| {
+        ReconstructError::Config {
         source_name: source_name.to_string(),
         message: format!(
             "{place}: z_s = {z} is not behind the lens (z_lens = {z_lens}): a source must have z_s > z_l"
         ),
+    }
     };
     match inputs.images {
         ConstraintSource::Catalog(cat) => {

@@ -1,0 +1,450 @@
+//! The paper's test (Sendra et al., sections 4 and 5; METHOD.md section 8): the simulated
+//! A1689-like cluster reconstructed on a 32 x 32 grid with QADP in three cases — (i) no galaxies,
+//! (ii) the perturbed "galaxy-model" layer, (iii) the "galaxy-true" layer — and the convergence
+//! study (grid mass, C and the source-position error vs iteration from a reasonable start, a
+//! bad start, and without galaxies).
+//!
+//! [`run_paper`] does the work and scores every case against the truth ([`metrics`]);
+//! [`report`] holds `report.json`, [`figures`] the PNG figures. Writing files is the CLI's job.
+
+mod figures;
+pub mod metrics;
+mod report;
+
+use glam::DVec2;
+use thiserror::Error;
+
+pub use figures::{render_figures, Figure};
+pub use report::{
+    markdown as report_markdown, CaseReport, Check, ConvergenceReport, PaperReport, RunSeries,
+    TruthReport,
+};
+
+use crate::inversion::{ConstraintMode, ConstraintSource, Layer, Weighting};
+use crate::maps::LensMaps;
+use crate::model::ModelError;
+use crate::products::{Clock, ProductOptions, Products, ProductsError};
+use crate::radial::{radial_profile, RadialBins, RadialError, RadialProfile};
+use crate::reconstruct::{
+    reconstruct, ConvergenceRecord, Inputs, LayerSource, ReconstructConfig, ReconstructError,
+    Reconstruction,
+};
+use crate::simulate::{GalaxySet, SimulateError, Simulation, SimulationConfig};
+use crate::solver::Control;
+use metrics::ArcRegion;
+
+/// Source redshift of the critical curves, Einstein radii and deflection errors (the paper
+/// compares curves for a typical source at z_s = 3).
+pub const Z_SOURCE_CURVES: f64 = 3.0;
+/// Width of the radial-profile bins, arcsec.
+const PROFILE_BIN_ARCSEC: f64 = 5.0;
+/// A recovered radial curve counts when it has this many points ...
+const RADIAL_MIN_POINTS: usize = 8;
+/// ... and lies on average within this distance of the true radial curve, arcsec.
+const RADIAL_TOLERANCE_ARCSEC: f64 = 5.0;
+
+/// What can stop `wslap paper`.
+#[derive(Debug, Error)]
+pub enum PaperError {
+    #[error("simulation: {0}")]
+    Simulate(#[from] SimulateError),
+    #[error("reconstruction of case {case}: {source}")]
+    Reconstruct {
+        case: &'static str,
+        source: Box<ReconstructError>,
+    },
+    #[error("truth model: {0}")]
+    Model(#[from] ModelError),
+    #[error("truth products: {0}")]
+    Products(#[from] ProductsError),
+    #[error("radial profile: {0}")]
+    Radial(#[from] RadialError),
+    #[error("{field} = {value} is not allowed ({reason})")]
+    BadSetting {
+        field: &'static str,
+        value: f64,
+        reason: &'static str,
+    },
+    #[error("figure {figure}: {message}")]
+    Figure {
+        figure: &'static str,
+        message: String,
+    },
+}
+
+/// The settings of the paper run (the CLI's flags).
+#[derive(Debug, Clone, PartialEq)]
+pub struct PaperConfig {
+    pub simulation: SimulationConfig,
+    /// QADP iterations of the three cases (default 8000, the paper's).
+    pub iterations: usize,
+    /// Iterations of the convergence study (default 50000, the paper's).
+    pub long_iterations: usize,
+    /// Grid cells per side (default 32, the paper's).
+    pub grid_cells: usize,
+    /// Map pixels per side of every product (default 256: 0.77 arcsec over the 198 arcsec field,
+    /// finer than the 6.2 arcsec cells; divisible by 32 so the grid maps are exact FFTs).
+    pub map_pixels: usize,
+    /// Gaussian width over the cell size.
+    pub cell_sigma_factor: f64,
+    /// Row weighting of the constraint pixels.
+    pub weighting: Weighting,
+    /// The "bad" start: every cell starts with this many times the true soft mass per cell ...
+    pub bad_start_cell_factor: f64,
+    /// ... and C starts at this value (the truth is 1).
+    pub bad_start_c: f64,
+    /// The "reasonable" start: cell mass in Msun and C (small, the paper's choice).
+    pub reasonable_start_cell_mass_msun: f64,
+    pub reasonable_start_c: f64,
+    /// Report every this many iterations.
+    pub report_every: usize,
+}
+
+impl Default for PaperConfig {
+    fn default() -> Self {
+        let solver = crate::reconstruct::SolverConfig::default();
+        Self {
+            simulation: SimulationConfig::default(),
+            iterations: 8000,
+            long_iterations: 50_000,
+            grid_cells: 32,
+            map_pixels: 256,
+            cell_sigma_factor: crate::inversion::GridConfig::default().cell_sigma_factor,
+            weighting: crate::inversion::ConstraintConfig::default().weighting,
+            bad_start_cell_factor: 10.0,
+            bad_start_c: 5.0,
+            reasonable_start_cell_mass_msun: solver.start_cell_mass_msun,
+            reasonable_start_c: solver.start_c,
+            report_every: 100,
+        }
+    }
+}
+
+/// The three cases of the paper.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Case {
+    NoGalaxies,
+    GalaxyModel,
+    GalaxyTrue,
+}
+
+impl Case {
+    pub const ALL: [Case; 3] = [Case::NoGalaxies, Case::GalaxyModel, Case::GalaxyTrue];
+
+    /// Key in `report.json`.
+    pub fn key(self) -> &'static str {
+        match self {
+            Case::NoGalaxies => "no_galaxies",
+            Case::GalaxyModel => "galaxy_model",
+            Case::GalaxyTrue => "galaxy_true",
+        }
+    }
+
+    /// Output directory name.
+    pub fn dir(self) -> &'static str {
+        match self {
+            Case::NoGalaxies => "case-no-galaxies",
+            Case::GalaxyModel => "case-galaxy-model",
+            Case::GalaxyTrue => "case-galaxy-true",
+        }
+    }
+
+    /// Label in figures and tables.
+    pub fn label(self) -> &'static str {
+        match self {
+            Case::NoGalaxies => "(i) no galaxies",
+            Case::GalaxyModel => "(ii) galaxy-model",
+            Case::GalaxyTrue => "(iii) galaxy-true",
+        }
+    }
+}
+
+/// One reconstructed case with its scores.
+#[derive(Debug)]
+pub struct CaseRun {
+    pub case: Case,
+    pub reconstruction: Reconstruction,
+    pub profile: RadialProfile,
+    /// Kappa of the grid cells alone (the recovered soft component), `D_ls/D_s = 1`.
+    pub soft_kappa: crate::grid::Map,
+    pub deflection_error: metrics::DeflectionError,
+    pub report: CaseReport,
+}
+
+/// Everything `wslap paper` computed.
+#[derive(Debug)]
+pub struct PaperRun {
+    pub config: PaperConfig,
+    pub simulation: Simulation,
+    /// Truth products at z_s = 3 on the common map.
+    pub truth: Products,
+    pub truth_profile: RadialProfile,
+    /// Kappa of the true soft component alone.
+    pub truth_soft_kappa: crate::grid::Map,
+    pub region: ArcRegion,
+    pub cases: Vec<CaseRun>,
+    pub report: PaperReport,
+}
+
+impl PaperConfig {
+    fn validate(&self) -> Result<(), PaperError> {
+        let bad = |field, value: f64, reason| PaperError::BadSetting {
+            field,
+            value,
+            reason,
+        };
+        if self.iterations == 0 || self.long_iterations == 0 {
+            return Err(bad(
+                "iterations",
+                self.iterations.min(self.long_iterations) as f64,
+                "must be at least 1",
+            ));
+        }
+        if self.report_every == 0 {
+            return Err(bad("report_every", 0.0, "must be at least 1"));
+        }
+        if !(self.bad_start_cell_factor.is_finite() && self.bad_start_cell_factor > 0.0) {
+            return Err(bad(
+                "bad_start_cell_factor",
+                self.bad_start_cell_factor,
+                "must be positive",
+            ));
+        }
+        Ok(())
+    }
+
+    /// The reconstruction settings shared by every run: the grid over the simulation field,
+    /// arc pixels as constraints, products at z_s = 3 on the common map.
+    fn reconstruct_config(&self, field_arcsec: f64, iterations: usize) -> ReconstructConfig {
+        let mut c = ReconstructConfig::default();
+        c.grid.cells = self.grid_cells;
+        c.grid.center_arcsec = Some(DVec2::ZERO);
+        c.grid.width_arcsec = Some(field_arcsec);
+        c.grid.cell_sigma_factor = self.cell_sigma_factor;
+        c.constraints.mode = ConstraintMode::Arcs;
+        c.constraints.weighting = self.weighting;
+        c.solver.iterations = iterations;
+        c.solver.report_every = self.report_every;
+        c.solver.start_cell_mass_msun = self.reasonable_start_cell_mass_msun;
+        c.solver.start_c = self.reasonable_start_c;
+        c.products.z_source = Z_SOURCE_CURVES;
+        c.products.pixels = self.map_pixels;
+        c.products.size_arcsec = Some(field_arcsec);
+        c
+    }
+}
+
+/// Runs the simulation, the three cases and the convergence study, and scores them.
+/// `say` receives one line per stage.
+pub fn run_paper(config: &PaperConfig, say: &mut dyn FnMut(&str)) -> Result<PaperRun, PaperError> {
+    config.validate()?;
+    let t_all = Clock::start();
+    let t = Clock::start();
+    let simulation = Simulation::new(&config.simulation)?;
+    let simulate_ms = t.ms();
+    say(&format!(
+        "simulated {} systems, {} arc pixels in {:.1} s",
+        simulation.arcs.systems.len(),
+        n_arc_pixels(&simulation),
+        simulate_ms / 1e3
+    ));
+    let field = simulation.config.field_arcsec;
+    let plane = simulation.plane;
+    let opts = ProductOptions {
+        z_source: Z_SOURCE_CURVES,
+        size_arcsec: field,
+        pixels: config.map_pixels,
+        ..ProductOptions::default()
+    };
+    let truth = Products::from_model(&simulation.truth_model(), &opts)?;
+    let geometry = truth.maps.geometry();
+    let soft_lens = simulation.soft_model().build_lens()?;
+    let truth_soft_kappa = LensMaps::from_lens(&soft_lens, geometry).kappa;
+    let pixels: Vec<DVec2> = simulation
+        .arcs
+        .systems
+        .iter()
+        .flat_map(|s| s.images.iter().flatten().copied())
+        .collect();
+    let region = ArcRegion::enclosing(DVec2::ZERO, &pixels);
+    let bins = profile_bins(&region, field);
+    let truth_profile = radial_profile(&truth.maps.kappa, DVec2::ZERO, &bins, &plane)?;
+    let truth_betas: Vec<(String, DVec2)> = simulation
+        .sources
+        .iter()
+        .map(|s| (s.id.clone(), s.beta_arcsec))
+        .collect();
+    let layer_true = simulation.layer(GalaxySet::True)?;
+    let layer_model = simulation.layer(GalaxySet::Model)?;
+    let f3 = truth.distance_ratio;
+
+    let mut cases = Vec::new();
+    for case in Case::ALL {
+        let layers: &[Layer] = match case {
+            Case::NoGalaxies => &[],
+            Case::GalaxyModel => std::slice::from_ref(&layer_model),
+            Case::GalaxyTrue => std::slice::from_ref(&layer_true),
+        };
+        let rc = config.reconstruct_config(field, config.iterations);
+        let rec = run_one(&simulation, layers, &rc, case.key())?;
+        let x_grid = grid_only(&rec);
+        let grid_lens =
+            rec.system
+                .reconstructed_lens(&x_grid)
+                .map_err(|e| PaperError::Reconstruct {
+                    case: case.key(),
+                    source: Box::new(e.into()),
+                })?;
+        let soft_kappa = LensMaps::from_lens(&grid_lens, geometry).kappa;
+        let profile = radial_profile(&rec.products.maps.kappa, DVec2::ZERO, &bins, &plane)?;
+        let deflection_error =
+            metrics::deflection_error(&truth.maps, &rec.products.maps, f3, &region);
+        let report = CaseReport::score(
+            &rec,
+            &truth,
+            &truth_profile,
+            &profile,
+            &deflection_error,
+            &truth_betas,
+        );
+        say(&format!(
+            "{}: grid mass {:.3e} Msun, C {:?}, deflection error median {:.2}\" p90 {:.2}\", theta_E(z=3) {:.1}\" ({:.1} s)",
+            case.label(),
+            report.grid_mass_msun,
+            report.c,
+            report.deflection_error_median_arcsec,
+            report.deflection_error_p90_arcsec,
+            report.einstein_radius_arcsec_z3,
+            (rec.timings.system_ms + rec.timings.solve_ms + rec.timings.products_ms + rec.timings.sources_ms) / 1e3
+        ));
+        cases.push(CaseRun {
+            case,
+            reconstruction: rec,
+            profile,
+            soft_kappa,
+            deflection_error,
+            report,
+        });
+    }
+
+    // The convergence study: the galaxy-true layer from the reasonable and the bad start, and
+    // the grid alone, each for `long_iterations`.
+    let soft_per_cell = simulation.soft_mass_msun / (config.grid_cells * config.grid_cells) as f64;
+    let mut series = Vec::new();
+    for (name, layers, start_mass, start_c) in [
+        (
+            "reasonable",
+            std::slice::from_ref(&layer_true),
+            config.reasonable_start_cell_mass_msun,
+            config.reasonable_start_c,
+        ),
+        (
+            "bad_start",
+            std::slice::from_ref(&layer_true),
+            config.bad_start_cell_factor * soft_per_cell,
+            config.bad_start_c,
+        ),
+        (
+            "no_galaxies",
+            &[][..],
+            config.reasonable_start_cell_mass_msun,
+            config.reasonable_start_c,
+        ),
+    ] {
+        let mut rc = config.reconstruct_config(field, config.long_iterations);
+        rc.solver.start_cell_mass_msun = start_mass;
+        rc.solver.start_c = start_c;
+        // Only the convergence records are used: coarse product maps save time.
+        rc.products.pixels = 64;
+        let t = Clock::start();
+        let rec = run_one(&simulation, layers, &rc, name)?;
+        let run = RunSeries::from_records(&rec, &truth_betas);
+        say(&format!(
+            "convergence, {name}: {} iterations, final grid mass {:.3e} Msun, C {:?} ({:.1} s)",
+            config.long_iterations,
+            run.grid_mass_msun.last().copied().unwrap_or(f64::NAN),
+            run.c.last(),
+            t.ms() / 1e3
+        ));
+        series.push((name, run, rec.convergence));
+    }
+    let convergence = ConvergenceReport::from_runs(series);
+    let report = PaperReport::assemble(
+        config,
+        &simulation,
+        &truth,
+        &truth_profile,
+        &region,
+        &cases,
+        convergence,
+        simulate_ms,
+        t_all.ms(),
+    );
+    Ok(PaperRun {
+        config: config.clone(),
+        simulation,
+        truth,
+        truth_profile,
+        truth_soft_kappa,
+        region,
+        cases,
+        report,
+    })
+}
+
+/// One reconstruction of the simulated arcs with the given galaxy layers.
+fn run_one(
+    simulation: &Simulation,
+    layers: &[Layer],
+    config: &ReconstructConfig,
+    name: &'static str,
+) -> Result<Reconstruction, PaperError> {
+    let inputs = Inputs {
+        images: ConstraintSource::Arcs(&simulation.arcs),
+        layers: if layers.is_empty() {
+            LayerSource::None
+        } else {
+            LayerSource::Given(layers)
+        },
+        plane: simulation.plane,
+        reference: None,
+        holdout: &[],
+        catalog: None,
+    };
+    let mut quiet = |_: &ConvergenceRecord| Control::Continue;
+    reconstruct(&inputs, config, &mut quiet).map_err(|e| PaperError::Reconstruct {
+        case: name,
+        source: Box::new(e),
+    })
+}
+
+/// The solution with every layer factor set to 0: the grid cells alone.
+fn grid_only(rec: &Reconstruction) -> Vec<f64> {
+    let mut x = rec.x.clone();
+    x[rec.system.layer_columns()]
+        .iter_mut()
+        .for_each(|v| *v = 0.0);
+    x
+}
+
+/// Profile bins of [`PROFILE_BIN_ARCSEC`] out to the arc region (inside the map).
+fn profile_bins(region: &ArcRegion, field_arcsec: f64) -> RadialBins {
+    let r_max = region
+        .radius_arcsec
+        .min(0.5 * field_arcsec - PROFILE_BIN_ARCSEC);
+    let count = ((r_max / PROFILE_BIN_ARCSEC).floor() as usize).max(2);
+    RadialBins::Linear {
+        r_min_arcsec: 0.0,
+        r_max_arcsec: count as f64 * PROFILE_BIN_ARCSEC,
+        count,
+    }
+}
+
+fn n_arc_pixels(simulation: &Simulation) -> usize {
+    simulation
+        .arcs
+        .systems
+        .iter()
+        .map(|s| s.images.iter().map(Vec::len).sum::<usize>())
+        .sum()
+}

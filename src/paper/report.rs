@@ -1,0 +1,491 @@
+//! `report.json` and `report.md` of `wslap paper`: the truth, the scores of each case, the
+//! convergence study, and the paper's findings checked one by one.
+
+use std::collections::BTreeMap;
+use std::fmt::Write as _;
+
+use glam::DVec2;
+use serde::{Deserialize, Serialize};
+
+use super::metrics::{self, ArcRegion, DeflectionError};
+use super::{CaseRun, PaperConfig, RADIAL_MIN_POINTS, RADIAL_TOLERANCE_ARCSEC};
+use crate::products::Products;
+use crate::radial::RadialProfile;
+use crate::reconstruct::{ConvergenceRecord, Reconstruction};
+use crate::simulate::Simulation;
+
+/// The true cluster.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct TruthReport {
+    /// Projected mass of the smooth halo inside the field square, Msun.
+    pub soft_mass_msun: f64,
+    /// Projected mass of the galaxy-true halos inside the field square, Msun.
+    pub galaxy_mass_msun: f64,
+    pub einstein_radius_arcsec_z3: f64,
+    pub radial_curve: bool,
+    pub n_systems: usize,
+    pub n_arc_pixels: usize,
+    /// Radius of the disc holding every arc pixel (where errors are measured), arcsec.
+    pub arc_region_radius_arcsec: f64,
+    /// Bin centres of the radial profiles, arcsec.
+    pub profile_r_arcsec: Vec<f64>,
+    /// Mean kappa (`D_ls/D_s = 1`) per bin.
+    pub profile_kappa: Vec<f64>,
+}
+
+/// The scores of one case.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct CaseReport {
+    /// Total mass of the grid cells, Msun (compare with the true soft mass).
+    pub grid_mass_msun: f64,
+    /// `C` per galaxy layer (the truth is 1 for galaxy-true); empty without galaxies.
+    pub c: Vec<f64>,
+    /// Median and 90th percentile of `|alpha_true - alpha_rec|` at z_s = 3 inside the arc
+    /// region, arcsec, after removing the unobservable uniform deflection.
+    pub deflection_error_median_arcsec: f64,
+    pub deflection_error_p90_arcsec: f64,
+    /// The uniform deflection removed, arcsec.
+    pub deflection_offset_arcsec: [f64; 2],
+    /// Largest `|rec - true| / true` of the radial kappa profile over the bins.
+    pub profile_max_rel_error: f64,
+    /// `(rec - true) / true` per bin.
+    pub profile_rel_error: Vec<f64>,
+    pub profile_kappa: Vec<f64>,
+    pub einstein_radius_arcsec_z3: f64,
+    /// Mean distance between recovered and true tangential critical curves at z_s = 3, arcsec
+    /// (null when no curve was recovered).
+    pub critical_curve_distance_arcsec: Option<f64>,
+    /// The paper's eq. 8, `sum |beta_rec - beta_true|^2`, arcsec^2.
+    pub beta_error: f64,
+    /// Root mean square of `|beta_rec - beta_true|` over the systems, arcsec.
+    pub beta_rms_arcsec: f64,
+    pub radial_curve_found: bool,
+    pub iterations: usize,
+    pub objective: f64,
+    pub timings_ms: BTreeMap<String, f64>,
+}
+
+impl CaseReport {
+    /// Scores one reconstruction.
+    pub(super) fn score(
+        rec: &Reconstruction,
+        truth: &Products,
+        truth_profile: &RadialProfile,
+        profile: &RadialProfile,
+        deflection: &DeflectionError,
+        truth_betas: &[(String, DVec2)],
+    ) -> Self {
+        let rel = metrics::relative_errors(&profile.kappa, &truth_profile.kappa);
+        let recovered: Vec<(String, DVec2)> = rec
+            .sources
+            .iter()
+            .map(|s| (s.id.clone(), s.beta_arcsec))
+            .collect();
+        let beta_error = metrics::beta_error_arcsec2(&recovered, truth_betas);
+        let timings_ms = BTreeMap::from([
+            ("system".to_string(), rec.timings.system_ms),
+            ("solve".to_string(), rec.timings.solve_ms),
+            ("products".to_string(), rec.timings.products_ms),
+            ("sources".to_string(), rec.timings.sources_ms),
+        ]);
+        Self {
+            grid_mass_msun: rec.grid_mass_msun(),
+            c: rec.layer_factors(),
+            deflection_error_median_arcsec: deflection.median_arcsec,
+            deflection_error_p90_arcsec: deflection.p90_arcsec,
+            deflection_offset_arcsec: deflection.offset_arcsec.to_array(),
+            profile_max_rel_error: rel.iter().map(|r| r.abs()).fold(0.0, f64::max),
+            profile_rel_error: rel,
+            profile_kappa: profile.kappa.clone(),
+            einstein_radius_arcsec_z3: rec.products.curves.einstein_radius_arcsec,
+            critical_curve_distance_arcsec: metrics::curve_distance_arcsec(
+                &truth.curves.tangential,
+                &rec.products.curves.tangential,
+            ),
+            beta_error,
+            beta_rms_arcsec: (beta_error / recovered.len().max(1) as f64).sqrt(),
+            radial_curve_found: metrics::radial_curve_found(
+                &truth.curves,
+                &rec.products.curves,
+                RADIAL_MIN_POINTS,
+                RADIAL_TOLERANCE_ARCSEC,
+            ),
+            iterations: rec.iterations,
+            objective: rec.convergence.last().map_or(f64::NAN, |r| r.objective),
+            timings_ms,
+        }
+    }
+}
+
+/// One run of the convergence study, per report.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct RunSeries {
+    pub grid_mass_msun: Vec<f64>,
+    /// `C` of the galaxy layer (empty for the run without galaxies).
+    pub c: Vec<f64>,
+    /// The paper's eq. 8 per report, arcsec^2.
+    pub beta_error: Vec<f64>,
+    pub objective: Vec<f64>,
+}
+
+impl RunSeries {
+    /// The series of one reconstruction's convergence records.
+    pub(super) fn from_records(rec: &Reconstruction, truth_betas: &[(String, DVec2)]) -> Self {
+        let ids: Vec<&String> = rec
+            .system
+            .constraints
+            .systems
+            .iter()
+            .map(|s| &s.id)
+            .collect();
+        let beta_error = rec
+            .convergence
+            .iter()
+            .map(|r| {
+                let recovered: Vec<(String, DVec2)> = ids
+                    .iter()
+                    .zip(&r.beta_arcsec)
+                    .map(|(id, b)| ((*id).clone(), *b))
+                    .collect();
+                metrics::beta_error_arcsec2(&recovered, truth_betas)
+            })
+            .collect();
+        Self {
+            grid_mass_msun: rec.convergence.iter().map(|r| r.grid_mass_msun).collect(),
+            c: rec
+                .convergence
+                .iter()
+                .filter_map(|r| r.c.first().copied())
+                .collect(),
+            beta_error,
+            objective: rec.convergence.iter().map(|r| r.objective).collect(),
+        }
+    }
+
+    /// The value of `series` at the report closest to `iteration`.
+    pub fn at(series: &[f64], iterations: &[usize], iteration: usize) -> Option<f64> {
+        iterations
+            .iter()
+            .enumerate()
+            .min_by_key(|(_, &it)| it.abs_diff(iteration))
+            .and_then(|(k, _)| series.get(k).copied())
+    }
+}
+
+/// The convergence study.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct ConvergenceReport {
+    /// Iteration of every report (shared by the runs).
+    pub iterations: Vec<usize>,
+    /// Galaxy-true layer, small start (the paper's "reasonable" start).
+    pub reasonable: RunSeries,
+    /// Galaxy-true layer, cell masses and C far too high.
+    pub bad_start: RunSeries,
+    /// The grid alone (case i), small start.
+    pub no_galaxies: RunSeries,
+}
+
+impl ConvergenceReport {
+    pub(super) fn from_runs(runs: Vec<(&str, RunSeries, Vec<ConvergenceRecord>)>) -> Self {
+        let iterations = runs
+            .first()
+            .map(|(_, _, r)| r.iter().map(|r| r.iteration).collect())
+            .unwrap_or_default();
+        let take = |name: &str| {
+            runs.iter()
+                .find(|(n, _, _)| *n == name)
+                .map(|(_, s, _)| s.clone())
+                .unwrap_or(RunSeries {
+                    grid_mass_msun: vec![],
+                    c: vec![],
+                    beta_error: vec![],
+                    objective: vec![],
+                })
+        };
+        Self {
+            iterations,
+            reasonable: take("reasonable"),
+            bad_start: take("bad_start"),
+            no_galaxies: take("no_galaxies"),
+        }
+    }
+}
+
+/// One of the paper's findings, measured.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Check {
+    pub name: String,
+    pub passed: bool,
+    pub detail: String,
+}
+
+/// `report.json`.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct PaperReport {
+    pub truth: TruthReport,
+    /// Keyed `no_galaxies`, `galaxy_model`, `galaxy_true`.
+    pub cases: BTreeMap<String, CaseReport>,
+    pub convergence: ConvergenceReport,
+    pub checks: Vec<Check>,
+    pub settings: BTreeMap<String, serde_json::Value>,
+    pub timings_ms: BTreeMap<String, f64>,
+}
+
+/// Tolerance of C in case (iii) (the issue: within 10% of the truth, 1).
+pub const C_TOLERANCE: f64 = 0.10;
+/// Tolerance of the grid mass against the true soft mass (the issue: within 15%).
+pub const GRID_MASS_TOLERANCE: f64 = 0.15;
+/// The paper's typical deflection error at 8000 iterations, arcsec.
+pub const PAPER_DEFLECTION_ERROR_ARCSEC: f64 = 3.0;
+
+impl PaperReport {
+    #[allow(clippy::too_many_arguments)]
+    pub(super) fn assemble(
+        config: &PaperConfig,
+        simulation: &Simulation,
+        truth: &Products,
+        truth_profile: &RadialProfile,
+        region: &ArcRegion,
+        cases: &[CaseRun],
+        convergence: ConvergenceReport,
+        simulate_ms: f64,
+        total_ms: f64,
+    ) -> Self {
+        let truth_report = TruthReport {
+            soft_mass_msun: simulation.soft_mass_msun,
+            galaxy_mass_msun: simulation.galaxy_mass_msun,
+            einstein_radius_arcsec_z3: truth.curves.einstein_radius_arcsec,
+            radial_curve: !truth.curves.radial.is_empty(),
+            n_systems: simulation.arcs.systems.len(),
+            n_arc_pixels: simulation
+                .arcs
+                .systems
+                .iter()
+                .map(|s| s.images.iter().map(Vec::len).sum::<usize>())
+                .sum(),
+            arc_region_radius_arcsec: region.radius_arcsec,
+            profile_r_arcsec: truth_profile.r_arcsec.clone(),
+            profile_kappa: truth_profile.kappa.clone(),
+        };
+        let case_reports: BTreeMap<String, CaseReport> = cases
+            .iter()
+            .map(|c| (c.case.key().to_string(), c.report.clone()))
+            .collect();
+        let settings = BTreeMap::from([
+            ("seed".to_string(), config.simulation.seed.into()),
+            ("iterations".to_string(), config.iterations.into()),
+            ("long_iterations".to_string(), config.long_iterations.into()),
+            ("grid_cells".to_string(), config.grid_cells.into()),
+            ("map_pixels".to_string(), config.map_pixels.into()),
+            (
+                "cell_sigma_factor".to_string(),
+                config.cell_sigma_factor.into(),
+            ),
+            (
+                "weighting".to_string(),
+                serde_json::to_value(config.weighting).unwrap_or_default(),
+            ),
+            (
+                "bad_start_cell_factor".to_string(),
+                config.bad_start_cell_factor.into(),
+            ),
+            ("bad_start_c".to_string(), config.bad_start_c.into()),
+            (
+                "reasonable_start_cell_mass_msun".to_string(),
+                config.reasonable_start_cell_mass_msun.into(),
+            ),
+            (
+                "reasonable_start_c".to_string(),
+                config.reasonable_start_c.into(),
+            ),
+            ("z_source_curves".to_string(), super::Z_SOURCE_CURVES.into()),
+        ]);
+        let mut timings_ms = BTreeMap::from([
+            ("simulate".to_string(), simulate_ms),
+            ("total".to_string(), total_ms),
+        ]);
+        for c in cases {
+            timings_ms.insert(
+                c.case.key().to_string(),
+                c.report.timings_ms.values().sum::<f64>(),
+            );
+        }
+        let checks = checks(
+            &truth_report,
+            &case_reports,
+            &convergence,
+            config.iterations,
+        );
+        Self {
+            truth: truth_report,
+            cases: case_reports,
+            convergence,
+            checks,
+            settings,
+            timings_ms,
+        }
+    }
+
+    /// Have all the paper's findings been reproduced.
+    pub fn all_passed(&self) -> bool {
+        self.checks.iter().all(|c| c.passed)
+    }
+}
+
+/// The paper's findings (the issue's "done when"), each measured.
+fn checks(
+    truth: &TruthReport,
+    cases: &BTreeMap<String, CaseReport>,
+    conv: &ConvergenceReport,
+    iterations: usize,
+) -> Vec<Check> {
+    let mut out = Vec::new();
+    let (Some(i), Some(ii), Some(iii)) = (
+        cases.get("no_galaxies"),
+        cases.get("galaxy_model"),
+        cases.get("galaxy_true"),
+    ) else {
+        return out;
+    };
+    let mut push = |name: &str, passed: bool, detail: String| {
+        out.push(Check {
+            name: name.to_string(),
+            passed,
+            detail,
+        })
+    };
+    for (label, c) in [("(ii)", ii), ("(iii)", iii)] {
+        push(
+            &format!("{label} recovers the profile better than (i)"),
+            c.profile_max_rel_error < i.profile_max_rel_error,
+            format!(
+                "max relative profile error {:.3} vs {:.3}",
+                c.profile_max_rel_error, i.profile_max_rel_error
+            ),
+        );
+        push(
+            &format!("{label} recovers the deflection better than (i)"),
+            c.deflection_error_median_arcsec < i.deflection_error_median_arcsec,
+            format!(
+                "median deflection error {:.2}\" vs {:.2}\"",
+                c.deflection_error_median_arcsec, i.deflection_error_median_arcsec
+            ),
+        );
+        push(
+            &format!("{label} recovers a radial critical curve"),
+            c.radial_curve_found,
+            format!(
+                "truth has one: {}; found within {RADIAL_TOLERANCE_ARCSEC}\": {}",
+                truth.radial_curve, c.radial_curve_found
+            ),
+        );
+    }
+    let c3 = iii.c.first().copied().unwrap_or(f64::NAN);
+    push(
+        "(iii) C within 10% of the truth (1)",
+        (c3 - 1.0).abs() <= C_TOLERANCE,
+        format!("C = {c3:.3}"),
+    );
+    push(
+        "(ii) median deflection error at most 3\"",
+        ii.deflection_error_median_arcsec <= PAPER_DEFLECTION_ERROR_ARCSEC,
+        format!("{:.2}\"", ii.deflection_error_median_arcsec),
+    );
+    for (name, run) in [("reasonable", &conv.reasonable), ("bad", &conv.bad_start)] {
+        let m = RunSeries::at(&run.grid_mass_msun, &conv.iterations, iterations);
+        let rel = m.map(|m| m / truth.soft_mass_msun - 1.0);
+        push(
+            &format!(
+                "grid mass within 15% of the soft mass at {iterations} iterations, {name} start"
+            ),
+            rel.is_some_and(|r| r.abs() <= GRID_MASS_TOLERANCE),
+            format!(
+                "grid mass {:.3e} Msun vs soft {:.3e} Msun ({:+.1}%)",
+                m.unwrap_or(f64::NAN),
+                truth.soft_mass_msun,
+                100.0 * rel.unwrap_or(f64::NAN)
+            ),
+        );
+    }
+    out
+}
+
+/// `report.md`: what was run, the numbers, the checks.
+pub fn markdown(report: &PaperReport) -> String {
+    let mut s = String::new();
+    let t = &report.truth;
+    let _ = writeln!(s, "# WSLAP+ paper test: the simulated A1689-like cluster\n");
+    let _ = writeln!(
+        s,
+        "Truth: soft (dark) mass {:.3e} Msun, galaxies {:.3e} Msun inside the field; Einstein radius at z_s = 3: {:.1}\"; {} systems, {} arc pixels; errors measured inside r < {:.1}\".\n",
+        t.soft_mass_msun, t.galaxy_mass_msun, t.einstein_radius_arcsec_z3, t.n_systems, t.n_arc_pixels, t.arc_region_radius_arcsec
+    );
+    let _ = writeln!(s, "## The three cases\n");
+    let _ = writeln!(
+        s,
+        "| case | grid mass (Msun) | C | defl. err. median (\") | p90 (\") | max profile rel. err. | theta_E z=3 (\") | curve distance (\") | beta error (\"^2) | radial curve |"
+    );
+    let _ = writeln!(s, "|---|---|---|---|---|---|---|---|---|---|");
+    for key in ["no_galaxies", "galaxy_model", "galaxy_true"] {
+        if let Some(c) = report.cases.get(key) {
+            let _ = writeln!(
+                s,
+                "| {key} | {:.3e} | {} | {:.2} | {:.2} | {:.3} | {:.1} | {} | {:.1} | {} |",
+                c.grid_mass_msun,
+                c.c.iter()
+                    .map(|v| format!("{v:.3}"))
+                    .collect::<Vec<_>>()
+                    .join(", "),
+                c.deflection_error_median_arcsec,
+                c.deflection_error_p90_arcsec,
+                c.profile_max_rel_error,
+                c.einstein_radius_arcsec_z3,
+                c.critical_curve_distance_arcsec
+                    .map_or("none".to_string(), |d| format!("{d:.2}")),
+                c.beta_error,
+                c.radial_curve_found
+            );
+        }
+    }
+    let _ = writeln!(s, "\n## The paper's findings, measured\n");
+    for c in &report.checks {
+        let mark = if c.passed { "yes" } else { "NO" };
+        let _ = writeln!(s, "- [{mark}] {}: {}", c.name, c.detail);
+    }
+    let conv = &report.convergence;
+    let _ = writeln!(s, "\n## Convergence study\n");
+    let _ = writeln!(s, "| iteration | grid mass reasonable | C reasonable | grid mass bad start | C bad start | grid mass no galaxies | beta error reasonable | beta error no galaxies |");
+    let _ = writeln!(s, "|---|---|---|---|---|---|---|---|");
+    let marks = [100, 300, 1000, 3000, 8000, 20000, 50000];
+    for m in marks {
+        if conv.iterations.last().is_some_and(|&last| m > last) {
+            continue;
+        }
+        let at = |v: &[f64]| {
+            RunSeries::at(v, &conv.iterations, m).map_or("-".to_string(), |x| format!("{x:.3e}"))
+        };
+        let at_c = |v: &[f64]| {
+            RunSeries::at(v, &conv.iterations, m).map_or("-".to_string(), |x| format!("{x:.3}"))
+        };
+        let _ = writeln!(
+            s,
+            "| {m} | {} | {} | {} | {} | {} | {} | {} |",
+            at(&conv.reasonable.grid_mass_msun),
+            at_c(&conv.reasonable.c),
+            at(&conv.bad_start.grid_mass_msun),
+            at_c(&conv.bad_start.c),
+            at(&conv.no_galaxies.grid_mass_msun),
+            at(&conv.reasonable.beta_error),
+            at(&conv.no_galaxies.beta_error),
+        );
+    }
+    let _ = writeln!(s, "\n## Settings\n");
+    for (k, v) in &report.settings {
+        let _ = writeln!(s, "- {k}: {v}");
+    }
+    let _ = writeln!(s, "\n## Timings (ms)\n");
+    for (k, v) in &report.timings_ms {
+        let _ = writeln!(s, "- {k}: {v:.0}");
+    }
+    s
+}

@@ -1,0 +1,92 @@
+//! The paper's test, reduced (fewer iterations, a coarser simulation pixel): the orderings the
+//! WSLAP+ paper found must hold — galaxies improve the profile and the deflection field, and
+//! recover the radial critical curve — and `report.json` has the documented shape.
+//!
+//! `wslap paper` with its defaults is the full run (BENCHMARKS.md, report.md); what it finds
+//! about C and the grid mass is recorded there, not asserted here (see the module docs of
+//! `wslap::paper`).
+
+#![cfg(not(target_arch = "wasm32"))]
+
+use wslap::paper::{run_paper, Case, PaperConfig};
+
+/// Iterations of the reduced run: enough for the galaxy layer to matter (the paper's solutions
+/// are good after a few thousand).
+const ITERATIONS: usize = 3000;
+/// The paper's typical deflection error at 8000 iterations, arcsec; case (ii) must do at least
+/// this well already at the reduced iteration count.
+const PAPER_DEFLECTION_ERROR_ARCSEC: f64 = 3.0;
+
+#[test]
+fn reduced_paper_run_reproduces_the_orderings() {
+    let mut config = PaperConfig {
+        iterations: ITERATIONS,
+        long_iterations: 400,
+        map_pixels: 128,
+        ..PaperConfig::default()
+    };
+    // 1 arcsec ray-shooting pixels: ~800 constraint pixels in 30 systems, fast in a debug build.
+    config.simulation.pixel_arcsec = 1.0;
+    let mut lines = Vec::new();
+    let run = run_paper(&config, &mut |l| lines.push(l.to_string())).unwrap();
+    let r = &run.report;
+    let case = |c: Case| &r.cases[c.key()];
+    let (i, ii, iii) = (
+        case(Case::NoGalaxies),
+        case(Case::GalaxyModel),
+        case(Case::GalaxyTrue),
+    );
+    let context = format!("{lines:#?}\n{}", wslap::paper::report_markdown(r));
+    for c in [ii, iii] {
+        assert!(
+            c.profile_max_rel_error < i.profile_max_rel_error,
+            "profile: {context}"
+        );
+        assert!(
+            c.deflection_error_median_arcsec < i.deflection_error_median_arcsec,
+            "deflection: {context}"
+        );
+        assert!(c.radial_curve_found, "radial curve: {context}");
+        assert_eq!(c.c.len(), 1);
+        assert!(c.c[0] > 0.0);
+    }
+    assert!(i.c.is_empty());
+    assert!(
+        ii.deflection_error_median_arcsec <= PAPER_DEFLECTION_ERROR_ARCSEC,
+        "{context}"
+    );
+    // The truth the scores refer to.
+    assert!(r.truth.radial_curve);
+    assert!((r.truth.soft_mass_msun / r.truth.galaxy_mass_msun - 3.0).abs() < 0.3);
+    // The convergence study: one value per report for each run, C only with galaxies.
+    let n = r.convergence.iterations.len();
+    assert!(n >= 4, "{n} reports");
+    assert_eq!(r.convergence.reasonable.grid_mass_msun.len(), n);
+    assert_eq!(r.convergence.bad_start.c.len(), n);
+    assert_eq!(r.convergence.no_galaxies.beta_error.len(), n);
+    assert!(r.convergence.no_galaxies.c.is_empty());
+    // The bad start begins far above the truth.
+    assert!(r.convergence.bad_start.grid_mass_msun[0] > 3.0 * r.truth.soft_mass_msun);
+    // report.json has the documented keys.
+    let json = serde_json::to_value(r).unwrap();
+    for key in [
+        "grid_mass_msun",
+        "c",
+        "deflection_error_median_arcsec",
+        "deflection_error_p90_arcsec",
+        "profile_max_rel_error",
+        "einstein_radius_arcsec_z3",
+        "critical_curve_distance_arcsec",
+        "beta_error",
+        "radial_curve_found",
+    ] {
+        assert!(json["cases"]["galaxy_model"].get(key).is_some(), "{key}");
+    }
+    assert!(json["truth"]["einstein_radius_arcsec_z3"].as_f64().unwrap() > 30.0);
+    // Every figure renders.
+    let figures = wslap::paper::render_figures(&run).unwrap();
+    assert_eq!(figures.len(), 5);
+    for f in &figures {
+        assert_eq!(&f.png[1..4], b"PNG", "{}", f.file_name);
+    }
+}
