@@ -436,3 +436,30 @@ fn cli_writes_every_file() {
     assert_eq!(summary["sources"].as_array().map(Vec::len), Some(30));
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// The app's built-in example (`www/examples/a1689-sim/`) is the paper's data set exactly:
+/// the default simulation (seed 1, 0.5 arcsec pixels). `WSLAP_REGENERATE=1` rewrites it.
+#[test]
+fn the_app_example_is_the_default_simulation() {
+    let sim = Simulation::new(&SimulationConfig::default()).unwrap();
+    let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("www/examples/a1689-sim");
+    let files = [
+        ("arcs.json", sim.arcs_json()),
+        ("members.cat", sim.member_catalog_text()),
+        ("images.cat", sim.image_catalog_text()),
+        ("model.json", sim.truth_model().to_json_string()),
+    ];
+    if std::env::var_os("WSLAP_REGENERATE").is_some() {
+        std::fs::create_dir_all(&dir).unwrap();
+        for (name, text) in &files {
+            std::fs::write(dir.join(name), text).unwrap();
+        }
+    }
+    for (name, fresh) in &files {
+        let committed = std::fs::read_to_string(dir.join(name)).unwrap_or_default();
+        assert!(
+            committed == *fresh,
+            "www/examples/a1689-sim/{name} is out of date: run `WSLAP_REGENERATE=1 cargo test --test simulate the_app_example`"
+        );
+    }
+}

@@ -6,7 +6,7 @@ import { join } from 'node:path';
 import { readFile } from 'node:fs/promises';
 import { openApp, imageStats, ARTIFACTS, setField, waitStatus, fitsAxes } from './browser.mjs';
 
-/** Iterations of the quick test runs (the example's own setting is 3000). */
+/** Iterations of the quick test runs (the examples' own settings are 8000 and 3000). */
 const QUICK_ITERATIONS = 600;
 
 test('the built-in example reconstructs and shows a map with critical curves', async () => {
@@ -14,7 +14,7 @@ test('the built-in example reconstructs and shows a map with critical curves', a
   try {
     const { page } = app;
     await waitStatus(page, /^Ready/);
-    assert.match(await page.textContent('#project-name'), /Teaching/);
+    assert.match(await page.textContent('#project-name'), /Simulated A1689/);
     // The data are shown before anything is computed.
     await page.waitForSelector('#view-image:not([hidden])');
     const data = await imageStats(page, '#view-image');
@@ -56,7 +56,7 @@ test('the built-in example reconstructs and shows a map with critical curves', a
     }
     await page.click('#tab-systems');
     await page.waitForSelector('#systems table');
-    assert.equal(await page.locator('#systems tbody tr').count(), 4);
+    assert.equal(await page.locator('#systems tbody tr').count(), 30);
     await page.click('#tab-kappa');
 
     // The FITS download parses with the map size.
@@ -77,6 +77,29 @@ test('the built-in example reconstructs and shows a map with critical curves', a
     assert.match(await page.textContent('#summary'), /Restored/);
     assert.deepEqual(app.consoleErrors, []);
     assert.deepEqual(app.foreignRequests, []);
+  } finally {
+    await app.close();
+  }
+});
+
+test('the teaching example loads from the menu and reconstructs', async () => {
+  const app = await openApp();
+  try {
+    const { page } = app;
+    await waitStatus(page, /^Ready/);
+    await page.selectOption('#example-select', { label: 'Teaching example: one halo, four sources' });
+    await page.waitForFunction(() => /Teaching/.test(document.getElementById('project-name').textContent));
+    await setField(page, '#set-reconstruct-solver-iterations', QUICK_ITERATIONS);
+    await page.click('#reconstruct');
+    await waitStatus(page, /^Done in/);
+    await page.waitForFunction(() => document.getElementById('view-image').dataset.view === 'kappa');
+    const stats = await imageStats(page, '#view-image');
+    assert.ok(stats.reddish > 50, `only ${stats.reddish} red curve pixels`);
+    await page.click('#tab-systems');
+    await page.waitForSelector('#systems table');
+    assert.equal(await page.locator('#systems tbody tr').count(), 4);
+    await page.screenshot({ path: join(ARTIFACTS, 'app-teaching.png'), fullPage: true });
+    assert.deepEqual(app.consoleErrors, []);
   } finally {
     await app.close();
   }

@@ -72,12 +72,27 @@ export async function setField(page, selector, value) {
   // Settings inputs remember the last accepted value in data-good; wait for it (or an error).
   const isSetting = await page.$eval(selector, (el) => el.id.startsWith('set-'));
   if (!isSetting) return;
-  await page.waitForFunction(([sel, v]) => {
+  const accepted = () => page.waitForFunction(([sel, v]) => {
     const el = document.querySelector(sel);
     const err = document.getElementById(`${el.id}-error`);
     if (err && err.textContent) throw new Error(`${sel}: ${err.textContent}`);
     return el.dataset.good === v;
-  }, [selector, String(value)]);
+  }, [selector, String(value)], { timeout: 15_000 });
+  try {
+    await accepted();
+  } catch {
+    // Under load a late form refresh has been seen to put the old value back before the change
+    // was applied (noted in the issue); type it once more, as a user would.
+    await page.locator(selector).fill(String(value));
+    await page.locator(selector).dispatchEvent('change');
+  }
+  try {
+    await accepted();
+  } catch (err) {
+    const [shown, good] = await page.$eval(selector, (el) => [el.value, el.dataset.good]);
+    const status = await page.textContent('#status');
+    throw new Error(`${selector} = '${value}' never accepted (shown '${shown}', accepted '${good}', status '${status}'): ${err.message}`);
+  }
 }
 
 /** Waits until the status line matches `pattern` (fails with the error shown, if any). */
