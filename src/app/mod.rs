@@ -16,8 +16,8 @@ mod views;
 
 use thiserror::Error;
 
+pub use crate::reconstruct::ReconstructSummary;
 pub use data::{DataRole, LoadReport, LoadedData, NamedText};
-pub use outputs::ReconstructSummary;
 pub use project::{Project, ProjectResult, PROJECT_FORMAT, PROJECT_VERSION};
 pub use run::{RunKind, SessionResult};
 pub use settings::{AppSettings, APP_MAP_PIXELS};

@@ -6,7 +6,7 @@ use std::path::{Path, PathBuf};
 use clap::Args;
 use serde::Serialize;
 use wslap::catalog::{parse_image_catalog, parse_member_catalog};
-use wslap::inversion::{export_system, parse_arcs, ConstraintMode, ConstraintSource, LinearSystem};
+use wslap::inversion::{export_system, parse_arcs, ConstraintMode, ConstraintSource};
 use wslap::reconstruct::{
     reconstruct, ConvergenceRecord, Inputs, LayerSource, ReconstructConfig, Reconstruction,
 };
@@ -152,70 +152,6 @@ fn name(path: &Path) -> String {
     path.display().to_string()
 }
 
-/// `summary.json` of a reconstruction.
-#[derive(Debug, Serialize)]
-struct ReconstructSummary<'a> {
-    settings: &'a ReconstructConfig,
-    status: String,
-    iterations: usize,
-    constraint_pixels: usize,
-    systems_fitted: Vec<&'a str>,
-    systems_excluded: Vec<String>,
-    layers: Vec<&'a str>,
-    c_per_layer: Vec<f64>,
-    grid_mass_msun: f64,
-    grid_cells: usize,
-    field_center_arcsec: [f64; 2],
-    field_width_arcsec: f64,
-    theta_shift_arcsec: f64,
-    einstein_radius_arcsec: f64,
-    einstein_radius_z_source: f64,
-    mass_within_arcsec: Vec<(f64, Option<f64>)>,
-    image_plane_rms_arcsec: Option<f64>,
-    holdout_image_plane_rms_arcsec: Option<f64>,
-    warnings: &'a [String],
-    maps: wslap::products::Summary,
-    timings_ms: wslap::reconstruct::StageTimings,
-}
-
-fn summary(r: &Reconstruction) -> ReconstructSummary<'_> {
-    let s: &LinearSystem = &r.system;
-    let maps = r.products.summary();
-    ReconstructSummary {
-        settings: &r.config,
-        status: format!("{:?}", r.status),
-        iterations: r.iterations,
-        constraint_pixels: s.constraints.pixels.len(),
-        systems_fitted: s
-            .constraints
-            .systems
-            .iter()
-            .map(|x| x.id.as_str())
-            .collect(),
-        systems_excluded: s
-            .constraints
-            .excluded
-            .iter()
-            .map(|e| format!("{} ({:?})", e.id, e.reason))
-            .collect(),
-        layers: s.layers.iter().map(|l| l.name.as_str()).collect(),
-        c_per_layer: r.layer_factors(),
-        grid_mass_msun: r.grid_mass_msun(),
-        grid_cells: s.grid.cells.len(),
-        field_center_arcsec: s.grid.center.to_array(),
-        field_width_arcsec: s.grid.width_arcsec,
-        theta_shift_arcsec: s.theta_shift_arcsec,
-        einstein_radius_arcsec: maps.einstein_radius_arcsec,
-        einstein_radius_z_source: maps.z_source,
-        mass_within_arcsec: maps.mass_within_arcsec.clone(),
-        image_plane_rms_arcsec: r.image_plane_rms_arcsec(false),
-        holdout_image_plane_rms_arcsec: r.image_plane_rms_arcsec(true),
-        warnings: &r.warnings,
-        maps,
-        timings_ms: r.timings,
-    }
-}
-
 /// Writes the map files, sources.json, convergence.json and summary.json into `dir`.
 pub(super) fn write_reconstruction(r: &Reconstruction, dir: &Path) -> Result<(), String> {
     write_products(&r.products, ColorScale::Log, dir)?;
@@ -225,7 +161,7 @@ pub(super) fn write_reconstruction(r: &Reconstruction, dir: &Path) -> Result<(),
     };
     write("sources.json", json(&r.sources)?)?;
     write("convergence.json", json(&r.convergence)?)?;
-    write("summary.json", json(&summary(r))?)?;
+    write("summary.json", json(&r.summary())?)?;
     Ok(())
 }
 

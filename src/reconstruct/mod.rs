@@ -6,6 +6,7 @@
 
 mod config;
 mod sources;
+mod summary;
 
 use glam::DVec2;
 use serde::{Deserialize, Serialize};
@@ -13,6 +14,7 @@ use thiserror::Error;
 
 pub use config::{ProductConfig, ReconstructConfig, SolverConfig};
 pub use sources::{ImageReport, SourceReport};
+pub use summary::{ReconstructSummary, Solved};
 
 use crate::catalog::{ImageCatalog, MemberCatalog};
 use crate::cosmology::LensPlane;
@@ -124,27 +126,39 @@ pub struct Reconstruction {
 }
 
 impl Reconstruction {
+    /// The solved system, for the quantities below and `summary.json`.
+    pub fn solved(&self) -> Solved<'_> {
+        Solved {
+            config: &self.config,
+            system: &self.system,
+            x: &self.x,
+            iterations: self.iterations,
+            sources: &self.sources,
+            warnings: &self.warnings,
+            timings: self.timings,
+        }
+    }
+
     /// `C_l` per layer.
     pub fn layer_factors(&self) -> Vec<f64> {
-        self.x[self.system.layer_columns()].to_vec()
+        self.solved().layer_factors()
     }
 
     /// Total mass of the grid cells in Msun.
     pub fn grid_mass_msun(&self) -> f64 {
-        self.x[self.system.cell_columns()].iter().sum::<f64>() * self.system.mass_unit_msun
+        self.solved().grid_mass_msun()
     }
 
     /// Root mean square of the offsets between observed and predicted images, arcsec, over the
     /// fitted (not held-out) systems; `None` when no image was matched.
     pub fn image_plane_rms_arcsec(&self, held_out: bool) -> Option<f64> {
-        let offsets: Vec<f64> = self
-            .sources
-            .iter()
-            .filter(|s| s.held_out == held_out)
-            .flat_map(|s| s.observed.iter().filter_map(|i| i.offset_arcsec))
-            .collect();
-        (!offsets.is_empty())
-            .then(|| (offsets.iter().map(|o| o * o).sum::<f64>() / offsets.len() as f64).sqrt())
+        self.solved().image_plane_rms_arcsec(held_out)
+    }
+
+    /// `summary.json` (what `wslap reconstruct` writes).
+    pub fn summary(&self) -> ReconstructSummary<'_> {
+        self.solved()
+            .summary(format!("{:?}", self.status), self.products.summary())
     }
 }
 

@@ -1,0 +1,116 @@
+//! `summary.json` of a reconstruction, shared by `wslap reconstruct` and the browser app (which
+//! keeps a solved system without the rest of a [`super::Reconstruction`], e.g. one restored
+//! from a project file), and the quantities it reports.
+
+use serde::Serialize;
+
+use super::{ReconstructConfig, SourceReport, StageTimings};
+use crate::inversion::LinearSystem;
+use crate::products::Summary;
+
+/// A solved system: what the summary is made of.
+#[derive(Debug, Clone, Copy)]
+pub struct Solved<'a> {
+    pub config: &'a ReconstructConfig,
+    pub system: &'a LinearSystem,
+    /// The solution `X`.
+    pub x: &'a [f64],
+    pub iterations: usize,
+    pub sources: &'a [SourceReport],
+    pub warnings: &'a [String],
+    pub timings: StageTimings,
+}
+
+impl<'a> Solved<'a> {
+    /// `C_l` per layer (empty when `x` is too short for the system).
+    pub fn layer_factors(&self) -> Vec<f64> {
+        self.x
+            .get(self.system.layer_columns())
+            .map(<[f64]>::to_vec)
+            .unwrap_or_default()
+    }
+
+    /// Total mass of the grid cells in Msun: the sum of the cell unknowns times the mass unit.
+    pub fn grid_mass_msun(&self) -> f64 {
+        let cells = self.x.get(self.system.cell_columns()).unwrap_or(&[]);
+        cells.iter().sum::<f64>() * self.system.mass_unit_msun
+    }
+
+    /// Root mean square of the offsets between observed and predicted images, arcsec, over the
+    /// fitted (or, with `held_out`, the held-out) systems; `None` when no image was matched.
+    pub fn image_plane_rms_arcsec(&self, held_out: bool) -> Option<f64> {
+        let offsets: Vec<f64> = self
+            .sources
+            .iter()
+            .filter(|s| s.held_out == held_out)
+            .flat_map(|s| s.observed.iter().filter_map(|i| i.offset_arcsec))
+            .collect();
+        (!offsets.is_empty())
+            .then(|| (offsets.iter().map(|o| o * o).sum::<f64>() / offsets.len() as f64).sqrt())
+    }
+
+    /// `summary.json`, with `status` as written ("Completed", "Cancelled", ...) and the map
+    /// summary of the products.
+    pub fn summary(self, status: String, maps: Summary) -> ReconstructSummary<'a> {
+        let s = self.system;
+        ReconstructSummary {
+            settings: self.config,
+            status,
+            iterations: self.iterations,
+            constraint_pixels: s.constraints.pixels.len(),
+            systems_fitted: s
+                .constraints
+                .systems
+                .iter()
+                .map(|x| x.id.as_str())
+                .collect(),
+            systems_excluded: s
+                .constraints
+                .excluded
+                .iter()
+                .map(|e| format!("{} ({:?})", e.id, e.reason))
+                .collect(),
+            layers: s.layers.iter().map(|l| l.name.as_str()).collect(),
+            c_per_layer: self.layer_factors(),
+            grid_mass_msun: self.grid_mass_msun(),
+            grid_cells: s.grid.cells.len(),
+            field_center_arcsec: s.grid.center.to_array(),
+            field_width_arcsec: s.grid.width_arcsec,
+            theta_shift_arcsec: s.theta_shift_arcsec,
+            einstein_radius_arcsec: maps.einstein_radius_arcsec,
+            einstein_radius_z_source: maps.z_source,
+            mass_within_arcsec: maps.mass_within_arcsec.clone(),
+            image_plane_rms_arcsec: self.image_plane_rms_arcsec(false),
+            holdout_image_plane_rms_arcsec: self.image_plane_rms_arcsec(true),
+            warnings: self.warnings,
+            maps,
+            timings_ms: self.timings,
+        }
+    }
+}
+
+/// `summary.json` of a reconstruction.
+#[derive(Debug, Serialize)]
+pub struct ReconstructSummary<'a> {
+    pub settings: &'a ReconstructConfig,
+    pub status: String,
+    pub iterations: usize,
+    pub constraint_pixels: usize,
+    pub systems_fitted: Vec<&'a str>,
+    pub systems_excluded: Vec<String>,
+    pub layers: Vec<&'a str>,
+    pub c_per_layer: Vec<f64>,
+    pub grid_mass_msun: f64,
+    pub grid_cells: usize,
+    pub field_center_arcsec: [f64; 2],
+    pub field_width_arcsec: f64,
+    pub theta_shift_arcsec: f64,
+    pub einstein_radius_arcsec: f64,
+    pub einstein_radius_z_source: f64,
+    pub mass_within_arcsec: Vec<(f64, Option<f64>)>,
+    pub image_plane_rms_arcsec: Option<f64>,
+    pub holdout_image_plane_rms_arcsec: Option<f64>,
+    pub warnings: &'a [String],
+    pub maps: Summary,
+    pub timings_ms: StageTimings,
+}
