@@ -45,6 +45,8 @@ pub enum FitsError {
         needed: usize,
         got: usize,
     },
+    #[error(transparent)]
+    TooLarge(#[from] crate::limits::TooLarge),
     #[error("{file}: header has no END card")]
     NoEnd { file: String },
     #[error("{file}: missing keyword {keyword}")]

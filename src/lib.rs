@@ -16,6 +16,7 @@ pub mod grid;
 pub mod images;
 pub mod inversion;
 pub mod lenstool_par;
+pub mod limits;
 pub mod maps;
 pub mod model;
 pub mod paper;

@@ -23,6 +23,7 @@ use serde::{Deserialize, Serialize};
 use thiserror::Error;
 
 use crate::cosmology::{Cosmology, CosmologyError, LensPlane};
+use crate::limits::{json_error_parts, InputKind, TooLarge};
 use crate::profiles::{
     Gaussian, Lens, MassComponent, Nfw, NfwEllipse, PointMass, ProfileError, Sis, TruncatedNfw,
 };
@@ -76,6 +77,9 @@ pub enum ModelError {
         value: f64,
         reason: &'static str,
     },
+    /// A text over [`crate::limits::MAX_JSON_BYTES`].
+    #[error(transparent)]
+    TooLarge(#[from] crate::limits::TooLarge),
     /// The component list is empty.
     #[error("{source_name}: the model has no components (\"components\" must list at least one)")]
     NoComponents { source_name: String },
@@ -216,6 +220,7 @@ impl ModelFile {
     /// Parses and validates a model file. `source_name` (e.g. the file name) prefixes every
     /// error message; JSON errors carry line and column, component errors the component index.
     pub fn from_json_str(text: &str, source_name: &str) -> Result<Self, ModelError> {
+        TooLarge::check_bytes(source_name, InputKind::Model, text.len() as u64)?;
         let mut model: Self =
             serde_json::from_str(text).map_err(|e| syntax_error(text, source_name, &e))?;
         model.source_name = source_name.to_string();
@@ -316,10 +321,7 @@ impl ModelFile {
 /// Turns a serde_json error into a [`ModelError`] with line and column. If the text is valid
 /// JSON and a component fails to parse on its own, the error also names that component.
 fn syntax_error(text: &str, source_name: &str, e: &serde_json::Error) -> ModelError {
-    let (line, column) = (e.line(), e.column());
-    let full = e.to_string();
-    let suffix = format!(" at line {line} column {column}");
-    let message = full.strip_suffix(&suffix).unwrap_or(&full).to_string();
+    let (line, column, message) = json_error_parts(e);
     // Attribute the error to a component only if that component fails on its own with the
     // same message (so a bad top-level field before it is not blamed on it).
     match failing_component(text) {

@@ -7,8 +7,10 @@ mod common;
 use common::assert_abs;
 use glam::DVec2;
 use wslap::catalog::{
-    parse_image_catalog, parse_member_catalog, CatalogError, ImageCatalog, Z_AGREEMENT_TOL,
+    parse_image_catalog, parse_member_catalog, CatalogError, ImageCatalog, DEGREE_LOOKALIKE,
+    FIELD_ERROR_DEG, Z_AGREEMENT_TOL,
 };
+use wslap::limits::{MAX_CATALOG_BYTES, MAX_CATALOG_ROWS};
 use wslap::sky::SkyReference;
 
 /// Positions computed by the same formula in another order: rounding of `RA - RA0` (~1e-13 deg)
@@ -575,4 +577,122 @@ fn unusable_requested_reference() {
         "{err}"
     );
     assert_contains(&err.to_string(), &["m.cat: requested sky reference"]);
+}
+
+#[cfg_attr(not(target_arch = "wasm32"), test)]
+#[cfg_attr(target_arch = "wasm32", wasm_bindgen_test::wasm_bindgen_test)]
+fn infinite_and_overflowing_values() {
+    let err = image_err("1.1 342.1 -44.5 0.1 0.1 0 1.2 0\n1.2 342.1 -44.5 inf 0.1 0 1.2 0\n");
+    assert_eq!(
+        err,
+        "bad.cat: line 2, column 4 (a): 'inf' is not a finite number"
+    );
+    let err = image_err("1.1 342.1 -44.5 0.1 0.1 0 1e999 0\n");
+    assert_eq!(
+        err,
+        "bad.cat: line 1, column 7 (z): '1e999' is out of range (it overflows a 64-bit float)"
+    );
+    let err = parse_member_catalog("m1 342.1 -44.5 0.1 0.1 0 -Infinity\n", "m.cat", None)
+        .unwrap_err()
+        .to_string();
+    assert_eq!(
+        err,
+        "m.cat: line 1, column 7 (mag): '-Infinity' is not a finite number"
+    );
+}
+
+#[cfg_attr(not(target_arch = "wasm32"), test)]
+#[cfg_attr(target_arch = "wasm32", wasm_bindgen_test::wasm_bindgen_test)]
+fn degrees_under_a_relative_header() {
+    // Absolute degrees with '#REFERENCE 3 ra0 dec0': every row is within DEGREE_LOOKALIKE of
+    // (ra0, dec0), which as arcsec offsets would put all images inside one arcsec.
+    let text = "#REFERENCE 3 342.18322 -44.530889\n\
+                1.1 342.1901 -44.5201 0.1 0.1 0 1.2 0\n\
+                1.2 342.1702 -44.5402 0.1 0.1 0 1.2 0\n";
+    let err = image_err(text);
+    assert_contains(
+        &err,
+        &[
+            "bad.cat: line 2, column 2 (x): '342.1901' (with y '-44.5201')",
+            "looks like a position in degrees",
+            &format!("every row is within {DEGREE_LOOKALIKE}"),
+            "'#REFERENCE 0'",
+        ],
+    );
+    // One row only: possible (an image at that very offset), so a warning.
+    let one = "#REFERENCE 3 342.18322 -44.530889\n1.1 342.19 -44.52 0.1 0.1 0 1.2 0\n";
+    let (_, warnings) = parse_image_catalog(one, "one.cat", None).unwrap();
+    assert_eq!(warnings.len(), 2, "{warnings:?}"); // and the single-image system
+    assert_contains(
+        &warnings[0].to_string(),
+        &["one.cat: line 2: column 2 (x): '342.19'", "the only row is"],
+    );
+}
+
+#[cfg_attr(not(target_arch = "wasm32"), test)]
+#[cfg_attr(target_arch = "wasm32", wasm_bindgen_test::wasm_bindgen_test)]
+fn arcsec_offsets_read_as_degrees() {
+    // An arcsec catalogue without its header whose values are all valid degrees: the rows
+    // spread over tens of degrees, not one lensing field.
+    let text = "1.1 12.5 30.2 0.1 0.1 0 1.2 0\n1.2 40.1 -20.3 0.1 0.1 0 1.2 0\n\
+                1.3 25.0 5.0 0.1 0.1 0 1.2 0\n";
+    let err = image_err(text);
+    assert_contains(
+        &err,
+        &[
+            "bad.cat: line 2, column 2 (ra): '40.1' (with dec '-20.3') is ",
+            "deg from the mean position",
+            "'#REFERENCE 3 ra0 dec0'",
+        ],
+    );
+    // A member about 2 deg from the others: unusual but possible, so a warning.
+    let members = "a 342.19 -44.52 0.5 0.4 10 19.5\nb 342.17 -44.54 0.5 0.4 10 20.5\n\
+                   c 346.0 -44.53 0.5 0.4 10 20.5\n";
+    let (_, warnings) = parse_member_catalog(members, "m.cat", None).unwrap();
+    assert_eq!(warnings.len(), 1, "{warnings:?}");
+    assert_contains(
+        &warnings[0].to_string(),
+        &["m.cat: line 3: column 2 (ra): '346.0'", "deg from the mean"],
+    );
+    // Relative offsets of more than FIELD_ERROR_DEG (here 10 deg in arcsec): an error.
+    let far = format!(
+        "#REFERENCE 3 10 20\n1.1 1.5 2.5 0 0 0 1.2 0\n1.2 {} 0 0 0 0 1.2 0\n",
+        FIELD_ERROR_DEG * 2.0 * 3600.0
+    );
+    assert_contains(
+        &image_err(&far),
+        &["bad.cat: line 3, column 2 (x): '36000'", "are arcsec"],
+    );
+}
+
+#[cfg_attr(not(target_arch = "wasm32"), test)]
+#[cfg_attr(target_arch = "wasm32", wasm_bindgen_test::wasm_bindgen_test)]
+fn too_many_rows() {
+    // The row count is checked as the rows are split, before any field is read.
+    let text = "x\n".repeat(MAX_CATALOG_ROWS + 1);
+    let err = parse_member_catalog(&text, "big.cat", None).unwrap_err();
+    assert!(matches!(err, CatalogError::TooLarge(_)), "{err}");
+    assert_eq!(
+        err.to_string(),
+        format!(
+            "big.cat: {} rows is more than the limit of {MAX_CATALOG_ROWS} rows for a catalogue",
+            MAX_CATALOG_ROWS + 1
+        )
+    );
+}
+
+#[cfg(not(target_arch = "wasm32"))]
+#[test]
+fn too_many_bytes() {
+    // Refused on its length alone (a text of blanks would otherwise read as "empty").
+    let text = " ".repeat(MAX_CATALOG_BYTES as usize + 1);
+    let err = image_err(&text);
+    assert_eq!(
+        err,
+        format!(
+            "bad.cat: {} bytes is more than the limit of {MAX_CATALOG_BYTES} bytes for a \
+             catalogue",
+            MAX_CATALOG_BYTES + 1
+        )
+    );
 }

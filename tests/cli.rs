@@ -438,3 +438,205 @@ fn reconstruct_from_arc_pixels() {
     ]);
     assert!(!out.status.success());
 }
+
+/// Runs `wslap reconstruct` with `args` (plus `--out`), expects failure, returns stderr.
+fn reconstruct_error(dir: &Path, args: &[&str]) -> String {
+    let out_dir = dir.join("never-written");
+    let mut all = vec!["reconstruct"];
+    all.extend(args);
+    all.extend(["--out", out_dir.to_str().unwrap()]);
+    let out = wslap(&all);
+    assert!(!out.status.success(), "{all:?} must fail");
+    assert!(
+        !out_dir.exists(),
+        "nothing is written when the input is bad"
+    );
+    String::from_utf8_lossy(&out.stderr).into_owned()
+}
+
+#[test]
+fn config_errors_say_file_line_and_column_once() {
+    let dir = temp_dir("config-once");
+    let images = shared("AS1063/lenstool_cats/cats_gold_mul_gold.cat");
+    let config = dir.join("config.json");
+    fs::write(&config, "{\n  \"grid\": {\"cells\": 12,}\n}").unwrap();
+    let err = reconstruct_error(
+        &dir,
+        &[
+            "--images",
+            &images,
+            "--z-lens",
+            "0.348",
+            "--config",
+            config.to_str().unwrap(),
+        ],
+    );
+    let expected = format!(
+        "error: {}: line 2, column 24: trailing comma\n",
+        config.display()
+    );
+    assert_eq!(err, expected);
+    // A number beyond f64 (JSON has no NaN or inf).
+    fs::write(&config, "{\"products\": {\"z_source\": 1e999}}").unwrap();
+    let err = reconstruct_error(
+        &dir,
+        &[
+            "--images",
+            &images,
+            "--z-lens",
+            "0.348",
+            "--config",
+            config.to_str().unwrap(),
+        ],
+    );
+    assert!(
+        err.contains("config.json: line 1, column 31: number out of range"),
+        "{err}"
+    );
+    assert_eq!(err.matches("line").count(), 1, "{err}");
+    // The model file of `wslap maps` likewise.
+    let model = dir.join("model.json");
+    fs::write(&model, "{\"z_lens\": 0.3,\n \"components\": [}").unwrap();
+    let out = wslap(&[
+        "maps",
+        "--model",
+        model.to_str().unwrap(),
+        "--out",
+        dir.join("o").to_str().unwrap(),
+    ]);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(err.contains("model.json: line 2, column 17: "), "{err}");
+    assert_eq!(err.matches("line").count(), 1, "{err}");
+}
+
+#[test]
+fn huge_files_are_refused_before_reading() {
+    let dir = temp_dir("huge");
+    // Sparse files: their size is in the metadata, no disk is used.
+    let cat = dir.join("huge.cat");
+    fs::File::create(&cat)
+        .unwrap()
+        .set_len(2 << 30)
+        .expect("sparse file");
+    let err = reconstruct_error(
+        &dir,
+        &["--images", cat.to_str().unwrap(), "--z-lens", "0.3"],
+    );
+    assert_eq!(
+        err,
+        format!(
+            "error: {}: 2147483648 bytes is more than the limit of {} bytes for a catalogue\n",
+            cat.display(),
+            wslap::limits::MAX_CATALOG_BYTES
+        )
+    );
+    let fits = dir.join("huge.fits");
+    fs::File::create(&fits)
+        .unwrap()
+        .set_len(wslap::limits::MAX_FITS_BYTES + 1)
+        .expect("sparse file");
+    let out = wslap(&[
+        "maps",
+        "--deflection",
+        fits.to_str().unwrap(),
+        fits.to_str().unwrap(),
+        "--z-lens",
+        "0.3",
+        "--out",
+        dir.join("o").to_str().unwrap(),
+    ]);
+    assert!(!out.status.success());
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        err.contains("huge.fits: 1073741825 bytes is more than the limit of 1073741824 bytes for a FITS file"),
+        "{err}"
+    );
+}
+
+#[test]
+fn catalogue_units_nan_and_empty_systems_name_file_and_line() {
+    let dir = temp_dir("units");
+    let run = |name: &str, text: &str, extra: &[&str]| {
+        let path = dir.join(name);
+        fs::write(&path, text).unwrap();
+        let mut args = vec!["--images", path.to_str().unwrap(), "--z-lens", "0.3"];
+        args.extend(extra);
+        reconstruct_error(&dir, &args)
+    };
+    // Degrees under a relative header.
+    let err = run(
+        "deg.cat",
+        "#REFERENCE 3 342.18322 -44.530889\n1.1 342.19 -44.52 0.1 0.1 0 1.2 0\n\
+         1.2 342.17 -44.54 0.1 0.1 0 1.2 0\n",
+        &[],
+    );
+    assert!(
+        err.contains("deg.cat: line 2, column 2 (x): '342.19'")
+            && err.contains("looks like a position in degrees"),
+        "{err}"
+    );
+    // Arcsec offsets without their header.
+    let err = run(
+        "arcsec.cat",
+        "1.1 12.5 30.2 0.1 0.1 0 1.2 0\n1.2 40.1 -20.3 0.1 0.1 0 1.2 0\n",
+        &[],
+    );
+    assert!(
+        err.contains("arcsec.cat: line ") && err.contains("#REFERENCE 3 ra0 dec0"),
+        "{err}"
+    );
+    // inf and an overflowing number.
+    let err = run(
+        "inf.cat",
+        "1.1 342.19 -44.52 0.1 0.1 0 1.2 0\n1.2 342.17 -44.54 0.1 1e999 0 1.2 0\n",
+        &[],
+    );
+    assert!(
+        err.contains("inf.cat: line 2, column 5 (b): '1e999' is out of range"),
+        "{err}"
+    );
+    // Every system unusable (a single image): the file and the line of each are named.
+    let err = run(
+        "single.cat",
+        "# two single images\n1.1 342.19 -44.52 0.1 0.1 0 1.2 0\n2.1 342.17 -44.54 0.1 0.1 0 2 0\n",
+        &[],
+    );
+    assert!(
+        err.contains("single.cat: no system is left")
+            && err.contains("1 (SingleImage, line 2), 2 (SingleImage, line 3)"),
+        "{err}"
+    );
+    // A source in front of the lens.
+    let err = run(
+        "front.cat",
+        "1.1 342.19 -44.52 0.1 0.1 0 1.2 0\n1.2 342.17 -44.54 0.1 0.1 0 1.2 0\n\
+         2.1 342.18 -44.53 0.1 0.1 0 0.2 0\n2.2 342.18 -44.51 0.1 0.1 0 0.2 0\n",
+        &[],
+    );
+    assert!(
+        err.contains("front.cat: line 3 (system 2): z_s = 0.2 is not behind the lens"),
+        "{err}"
+    );
+    // An arcs file with an empty image, and one with a system in front of the lens.
+    let arcs = dir.join("arcs.json");
+    fs::write(
+        &arcs,
+        "{\"systems\": [\n {\"id\": \"a\", \"z\": 2, \"images\": [[[1, 2]], []]}]}",
+    )
+    .unwrap();
+    let err = reconstruct_error(&dir, &["--arcs", arcs.to_str().unwrap(), "--z-lens", "0.3"]);
+    assert!(
+        err.contains("arcs.json: line 2: system a: no pixels in image 1"),
+        "{err}"
+    );
+    fs::write(
+        &arcs,
+        "{\"systems\": [\n {\"id\": \"a\", \"z\": 0.2, \"images\": [[[1, 2]], [[-1, -2]]]}]}",
+    )
+    .unwrap();
+    let err = reconstruct_error(&dir, &["--arcs", arcs.to_str().unwrap(), "--z-lens", "0.3"]);
+    assert!(
+        err.contains("arcs.json: system a: z_s = 0.2 is not behind the lens (z_lens = 0.3)"),
+        "{err}"
+    );
+}

@@ -103,6 +103,11 @@ pub enum CatalogError {
     #[error("{source_name}: the catalogue has no sky reference, so it cannot change frame")]
     NoReference { source_name: String },
 
+    /// A text over [`crate::limits::MAX_CATALOG_BYTES`] or with more rows than
+    /// [`crate::limits::MAX_CATALOG_ROWS`].
+    #[error(transparent)]
+    TooLarge(#[from] crate::limits::TooLarge),
+
     /// A default source redshift that is not finite and positive.
     #[error("{source_name}: default source redshift {z} must be finite and > 0")]
     BadDefaultRedshift { source_name: String, z: f64 },

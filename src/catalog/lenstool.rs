@@ -9,6 +9,7 @@ use glam::DVec2;
 
 use super::frame;
 use super::rows::{read_table, warn_extra_columns, Fields};
+use super::units::{check_field, RowPosition};
 use super::{
     CatalogError, CatalogWarning, Image, ImageCatalog, ImageSystem, Member, MemberCatalog,
 };
@@ -33,7 +34,8 @@ const MEMBER_LAYOUT: &str = "id x y a b theta mag [lum]";
 /// Ids are `system.image`: the system is the text before the first '.' (`4.2a` and `14c.1`
 /// are systems `4` and `14c`). `z = 0` means unknown (`None`); images of one system must agree
 /// within [`Z_AGREEMENT_TOL`] (their mean is used, with a warning when they differ or some are
-/// unknown). Warnings: single-image systems, extra columns (ignored).
+/// unknown). Warnings: single-image systems, extra columns (ignored). Positions that do not
+/// fit one lensing field in the header's unit are refused or warned about (`units.rs`).
 pub fn parse_image_catalog(
     text: &str,
     source_name: &str,
@@ -47,6 +49,7 @@ pub fn parse_image_catalog(
     let mut extra_lines = Vec::new();
     let mut seen: HashMap<&str, usize> = HashMap::new();
     let mut parsed = Vec::with_capacity(table.rows.len());
+    let mut positions = Vec::with_capacity(table.rows.len());
     for row in &table.rows {
         let f = Fields {
             row,
@@ -66,6 +69,11 @@ pub fn parse_image_catalog(
         }
         seen.insert(id, row.line);
         let shape = f.shape(table.coords)?;
+        positions.push(RowPosition {
+            line: row.line,
+            raw: shape.raw,
+            text: [row.fields[1], row.fields[2]],
+        });
         let z = f.redshift(6)?;
         let mag = f.optional(7)?;
         let image = Image {
@@ -80,6 +88,7 @@ pub fn parse_image_catalog(
         parsed.push((system, z, image));
     }
     warn_extra_columns(&extra_lines, source_name, &mut warnings);
+    check_field(table.coords, &positions, source_name, &mut warnings)?;
     let raw: Vec<DVec2> = parsed.iter().map(|(_, _, im)| im.position).collect();
     let (frame_ref, positions) = table.coords.into_frame(&raw, requested);
     for ((_, _, image), p) in parsed.iter_mut().zip(positions) {
@@ -112,6 +121,7 @@ pub fn parse_member_catalog(
     let mut extra_lines = Vec::new();
     let mut seen: HashMap<&str, usize> = HashMap::new();
     let mut members = Vec::with_capacity(table.rows.len());
+    let mut positions = Vec::with_capacity(table.rows.len());
     for row in &table.rows {
         let f = Fields {
             row,
@@ -129,6 +139,11 @@ pub fn parse_member_catalog(
         }
         seen.insert(id, row.line);
         let shape = f.shape(table.coords)?;
+        positions.push(RowPosition {
+            line: row.line,
+            raw: shape.raw,
+            text: [row.fields[1], row.fields[2]],
+        });
         members.push(Member {
             id: id.into(),
             position: shape.raw,
@@ -141,6 +156,7 @@ pub fn parse_member_catalog(
         });
     }
     warn_extra_columns(&extra_lines, source_name, &mut warnings);
+    check_field(table.coords, &positions, source_name, &mut warnings)?;
     let raw: Vec<DVec2> = members.iter().map(|m| m.position).collect();
     let (frame_ref, positions) = table.coords.into_frame(&raw, requested);
     for (m, p) in members.iter_mut().zip(positions) {

@@ -14,9 +14,11 @@ mod error;
 mod frame;
 mod lenstool;
 mod rows;
+mod units;
 
 pub use error::{CatalogError, CatalogWarning};
 pub use lenstool::{parse_image_catalog, parse_member_catalog, Z_AGREEMENT_TOL};
+pub use units::{DEGREE_LOOKALIKE, FIELD_ERROR_DEG, FIELD_WARN_DEG};
 
 /// One observed image of a multiply-lensed source.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]

@@ -5,6 +5,7 @@ use glam::DVec2;
 
 use super::frame::{self, Coords};
 use super::{CatalogError, CatalogWarning};
+use crate::limits::{InputKind, TooLarge, MAX_CATALOG_ROWS};
 
 /// Columns of both formats: the required ones, then one optional.
 pub(super) const REQUIRED_COLUMNS: usize = 7;
@@ -25,6 +26,7 @@ pub(super) struct Table<'a> {
 /// Splits the text into rows, reading the `#REFERENCE` header (which must precede the rows
 /// and appear once) and skipping blank and `#` lines.
 pub(super) fn read_table<'a>(text: &'a str, source_name: &str) -> Result<Table<'a>, CatalogError> {
+    TooLarge::check_bytes(source_name, InputKind::Catalog, text.len() as u64)?;
     let text = text.strip_prefix('\u{feff}').unwrap_or(text);
     let mut header: Option<(usize, Coords)> = None;
     let mut rows: Vec<Row<'a>> = Vec::new();
@@ -37,6 +39,11 @@ pub(super) fn read_table<'a>(text: &'a str, source_name: &str) -> Result<Table<'
             continue;
         }
         if !t.starts_with('#') {
+            if rows.len() == MAX_CATALOG_ROWS {
+                let n = rows.len() as u64 + 1;
+                let max = MAX_CATALOG_ROWS as u64;
+                TooLarge::check(source_name, "rows", n, max, "a catalogue")?;
+            }
             rows.push(Row {
                 line,
                 fields: t.split_whitespace().collect(),
@@ -128,6 +135,11 @@ impl Fields<'_, '_> {
     pub(super) fn number(&self, i: usize) -> Result<f64, CatalogError> {
         match self.row.fields[i].parse::<f64>() {
             Err(_) => Err(self.bad(i, "is not a number")),
+            Ok(v)
+                if v.is_infinite() && !self.row.fields[i].to_ascii_lowercase().contains("inf") =>
+            {
+                Err(self.bad(i, "is out of range (it overflows a 64-bit float)"))
+            }
             Ok(v) if !v.is_finite() => Err(self.bad(i, "is not a finite number")),
             Ok(v) => Ok(v),
         }

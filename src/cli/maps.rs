@@ -3,8 +3,11 @@
 use std::fs;
 use std::path::{Path, PathBuf};
 
+use super::input::{read_bytes, read_text};
+
 use clap::Args;
 use wslap::fits::read_image;
+use wslap::limits::InputKind;
 use wslap::model::ModelFile;
 use wslap::products::{ProductOptions, Products};
 use wslap::render::ColorScale;
@@ -67,7 +70,7 @@ impl From<Scale> for ColorScale {
 
 pub fn run(args: &MapsArgs) -> Result<(), String> {
     let products = if let Some(path) = &args.model {
-        let text = read_text(path)?;
+        let text = read_text(path, InputKind::Model)?;
         let model = ModelFile::from_json_str(&text, &path.display().to_string())
             .map_err(|e| e.to_string())?;
         let opts = ProductOptions {
@@ -99,12 +102,8 @@ pub fn run(args: &MapsArgs) -> Result<(), String> {
     Ok(())
 }
 
-fn read_text(path: &Path) -> Result<String, String> {
-    fs::read_to_string(path).map_err(|e| format!("{}: {e}", path.display()))
-}
-
 fn read_map(path: &Path) -> Result<(wslap::Map, Option<wslap::sky::SkyReference>), String> {
-    let bytes = fs::read(path).map_err(|e| format!("{}: {e}", path.display()))?;
+    let bytes = read_bytes(path, InputKind::Fits)?;
     let image = read_image(&bytes, &path.display().to_string()).map_err(|e| e.to_string())?;
     let (_, reference) = image.geometry().map_err(|e| e.to_string())?;
     let map = image.to_map().map_err(|e| e.to_string())?;

@@ -1,5 +1,6 @@
 //! Command-line parsing and the subcommands (native only).
 
+mod input;
 mod maps;
 mod paper;
 mod reconstruct;

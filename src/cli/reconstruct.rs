@@ -7,6 +7,7 @@ use clap::Args;
 use serde::Serialize;
 use wslap::catalog::{parse_image_catalog, parse_member_catalog};
 use wslap::inversion::{export_system, parse_arcs, ConstraintMode, ConstraintSource};
+use wslap::limits::InputKind;
 use wslap::reconstruct::{
     reconstruct, ConvergenceRecord, Inputs, LayerSource, ReconstructConfig, Reconstruction,
 };
@@ -14,6 +15,7 @@ use wslap::render::ColorScale;
 use wslap::solver::Control;
 use wslap::{Cosmology, LensPlane};
 
+use super::input::read_text;
 use super::maps::write_products;
 
 /// Free-form mass reconstruction (WSLAP+) from multiple images and member galaxies.
@@ -67,10 +69,11 @@ pub struct ReconstructArgs {
 
 pub fn run(args: &ReconstructArgs) -> Result<(), String> {
     let mut config = match &args.config {
-        Some(path) => {
-            ReconstructConfig::from_json_str(&read_text(path)?, &path.display().to_string())
-                .map_err(|e| e.to_string())?
-        }
+        Some(path) => ReconstructConfig::from_json_str(
+            &read_text(path, InputKind::Config)?,
+            &path.display().to_string(),
+        )
+        .map_err(|e| e.to_string())?,
         None => ReconstructConfig::default(),
     };
     if let Some(n) = args.iterations {
@@ -83,13 +86,15 @@ pub fn run(args: &ReconstructArgs) -> Result<(), String> {
     let plane = LensPlane::new(cosmology, args.z_lens).map_err(|e| e.to_string())?;
     let (catalog, arcs, mut warnings) = match (&args.images, &args.arcs) {
         (Some(path), _) => {
-            let (c, w) = parse_image_catalog(&read_text(path)?, &name(path), None)
-                .map_err(|e| e.to_string())?;
+            let (c, w) =
+                parse_image_catalog(&read_text(path, InputKind::Catalog)?, &name(path), None)
+                    .map_err(|e| e.to_string())?;
             (Some(c), None, w)
         }
         (None, Some(path)) => {
             config.constraints.mode = ConstraintMode::Arcs;
-            let a = parse_arcs(&read_text(path)?, &name(path)).map_err(|e| e.to_string())?;
+            let a = parse_arcs(&read_text(path, InputKind::Arcs)?, &name(path))
+                .map_err(|e| e.to_string())?;
             (None, Some(a), Vec::new())
         }
         (None, None) => return Err("give --images or --arcs".to_string()),
@@ -97,8 +102,12 @@ pub fn run(args: &ReconstructArgs) -> Result<(), String> {
     let reference = catalog.as_ref().and_then(|c| c.reference);
     let members = match &args.members {
         Some(path) => {
-            let (m, w) = parse_member_catalog(&read_text(path)?, &name(path), reference)
-                .map_err(|e| e.to_string())?;
+            let (m, w) = parse_member_catalog(
+                &read_text(path, InputKind::Catalog)?,
+                &name(path),
+                reference,
+            )
+            .map_err(|e| e.to_string())?;
             warnings.extend(w);
             Some(m)
         }
@@ -142,10 +151,6 @@ pub fn run(args: &ReconstructArgs) -> Result<(), String> {
     write_reconstruction(&result, &args.out)?;
     println!("{}", one_line(&result, &args.out));
     Ok(())
-}
-
-fn read_text(path: &Path) -> Result<String, String> {
-    fs::read_to_string(path).map_err(|e| format!("{}: {e}", path.display()))
 }
 
 fn name(path: &Path) -> String {

@@ -3,8 +3,7 @@
 use super::card::{Card, CardValue, CARD_LEN};
 use super::{FitsError, FitsImage, BLOCK};
 
-/// Largest image this reader accepts, in pixels (guards against absurd NAXIS values).
-const MAX_PIXELS: usize = 1 << 28;
+use crate::limits::{InputKind, TooLarge, MAX_FITS_PIXELS};
 
 /// Reads the 2-D image of a FITS file: the primary HDU, or the first `IMAGE` extension when the
 /// primary HDU has no data (`NAXIS = 0`). Values are `BZERO + BSCALE * stored`; integer pixels
@@ -14,6 +13,7 @@ pub fn read_image(bytes: &[u8], source_name: &str) -> Result<FitsImage, FitsErro
     if bytes.is_empty() {
         return Err(FitsError::Empty { file });
     }
+    TooLarge::check_bytes(&file, InputKind::Fits, bytes.len() as u64)?;
     let first = Card::parse(&bytes[..bytes.len().min(CARD_LEN)]);
     if first.keyword != "SIMPLE" || first.value != Some(CardValue::Logical(true)) {
         let found = first.keyword.clone() + " " + &first.comment;
@@ -173,14 +173,18 @@ impl Hdu<'_> {
             });
         }
         let (width, height) = (axes[0], axes[1]);
-        let len = self.data_len()?;
-        if width == 0 || height == 0 || width.saturating_mul(height) > MAX_PIXELS {
+        if width == 0 || height == 0 || width.saturating_mul(height) > MAX_FITS_PIXELS {
             return Err(self.bad(
-                "NAXIS1",
+                "NAXIS1 x NAXIS2",
                 format!("{width} x {height}"),
-                "image size must be 1 to 2^28 pixels",
+                &format!(
+                    "an image must have 1 to {MAX_FITS_PIXELS} pixels (a 10000 x 10000 map); \
+                     this header claims {}",
+                    width as u128 * height as u128
+                ),
             ));
         }
+        let len = self.data_len()?;
         if ![16, 32, -32, -64].contains(&bitpix) {
             return Err(FitsError::UnsupportedBitpix { file, bitpix });
         }

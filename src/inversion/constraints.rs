@@ -7,7 +7,7 @@
 //!   0.2 arcsec, an HST drizzled pixel scale) centred on the image that fall inside its
 //!   catalogue ellipse (`a`, `b` semi-axes in arcsec, `theta` degrees counter-clockwise from
 //!   +x), about `pi a b / pixel^2` of them and always at least the centre;
-//! - `arcs`: pixels given explicitly in an arc file (see [`parse_arcs`]).
+//! - `arcs`: pixels given explicitly in an arc file (see [`super::parse_arcs`]).
 //!
 //! Weights (the diagonal of `W`, in 1/arcsec^2) are `w / sigma_pos^2` with `w` from the
 //! weighting scheme: `equal_per_image` (default) gives each image a total `w` of 1 shared by
@@ -25,6 +25,8 @@ use serde::{Deserialize, Serialize};
 use thiserror::Error;
 
 use crate::catalog::ImageCatalog;
+
+use super::arcs::ArcCatalog;
 
 /// What can be wrong with constraint settings or inputs.
 #[derive(Debug, Error, Clone, PartialEq)]
@@ -47,12 +49,16 @@ pub enum ConstraintError {
         column: usize,
         message: String,
     },
-    #[error("{source_name}: system {system}: {reason}")]
+    /// One system of an arcs file; `line` is where the system's object starts.
+    #[error("{source_name}: line {line}: system {system}: {reason}")]
     ArcsSystem {
         source_name: String,
+        line: usize,
         system: String,
         reason: String,
     },
+    #[error(transparent)]
+    TooLarge(#[from] crate::limits::TooLarge),
     #[error("{source_name}: line {line}: image {id}: {field} = {value} is not allowed ({reason})")]
     BadImage {
         source_name: String,
@@ -223,22 +229,6 @@ pub struct ConstraintSet {
     pub warnings: Vec<String>,
 }
 
-/// Explicit arc pixels, from [`parse_arcs`].
-#[derive(Debug, Clone, PartialEq)]
-pub struct ArcCatalog {
-    pub source_name: String,
-    pub systems: Vec<ArcSystem>,
-}
-
-/// The pixels of one system of an arc file; a flat `pixels` list is one image.
-#[derive(Debug, Clone, PartialEq)]
-pub struct ArcSystem {
-    pub id: String,
-    pub z: Option<f64>,
-    /// Pixel positions in arcsec, per image.
-    pub images: Vec<Vec<DVec2>>,
-}
-
 /// Where the constraints come from.
 #[derive(Debug, Clone, Copy)]
 pub enum ConstraintSource<'a> {
@@ -246,102 +236,6 @@ pub enum ConstraintSource<'a> {
     Catalog(&'a ImageCatalog),
     /// Explicit arc pixels (mode `arcs`).
     Arcs(&'a ArcCatalog),
-}
-
-#[derive(Deserialize)]
-#[serde(untagged)]
-enum IdJson {
-    Text(String),
-    Number(serde_json::Number),
-}
-
-#[derive(Deserialize)]
-#[serde(deny_unknown_fields)]
-struct ArcSystemJson {
-    id: IdJson,
-    #[serde(default)]
-    z: Option<f64>,
-    #[serde(default)]
-    pixels: Option<Vec<[f64; 2]>>,
-    #[serde(default)]
-    images: Option<Vec<Vec<[f64; 2]>>>,
-}
-
-#[derive(Deserialize)]
-#[serde(deny_unknown_fields)]
-struct ArcsJson {
-    systems: Vec<ArcSystemJson>,
-}
-
-/// Parses an arc file (`source_name` names it in errors):
-///
-/// ```json
-/// {"systems": [
-///   {"id": "1", "z": 2.1, "pixels": [[x, y], ...]},
-///   {"id": "2", "z": null, "images": [[[x, y], ...], [[x, y], ...]]}]}
-/// ```
-///
-/// Positions in arcsec in the frame of METHOD.md section 1. Each system has either `pixels`
-/// (all its pixels, counted as one image) or `images` (one pixel list per image); `z` null,
-/// 0 or absent means unknown. Ids must be unique, pixel lists non-empty and finite.
-pub fn parse_arcs(text: &str, source_name: &str) -> Result<ArcCatalog, ConstraintError> {
-    let raw: ArcsJson = serde_json::from_str(text).map_err(|e| ConstraintError::ArcsSyntax {
-        source_name: source_name.to_string(),
-        line: e.line(),
-        column: e.column(),
-        message: e.to_string(),
-    })?;
-    let mut systems: Vec<ArcSystem> = Vec::with_capacity(raw.systems.len());
-    for s in raw.systems {
-        let id = match s.id {
-            IdJson::Text(t) => t,
-            IdJson::Number(n) => n.to_string(),
-        };
-        let fail = |reason: String| ConstraintError::ArcsSystem {
-            source_name: source_name.to_string(),
-            system: id.clone(),
-            reason,
-        };
-        if systems.iter().any(|o| o.id == id) {
-            return Err(fail("the id appears twice".into()));
-        }
-        let images: Vec<Vec<[f64; 2]>> = match (s.pixels, s.images) {
-            (Some(p), None) => vec![p],
-            (None, Some(i)) => i,
-            _ => return Err(fail("give exactly one of \"pixels\" and \"images\"".into())),
-        };
-        if images.is_empty() || images.iter().any(|i| i.is_empty()) {
-            return Err(fail("every pixel list must hold at least one pixel".into()));
-        }
-        if let Some(p) = images
-            .iter()
-            .flatten()
-            .find(|p| !(p[0].is_finite() && p[1].is_finite()))
-        {
-            return Err(fail(format!("pixel [{}, {}] is not finite", p[0], p[1])));
-        }
-        let z = match s.z {
-            Some(0.0) => None,
-            Some(z) if !(z.is_finite() && z > 0.0 && z < 20.0) => {
-                return Err(fail(format!(
-                    "z = {z} must be in (0, 20), or 0/null when unknown"
-                )));
-            }
-            z => z,
-        };
-        systems.push(ArcSystem {
-            id,
-            z,
-            images: images
-                .into_iter()
-                .map(|i| i.into_iter().map(|[x, y]| DVec2::new(x, y)).collect())
-                .collect(),
-        });
-    }
-    Ok(ArcCatalog {
-        source_name: source_name.to_string(),
-        systems,
-    })
 }
 
 /// Lattice points `center + (i, j) * pixel` (arcsec) inside the ellipse of semi-axes `a`, `b`
@@ -550,7 +444,10 @@ pub fn build_constraints(
         let excluded: Vec<String> = set
             .excluded
             .iter()
-            .map(|e| format!("{} ({:?})", e.id, e.reason))
+            .map(|e| match first_line(source, &e.id) {
+                Some(line) => format!("{} ({:?}, line {line})", e.id, e.reason),
+                None => format!("{} ({:?})", e.id, e.reason),
+            })
             .collect();
         return Err(ConstraintError::NoSystems {
             source_name,
@@ -562,6 +459,19 @@ pub fn build_constraints(
         });
     }
     Ok(set)
+}
+
+/// The catalogue line of a system's first image (`None` for arc files).
+fn first_line(source: ConstraintSource<'_>, id: &str) -> Option<usize> {
+    match source {
+        ConstraintSource::Catalog(c) => c
+            .systems
+            .iter()
+            .find(|s| s.id == id)
+            .and_then(|s| s.images.first())
+            .map(|i| i.line),
+        ConstraintSource::Arcs(_) => None,
+    }
 }
 
 /// Appends one system's pixels with their weights (module documentation).

@@ -2,6 +2,7 @@
 //! the cell grid, the member-galaxy layers, the constraint pixels and the linear system
 //! `Theta = Gamma X` with its normal equations.
 
+mod arcs;
 mod constraints;
 mod grid;
 mod grid_fft;
@@ -9,10 +10,11 @@ mod members;
 mod npy;
 mod system;
 
+pub use arcs::{parse_arcs, ArcCatalog, ArcSystem};
 pub use constraints::{
-    build_constraints, ellipse_pixels, parse_arcs, ArcCatalog, ArcSystem, ConstraintConfig,
-    ConstraintError, ConstraintMode, ConstraintPixel, ConstraintSet, ConstraintSource,
-    ConstraintSystem, ExcludedSystem, Exclusion, Weighting,
+    build_constraints, ellipse_pixels, ConstraintConfig, ConstraintError, ConstraintMode,
+    ConstraintPixel, ConstraintSet, ConstraintSource, ConstraintSystem, ExcludedSystem, Exclusion,
+    Weighting,
 };
 pub use grid::{cell_unit_deflection, Cell, CellGrid, GridConfig, GridError, GridMass};
 pub use grid_fft::MapPlan;

@@ -4,6 +4,7 @@
 use serde::{Deserialize, Serialize};
 
 use crate::inversion::{ConstraintConfig, GridConfig, MemberConfig, SystemConfig};
+use crate::limits::{json_error_message, InputKind, TooLarge};
 use crate::solver::QadpSettings;
 
 use super::ReconstructError;
@@ -76,11 +77,13 @@ impl Default for ProductConfig {
 }
 
 impl ReconstructConfig {
-    /// Parses a configuration file; errors name the file, line and column.
+    /// Parses a configuration file; errors name the file, line and column (once), and a text
+    /// over [`crate::limits::MAX_JSON_BYTES`] is refused before parsing.
     pub fn from_json_str(text: &str, source_name: &str) -> Result<Self, ReconstructError> {
+        TooLarge::check_bytes(source_name, InputKind::Config, text.len() as u64)?;
         let config: Self = serde_json::from_str(text).map_err(|e| ReconstructError::Config {
             source_name: source_name.to_string(),
-            message: format!("line {}, column {}: {e}", e.line(), e.column()),
+            message: json_error_message(&e),
         })?;
         config.validate().map_err(|e| ReconstructError::Config {
             source_name: source_name.to_string(),

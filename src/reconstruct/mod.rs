@@ -56,6 +56,8 @@ pub enum ReconstructError {
     Images(#[from] ImageError),
     #[error(transparent)]
     Products(#[from] ProductsError),
+    #[error(transparent)]
+    TooLarge(#[from] crate::limits::TooLarge),
     #[error("no system is left to constrain the lens ({0})")]
     NoConstraints(String),
 }

@@ -1,0 +1,212 @@
+//! Bad JSON and FITS inputs in memory (what the browser app passes to the core): each error
+//! names the file, says line and column once, and the size limits refuse a huge input before
+//! it is parsed. Catalogue cases are in tests/catalog.rs, command-line ones in tests/cli.rs.
+
+mod common;
+
+use wslap::fits::{read_image, FitsError};
+use wslap::inversion::{parse_arcs, ConstraintError};
+use wslap::limits::{MAX_ARC_PIXELS, MAX_FITS_PIXELS, MAX_JSON_BYTES};
+use wslap::model::ModelFile;
+use wslap::reconstruct::ReconstructConfig;
+
+fn config_err(text: &str) -> String {
+    ReconstructConfig::from_json_str(text, "config.json")
+        .expect_err("must be rejected")
+        .to_string()
+}
+
+fn arcs_err(text: &str) -> String {
+    parse_arcs(text, "arcs.json")
+        .expect_err("must be rejected")
+        .to_string()
+}
+
+/// The message names the place once: one "line" and one "column".
+#[track_caller]
+fn assert_place_once(message: &str) {
+    assert_eq!(message.matches("line").count(), 1, "{message}");
+    assert_eq!(message.matches("column").count(), 1, "{message}");
+}
+
+#[cfg_attr(not(target_arch = "wasm32"), test)]
+#[cfg_attr(target_arch = "wasm32", wasm_bindgen_test::wasm_bindgen_test)]
+fn config_syntax_errors_say_the_place_once() {
+    let err = config_err("{\n  \"grid\": {\"cells\": }\n}");
+    assert_eq!(err, "config.json: line 2, column 21: expected value");
+    let err = config_err("{\"solver\": {\"iterations\": 10, \"speed\": 2}}");
+    assert!(
+        err.starts_with("config.json: line 1, column 37: unknown field `speed`"),
+        "{err}"
+    );
+    assert_place_once(&err);
+    // JSON has no NaN or infinity; a number beyond f64 is refused where it is written.
+    let err = config_err("{\"products\": {\"z_source\": 1e999}}");
+    assert_eq!(err, "config.json: line 1, column 31: number out of range");
+    let err = config_err("");
+    assert_eq!(
+        err,
+        "config.json: line 1, column 0: EOF while parsing a value"
+    );
+}
+
+#[cfg_attr(not(target_arch = "wasm32"), test)]
+#[cfg_attr(target_arch = "wasm32", wasm_bindgen_test::wasm_bindgen_test)]
+fn config_values_out_of_range_name_the_file_and_field() {
+    let err = config_err("{\"products\": {\"z_source\": -1}}");
+    assert_eq!(
+        err,
+        "config.json: products.z_source = -1 is not allowed (must be a positive redshift)"
+    );
+}
+
+#[cfg_attr(not(target_arch = "wasm32"), test)]
+#[cfg_attr(target_arch = "wasm32", wasm_bindgen_test::wasm_bindgen_test)]
+fn model_syntax_errors_say_the_place_once() {
+    let text = "{\"z_lens\": 0.3,\n \"components\": [{\"type\": \"sis\", \"x\": 1e999, \"y\": 0, \
+                \"sigma_v\": 200}]}";
+    let err = ModelFile::from_json_str(text, "model.json")
+        .unwrap_err()
+        .to_string();
+    assert_eq!(err, "model.json: line 2, column 42: number out of range");
+    let err = ModelFile::from_json_str("{\"z_lens\": 0.3, \"components\": [", "model.json")
+        .unwrap_err()
+        .to_string();
+    assert_place_once(&err);
+    assert!(err.starts_with("model.json: line 1, column 31: "), "{err}");
+}
+
+#[cfg_attr(not(target_arch = "wasm32"), test)]
+#[cfg_attr(target_arch = "wasm32", wasm_bindgen_test::wasm_bindgen_test)]
+fn arcs_errors_name_the_line_of_the_system() {
+    let text = "{\"systems\": [\n  {\"id\": \"a\", \"z\": 2, \"pixels\": [[0, 1], [1, 1]]},\n  \
+                {\"id\": \"b\", \"z\": 2, \"images\": [[[3, 4]], []]}\n]}";
+    assert_eq!(
+        arcs_err(text),
+        "arcs.json: line 3: system b: no pixels in image 1 (from 0): every pixel list must \
+         hold at least one pixel"
+    );
+    let text = "{\"systems\": [\n  {\"id\": \"a\", \"z\": 2, \"pixels\": []}]}";
+    assert!(arcs_err(text).starts_with("arcs.json: line 2: system a: no pixels"));
+    // A syntax error inside a system: its line and column in the file, said once.
+    let text = "{\"systems\": [\n  {\"id\": \"a\", \"z\": 2, \"pixels\": [[0, 1]]},\n  \
+                {\"id\": \"b\", \"z\": 2, \"pixels\": [[1e999, 0]]}]}";
+    assert_eq!(
+        arcs_err(text),
+        "arcs.json: line 3, column 39: number out of range"
+    );
+    let text = "{\"systems\": [\n  {\"id\": \"a\",\n   \"zz\": 2, \"pixels\": [[0, 1]]}]}";
+    let err = arcs_err(text);
+    assert!(
+        err.starts_with("arcs.json: line 3, column 7: unknown field `zz`"),
+        "{err}"
+    );
+    assert_place_once(&err);
+    let text = "{\"systems\": [{\"id\": \"a\", \"z\": 1e30, \"pixels\": [[0, 1]]}]}";
+    assert_eq!(
+        arcs_err(text),
+        "arcs.json: line 1: system a: z = 1000000000000000000000000000000 must be in (0, 20), \
+         or 0/null when unknown"
+    );
+}
+
+#[cfg_attr(not(target_arch = "wasm32"), test)]
+#[cfg_attr(target_arch = "wasm32", wasm_bindgen_test::wasm_bindgen_test)]
+fn arcs_pixel_limit() {
+    let pixels = vec!["[0,0]"; MAX_ARC_PIXELS / 2 + 1].join(",");
+    let text = format!(
+        "{{\"systems\": [{{\"id\": 1, \"pixels\": [{pixels}]}}, {{\"id\": 2, \"pixels\": \
+         [{pixels}]}}]}}"
+    );
+    let err = parse_arcs(&text, "arcs.json").unwrap_err();
+    assert!(matches!(err, ConstraintError::TooLarge(_)), "{err}");
+    assert_eq!(
+        err.to_string(),
+        format!(
+            "arcs.json: {} pixels is more than the limit of {MAX_ARC_PIXELS} pixels for an \
+             arcs file",
+            2 * (MAX_ARC_PIXELS / 2 + 1)
+        )
+    );
+}
+
+#[cfg(not(target_arch = "wasm32"))]
+#[test]
+fn json_size_limit() {
+    let text = " ".repeat(MAX_JSON_BYTES as usize + 1);
+    let err = ModelFile::from_json_str(&text, "model.json")
+        .unwrap_err()
+        .to_string();
+    assert_eq!(
+        err,
+        format!(
+            "model.json: {} bytes is more than the limit of {MAX_JSON_BYTES} bytes for a model \
+             file",
+            MAX_JSON_BYTES + 1
+        )
+    );
+    assert!(config_err(&text).contains("bytes for a settings file"));
+}
+
+/// One FITS header block of the given cards (80 characters each) and END.
+fn fits_header(cards: &[&str]) -> Vec<u8> {
+    let mut out: Vec<u8> = cards
+        .iter()
+        .chain(&["END"])
+        .flat_map(|c| format!("{c:<80}").into_bytes())
+        .collect();
+    out.resize(out.len().div_ceil(2880) * 2880, b' ');
+    out
+}
+
+#[cfg_attr(not(target_arch = "wasm32"), test)]
+#[cfg_attr(target_arch = "wasm32", wasm_bindgen_test::wasm_bindgen_test)]
+fn fits_header_claiming_a_huge_image() {
+    // The header alone (2880 bytes) claims 10^12 pixels: refused without reading or allocating.
+    let bytes = fits_header(&[
+        "SIMPLE  =                    T",
+        "BITPIX  =                  -32",
+        "NAXIS   =                    2",
+        "NAXIS1  =              1000000",
+        "NAXIS2  =              1000000",
+    ]);
+    let err = read_image(&bytes, "huge.fits").unwrap_err();
+    assert!(matches!(err, FitsError::BadKeyword { .. }), "{err}");
+    assert_eq!(
+        err.to_string(),
+        format!(
+            "huge.fits: keyword NAXIS1 x NAXIS2 = 1000000 x 1000000: an image must have 1 to \
+             {MAX_FITS_PIXELS} pixels (a 10000 x 10000 map); this header claims 1000000000000"
+        )
+    );
+}
+
+#[cfg_attr(not(target_arch = "wasm32"), test)]
+#[cfg_attr(target_arch = "wasm32", wasm_bindgen_test::wasm_bindgen_test)]
+fn fits_nan_and_infinite_pixels_are_refused_as_maps() {
+    let mut bytes = fits_header(&[
+        "SIMPLE  =                    T",
+        "BITPIX  =                  -32",
+        "NAXIS   =                    2",
+        "NAXIS1  =                    2",
+        "NAXIS2  =                    2",
+        "CTYPE1  = 'RA---TAN'",
+        "CTYPE2  = 'DEC--TAN'",
+        "CRPIX1  =                  1.5",
+        "CRPIX2  =                  1.5",
+        "CRVAL1  =                 10.0",
+        "CRVAL2  =                 20.0",
+        "CDELT1  =             -0.00025",
+        "CDELT2  =              0.00025",
+    ]);
+    for v in [1.0f32, f32::NAN, f32::INFINITY, 2.0] {
+        bytes.extend_from_slice(&v.to_be_bytes());
+    }
+    bytes.resize(2 * 2880, 0);
+    let image = read_image(&bytes, "nan.fits").unwrap();
+    let err = image.to_map().unwrap_err().to_string();
+    assert_eq!(
+        err,
+        "nan.fits: 2 pixels are NaN or infinite (first at column 1, row 0, from 0)"
+    );
+}
