@@ -4,10 +4,12 @@
 
 mod common;
 
+use glam::DVec2;
 use serde_json::json;
 use wslap::app::examples::{teaching_image_catalog, TEACHING_SOURCES};
-use wslap::app::{DataRole, RunKind, Session, ViewOptions};
+use wslap::app::{system_rgb, DataRole, RunKind, Session, ViewOptions, MAX_STORED_FITS_BYTES};
 use wslap::demo::TEACHING_MODEL_JSON;
+use wslap::render::{LegendPlace, PIXEL_ALPHA};
 use wslap::solver::Control;
 
 /// A quick reconstruction: 16 x 16 cells, 400 iterations, 64-pixel maps.
@@ -268,4 +270,185 @@ fn committed_teaching_model_is_the_demo_model() {
         std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("www/examples/teaching/model.json");
     let committed = std::fs::read_to_string(&path).unwrap();
     assert_eq!(committed.trim(), TEACHING_MODEL_JSON.trim());
+}
+
+/// A forward run of the teaching model on a 64-pixel, 64-arcsec map, and its deflection FITS.
+fn forward_session() -> (Session, Vec<u8>, Vec<u8>) {
+    let mut s = Session::new();
+    s.load_text(DataRole::Model, "model.json", TEACHING_MODEL_JSON)
+        .unwrap();
+    for (path, value) in [
+        ("z_lens", json!(0.3)),
+        ("reconstruct.products.size_arcsec", json!(64.0)),
+        ("reconstruct.products.pixels", json!(64)),
+    ] {
+        s.set_field(path, value).unwrap();
+    }
+    s.run(RunKind::Forward, &mut |_| Control::Continue).unwrap();
+    let fits = s.result().unwrap().products.fits_files().unwrap();
+    let file = |name: &str| fits.iter().find(|(n, _)| *n == name).unwrap().1.clone();
+    let (x, y) = (file("x-arcsec-deflect.fits"), file("y-arcsec-deflect.fits"));
+    (s, x, y)
+}
+
+#[cfg_attr(not(target_arch = "wasm32"), test)]
+#[cfg_attr(target_arch = "wasm32", wasm_bindgen_test::wasm_bindgen_test)]
+fn a_lookup_project_keeps_its_deflection_maps() {
+    let (_, fx, fy) = forward_session();
+    let mut s = Session::new();
+    s.set_field("z_lens", json!(0.3)).unwrap();
+    s.set_field("reconstruct.products.z_source", json!(3.0))
+        .unwrap();
+    s.load_fits(0, "alpha_x.fits", &fx).unwrap();
+    s.load_fits(1, "alpha_y.fits", &fy).unwrap();
+    s.run(RunKind::Lookup, &mut |_| Control::Continue).unwrap();
+    let text = s.project_json().unwrap();
+    let project: serde_json::Value = serde_json::from_str(&text).unwrap();
+    assert_eq!(project["data"]["deflection_x"]["name"], "alpha_x.fits");
+
+    let mut t = Session::new();
+    let report = t.open_project(&text, "lookup.json").unwrap();
+    assert_eq!(report.result, "recomputed", "{}", report.message);
+    for axis in 0..2 {
+        let (a, b) = (
+            s.data.deflection[axis].as_ref().unwrap(),
+            t.data.deflection[axis].as_ref().unwrap(),
+        );
+        assert_eq!(a.name, b.name);
+        assert_eq!(a.map.data, b.map.data, "axis {axis}: the map changed");
+        assert_eq!(
+            b.fits.as_deref(),
+            Some([fx.as_slice(), fy.as_slice()][axis])
+        );
+    }
+    let (a, b) = (s.result().unwrap(), t.result().unwrap());
+    assert_eq!(b.kind, RunKind::Lookup);
+    assert_eq!(b.products.curves.z_source, 3.0);
+    assert_eq!(
+        a.products.curves.einstein_radius_arcsec,
+        b.products.curves.einstein_radius_arcsec
+    );
+    // The reopened session writes the same data (the summary's timings differ).
+    let again: serde_json::Value = serde_json::from_str(&t.project_json().unwrap()).unwrap();
+    assert!(again["data"] == project["data"], "the stored data changed");
+}
+
+#[cfg_attr(not(target_arch = "wasm32"), test)]
+#[cfg_attr(target_arch = "wasm32", wasm_bindgen_test::wasm_bindgen_test)]
+fn a_project_with_a_broken_or_oversized_fits_is_refused_and_changes_nothing() {
+    let (mut s, fx, _) = forward_session();
+    s.load_fits(0, "alpha_x.fits", &fx).unwrap();
+    let text = s.project_json().unwrap();
+    let mut project: serde_json::Value = serde_json::from_str(&text).unwrap();
+    project["data"]["deflection_x"]["fits_base64"] = json!("AAAA*AAA");
+    let before = s.project_json().unwrap();
+    let err = s
+        .open_project(&project.to_string(), "p.json")
+        .unwrap_err()
+        .to_string();
+    assert!(
+        err.contains("p.json") && err.contains("alpha_x.fits") && err.contains("not base64"),
+        "{err}"
+    );
+    // Just above the stated limit (base64 of MAX_STORED_FITS_BYTES + 3 bytes and more).
+    let too_big = "A".repeat((MAX_STORED_FITS_BYTES / 3 + 2) * 4);
+    project["data"]["deflection_x"]["fits_base64"] = json!(too_big);
+    let err = s
+        .open_project(&project.to_string(), "p.json")
+        .unwrap_err()
+        .to_string();
+    assert!(
+        err.contains(&MAX_STORED_FITS_BYTES.to_string()) && err.contains("alpha_x.fits"),
+        "{err}"
+    );
+    assert_eq!(s.project_json().unwrap(), before);
+    // A project written before FITS maps were stored still opens.
+    project["data"]
+        .as_object_mut()
+        .unwrap()
+        .remove("deflection_x");
+    let report = s.open_project(&project.to_string(), "old.json").unwrap();
+    assert_eq!(report.result, "recomputed", "{}", report.message);
+    assert!(s.data.deflection[0].is_none());
+}
+
+/// Two systems of 3 x 3 arc pixels (0.5 arcsec) on the teaching model's map.
+const TWO_ARCS_JSON: &str = r#"{"systems": [
+  {"id": "a", "z": 2.0, "pixels": [[-10.5, 9.5], [-10, 9.5], [-9.5, 9.5], [-10.5, 10], [-10, 10],
+     [-9.5, 10], [-10.5, 10.5], [-10, 10.5], [-9.5, 10.5]]},
+  {"id": "b", "z": 2.0, "pixels": [[9.5, -10.5], [10, -10.5], [10.5, -10.5], [9.5, -10], [10, -10],
+     [10.5, -10], [9.5, -9.5], [10, -9.5], [10.5, -9.5]]}
+]}"#;
+
+fn rgb(pm: &tiny_skia::Pixmap, (x, y): (f32, f32)) -> [u8; 3] {
+    let p = pm.pixel(x as u32, y as u32).expect("inside the figure");
+    [p.red(), p.green(), p.blue()]
+}
+
+#[cfg_attr(not(target_arch = "wasm32"), test)]
+#[cfg_attr(target_arch = "wasm32", wasm_bindgen_test::wasm_bindgen_test)]
+fn arc_pixels_are_drawn_in_system_colours_and_the_legend_leaves_the_map_free() {
+    /// Channel tolerance of the alpha blend (rounding of 8-bit colours).
+    const BLEND_TOL: i32 = 3;
+    let (mut s, _, _) = forward_session();
+    s.load_text(DataRole::Arcs, "arcs.json", TWO_ARCS_JSON)
+        .unwrap();
+    s.run(RunKind::Forward, &mut |_| Control::Continue).unwrap();
+    let r = s.result().unwrap();
+    assert_eq!(r.arcs.len(), 2);
+    assert_eq!(r.arc_pixel_mas, 500);
+    let below = ViewOptions::default();
+    let bare = ViewOptions {
+        show_observed: false,
+        ..below
+    };
+    let frame = s.kappa_frame(&below).unwrap();
+    let decode = |o: &ViewOptions| tiny_skia::Pixmap::decode_png(&s.kappa_view(o).unwrap().png);
+    let (with, without) = (decode(&below).unwrap(), decode(&bare).unwrap());
+    assert_eq!((with.width(), with.height()), (frame.width, frame.height));
+    for (k, centre) in [(0, DVec2::new(-10.0, 10.0)), (1, DVec2::new(10.0, -10.0))] {
+        let at = frame.arcsec_to_screen(centre);
+        let (fg, bg) = (system_rgb(k), rgb(&without, at));
+        let got = rgb(&with, at);
+        for c in 0..3 {
+            let want = PIXEL_ALPHA * fg[c] as f32 + (1.0 - PIXEL_ALPHA) * bg[c] as f32;
+            assert!(
+                (got[c] as i32 - want.round() as i32).abs() <= BLEND_TOL,
+                "system {k}: {got:?} is not {fg:?} at {PIXEL_ALPHA} over {bg:?}"
+            );
+        }
+    }
+    assert_ne!(system_rgb(0), system_rgb(1));
+    // Legend under the map: the map is the same with or without it except for the arcs;
+    // its text (dark pixels) lies below the x-axis title, and the figure is taller than
+    // the one with the legend in the map's corner.
+    let inside = ViewOptions {
+        legend: LegendPlace::InsideTopRight,
+        ..below
+    };
+    let corner = decode(&inside).unwrap();
+    let (x0, y0) = (frame.map_left + frame.map_side * 0.75, frame.map_top + 4.0);
+    let differs = |a: &tiny_skia::Pixmap, b: &tiny_skia::Pixmap| {
+        (0..20).any(|k| {
+            rgb(a, (x0 + 2.0 * k as f32, y0 + 6.0)) != rgb(b, (x0 + 2.0 * k as f32, y0 + 6.0))
+        })
+    };
+    assert!(differs(&corner, &without), "the corner legend is not drawn");
+    let bare_inside = decode(&ViewOptions {
+        show_observed: false,
+        ..inside
+    })
+    .unwrap();
+    assert!(corner.height() < with.height());
+    assert!(bare_inside.height() < without.height());
+    assert!(!differs(&with, &without), "the legend covers the map");
+    let legend_rows = (frame.map_top + frame.map_side + 40.0) as u32..with.height();
+    let dark = legend_rows
+        .flat_map(|y| (0..with.width()).map(move |x| (x, y)))
+        .filter(|&(x, y)| rgb(&with, (x as f32, y as f32)).iter().all(|&c| c < 60))
+        .count();
+    assert!(
+        dark > 50,
+        "no legend text under the map ({dark} dark pixels)"
+    );
 }

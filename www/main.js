@@ -5,7 +5,7 @@ import { LensClient } from './lens-client.js';
 import { loadProject, saveProject } from './js/store.js';
 import { buildFileRows, setFileStatus, ROLES } from './js/files.js';
 import { buildSettings, showSettings } from './js/settings.js';
-import { wireViews, showPng, showSystems, viewOptions, currentView } from './js/views.js';
+import { wireViews, showPng, showSystems, viewOptions, currentView, refreshReadout } from './js/views.js';
 import { showDownloads } from './js/downloads.js';
 
 const $ = (id) => document.getElementById(id);
@@ -16,6 +16,15 @@ let settings = null;
 
 const client = new LensClient({ onCrash: (m) => showError(m) });
 const ask = (type, payload = {}, onProgress) => client.request(type, payload, onProgress);
+
+// Settings as the worker answered them, numbered in the order it did (`revision`), so that the
+// form never shows an older answer over a newer one (answers are awaited in the worker's order).
+let revision = 0;
+async function askSettings(type, payload) {
+  const answer = await ask(type, payload);
+  answer.revision = ++revision;
+  return answer;
+}
 
 function setStatus(text) { $('status').textContent = text; }
 function showError(text) { $('error').textContent = text; $('error').hidden = false; }
@@ -55,6 +64,8 @@ async function render() {
     }
     const { png } = await ask('view', { name, options: viewOptions() });
     showPng(name, png);
+    // The read-out under a still cursor follows the new map (z_s, a new result).
+    if (name === 'kappa') await refreshReadout();
   } catch (err) {
     $('view-image').hidden = true;
     $('summary').textContent = err.message;
@@ -119,8 +130,8 @@ async function cancel() {
 }
 
 async function afterOpen(report) {
-  settings = await ask('settings');
-  showSettings(settings);
+  settings = await askSettings('settings');
+  showSettings(settings, { force: true });
   $('z-curves').value = settings.reconstruct.products.z_source;
   const loaded = await refreshLoaded();
   for (const { role } of ROLES) setFileStatus(role, loaded[role] ? `${loaded[role]}: loaded` : '');
@@ -182,13 +193,13 @@ async function onFile(role, file) {
 
 async function applySetting(path, value) {
   if (path === 'reconstruct.products.z_source') return setZ(value);
-  settings = await ask('setField', { path, value });
+  settings = await askSettings('setField', { path, value });
   await persist();
   return settings;
 }
 
 async function setZ(z) {
-  settings = await ask('setZSource', { z });
+  settings = await askSettings('setZSource', { z });
   $('z-curves').value = z;
   showSettings(settings);
   if (resultKind) {

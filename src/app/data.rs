@@ -49,12 +49,18 @@ pub struct NamedText {
     pub text: String,
 }
 
+/// Largest deflection FITS file a project keeps (bytes; a 2048 x 2048 float32 map and its
+/// header fit). A larger map is used, but must be loaded again after the page is reloaded.
+pub const MAX_STORED_FITS_BYTES: usize = 20 * 1024 * 1024;
+
 /// A deflection map (HFF convention, arcsec at `D_ls/D_s = 1`) read from FITS.
 #[derive(Debug, Clone)]
 pub struct NamedMap {
     pub name: String,
     pub map: Map,
     pub reference: Option<SkyReference>,
+    /// The file as read, kept for the project file (`None` above [`MAX_STORED_FITS_BYTES`]).
+    pub fits: Option<Vec<u8>>,
 }
 
 /// What loading a file found, for the line next to it.
@@ -76,6 +82,28 @@ pub struct LoadedData {
     pub model: Option<NamedText>,
     /// Deflection maps along x and y (look-up mode).
     pub deflection: [Option<NamedMap>; 2],
+}
+
+/// Arc pixel side assumed when it cannot be measured (milliarcsec).
+pub const DEFAULT_ARC_PIXEL_MAS: u32 = 200;
+/// Largest arc pixel side drawn (milliarcsec; sparser "pixels" are points, not pixels).
+const MAX_ARC_PIXEL_MAS: f64 = 5000.0;
+
+/// The arc pixels of one system.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ArcPixels {
+    pub id: String,
+    pub pixels_arcsec: Vec<DVec2>,
+}
+
+/// The warning for a FITS file of `len` bytes that the project file does not keep.
+fn too_large_to_keep(name: &str, len: usize) -> String {
+    const MIB: f64 = 1024.0 * 1024.0;
+    format!(
+        "{name}: {:.1} MB is more than the {:.0} MB a project keeps; it is used now, but load it again after reloading the page",
+        len as f64 / MIB,
+        MAX_STORED_FITS_BYTES as f64 / MIB
+    )
 }
 
 /// The catalogues of a session in one frame, the way `wslap reconstruct` reads them: images
@@ -103,6 +131,51 @@ impl ParsedData {
         let arcs = self.arcs.iter().flat_map(|a| a.systems.iter());
         arcs.flat_map(|s| s.images.iter().flatten().copied())
             .collect()
+    }
+
+    /// Catalogue image positions only (no arc pixels), arcsec.
+    pub fn catalog_arcsec(&self) -> Vec<DVec2> {
+        let c = self.images.iter().flat_map(|c| c.images());
+        c.map(|i| i.position).collect()
+    }
+
+    /// The arc pixels of each system (all its images together), in file order.
+    pub fn arc_systems(&self) -> Vec<ArcPixels> {
+        let systems = self.arcs.iter().flat_map(|a| a.systems.iter());
+        systems
+            .map(|s| ArcPixels {
+                id: s.id.clone(),
+                pixels_arcsec: s.images.iter().flatten().copied().collect(),
+            })
+            .collect()
+    }
+
+    /// Side of one arc pixel in milliarcsec: the median distance from a pixel to its nearest
+    /// neighbour in the same image ([`DEFAULT_ARC_PIXEL_MAS`] if no image has two pixels).
+    pub fn arc_pixel_mas(&self) -> u32 {
+        let mut nearest: Vec<f64> = Vec::new();
+        let images = self
+            .arcs
+            .iter()
+            .flat_map(|a| &a.systems)
+            .flat_map(|s| &s.images);
+        for image in images {
+            for (k, p) in image.iter().enumerate() {
+                let others = image.iter().enumerate().filter(|&(j, _)| j != k);
+                let d = others
+                    .map(|(_, q)| p.distance(*q))
+                    .fold(f64::INFINITY, f64::min);
+                if d.is_finite() && d > 0.0 {
+                    nearest.push(d);
+                }
+            }
+        }
+        if nearest.is_empty() {
+            return DEFAULT_ARC_PIXEL_MAS;
+        }
+        nearest.sort_by(f64::total_cmp);
+        let median_mas = nearest[nearest.len() / 2] * 1000.0;
+        median_mas.round().clamp(1.0, MAX_ARC_PIXEL_MAS) as u32
     }
 
     /// Member positions, arcsec.
@@ -205,6 +278,10 @@ impl LoadedData {
         if blanks > 0 {
             warnings.push(format!("{name}: {blanks} blank pixels set to 0"));
         }
+        let fits = (bytes.len() <= MAX_STORED_FITS_BYTES).then(|| bytes.to_vec());
+        if fits.is_none() {
+            warnings.push(too_large_to_keep(name, bytes.len()));
+        }
         let summary = format!(
             "{n} x {n} pixels, {:.1} arcsec wide",
             map.geometry.size_arcsec
@@ -213,6 +290,7 @@ impl LoadedData {
             name: name.to_string(),
             map,
             reference,
+            fits,
         });
         Ok(LoadReport {
             role: ["deflection_x", "deflection_y"][axis].to_string(),

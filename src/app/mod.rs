@@ -17,11 +17,13 @@ mod views;
 use thiserror::Error;
 
 pub use crate::reconstruct::ReconstructSummary;
-pub use data::{DataRole, LoadReport, LoadedData, NamedText};
-pub use project::{Project, ProjectResult, PROJECT_FORMAT, PROJECT_VERSION};
+pub use data::{
+    ArcPixels, DataRole, LoadReport, LoadedData, NamedMap, NamedText, MAX_STORED_FITS_BYTES,
+};
+pub use project::{Project, ProjectResult, StoredFits, PROJECT_FORMAT, PROJECT_VERSION};
 pub use run::{RunKind, SessionResult};
 pub use settings::{AppSettings, APP_MAP_PIXELS};
-pub use views::{HoverReadout, ViewOptions, ViewPng};
+pub use views::{system_rgb, HoverReadout, ViewOptions, ViewPng, SYSTEM_RGB};
 
 /// What the app reports to the user; every message names the file, line or setting.
 #[derive(Debug, Error)]

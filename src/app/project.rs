@@ -4,28 +4,39 @@
 //!
 //! ```json
 //! {"format": "wslap-project", "version": 1, "name": "...",
-//!  "data": {"images": {"name": "...", "text": "..."}, "members": null, "arcs": null, "model": null},
+//!  "data": {"images": {"name": "...", "text": "..."}, "members": null, "arcs": null, "model": null,
+//!           "deflection_x": {"name": "...", "fits_base64": "..."}, "deflection_y": null},
 //!  "settings": {...AppSettings...},
 //!  "result": {"kind": "reconstruct", "summary": {...}, "x": [...], "iterations": 8000,
 //!             "sources": [...], "convergence": [...]}}
 //! ```
-//! Deflection FITS maps are not stored (they are large binaries): load them again.
+//! Deflection FITS files (look-up mode) are stored as base64 up to
+//! [`MAX_STORED_FITS_BYTES`] each; a larger one is left out (the app says so when it is
+//! loaded) and must be loaded again. Files without the deflection fields still read.
 
 use serde::{Deserialize, Serialize};
 
 use crate::reconstruct::{ConvergenceRecord, SourceReport};
 
-use super::data::NamedText;
+use super::data::{NamedText, MAX_STORED_FITS_BYTES};
 use super::outputs::pretty;
 use super::run::RunKind;
 use super::{AppError, AppSettings, Session};
+use base64::Engine as _;
 
 /// The `format` field of every project file.
 pub const PROJECT_FORMAT: &str = "wslap-project";
 /// The version this code writes and reads.
 pub const PROJECT_VERSION: u32 = 1;
 
-/// The data texts of a project.
+/// A deflection FITS file in a project: its name and bytes in base64.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct StoredFits {
+    pub name: String,
+    pub fits_base64: String,
+}
+
+/// The data texts of a project and its deflection FITS files.
 #[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
 #[serde(default)]
 pub struct ProjectData {
@@ -33,6 +44,23 @@ pub struct ProjectData {
     pub members: Option<NamedText>,
     pub arcs: Option<NamedText>,
     pub model: Option<NamedText>,
+    pub deflection_x: Option<StoredFits>,
+    pub deflection_y: Option<StoredFits>,
+}
+
+/// The bytes of a stored FITS file; refused (naming the project and file) when its text is
+/// not base64 or would decode to more than [`MAX_STORED_FITS_BYTES`].
+fn stored_bytes(f: &StoredFits, source_name: &str) -> Result<Vec<u8>, AppError> {
+    let bad = |why: String| AppError::File(format!("{source_name}: {}: {why}", f.name));
+    let decoded_len = f.fits_base64.len() / 4 * 3;
+    if decoded_len > MAX_STORED_FITS_BYTES + 3 {
+        return Err(bad(format!(
+            "about {decoded_len} bytes, more than the {MAX_STORED_FITS_BYTES} a project may hold"
+        )));
+    }
+    base64::engine::general_purpose::STANDARD
+        .decode(&f.fits_base64)
+        .map_err(|e| bad(format!("not base64: {e}")))
 }
 
 /// The stored result.
@@ -81,6 +109,13 @@ impl Session {
     /// The project of this session (pretty JSON).
     pub fn project_json(&self) -> Result<String, AppError> {
         let d = &self.data;
+        let stored = |axis: usize| {
+            let m = d.deflection[axis].as_ref()?;
+            Some(StoredFits {
+                name: m.name.clone(),
+                fits_base64: base64::engine::general_purpose::STANDARD.encode(m.fits.as_ref()?),
+            })
+        };
         let result = match &self.result {
             None => None,
             Some(r) => Some(ProjectResult {
@@ -110,6 +145,8 @@ impl Session {
                 members: d.members.clone(),
                 arcs: d.arcs.clone(),
                 model: d.model.clone(),
+                deflection_x: stored(0),
+                deflection_y: stored(1),
             },
             settings: self.settings.clone(),
             result,
@@ -155,6 +192,16 @@ impl Session {
         ] {
             if let Some(f) = file {
                 next.load_text(role, &f.name, &f.text)
+                    .map_err(|e| AppError::File(format!("{source_name}: {e}")))?;
+            }
+        }
+        for (axis, file) in [&p.data.deflection_x, &p.data.deflection_y]
+            .into_iter()
+            .enumerate()
+        {
+            if let Some(f) = file {
+                let bytes = stored_bytes(f, source_name)?;
+                next.load_fits(axis, &f.name, &bytes)
                     .map_err(|e| AppError::File(format!("{source_name}: {e}")))?;
             }
         }

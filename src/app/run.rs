@@ -18,7 +18,7 @@ use crate::reconstruct::{
 };
 use crate::solver::Control;
 
-use super::data::ParsedData;
+use super::data::{ArcPixels, ParsedData, DEFAULT_ARC_PIXEL_MAS};
 use super::{AppError, Session};
 
 /// Map width of a forward model without a `products.size_arcsec` setting (arcsec).
@@ -58,8 +58,11 @@ pub struct ReconstructionResult {
 pub struct SessionResult {
     pub kind: RunKind,
     pub products: Products,
-    /// Observed images (arcsec), members (arcsec) of the data.
+    /// Catalogue images (arcsec), arc pixels per system and members (arcsec) of the data.
     pub observed: Vec<DVec2>,
+    pub arcs: Vec<ArcPixels>,
+    /// Side of one arc pixel (milliarcsec), see [`ParsedData::arc_pixel_mas`].
+    pub arc_pixel_mas: u32,
     pub members: Vec<DVec2>,
     pub reconstruction: Option<ReconstructionResult>,
     /// Wall-clock time of the run in ms.
@@ -156,7 +159,9 @@ impl Session {
         Ok(SessionResult {
             kind: RunKind::Reconstruct,
             products: r.products,
-            observed: parsed.observed_arcsec(),
+            observed: parsed.catalog_arcsec(),
+            arcs: parsed.arc_systems(),
+            arc_pixel_mas: parsed.arc_pixel_mas(),
             members: parsed.members_arcsec(),
             reconstruction: Some(ReconstructionResult {
                 config: r.config,
@@ -224,7 +229,9 @@ impl Session {
         self.result = Some(SessionResult {
             kind: RunKind::Reconstruct,
             products,
-            observed: parsed.observed_arcsec(),
+            observed: parsed.catalog_arcsec(),
+            arcs: parsed.arc_systems(),
+            arc_pixel_mas: parsed.arc_pixel_mas(),
             members: parsed.members_arcsec(),
             reconstruction: Some(ReconstructionResult {
                 config,
@@ -264,7 +271,9 @@ impl Session {
         Ok(SessionResult {
             kind: RunKind::Forward,
             products,
-            observed: parsed.observed_arcsec(),
+            observed: parsed.catalog_arcsec(),
+            arcs: parsed.arc_systems(),
+            arc_pixel_mas: parsed.arc_pixel_mas(),
             members: parsed.members_arcsec(),
             reconstruction: None,
             elapsed_ms: 0.0,
@@ -290,6 +299,8 @@ impl Session {
             kind: RunKind::Lookup,
             products,
             observed: Vec::new(),
+            arcs: Vec::new(),
+            arc_pixel_mas: DEFAULT_ARC_PIXEL_MAS,
             members: Vec::new(),
             reconstruction: None,
             elapsed_ms: 0.0,

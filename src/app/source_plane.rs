@@ -9,7 +9,7 @@ use crate::render::OverlayPoints;
 use crate::render::{render_kappa_png, ColorScale, Colormap, KappaPlotOptions, Marker, Overlay};
 use crate::CriticalCurves;
 
-use super::views::{ViewOptions, ViewPng, MEMBER_RGB, OBSERVED_RGB};
+use super::views::{arc_overlays, system_rgb, ViewOptions, ViewPng, MEMBER_RGB, OBSERVED_RGB};
 use super::{AppError, Session};
 
 /// Source-plane pixels a side.
@@ -103,9 +103,19 @@ impl Session {
         let p = &r.products;
         let sources = r.reconstruction.iter().flat_map(|x| x.sources.iter());
         let betas: Vec<DVec2> = sources.clone().map(|s| s.beta_arcsec).collect();
-        let back: Vec<DVec2> = sources
-            .flat_map(|s| s.observed.iter().map(|i| i.beta_arcsec))
-            .collect();
+        // With arcs, each system's images mapped back in its colour (as its arc pixels).
+        let colour = |id: &str| r.arcs.iter().position(|a| a.id == id).map(system_rgb);
+        let mut back: Vec<OverlayPoints> = Vec::new();
+        for s in sources {
+            let rgb = colour(&s.id).unwrap_or(OBSERVED_RGB);
+            let label = if back.is_empty() {
+                "images mapped back"
+            } else {
+                ""
+            };
+            let p = s.observed.iter().map(|i| i.beta_arcsec).collect();
+            back.push(set(label, rgb, Marker::Plus, p));
+        }
         let caustics = caustics_as_curves(&p.curves);
         let all = caustics.tangential.iter().chain(&caustics.radial).flatten();
         let region = square_around(
@@ -116,10 +126,10 @@ impl Session {
         let map = ray_shot(&p.maps, p.distance_ratio, region);
         let overlay = Overlay {
             curves: Some(&caustics),
-            points: vec![
-                set("images mapped back", OBSERVED_RGB, Marker::Plus, back),
-                set("beta", BETA_RGB, Marker::Square, betas),
-            ],
+            points: back
+                .into_iter()
+                .chain([set("beta", BETA_RGB, Marker::Square, betas)])
+                .collect(),
         };
         let plot = KappaPlotOptions {
             scale: ColorScale::Log,
@@ -133,6 +143,7 @@ impl Session {
             )),
             colorbar_label: Some("log10 total magnification".to_string()),
             show_caustics: false,
+            legend: opts.legend,
         };
         let png = render_kappa_png(&map, &overlay, &plot)
             .map_err(|e| AppError::Run(format!("rendering: {e}")))?;
@@ -148,6 +159,8 @@ impl Session {
         let parsed = self.data.parse()?;
         let observed = parsed.observed_arcsec();
         let members = parsed.members_arcsec();
+        let catalog = parsed.catalog_arcsec();
+        let arcs = arc_overlays(&parsed.arc_systems(), parsed.arc_pixel_mas());
         if observed.is_empty() && members.is_empty() {
             return Err(AppError::Missing("no catalogue is loaded".to_string()));
         }
@@ -162,18 +175,22 @@ impl Session {
         };
         let overlay = Overlay {
             curves: None,
-            points: vec![
-                set("members", MEMBER_RGB, Marker::Circle, members),
-                set("observed images", OBSERVED_RGB, Marker::Plus, observed),
-            ],
+            points: arcs
+                .into_iter()
+                .chain([
+                    set("members", MEMBER_RGB, Marker::Circle, members),
+                    set("observed images", OBSERVED_RGB, Marker::Plus, catalog),
+                ])
+                .collect(),
         };
         let plot = KappaPlotOptions {
             vmin: Some(-1.0),
             vmax: Some(1.0),
             colormap: Colormap::Viridis,
             map_pixels_on_screen: opts.map_pixels_on_screen,
-            title: Some(format!("{}: the data (no mass map yet)", self.name)),
+            title: Some("the data (no mass map yet)".to_string()),
             colorbar_label: Some("(reconstruct to see kappa)".to_string()),
+            legend: opts.legend,
             ..KappaPlotOptions::default()
         };
         let png = render_kappa_png(&map, &overlay, &plot)

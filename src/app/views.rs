@@ -5,10 +5,11 @@ use glam::DVec2;
 use serde::{Deserialize, Serialize};
 
 use crate::render::{
-    kappa_figure_frame, render_kappa_png, ColorScale, FigureFrame, KappaPlotOptions, Marker,
-    Overlay, OverlayPoints,
+    kappa_figure_frame_for, render_kappa_png, ColorScale, FigureFrame, KappaPlotOptions,
+    LegendPlace, Marker, Overlay, OverlayPoints,
 };
 
+use super::data::ArcPixels;
 use super::{AppError, Session};
 
 /// Observed images: magenta plus signs.
@@ -17,6 +18,38 @@ pub const OBSERVED_RGB: [u8; 3] = [255, 60, 255];
 pub const PREDICTED_RGB: [u8; 3] = [255, 170, 0];
 /// Member galaxies: white circles.
 pub const MEMBER_RGB: [u8; 3] = [255, 255, 255];
+/// One colour per multiple-image system (arc pixels, their images mapped back, the systems
+/// table), used in turn; none is the red or cyan of the curves, the white of the members or
+/// the orange of the predicted images.
+pub const SYSTEM_RGB: [[u8; 3]; 10] = [
+    [255, 60, 255],
+    [120, 255, 90],
+    [255, 220, 110],
+    [150, 120, 255],
+    [255, 120, 150],
+    [90, 255, 210],
+    [120, 170, 255],
+    [230, 255, 60],
+    [255, 150, 230],
+    [200, 150, 90],
+];
+/// Legend text of the arc pixels (one set per system, only the first is labelled).
+const ARC_LABEL: &str = "arc pixels (colour: system)";
+
+/// The colour of the `k`-th system (in the order of the data file).
+pub fn system_rgb(k: usize) -> [u8; 3] {
+    SYSTEM_RGB[k % SYSTEM_RGB.len()]
+}
+
+/// The arc pixels of every system as filled squares of side `side_mas`, in the system colours.
+pub(super) fn arc_overlays(arcs: &[ArcPixels], side_mas: u32) -> Vec<OverlayPoints> {
+    let marker = Marker::Pixel { side_mas };
+    let sets = arcs.iter().enumerate().map(|(k, a)| {
+        let label = if k == 0 { ARC_LABEL } else { "" };
+        points(label, system_rgb(k), marker, a.pixels_arcsec.clone())
+    });
+    sets.collect()
+}
 
 /// What to draw.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
@@ -29,6 +62,8 @@ pub struct ViewOptions {
     pub show_predicted: bool,
     /// Map side on screen in pixels (default 512).
     pub map_pixels_on_screen: u32,
+    /// Where the figures' legends go (default: under the map, so no data are hidden).
+    pub legend: LegendPlace,
 }
 
 impl Default for ViewOptions {
@@ -39,6 +74,7 @@ impl Default for ViewOptions {
             show_observed: true,
             show_predicted: true,
             map_pixels_on_screen: 512,
+            legend: LegendPlace::Below,
         }
     }
 }
@@ -63,7 +99,7 @@ pub struct HoverReadout {
     pub z_source: f64,
 }
 
-fn points(label: &str, rgb: [u8; 3], marker: Marker, p: Vec<DVec2>) -> OverlayPoints {
+pub(super) fn points(label: &str, rgb: [u8; 3], marker: Marker, p: Vec<DVec2>) -> OverlayPoints {
     OverlayPoints {
         label: label.to_string(),
         color: rgb,
@@ -86,18 +122,24 @@ impl Session {
                 "kappa (z_l = {}), critical curves at z_s = {}",
                 r.products.plane.z_lens, r.products.curves.z_source
             )),
+            legend: opts.legend,
             ..KappaPlotOptions::default()
         })
     }
 
-    /// The kappa map (lin/log) with colour bar, arcsec axes, tangential (red) and radial (cyan)
-    /// critical curves, members, observed and predicted images.
-    pub fn kappa_view(&self, opts: &ViewOptions) -> Result<ViewPng, AppError> {
+    /// What the kappa view draws over the map: the curves, the arc pixels (one colour per
+    /// system), members, catalogue images and predicted images, as `opts` selects.
+    fn kappa_overlay(&self, opts: &ViewOptions) -> Result<Overlay<'_>, AppError> {
         let r = self.result()?;
         let mut overlay = Overlay {
             curves: Some(&r.products.curves),
             points: Vec::new(),
         };
+        if opts.show_observed {
+            overlay
+                .points
+                .extend(arc_overlays(&r.arcs, r.arc_pixel_mas));
+        }
         if opts.show_members {
             let m = r.members.clone();
             overlay
@@ -116,6 +158,15 @@ impl Session {
                 .points
                 .push(points("predicted", PREDICTED_RGB, Marker::Cross, p));
         }
+        Ok(overlay)
+    }
+
+    /// The kappa map (lin/log) with colour bar, arcsec axes, tangential (red) and radial (cyan)
+    /// critical curves, arc pixels, members, observed and predicted images; the legend where
+    /// `opts.legend` puts it.
+    pub fn kappa_view(&self, opts: &ViewOptions) -> Result<ViewPng, AppError> {
+        let r = self.result()?;
+        let overlay = self.kappa_overlay(opts)?;
         let png = render_kappa_png(&r.products.maps.kappa, &overlay, &self.kappa_options(opts)?)
             .map_err(render)?;
         Ok(ViewPng {
@@ -127,7 +178,8 @@ impl Session {
     /// Where the map lies in the kappa view drawn with `opts` (PNG pixels).
     pub fn kappa_frame(&self, opts: &ViewOptions) -> Result<FigureFrame, AppError> {
         let kappa = &self.result()?.products.maps.kappa;
-        kappa_figure_frame(kappa, &self.kappa_options(opts)?).map_err(render)
+        let overlay = self.kappa_overlay(opts)?;
+        kappa_figure_frame_for(kappa, &overlay, &self.kappa_options(opts)?).map_err(render)
     }
 
     /// x, y (arcsec), kappa and magnification under the point `(px, py)` of the kappa view

@@ -6,9 +6,9 @@ use tiny_skia::{Color, Paint, PathBuilder, Pixmap, Rect, Stroke, Transform};
 use super::axes::nice_ticks;
 use super::colormap::{color_limits, value_rgb};
 use super::font::{draw_text, text_width, Anchor, CAP};
-use super::overlay::{draw_legend, draw_overlay};
-use super::ColorScale;
+use super::overlay::{below_height, draw_legend, draw_overlay, legend_entries, Key};
 use super::{check_map, KappaPlotOptions, Overlay, RenderError};
+use super::{ColorScale, LegendPlace};
 use crate::grid::{Map, MapGeometry};
 
 /// Pixel positions of the parts of the figure.
@@ -23,6 +23,8 @@ pub(super) struct Layout {
     pub(super) cb_w: f32,
     pub(super) width: u32,
     pub(super) height: u32,
+    /// Top of the legend under the map (when it goes there).
+    pub(super) legend_top: f32,
 }
 
 impl Layout {
@@ -44,6 +46,7 @@ impl Layout {
         .round();
         let left = (pad + ch + 2.0 * gap + y_label_w + gap + tick).round();
         let bottom = tick + gap + ch + 3.0 * gap + ch + pad;
+        let legend_top = (top + m + bottom - pad + 2.0 * gap).round();
         let cb_x = (left + m + 4.0 * sf + 8.0).round();
         let cb_w = (m / 24.0).round().max(10.0);
         let right_edge = cb_x + cb_w + tick + gap + cb_label_w + 2.0 * gap + ch + pad;
@@ -56,6 +59,20 @@ impl Layout {
             cb_w,
             width: right_edge.ceil() as u32,
             height: (top + m + bottom).ceil() as u32,
+            legend_top,
+        }
+    }
+
+    /// Width available to a row of the legend under the map (from the map's left edge).
+    pub(super) fn legend_avail(&self) -> f32 {
+        self.width as f32 - self.left - (4.0 * self.s as f32 + 4.0)
+    }
+
+    /// Makes room for a legend of `entries` under the map.
+    fn add_legend_below(&mut self, entries: &[(String, Key)]) {
+        let h = below_height(self, entries, self.legend_avail());
+        if h > 0.0 {
+            self.height = (self.legend_top + h).ceil() as u32;
         }
     }
 
@@ -136,13 +153,14 @@ impl FigureFrame {
 
 struct Plan {
     layout: Layout,
+    legend: Vec<(String, Key)>,
     limits: (f64, f64),
     x_ticks: Vec<(f64, String)>,
     y_ticks: Vec<(f64, String)>,
     cb_ticks: Vec<(f64, String)>,
 }
 
-fn plan(kappa: &Map, opts: &KappaPlotOptions) -> Result<Plan, RenderError> {
+fn plan(kappa: &Map, overlay: &Overlay, opts: &KappaPlotOptions) -> Result<Plan, RenderError> {
     opts.validate()?;
     check_map(kappa)?;
     let limits = color_limits(kappa, opts.scale, opts.vmin, opts.vmax)?;
@@ -153,14 +171,19 @@ fn plan(kappa: &Map, opts: &KappaPlotOptions) -> Result<Plan, RenderError> {
     let cb_ticks = nice_ticks(limits.0, limits.1, 5);
     let s = (opts.map_pixels_on_screen / 256).max(1);
     let widest = |t: &[(f64, String)]| t.iter().map(|(_, l)| text_width(l, s)).fold(0.0, f32::max);
-    let layout = Layout::new(
+    let mut layout = Layout::new(
         opts.map_pixels_on_screen,
         opts.title.is_some(),
         widest(&y_ticks),
         widest(&cb_ticks),
     );
+    let legend = legend_entries(overlay, opts.show_caustics);
+    if opts.legend == LegendPlace::Below {
+        layout.add_legend_below(&legend);
+    }
     Ok(Plan {
         layout,
+        legend,
         limits,
         x_ticks,
         y_ticks,
@@ -168,12 +191,23 @@ fn plan(kappa: &Map, opts: &KappaPlotOptions) -> Result<Plan, RenderError> {
     })
 }
 
-/// The [`FigureFrame`] of the figure [`render_kappa_png`] draws for these inputs.
+/// The [`FigureFrame`] of the figure [`render_kappa_png`] draws for `kappa` and `opts` with
+/// an overlay without legend entries. The map's place does not depend on the overlay; the
+/// figure's height does when the legend goes below it (see [`kappa_figure_frame_for`]).
 pub fn kappa_figure_frame(
     kappa: &Map,
     opts: &KappaPlotOptions,
 ) -> Result<FigureFrame, RenderError> {
-    let l = plan(kappa, opts)?.layout;
+    kappa_figure_frame_for(kappa, &Overlay::default(), opts)
+}
+
+/// The [`FigureFrame`] of the figure [`render_kappa_png`] draws for exactly these inputs.
+pub fn kappa_figure_frame_for(
+    kappa: &Map,
+    overlay: &Overlay,
+    opts: &KappaPlotOptions,
+) -> Result<FigureFrame, RenderError> {
+    let l = plan(kappa, overlay, opts)?.layout;
     Ok(FigureFrame {
         width: l.width,
         height: l.height,
@@ -186,7 +220,7 @@ pub fn kappa_figure_frame(
 
 /// A PNG figure of `kappa` (module docs of [`super`]): colour-mapped map with +x right, +y up,
 /// axes in arcsec, colour bar ("kappa" or "log10 kappa"), critical curves, points, a legend
-/// and an optional title. The map occupies `opts.map_pixels_on_screen` pixels a side; colour
+/// (in the map's corner or under it, [`KappaPlotOptions::legend`]) and an optional title. The map occupies `opts.map_pixels_on_screen` pixels a side; colour
 /// limits as in [`super::color_limits`].
 pub fn render_kappa_png(
     kappa: &Map,
@@ -195,11 +229,12 @@ pub fn render_kappa_png(
 ) -> Result<Vec<u8>, RenderError> {
     let Plan {
         layout,
+        legend,
         limits,
         x_ticks,
         y_ticks,
         cb_ticks,
-    } = plan(kappa, opts)?;
+    } = plan(kappa, overlay, opts)?;
     let g = kappa.geometry;
     let s = layout.s;
     let mut pm = Pixmap::new(layout.width, layout.height).ok_or_else(|| {
@@ -212,8 +247,8 @@ pub fn render_kappa_png(
     draw_map(&mut pm, kappa, &layout, opts, limits);
     draw_axes(&mut pm, &layout, &g, &x_ticks, &y_ticks);
     draw_colorbar(&mut pm, &layout, opts, limits, &cb_ticks);
-    let legend = draw_overlay(&mut pm, &layout, &g, overlay, opts.show_caustics);
-    draw_legend(&mut pm, &layout, &legend);
+    draw_overlay(&mut pm, &layout, &g, overlay, opts.show_caustics);
+    draw_legend(&mut pm, &layout, &legend, opts.legend);
     if let Some(title) = &opts.title {
         let at = (layout.left + layout.m / 2.0, 4.0 * s as f32 + 4.0);
         draw_text(&mut pm, title, at, s, Color::BLACK, Anchor::TopCenter, true);

@@ -28,7 +28,7 @@ pub use compose::{
     compose_grid, compose_png_grid, grid_offsets, GridLayout, MAX_COMPOSED_PIXELS,
     MAX_COMPOSED_SIDE_PX,
 };
-pub use figure::{kappa_figure_frame, render_kappa_png, FigureFrame};
+pub use figure::{kappa_figure_frame, kappa_figure_frame_for, render_kappa_png, FigureFrame};
 pub use overlay::{CAUSTIC_RGB, RADIAL_RGB, TANGENTIAL_RGB};
 pub use plot::{
     Axis, AxisScale, LinePlot, LineStyle, PlotFrame, Reference, Series, MAX_LINE_WIDTH_PX, PALETTE,
@@ -84,9 +84,32 @@ pub enum Marker {
     Cross,
     Plus,
     Square,
+    /// A filled, semi-transparent ([`PIXEL_ALPHA`]) square of side `side_mas` milliarcsec
+    /// centred on the position (at least [`MIN_PIXEL_SIDE_PX`] screen pixels), e.g. one
+    /// constraint pixel of an arc; overlapping squares of one set do not darken each other.
+    Pixel {
+        side_mas: u32,
+    },
+}
+
+/// Opacity of [`Marker::Pixel`] squares.
+pub const PIXEL_ALPHA: f32 = 0.7;
+/// Smallest side of a [`Marker::Pixel`] square on screen, in pixels.
+pub const MIN_PIXEL_SIDE_PX: f32 = 2.0;
+
+/// Where the legend of [`render_kappa_png`] goes.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum LegendPlace {
+    /// A box in the top-right corner of the map (covers part of it).
+    #[default]
+    InsideTopRight,
+    /// Rows under the x-axis title, outside the map (the figure grows downwards).
+    Below,
 }
 
 /// A labelled set of positions (arcsec, frame of METHOD.md section 1), e.g. observed images.
+/// A set with an empty `label` is drawn but has no legend entry.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct OverlayPoints {
     pub label: String,
@@ -123,6 +146,8 @@ pub struct KappaPlotOptions {
     pub colorbar_label: Option<String>,
     /// Also draw the caustics of [`Overlay::curves`] (default false).
     pub show_caustics: bool,
+    /// Where the legend goes (default: inside the map's top-right corner).
+    pub legend: LegendPlace,
 }
 
 impl Default for KappaPlotOptions {
@@ -136,6 +161,7 @@ impl Default for KappaPlotOptions {
             title: None,
             colorbar_label: None,
             show_caustics: false,
+            legend: LegendPlace::InsideTopRight,
         }
     }
 }

@@ -1,4 +1,4 @@
-//! Curves, point markers and the legend drawn over the map.
+//! Curves, point markers, constraint pixels and the legend (over the map or under it).
 
 use glam::DVec2;
 use tiny_skia::{
@@ -8,7 +8,7 @@ use tiny_skia::{
 
 use super::figure::{color, frame, paint, Layout};
 use super::font::{draw_text, text_width, Anchor};
-use super::{Marker, Overlay};
+use super::{LegendPlace, Marker, Overlay, MIN_PIXEL_SIDE_PX, PIXEL_ALPHA};
 use crate::ds9::polyline_is_open;
 use crate::grid::MapGeometry;
 
@@ -81,6 +81,7 @@ fn marker_path(marker: Marker, (x, y): (f32, f32), r: f32) -> Option<Path> {
     match marker {
         Marker::Circle => pb.push_circle(x, y, r),
         Marker::Square => pb.push_rect(Rect::from_xywh(x - r, y - r, 2.0 * r, 2.0 * r)?),
+        Marker::Pixel { .. } => return None,
         Marker::Cross | Marker::Plus => {
             let (a, b) = if marker == Marker::Cross {
                 (r, r)
@@ -96,15 +97,69 @@ fn marker_path(marker: Marker, (x, y): (f32, f32), r: f32) -> Option<Path> {
     pb.finish()
 }
 
-/// Draws curves and points clipped to the map; returns the legend entries.
+/// Screen side of a [`Marker::Pixel`] of `side_mas` milliarcsec on a map of geometry `g`.
+fn pixel_side_px(l: &Layout, g: &MapGeometry, side_mas: u32) -> f32 {
+    let px_per_arcsec = l.m as f64 / g.size_arcsec;
+    ((side_mas as f64 / 1000.0 * px_per_arcsec) as f32).max(MIN_PIXEL_SIDE_PX)
+}
+
+/// Fills one square per position as a single path, so overlaps are not darkened twice.
+fn fill_pixels(
+    pm: &mut Pixmap,
+    centres: impl Iterator<Item = (f32, f32)>,
+    side: f32,
+    rgb: [u8; 3],
+    mask: Option<&Mask>,
+) {
+    let mut pb = PathBuilder::new();
+    for (x, y) in centres {
+        if let Some(r) = Rect::from_xywh(x - side / 2.0, y - side / 2.0, side, side) {
+            pb.push_rect(r);
+        }
+    }
+    if let Some(path) = pb.finish() {
+        let p = paint(color(rgb, PIXEL_ALPHA), false);
+        pm.fill_path(&path, &p, FillRule::Winding, Transform::identity(), mask);
+    }
+}
+
+/// The legend entries of `overlay`: the curves that have lines, then every labelled,
+/// non-empty point set.
+pub(super) fn legend_entries(overlay: &Overlay, show_caustics: bool) -> Vec<(String, Key)> {
+    let mut legend: Vec<(String, Key)> = Vec::new();
+    if let Some(c) = overlay.curves {
+        let drawn = |lines: &Vec<Vec<DVec2>>| lines.iter().any(|v| v.len() >= 2);
+        let mut sets = vec![
+            ("tangential", drawn(&c.tangential), TANGENTIAL_RGB, false),
+            ("radial", drawn(&c.radial), RADIAL_RGB, false),
+        ];
+        if show_caustics {
+            let any = drawn(&c.caustics.tangential) || drawn(&c.caustics.radial);
+            sets.push(("caustics", any, CAUSTIC_RGB, true));
+        }
+        for (label, drawn, rgb, dashed) in sets {
+            if drawn {
+                legend.push((label.to_string(), Key::Line { rgb, dashed }));
+            }
+        }
+    }
+    for set in &overlay.points {
+        if !set.positions_arcsec.is_empty() && !set.label.is_empty() {
+            let (rgb, marker) = (set.color, set.marker);
+            legend.push((set.label.clone(), Key::Point { rgb, marker }));
+        }
+    }
+    legend
+}
+
+/// Draws pixel sets, curves and point markers, clipped to the map.
 pub(super) fn draw_overlay(
     pm: &mut Pixmap,
     l: &Layout,
     g: &MapGeometry,
     overlay: &Overlay,
     show_caustics: bool,
-) -> Vec<(String, Key)> {
-    let mut legend = Vec::new();
+) {
     let mut mask = Mask::new(pm.width(), pm.height());
     if let (Some(m), Some(r)) = (mask.as_mut(), Rect::from_xywh(l.left, l.top, l.m, l.m)) {
         m.fill_path(
@@ -115,64 +170,148 @@ pub(super) fn draw_overlay(
         );
     }
     let mask = mask.as_ref();
+    // Pixels first: the curves and markers stay readable on top of them.
+    for set in &overlay.points {
+        if let Marker::Pixel { side_mas } = set.marker {
+            let side = pixel_side_px(l, g, side_mas);
+            let centres = set.positions_arcsec.iter().map(|&p| l.screen(g, p));
+            fill_pixels(pm, centres, side, set.color, mask);
+        }
+    }
     let width = 1.25 * l.s as f32 + 0.5;
     if let Some(c) = overlay.curves {
         let mut sets = vec![
-            ("tangential", &c.tangential, TANGENTIAL_RGB, false),
-            ("radial", &c.radial, RADIAL_RGB, false),
+            (&c.tangential, TANGENTIAL_RGB, false),
+            (&c.radial, RADIAL_RGB, false),
         ];
         if show_caustics {
-            sets.push(("caustics", &c.caustics.tangential, CAUSTIC_RGB, true));
-            sets.push(("caustics", &c.caustics.radial, CAUSTIC_RGB, true));
+            sets.push((&c.caustics.tangential, CAUSTIC_RGB, true));
+            sets.push((&c.caustics.radial, CAUSTIC_RGB, true));
         }
-        for (label, lines, rgb, dashed) in sets {
-            let mut drawn = false;
+        for (lines, rgb, dashed) in sets {
             for path in lines
                 .iter()
                 .filter(|v| v.len() >= 2)
                 .filter_map(|v| polyline_path(l, g, v))
             {
                 halo_stroke(pm, &path, rgb, width, dashed, mask);
-                drawn = true;
-            }
-            if drawn && !legend.iter().any(|(name, _)| name == label) {
-                legend.push((label.to_string(), Key::Line { rgb, dashed }));
             }
         }
     }
     let r = 3.0 * l.s as f32 + 1.0;
     for set in &overlay.points {
+        if matches!(set.marker, Marker::Pixel { .. }) {
+            continue;
+        }
         for &p in &set.positions_arcsec {
             if let Some(path) = marker_path(set.marker, l.screen(g, p), r) {
                 halo_stroke(pm, &path, set.color, width, false, mask);
             }
         }
-        if !set.positions_arcsec.is_empty() {
-            legend.push((
-                set.label.clone(),
-                Key::Point {
-                    rgb: set.color,
-                    marker: set.marker,
-                },
-            ));
-        }
     }
-    legend
 }
 
-/// A box in the top-right corner of the map with one row per entry.
-pub(super) fn draw_legend(pm: &mut Pixmap, l: &Layout, entries: &[(String, Key)]) {
+/// Sizes of the legend parts: (padding, sample width, row height) in pixels.
+fn legend_metrics(l: &Layout) -> (f32, f32, f32) {
+    let sf = l.s as f32;
+    (3.0 * sf + 2.0, 14.0 * sf, l.ch() + 4.0 * sf)
+}
+
+/// Left offsets and rows of the entries laid out in rows no wider than `avail` pixels (the
+/// legend under the map): `(x offset from the first column, row index)` per entry.
+pub(super) fn below_flow(l: &Layout, entries: &[(String, Key)], avail: f32) -> Vec<(f32, usize)> {
+    let (_, sample, _) = legend_metrics(l);
+    let (gap, spacing) = (l.gap() + 2.0 * l.s as f32, 4.0 * l.gap());
+    let mut out = Vec::with_capacity(entries.len());
+    let (mut x, mut row) = (0.0, 0);
+    for (label, _) in entries {
+        let w = sample + gap + text_width(label, l.s);
+        if x > 0.0 && x + w > avail {
+            x = 0.0;
+            row += 1;
+        }
+        out.push((x, row));
+        x += w + spacing;
+    }
+    out
+}
+
+/// Height in pixels of the legend under the map (0 without entries).
+pub(super) fn below_height(l: &Layout, entries: &[(String, Key)], avail: f32) -> f32 {
+    let rows = below_flow(l, entries, avail)
+        .last()
+        .map_or(0, |&(_, r)| r + 1);
+    let (pad, _, row) = legend_metrics(l);
+    if rows == 0 {
+        0.0
+    } else {
+        rows as f32 * row + pad
+    }
+}
+
+/// Draws one legend row's sample (line, marker or pixel swatch) centred at height `cy`.
+fn draw_sample(pm: &mut Pixmap, l: &Layout, key: &Key, x: f32, cy: f32, sample: f32) {
+    let sf = l.s as f32;
+    let width = 1.25 * sf + 0.5;
+    let (rgb, dashed) = match key {
+        Key::Line { rgb, dashed } => (*rgb, *dashed),
+        Key::Point { rgb, .. } => (*rgb, false),
+    };
+    let path = match key {
+        Key::Line { .. } => {
+            let mut pb = PathBuilder::new();
+            pb.move_to(x, cy);
+            pb.line_to(x + sample, cy);
+            pb.finish()
+        }
+        Key::Point {
+            marker: Marker::Pixel { .. },
+            ..
+        } => {
+            let side = 6.0 * sf + 2.0;
+            let centre = [(x + sample / 2.0, cy)].into_iter();
+            fill_pixels(pm, centre, side, rgb, None);
+            None
+        }
+        Key::Point { marker, .. } => marker_path(*marker, (x + sample / 2.0, cy), 3.0 * sf + 1.0),
+    };
+    if let Some(p) = path {
+        halo_stroke(pm, &p, rgb, width, dashed, None);
+    }
+}
+
+/// Draws the legend: a box in the map's top-right corner, or rows under the x-axis title
+/// starting at `l.legend_top` (see [`below_flow`]).
+pub(super) fn draw_legend(
+    pm: &mut Pixmap,
+    l: &Layout,
+    entries: &[(String, Key)],
+    place: LegendPlace,
+) {
     if entries.is_empty() {
         return;
     }
-    let (s, ch, gap) = (l.s, l.ch(), l.gap());
+    let (s, ch) = (l.s, l.ch());
     let sf = s as f32;
-    let (pad, sample, row) = (3.0 * sf + 2.0, 14.0 * sf, ch + 4.0 * sf);
+    let (pad, sample, row) = legend_metrics(l);
+    let gap = l.gap() + 2.0 * sf;
+    let text = |pm: &mut Pixmap, label: &str, at: (f32, f32)| {
+        draw_text(pm, label, at, s, Color::BLACK, Anchor::MiddleLeft, true);
+    };
+    if place == LegendPlace::Below {
+        let x0 = l.left;
+        for ((label, key), (dx, r)) in entries.iter().zip(below_flow(l, entries, l.legend_avail()))
+        {
+            let (x, cy) = (x0 + dx, l.legend_top + row * r as f32 + ch / 2.0);
+            draw_sample(pm, l, key, x, cy, sample);
+            text(pm, label, (x + sample + gap, cy));
+        }
+        return;
+    }
     let label_w = entries
         .iter()
         .map(|(t, _)| text_width(t, s))
         .fold(0.0, f32::max);
-    let gap = gap + 2.0 * sf;
     let (w, h) = (
         pad + sample + gap + label_w + pad,
         2.0 * pad + row * entries.len() as f32 - 4.0 * sf,
@@ -190,35 +329,9 @@ pub(super) fn draw_legend(pm: &mut Pixmap, l: &Layout, entries: &[(String, Key)]
         );
         frame(pm, x, y, w, h);
     }
-    let width = 1.25 * sf + 0.5;
     for (k, (label, key)) in entries.iter().enumerate() {
         let cy = y + pad + row * k as f32 + ch / 2.0;
-        let path = match key {
-            Key::Line { .. } => {
-                let mut pb = PathBuilder::new();
-                pb.move_to(x + pad, cy);
-                pb.line_to(x + pad + sample, cy);
-                pb.finish()
-            }
-            Key::Point { marker, .. } => {
-                marker_path(*marker, (x + pad + sample / 2.0, cy), 3.0 * sf + 1.0)
-            }
-        };
-        let (rgb, dashed) = match key {
-            Key::Line { rgb, dashed } => (*rgb, *dashed),
-            Key::Point { rgb, .. } => (*rgb, false),
-        };
-        if let Some(p) = path {
-            halo_stroke(pm, &p, rgb, width, dashed, None);
-        }
-        draw_text(
-            pm,
-            label,
-            (x + pad + sample + gap, cy),
-            s,
-            Color::BLACK,
-            Anchor::MiddleLeft,
-            true,
-        );
+        draw_sample(pm, l, key, x + pad, cy, sample);
+        text(pm, label, (x + pad + sample + gap, cy));
     }
 }

@@ -158,13 +158,25 @@ impl AppSession {
         }
     }
 
-    /// Per-system reports (`sources.json` as objects).
+    /// Per-system reports (`sources.json` as objects), each with `rgb`: the CSS colour of its
+    /// arc pixels in the views (`null` for catalogue systems, drawn as markers).
     pub fn sources(&self) -> Result<JsValue, JsError> {
         let r = self.inner.result().map_err(err)?;
-        match &r.reconstruction {
-            Some(x) => to_js(&x.sources),
-            None => Ok(js_sys::Array::new().into()),
+        let Some(x) = &r.reconstruction else {
+            return Ok(js_sys::Array::new().into());
+        };
+        let mut rows = serde_json::to_value(&x.sources).map_err(err)?;
+        for row in rows.as_array_mut().into_iter().flatten() {
+            let id = row.get("id").and_then(|v| v.as_str()).unwrap_or_default();
+            let rgb = r.arcs.iter().position(|a| a.id == id).map(|k| {
+                let [red, green, blue] = crate::app::system_rgb(k);
+                format!("rgb({red}, {green}, {blue})")
+            });
+            if let Some(obj) = row.as_object_mut() {
+                obj.insert("rgb".to_string(), rgb.into());
+            }
         }
+        to_js(&rows)
     }
 
     /// A download: `summary.json`, `sources.json`, `convergence.json`, `critical-curves.json`,

@@ -40,9 +40,10 @@ export async function openApp({ width = 1280, height = 900 } = {}) {
   };
 }
 
-/** Statistics of the rendered image `selector` read back through a canvas in the page. */
-export async function imageStats(page, selector) {
-  return page.$eval(selector, (img) => {
+/** Statistics of the rendered image `selector` read back through a canvas in the page;
+ * `near` counts the pixels within `tol` (per channel) of the colour `rgb`. */
+export async function imageStats(page, selector, { rgb = [0, 0, 0], tol = -1 } = {}) {
+  return page.$eval(selector, (img, [want, tol]) => {
     const c = document.createElement('canvas');
     c.width = img.naturalWidth;
     c.height = img.naturalHeight;
@@ -53,15 +54,17 @@ export async function imageStats(page, selector) {
     let reddish = 0;
     let magenta = 0;
     let white = 0;
+    let near = 0;
     for (let k = 0; k < data.length; k += 4) {
       const [r, g, b] = [data[k], data[k + 1], data[k + 2]];
+      if (Math.abs(r - want[0]) <= tol && Math.abs(g - want[1]) <= tol && Math.abs(b - want[2]) <= tol) near += 1;
       colours.add((r >> 3) << 10 | (g >> 3) << 5 | (b >> 3));
       if (r > 200 && g < 80 && b < 80) reddish += 1;
       if (r > 220 && g < 100 && b > 220) magenta += 1;
       if (r > 250 && g > 250 && b > 250) white += 1;
     }
-    return { width: c.width, height: c.height, distinctColours: colours.size, reddish, magenta, white };
-  });
+    return { width: c.width, height: c.height, distinctColours: colours.size, reddish, magenta, white, near };
+  }, [rgb, tol]);
 }
 
 /** Types `value` into the input `selector` and commits it (a change event). */
@@ -72,22 +75,13 @@ export async function setField(page, selector, value) {
   // Settings inputs remember the last accepted value in data-good; wait for it (or an error).
   const isSetting = await page.$eval(selector, (el) => el.id.startsWith('set-'));
   if (!isSetting) return;
-  const accepted = () => page.waitForFunction(([sel, v]) => {
-    const el = document.querySelector(sel);
-    const err = document.getElementById(`${el.id}-error`);
-    if (err && err.textContent) throw new Error(`${sel}: ${err.textContent}`);
-    return el.dataset.good === v;
-  }, [selector, String(value)], { timeout: 15_000 });
   try {
-    await accepted();
-  } catch {
-    // Under load a late form refresh has been seen to put the old value back before the change
-    // was applied (noted in the issue); type it once more, as a user would.
-    await page.locator(selector).fill(String(value));
-    await page.locator(selector).dispatchEvent('change');
-  }
-  try {
-    await accepted();
+    await page.waitForFunction(([sel, v]) => {
+      const el = document.querySelector(sel);
+      const err = document.getElementById(`${el.id}-error`);
+      if (err && err.textContent) throw new Error(`${sel}: ${err.textContent}`);
+      return el.dataset.good === v && el.value === v;
+    }, [selector, String(value)], { timeout: 15_000 });
   } catch (err) {
     const [shown, good] = await page.$eval(selector, (el) => [el.value, el.dataset.good]);
     const status = await page.textContent('#status');

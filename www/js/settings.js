@@ -6,6 +6,7 @@ export const FIELDS = [
   { path: 'h0', label: 'H0 [km/s/Mpc]', type: 'number', step: 0.1 },
   { path: 'omega_m', label: 'Ωm (flat ΛCDM)', type: 'number', step: 0.01 },
   { path: 'reconstruct.grid.cells', label: 'Grid cells per side', type: 'int' },
+  { path: 'reconstruct.grid.cell_sigma_factor', label: 'Cell width (Gaussian σ / cell size)', type: 'number', step: 0.05 },
   { path: 'reconstruct.grid.width_arcsec', label: 'Field width [arcsec] (empty: automatic)', type: 'optional' },
   { path: 'reconstruct.members.mass_to_light', label: 'Members M/L [Msun/Lsun]', type: 'number', step: 1 },
   { path: 'reconstruct.members.layers', label: 'Member layers', type: 'text',
@@ -18,7 +19,14 @@ export const FIELDS = [
   { path: 'reconstruct.products.size_arcsec', label: 'Map width [arcsec] (empty: the field)', type: 'optional' },
 ];
 
-let changes = 0;
+// A change is sent when an input fires 'change'; the worker answers with all the settings.
+// Such an answer may arrive while the user types in another input (or in the same one again),
+// so a refresh never touches an input that is being edited (typed into since its last change)
+// or whose own change is still on its way. Answers carry `revision`, the order in which the
+// worker produced them: one older than the settings shown only settles its own input.
+let changes = 0; // number of the last change sent
+let shown = -1; // revision of the settings the form shows
+const busy = new Map(); // input -> { edited: typed since its last change, waiting: number of its change in flight }
 const id = (path) => `set-${path.replaceAll('.', '-')}`;
 
 function get(obj, path) {
@@ -46,30 +54,61 @@ export function buildSettings(form, apply) {
       <span class="field-error" id="${id(f.path)}-error" role="alert"></span>`;
     form.append(row);
     const input = row.querySelector('input, select');
+    const state = { edited: false, waiting: 0 };
+    busy.set(input, state);
+    input.addEventListener('input', () => { state.edited = true; });
     input.addEventListener('change', async () => {
       const err = document.getElementById(`${id(f.path)}-error`);
       const ticket = ++changes;
+      state.edited = false;
+      state.waiting = ticket;
+      let settings = null;
+      let problem = null;
       try {
-        const settings = await apply(f.path, parse(f, input.value));
-        err.textContent = '';
-        // An older answer must not overwrite the form after a newer change.
-        if (ticket === changes) showSettings(settings);
-        else input.dataset.good = input.value;
+        settings = await apply(f.path, parse(f, input.value));
       } catch (e) {
-        err.textContent = e.message;
-        input.value = input.dataset.good ?? '';
+        problem = e;
       }
+      // Only the answer to this input's latest change settles it.
+      if (state.waiting !== ticket) return;
+      state.waiting = 0;
+      // A cancel restarts the worker and then shows the restored settings.
+      if (problem?.cancelled) return;
+      if (problem) {
+        err.textContent = problem.message;
+        if (!state.edited) input.value = input.dataset.good ?? '';
+        return;
+      }
+      err.textContent = '';
+      if ((settings.revision ?? Infinity) >= shown) refresh(settings);
+      else if (!state.edited) input.value = input.dataset.good; // the newer settings shown hold it
     });
   }
 }
 
-/** Puts `settings` into the form (and remembers them as the values to fall back to). */
-export function showSettings(settings) {
+/** Shows `settings`: inputs that are being edited or wait for the answer to their own change
+ * keep what the user typed (only the value they fall back to moves). */
+function refresh(settings) {
+  shown = settings.revision ?? shown;
   for (const f of FIELDS) {
     const input = document.getElementById(id(f.path));
     if (!input) continue;
     const v = get(settings, f.path);
-    input.value = v == null ? '' : String(v);
-    input.dataset.good = input.value;
+    const text = v == null ? '' : String(v);
+    input.dataset.good = text;
+    const state = busy.get(input);
+    if (!state || (!state.edited && !state.waiting)) input.value = text;
   }
+}
+
+/** Puts `settings` into the form (and remembers them as the values to fall back to), unless
+ * newer ones are shown. With `force` (a project or example was opened) every input shows them
+ * and pending edits are dropped; otherwise inputs being edited keep what the user typed. */
+export function showSettings(settings, { force = false } = {}) {
+  if (force) {
+    for (const state of busy.values()) { state.edited = false; state.waiting = 0; }
+  } else if ((settings.revision ?? Infinity) < shown) {
+    return;
+  }
+  refresh(settings);
 }

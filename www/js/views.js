@@ -5,6 +5,34 @@ const img = () => document.getElementById('view-image');
 let current = 'kappa';
 let url = null;
 const pngs = {}; // view name -> Blob, for downloads
+let app = null; // renders views and answers hovers (set by wireViews)
+let point = null; // { x, y, pin }: PNG pixels of the kappa view last hovered or clicked
+let busy = false; // a hover question is on its way
+let queued = false; // ask again when it is answered (the cursor moved or the map changed)
+
+/** Asks for the read-out at `point` and shows it; one question at a time, the latest wins. */
+async function readOut() {
+  if (!point) return;
+  if (busy) { queued = true; return; }
+  busy = true;
+  const { x, y, pin } = point;
+  const readout = document.getElementById('readout');
+  try {
+    const h = await app.hover(x, y);
+    if (h) {
+      const text = `x = ${h.x_arcsec.toFixed(2)}″, y = ${h.y_arcsec.toFixed(2)}″, κ = ${h.kappa.toFixed(3)}, ` +
+        `μ(z_s = ${h.z_source}) = ${h.magnification.toFixed(2)}`;
+      readout.textContent = pin ? `Clicked: ${text}` : text;
+    }
+  } catch { /* the worker is busy with a run or was restarted */ }
+  busy = false;
+  if (queued) { queued = false; await readOut(); }
+}
+
+/** Reads out again at the last point, e.g. after z_s changed: μ depends on it. */
+export async function refreshReadout() {
+  if (point && img().dataset.view === 'kappa') await readOut();
+}
 
 export function viewOptions() {
   return { scale: document.getElementById('scale').value };
@@ -41,7 +69,9 @@ export function showPng(name, bytes) {
 export function showSystems(sources) {
   const box = document.getElementById('systems');
   const f = (v, d = 2) => (v == null ? '–' : Number(v).toFixed(d));
-  const rows = sources.map((s) => `<tr><th scope="row">${s.id}${s.held_out ? ' (held out)' : ''}</th>
+  // The colour of the system's arc pixels in the views (none for catalogue systems).
+  const swatch = (s) => (s.rgb ? `<span class="swatch" style="background:${s.rgb}" aria-hidden="true"></span>` : '');
+  const rows = sources.map((s) => `<tr><th scope="row">${swatch(s)}${s.id}${s.held_out ? ' (held out)' : ''}</th>
     <td>${f(s.z, 3)}${s.z_assumed ? '*' : ''}</td><td>${f(s.beta_arcsec[0])}, ${f(s.beta_arcsec[1])}</td>
     <td>${f(s.scatter_arcsec)}</td><td>${s.observed.length} / ${s.predicted.length}</td>
     <td>${s.observed.map((o) => `${o.id}: ${f(o.offset_arcsec)}`).join('<br>')}</td>
@@ -55,7 +85,8 @@ export function showSystems(sources) {
 }
 
 /** Wires the tabs (click and arrow keys) and the read-out. `app` renders views and hovers. */
-export function wireViews(app) {
+export function wireViews(appApi) {
+  app = appApi;
   const tabs = [...document.querySelectorAll('[role=tab]')];
   tabs.forEach((tab, k) => {
     tab.addEventListener('click', () => { selectTab(tab.dataset.view); app.render(); });
@@ -68,27 +99,16 @@ export function wireViews(app) {
     });
   });
   selectTab('kappa');
-  let busy = false;
-  let pending = null;
-  const readout = document.getElementById('readout');
-  const ask = async (e, pin) => {
+  const ask = (e, pin) => {
     const el = img();
     if (el.dataset.view !== 'kappa' || !el.naturalWidth) return;
     const r = el.getBoundingClientRect();
-    const x = (e.clientX - r.left) * el.naturalWidth / r.width;
-    const y = (e.clientY - r.top) * el.naturalHeight / r.height;
-    if (busy) { pending = [e, pin]; return; }
-    busy = true;
-    try {
-      const h = await app.hover(x, y);
-      if (h) {
-        const text = `x = ${h.x_arcsec.toFixed(2)}″, y = ${h.y_arcsec.toFixed(2)}″, κ = ${h.kappa.toFixed(3)}, ` +
-          `μ(z_s = ${h.z_source}) = ${h.magnification.toFixed(2)}`;
-        readout.textContent = pin ? `Clicked: ${text}` : text;
-      }
-    } catch { /* the worker is busy with a run or was restarted */ }
-    busy = false;
-    if (pending) { const [pe, pp] = pending; pending = null; ask(pe, pp); }
+    point = {
+      x: (e.clientX - r.left) * el.naturalWidth / r.width,
+      y: (e.clientY - r.top) * el.naturalHeight / r.height,
+      pin,
+    };
+    readOut();
   };
   img().addEventListener('mousemove', (e) => ask(e, false));
   img().addEventListener('click', (e) => ask(e, true));

@@ -1,0 +1,198 @@
+// End-to-end: settings typed quickly one after the other all stick (and survive a reload);
+// catalogues dropped on the drop zone load; forward mode with a model file, a PNG download
+// and the read-out following z_s; look-up mode from deflection FITS that survives a reload.
+import { test } from 'node:test';
+import assert from 'node:assert/strict';
+import { join } from 'node:path';
+import { readFile, writeFile, mkdtemp } from 'node:fs/promises';
+import { tmpdir } from 'node:os';
+import { openApp, imageStats, ARTIFACTS, ROOT, setField, waitStatus } from './browser.mjs';
+
+const AS1063 = join(ROOT, '..', 'shared', 'data', 'AS1063', 'lenstool_cats');
+const TEACHING_MODEL = join(ROOT, 'www', 'examples', 'teaching', 'model.json');
+const PNG_SIGNATURE = [0x89, 0x50, 0x4e, 0x47, 0x0d, 0x0a, 0x1a, 0x0a];
+
+/** Width and height from a PNG's IHDR chunk. */
+function pngSize(bytes) {
+  assert.deepEqual([...bytes.subarray(0, 8)], PNG_SIGNATURE, 'not a PNG');
+  assert.equal(bytes.subarray(12, 16).toString('latin1'), 'IHDR');
+  return [bytes.readUInt32BE(16), bytes.readUInt32BE(20)];
+}
+
+const good = (page, sel) => page.$eval(sel, (el) => [el.value, el.dataset.good]);
+
+/** Waits until every input of `want` (selector -> value) shows and holds its value. */
+async function waitAccepted(page, want) {
+  await page.waitForFunction((w) => Object.entries(w).every(([sel, v]) => {
+    const el = document.querySelector(sel);
+    return el.value === v && el.dataset.good === v;
+  }), want, { timeout: 15_000 });
+}
+
+test('settings changed in quick succession all stick and survive a reload', async () => {
+  const app = await openApp();
+  try {
+    const { page } = app;
+    await waitStatus(page, /^Ready/);
+    await page.click('#settings-panel summary');
+    // The race of the issue: one change is on its way while the user types in another input.
+    // The answer to the first must not put the old value back into the second.
+    await page.evaluate(() => {
+      const edit = (id, v, commit) => {
+        const el = document.getElementById(id);
+        el.value = v;
+        el.dispatchEvent(new Event('input', { bubbles: true }));
+        if (commit) el.dispatchEvent(new Event('change', { bubbles: true }));
+      };
+      edit('set-reconstruct-grid-cells', '20', true);
+      edit('set-reconstruct-solver-iterations', '321', false);
+    });
+    await page.waitForFunction(() => document.getElementById('set-reconstruct-grid-cells').dataset.good === '20');
+    assert.deepEqual(await good(page, '#set-reconstruct-solver-iterations'), ['321', '8000'],
+      'the answer to another change overwrote what was being typed');
+    // Commit it and, at once, two more through the keyboard (Tab commits by leaving the input).
+    await page.$eval('#set-reconstruct-solver-iterations', (el) => el.dispatchEvent(new Event('change')));
+    await page.fill('#set-reconstruct-members-mass_to_light', '25');
+    await page.press('#set-reconstruct-members-mass_to_light', 'Tab');
+    await page.fill('#set-omega_m', '0.31');
+    await page.press('#set-omega_m', 'Tab');
+    const want = {
+      '#set-reconstruct-grid-cells': '20',
+      '#set-reconstruct-solver-iterations': '321',
+      '#set-reconstruct-members-mass_to_light': '25',
+      '#set-omega_m': '0.31',
+    };
+    await waitAccepted(page, want);
+    // Once more, two fields through the test helper back to back.
+    await setField(page, '#set-h0', 68);
+    await setField(page, '#set-reconstruct-grid-cells', 22);
+    want['#set-reconstruct-grid-cells'] = '22';
+    want['#set-h0'] = '68';
+    await waitAccepted(page, want);
+    await page.reload();
+    await waitStatus(page, /^Restored/);
+    await page.click('#settings-panel summary');
+    await waitAccepted(page, want);
+    assert.deepEqual(app.consoleErrors, []);
+  } finally {
+    await app.close();
+  }
+});
+
+test('catalogues dropped on the drop zone load in their roles', async () => {
+  const app = await openApp();
+  try {
+    const { page } = app;
+    await waitStatus(page, /^Ready/);
+    const files = [
+      ['cats_gold_mul_gold.cat', await readFile(join(AS1063, 'cats_gold_mul_gold.cat'), 'utf8')],
+      ['cats_gold_ref_potential_w_clumpNE.cat',
+        await readFile(join(AS1063, 'cats_gold_ref_potential_w_clumpNE.cat'), 'utf8')],
+    ];
+    const dataTransfer = await page.evaluateHandle((list) => {
+      const dt = new DataTransfer();
+      for (const [name, text] of list) dt.items.add(new File([text], name, { type: 'text/plain' }));
+      return dt;
+    }, files);
+    await page.dispatchEvent('#drop-zone', 'dragover', { dataTransfer });
+    assert.equal(await page.$eval('#drop-zone', (el) => el.classList.contains('over')), true);
+    await page.dispatchEvent('#drop-zone', 'drop', { dataTransfer });
+    await page.waitForFunction(() => /19 systems, 50 images/.test(document.getElementById('status-images').textContent));
+    await page.waitForFunction(() => /cats_gold_ref_potential_w_clumpNE\.cat: \d+ members/
+      .test(document.getElementById('status-members').textContent));
+    assert.equal(await page.$eval('#drop-zone', (el) => el.classList.contains('over')), false);
+    assert.equal(await page.isDisabled('#reconstruct'), false);
+    assert.deepEqual(app.consoleErrors, []);
+  } finally {
+    await app.close();
+  }
+});
+
+test('forward mode draws a model file; the PNG download and the read-out follow', async () => {
+  const app = await openApp();
+  try {
+    const { page } = app;
+    await waitStatus(page, /^Ready/);
+    await page.waitForSelector('#view-image:not([hidden])');
+    const before = await imageStats(page, '#view-image');
+    await page.setInputFiles('#file-model', TEACHING_MODEL);
+    await page.waitForFunction(() => /model\.json: 2 components/.test(document.getElementById('status-model').textContent));
+    await page.click('#forward');
+    await waitStatus(page, /^Done in/);
+    await page.waitForFunction(() => document.getElementById('view-image').dataset.view === 'kappa');
+    const after = await imageStats(page, '#view-image');
+    assert.ok(after.distinctColours > before.distinctColours + 100,
+      `map unchanged: ${before.distinctColours} -> ${after.distinctColours} colours`);
+    assert.ok(after.reddish > 50, `only ${after.reddish} red curve pixels`);
+    await page.screenshot({ path: join(ARTIFACTS, 'app-forward.png'), fullPage: true });
+
+    // The read-out under a still cursor follows z_s (the magnification depends on it).
+    const box = await (await page.$('#view-image')).boundingBox();
+    await page.mouse.move(box.x + box.width * 0.42, box.y + box.height * 0.38);
+    await page.waitForFunction(() => /μ\(z_s = 3\)/.test(document.getElementById('readout').textContent));
+    const at3 = await page.textContent('#readout');
+    await setField(page, '#z-curves', 1.2);
+    await page.waitForFunction(() => /μ\(z_s = 1\.2\)/.test(document.getElementById('readout').textContent));
+    assert.notEqual(await page.textContent('#readout'), at3.replace('z_s = 3', 'z_s = 1.2'),
+      'the magnification did not change with z_s');
+
+    // PNG download of the view: a PNG of the size shown.
+    const [w, h] = await page.$eval('#view-image', (el) => [el.naturalWidth, el.naturalHeight]);
+    await page.click('#downloads-panel summary');
+    const [download] = await Promise.all([page.waitForEvent('download'), page.click('#dl-kappa-png')]);
+    assert.equal(download.suggestedFilename(), 'kappa.png');
+    assert.deepEqual(pngSize(await readFile(await download.path())), [w, h]);
+    assert.deepEqual(app.consoleErrors, []);
+  } finally {
+    await app.close();
+  }
+});
+
+test('look-up mode reads deflection FITS, shows μ where clicked and survives a reload', async () => {
+  const app = await openApp();
+  try {
+    const { page } = app;
+    await waitStatus(page, /^Ready/);
+    // Deflection maps from a forward run of the teaching model, downloaded as FITS.
+    await page.setInputFiles('#file-model', TEACHING_MODEL);
+    await page.waitForFunction(() => /2 components/.test(document.getElementById('status-model').textContent));
+    await setField(page, '#set-reconstruct-products-size_arcsec', 80);
+    await page.click('#forward');
+    await waitStatus(page, /^Done in/);
+    await page.click('#downloads-panel summary');
+    const dir = await mkdtemp(join(tmpdir(), 'wslap-e2e-'));
+    const saved = {};
+    for (const axis of ['x', 'y']) {
+      const [d] = await Promise.all([page.waitForEvent('download'), page.click(`#dl-${axis}-arcsec-deflect-fits`)]);
+      saved[axis] = join(dir, `${axis}-arcsec-deflect.fits`);
+      await writeFile(saved[axis], await readFile(await d.path()));
+    }
+    await page.setInputFiles('#file-deflection_x', saved.x);
+    await page.setInputFiles('#file-deflection_y', saved.y);
+    await page.waitForFunction(() => /256 x 256 pixels/.test(document.getElementById('status-deflection_y').textContent));
+    await page.waitForFunction(() => !document.getElementById('lookup').disabled);
+    await page.click('#lookup');
+    await waitStatus(page, /^Done in/);
+    await page.waitForFunction(() => document.getElementById('view-image').dataset.view === 'kappa');
+    const stats = await imageStats(page, '#view-image');
+    assert.ok(stats.reddish > 50, `only ${stats.reddish} red curve pixels`);
+    const box = await (await page.$('#view-image')).boundingBox();
+    await page.mouse.click(box.x + box.width * 0.45, box.y + box.height * 0.4);
+    await page.waitForFunction(() => /^Clicked: .*μ\(z_s = 3\) = -?\d/.test(document.getElementById('readout').textContent));
+    await page.screenshot({ path: join(ARTIFACTS, 'app-lookup.png'), fullPage: true });
+    const caption = await page.textContent('#summary');
+
+    // The session, deflection maps included, comes back after a reload.
+    await page.reload();
+    await waitStatus(page, /^Restored/);
+    await page.waitForFunction(() => /x-arcsec-deflect\.fits: loaded/.test(document.getElementById('status-deflection_x').textContent));
+    await page.waitForFunction(() => document.getElementById('view-image').dataset.view === 'kappa');
+    assert.equal(await page.isDisabled('#lookup'), false);
+    assert.equal(await page.textContent('#summary'), caption);
+    const again = await imageStats(page, '#view-image');
+    assert.ok(again.reddish > 50, `after reload only ${again.reddish} red curve pixels`);
+    assert.deepEqual(app.consoleErrors, []);
+  } finally {
+    await app.close();
+  }
+});
