@@ -83,10 +83,57 @@ fn reduced_paper_run_reproduces_the_orderings() {
         assert!(json["cases"]["galaxy_model"].get(key).is_some(), "{key}");
     }
     assert!(json["truth"]["einstein_radius_arcsec_z3"].as_f64().unwrap() > 30.0);
+    // Masses inside the arc region: part of the field's, and the grid's is measured per case.
+    assert!(r.truth.soft_mass_region_msun > 0.0);
+    assert!(r.truth.soft_mass_region_msun < r.truth.soft_mass_msun);
+    assert!(r.truth.galaxy_mass_region_msun > 0.0);
+    assert!(r.truth.galaxy_mass_region_msun < r.truth.galaxy_mass_msun);
+    for c in [i, ii, iii] {
+        assert!(c.grid_mass_region_msun > 0.0 && c.grid_mass_region_msun <= c.grid_mass_msun);
+    }
+    // The studies: four starts (the reasonable one reproduces case iii), the bad one also on
+    // its own, and one default and one best row per swept setting.
+    let st = &r.studies;
+    assert_eq!(st.starts.len(), 4);
+    let reasonable = st.starts.iter().find(|s| s.label == "reasonable").unwrap();
+    assert_eq!(reasonable.c, iii.c[0]);
+    for s in &st.starts {
+        assert!(s.chi2.is_finite() && s.chi2 > 0.0, "{}: chi2 {}", s.label, s.chi2);
+        assert!(s.source_rms_arcsec > 0.0 && s.source_rms_arcsec < 10.0);
+    }
+    let bad = st.bad_start.as_ref().unwrap();
+    assert!(bad.start_c > 1.0 && bad.start_cell_mass_msun > reasonable.start_cell_mass_msun);
+    for p in ["cell_sigma_factor", "weighting", "member_r_s_law"] {
+        let rows: Vec<_> = st.sweep.iter().filter(|row| row.parameter == p).collect();
+        assert!(rows.len() >= 3, "{p}: {} rows", rows.len());
+        assert_eq!(rows.iter().filter(|row| row.is_default).count(), 1, "{p}");
+        assert_eq!(rows.iter().filter(|row| row.best).count(), 1, "{p}");
+        let best = rows.iter().find(|row| row.best).unwrap();
+        assert!(rows
+            .iter()
+            .all(|row| row.deflection_error_median_arcsec >= best.deflection_error_median_arcsec));
+    }
+    // The default cell width and weighting rows are case (ii) itself.
+    let default_width = st
+        .sweep
+        .iter()
+        .find(|row| row.parameter == "cell_sigma_factor" && row.is_default)
+        .unwrap();
+    assert_eq!(
+        default_width.deflection_error_median_arcsec,
+        ii.deflection_error_median_arcsec
+    );
+    assert!(markdown_has_tables(&wslap::paper::report_markdown(r)));
     // Every figure renders.
     let figures = wslap::paper::render_figures(&run).unwrap();
     assert_eq!(figures.len(), 5);
     for f in &figures {
         assert_eq!(&f.png[1..4], b"PNG", "{}", f.file_name);
     }
+}
+
+/// report.md has the studies' tables.
+fn markdown_has_tables(md: &str) -> bool {
+    md.contains("## Case (iii) from several starts")
+        && md.contains("## The open defaults, measured")
 }

@@ -40,12 +40,17 @@ pub struct PaperArgs {
     /// Start value of C in the cases and the reasonable start.
     #[arg(long)]
     start_c: Option<f64>,
-    /// Gaussian width of a cell over its size.
+    /// Gaussian width of a cell over its size (default 1.25: the best of the sweep in
+    /// report.md on this cluster; the general default of `wslap reconstruct` is 0.75).
     #[arg(long)]
     cell_sigma: Option<f64>,
     /// Row weighting: equal_per_image, equal_per_pixel or equal_per_system.
     #[arg(long)]
     weighting: Option<String>,
+    /// Skip the studies of report.md (C from several starts, the sweep of the open defaults):
+    /// about half the run time.
+    #[arg(long)]
+    no_studies: bool,
 }
 
 pub fn run(args: &PaperArgs) -> Result<(), String> {
@@ -56,6 +61,7 @@ pub fn run(args: &PaperArgs) -> Result<(), String> {
         ..PaperConfig::default()
     };
     config.simulation.seed = args.seed;
+    config.studies = !args.no_studies;
     if let Some(m) = args.start_cell_mass {
         config.reasonable_start_cell_mass_msun = m;
     }

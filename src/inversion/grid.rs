@@ -8,8 +8,15 @@
 //! Default width: `s = 0.75` cell. Equal masses on a square lattice of spacing `h` give a
 //! peak-to-peak ripple of about `8 exp(-2 pi^2 s^2 / h^2)` in the convergence: measured 5.9%
 //! at `s = 0.5 h` (METHOD.md: ~6%), 1.2e-4 at `s = 0.75 h` and 2e-8 at `s = h`
-//! (tests/inversion.rs checks the first two). 0.75 is the narrowest width that is smooth, so it
-//! keeps the most resolution.
+//! (tests/inversion.rs checks that the default is smooth and 0.5 is not). 0.75 is the
+//! narrowest width that is smooth, so it keeps the most resolution.
+//!
+//! The best width depends on the data. On the paper's simulated cluster (`wslap paper`, the
+//! sweep in its report.md; 32 x 32 cells over 198") wider cells fit better: case (ii)'s median
+//! deflection error is 2.70" at 0.5, 2.42" at 0.75, 1.73" at 1.0, 0.98" at 1.25, 1.13" at 1.5
+//! and 2.27" at 2.0 cells, so `wslap paper` and the app's example of that cluster use 1.25. On
+//! the synthetic lens of tests/reconstruct.rs (16 x 16 cells) 1.25 doubles the image-plane rms
+//! (1.26" to 2.40"), so the general default stays at the smooth minimum.
 
 use glam::DVec2;
 use serde::{Deserialize, Serialize};
