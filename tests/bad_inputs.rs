@@ -6,7 +6,7 @@ mod common;
 
 use wslap::fits::{read_image, FitsError};
 use wslap::inversion::{parse_arcs, ConstraintError};
-use wslap::limits::{MAX_ARC_PIXELS, MAX_FITS_PIXELS, MAX_JSON_BYTES};
+use wslap::limits::{MAX_ARC_PIXELS, MAX_FITS_PIXELS};
 use wslap::model::ModelFile;
 use wslap::reconstruct::ReconstructConfig;
 
@@ -133,6 +133,7 @@ fn arcs_pixel_limit() {
 #[cfg(not(target_arch = "wasm32"))]
 #[test]
 fn json_size_limit() {
+    use wslap::limits::MAX_JSON_BYTES;
     let text = " ".repeat(MAX_JSON_BYTES as usize + 1);
     let err = ModelFile::from_json_str(&text, "model.json")
         .unwrap_err()
