@@ -175,6 +175,19 @@ impl Products {
         )
     }
 
+    /// Products of lens maps already computed for `lens` (e.g. the simulation's truth maps),
+    /// at `z_source`; the maps' geometry is the products'.
+    pub fn from_lens_maps(
+        maps: LensMaps,
+        lens: &dyn MassComponent,
+        plane: LensPlane,
+        reference: Option<SkyReference>,
+        z_source: f64,
+    ) -> Result<Self, ProductsError> {
+        let f = plane.distance_ratio(z_source)?;
+        Self::finish(maps, plane, reference, f, z_source, Some(lens), 0.0)
+    }
+
     /// Products of published deflection maps (HFF convention, `D_ls/D_s = 1`, arcsec).
     pub fn from_deflection(
         alpha_x: Map,

@@ -186,6 +186,9 @@ pub struct Simulation {
     pub arcs: ArcCatalog,
     /// Lensed surface brightness of all sources on the `pixel_arcsec` grid of the field.
     pub image: Map,
+    /// The truth's lens maps on the same grid (`D_ls/D_s = 1`): what the sources were
+    /// ray-shot through, reused for the written truth products.
+    pub truth_maps: LensMaps,
     /// Soft halo, projected inside the field square.
     pub soft_mass_msun: f64,
     /// Galaxy-true, projected inside the field square.
@@ -251,6 +254,7 @@ impl Simulation {
                 geometry: MapGeometry::centered(config.field_arcsec, 1),
                 data: vec![0.0],
             },
+            truth_maps: LensMaps::zeros(MapGeometry::centered(config.field_arcsec, 1)),
             soft_mass_msun: cl.soft_mass_msun,
             galaxy_mass_msun: cl.galaxy_mass_msun,
             galaxy_normalisation: cl.galaxy_norm,
@@ -290,6 +294,7 @@ impl Simulation {
             })
             .collect();
         sim.sources = placed.into_iter().map(|p| p.source).collect();
+        sim.truth_maps = maps;
         sim.elapsed_ms = clock.ms();
         Ok(sim)
     }

@@ -203,7 +203,7 @@ pub fn write_simulation(
     dir: &std::path::Path,
 ) -> Result<Vec<std::path::PathBuf>, SimulateError> {
     use super::GalaxySet;
-    use crate::products::{ProductOptions, Products};
+    use crate::products::Products;
     use crate::render::ColorScale;
 
     let truth = dir.join("truth");
@@ -238,13 +238,14 @@ pub fn write_simulation(
             .to_json_string()
             .as_bytes(),
     )?;
-    let opts = ProductOptions {
-        z_source: super::SUMMARY_Z_SOURCE,
-        size_arcsec: sim.config.field_arcsec,
-        pixels: sim.image.geometry.pixels,
-        scale: ColorScale::Log,
-    };
-    let products = Products::from_model(&model, &opts)?;
+    // The maps the sources were ray-shot through: not computed again.
+    let products = Products::from_lens_maps(
+        sim.truth_maps.clone(),
+        &model.build_lens()?,
+        sim.plane,
+        model.reference,
+        super::SUMMARY_Z_SOURCE,
+    )?;
     for (name, bytes) in products.fits_files()? {
         write(truth.join(name), &bytes)?;
     }
