@@ -77,7 +77,8 @@ pub struct SystemConfig {
     pub theta_shift_arcsec: Option<f64>,
     /// Largest block of `Gamma` rows held at once, in MB (default 64). Allowed [0.001, 1e5].
     pub block_mbytes: f64,
-    /// Threads for filling rows; 0 (default) = all available (always 1 on wasm32).
+    /// Threads for filling rows and for the QADP passes of a reconstruction; 0 (default) = all
+    /// available (always 1 on wasm32).
     pub threads: usize,
 }
 

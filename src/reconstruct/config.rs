@@ -137,7 +137,8 @@ impl ReconstructConfig {
         QadpSettings {
             iterations: self.solver.iterations,
             report_every: self.solver.report_every,
-            ..QadpSettings::default()
+            // One thread count for the whole run (`system.threads`).
+            threads: self.system.threads,
         }
     }
 }

@@ -1,0 +1,70 @@
+// The browser app's built-in example (the simulated A1689-like cluster) reconstructed in the
+// web worker with the example's own settings, against the same run natively on one thread.
+// Prints the worker time ("Done in" of the status line), first contentful paint, the native
+// wall time and their ratio, and the wasm bundle size. BENCHMARKS.md records the figures.
+//
+//   npm run build && cargo build --release && node benches/app-example.mjs
+//
+// Needs www/pkg (npm run build), target/release/wslap and /usr/bin/chromium (or CHROMIUM).
+import { execFileSync } from 'node:child_process';
+import { mkdtempSync, readFileSync, statSync, writeFileSync } from 'node:fs';
+import { tmpdir } from 'node:os';
+import { join } from 'node:path';
+import { openApp, ROOT, waitStatus } from '../tests/e2e/browser.mjs';
+
+const index = JSON.parse(readFileSync(join(ROOT, 'www/examples/index.json'), 'utf8'));
+const example = index.examples[0];
+
+// The example's settings as the CONFIG.json of `wslap reconstruct` (dot paths under
+// "reconstruct."), over the app's defaults that differ from the CLI's (256-pixel maps:
+// APP_MAP_PIXELS in src/app/settings.rs), with one thread: the worker has one.
+const config = { system: { threads: 1 }, products: { pixels: 256 } };
+for (const [path, value] of Object.entries(example.settings)) {
+  const keys = path.split('.');
+  if (keys[0] !== 'reconstruct') continue;
+  let node = config;
+  for (const k of keys.slice(1, -1)) node = node[k] ??= {};
+  node[keys.at(-1)] = value;
+}
+const file = (role) => join(ROOT, 'www/examples', example.files.find((f) => f.role === role).path);
+
+const app = await openApp();
+let worker;
+let paint;
+let workerStages;
+try {
+  const { page } = app;
+  await waitStatus(page, /^Ready/);
+  paint = await page.evaluate(() =>
+    performance.getEntriesByName('first-contentful-paint')[0]?.startTime);
+  await page.click('#reconstruct');
+  await waitStatus(page, /^Done in/, 600_000);
+  const status = await page.textContent('#status');
+  worker = Number(status.match(/Done in (\d+(?:\.\d+)?) s/)[1]);
+  // The worker's own stage timings, from its summary.json.
+  await page.$eval('details:has(#downloads)', (d) => { d.open = true; });
+  const [download] = await Promise.all([page.waitForEvent('download'), page.click('#dl-summary-json')]);
+  workerStages = JSON.parse(readFileSync(await download.path(), 'utf8')).timings_ms;
+} finally {
+  await app.close();
+}
+
+const dir = mkdtempSync(join(tmpdir(), 'wslap-bench-'));
+const cfg = join(dir, 'config.json');
+writeFileSync(cfg, JSON.stringify(config));
+const t0 = process.hrtime.bigint();
+execFileSync(join(ROOT, 'target/release/wslap'), [
+  'reconstruct', '--arcs', file('arcs'), '--members', file('members'),
+  '--z-lens', String(example.z_lens), '--config', cfg, '--out', join(dir, 'out'),
+], { stdio: 'ignore' });
+const native = Number(process.hrtime.bigint() - t0) / 1e9;
+const nativeStages = JSON.parse(readFileSync(join(dir, 'out', 'summary.json'), 'utf8')).timings_ms;
+const stages = (t) => Object.entries(t).map(([k, v]) => `${k} ${(v / 1e3).toFixed(2)}`).join(', ');
+const wasm = statSync(join(ROOT, 'www/pkg/wslap_bg.wasm')).size;
+
+console.log(`example: ${example.id}, settings ${JSON.stringify(config)}`);
+console.log(`browser worker: ${worker.toFixed(1)} s (stages in s: ${stages(workerStages)})`);
+console.log(`native, one thread: ${native.toFixed(1)} s wall (stages in s: ${stages(nativeStages)})`);
+console.log(`ratio: ${(worker / native).toFixed(2)}x`);
+console.log(`first contentful paint: ${paint?.toFixed(0)} ms`);
+console.log(`wasm bundle: ${(wasm / 1e6).toFixed(2)} MB`);
