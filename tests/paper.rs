@@ -98,7 +98,12 @@ fn reduced_paper_run_reproduces_the_orderings() {
     let reasonable = st.starts.iter().find(|s| s.label == "reasonable").unwrap();
     assert_eq!(reasonable.c, iii.c[0]);
     for s in &st.starts {
-        assert!(s.chi2.is_finite() && s.chi2 > 0.0, "{}: chi2 {}", s.label, s.chi2);
+        assert!(
+            s.chi2.is_finite() && s.chi2 > 0.0,
+            "{}: chi2 {}",
+            s.label,
+            s.chi2
+        );
         assert!(s.source_rms_arcsec > 0.0 && s.source_rms_arcsec < 10.0);
     }
     let bad = st.bad_start.as_ref().unwrap();

@@ -37,6 +37,26 @@ test('the built-in example reconstructs and shows a map with critical curves', a
     assert.ok(r2 > 3, before);
     await page.screenshot({ path: join(ARTIFACTS, 'app-example.png'), fullPage: true });
 
+    // "Show: predicted" off removes the orange crosses of the predicted images (and their
+    // legend entry); on again brings them back.
+    const orange = { rgb: [255, 170, 0], tol: 12 };
+    const withPredicted = (await imageStats(page, '#view-image', orange)).near;
+    assert.ok(withPredicted > 50, `only ${withPredicted} orange pixels of predicted images`);
+    const redrawn = async (toggle) => {
+      const src = await page.getAttribute('#view-image', 'src');
+      await toggle();
+      await page.waitForFunction((old) => {
+        const img = document.getElementById('view-image');
+        return img.src !== old && img.complete && img.naturalWidth > 0;
+      }, src);
+    };
+    await redrawn(() => page.uncheck('#show-predicted'));
+    const without = (await imageStats(page, '#view-image', orange)).near;
+    assert.ok(without < withPredicted / 10, `${without} orange pixels left of ${withPredicted}`);
+    await page.screenshot({ path: join(ARTIFACTS, 'app-example-no-predicted.png'), fullPage: true });
+    await redrawn(() => page.check('#show-predicted'));
+    assert.equal((await imageStats(page, '#view-image', orange)).near, withPredicted);
+
     // Hover read-out in the middle of the map.
     const box = await (await page.$('#view-image')).boundingBox();
     await page.mouse.move(box.x + box.width * 0.45, box.y + box.height * 0.5);

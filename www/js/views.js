@@ -35,7 +35,13 @@ export async function refreshReadout() {
 }
 
 export function viewOptions() {
-  return { scale: document.getElementById('scale').value };
+  const on = (id) => document.getElementById(id).checked;
+  return {
+    scale: document.getElementById('scale').value,
+    show_members: on('show-members'),
+    show_observed: on('show-observed'),
+    show_predicted: on('show-predicted'),
+  };
 }
 
 export function currentView() { return current; }
