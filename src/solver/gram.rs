@@ -18,8 +18,10 @@ const KC: usize = 256;
 const NC_PANELS: usize = 32;
 /// Rows of `A` per register tile.
 const MR: usize = 4;
-/// Columns of `A` per register tile.
-const NR: usize = 8;
+/// Columns of `A` per register tile: 4 x 8 f64 sums in 16 AVX2 registers natively; 4 x 4 in
+/// WebAssembly, whose code the browser maps onto 16 128-bit registers (8 sums, 2 packed rows,
+/// a broadcast value).
+const NR: usize = if cfg!(target_arch = "wasm32") { 4 } else { 8 };
 
 /// Accumulates `A = sum_r w_r g_r g_r^T` and `b = -sum_r w_r theta_r g_r` over rows `g_r` of
 /// `Gamma` (`n` unknowns each), weights `w_r >= 0` and data `theta_r` (arcsec in WSLAP+).
@@ -273,6 +275,7 @@ fn band_update_body<const FUSED: bool>(
 }
 
 /// `tile[ii][jj] = sum_r a[r][ii] b[r][jj]` over the `k` packed rows.
+#[cfg(not(all(target_arch = "wasm32", target_feature = "simd128")))]
 #[inline(always)]
 fn tile_product<const FUSED: bool>(panel_a: &[f64], panel_b: &[f64]) -> [[f64; NR]; MR] {
     let mut acc = [[0.0; NR]; MR];
@@ -288,4 +291,39 @@ fn tile_product<const FUSED: bool>(panel_a: &[f64], panel_b: &[f64]) -> [[f64; N
         }
     }
     acc
+}
+
+/// [`tile_product`] in WebAssembly SIMD, the 4 x 4 tile as 8 `f64x2` sums. Not inlined, on
+/// purpose: browsers compile a wasm function with a quick baseline compiler first and optimise
+/// it only after it has been called often (no on-stack replacement), and the normal equations
+/// of a whole system are one call of `add_rows`. As its own function the tile is optimised
+/// after its first few calls (measured in Node: `add_rows` of the app example 1.9 s inlined).
+#[cfg(all(target_arch = "wasm32", target_feature = "simd128"))]
+#[inline(never)]
+fn tile_product<const FUSED: bool>(panel_a: &[f64], panel_b: &[f64]) -> [[f64; NR]; MR] {
+    use core::arch::wasm32::{f64x2_add, f64x2_extract_lane, f64x2_mul, f64x2_splat, v128};
+    const _: () = assert!(MR == 4 && NR == 4);
+    let mut acc: [v128; MR * NR / 2] = [f64x2_splat(0.0); MR * NR / 2];
+    for (av, bv) in panel_a.chunks_exact(MR).zip(panel_b.chunks_exact(NR)) {
+        let b = [
+            core::arch::wasm32::f64x2(bv[0], bv[1]),
+            core::arch::wasm32::f64x2(bv[2], bv[3]),
+        ];
+        for (ii, &a_ii) in av.iter().enumerate() {
+            let a = f64x2_splat(a_ii);
+            for (q, bq) in b.iter().enumerate() {
+                let k = ii * NR / 2 + q;
+                acc[k] = f64x2_add(acc[k], f64x2_mul(a, *bq));
+            }
+        }
+    }
+    let mut tile = [[0.0; NR]; MR];
+    for (ii, row) in tile.iter_mut().enumerate() {
+        for q in 0..NR / 2 {
+            let v = acc[ii * NR / 2 + q];
+            row[2 * q] = f64x2_extract_lane::<0>(v);
+            row[2 * q + 1] = f64x2_extract_lane::<1>(v);
+        }
+    }
+    tile
 }
