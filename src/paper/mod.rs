@@ -346,7 +346,8 @@ pub fn run_paper(config: &PaperConfig, say: &mut dyn FnMut(&str)) -> Result<Pape
         let inputs = studies::StudyInputs {
             layer_true: &layer_true,
             layer_model: &layer_model,
-            case_ii: &case_report(&cases, Case::GalaxyModel),
+            case_ii: case_run(&cases, Case::GalaxyModel),
+            case_iii: case_run(&cases, Case::GalaxyTrue),
         };
         studies::run_studies(config, &simulation, &scorer, &inputs, say)?
     } else {
@@ -454,11 +455,10 @@ fn run_one(
 }
 
 /// The scores of `case` (every case is run before the studies).
-fn case_report(cases: &[CaseRun], case: Case) -> CaseReport {
+fn case_run(cases: &[CaseRun], case: Case) -> &CaseRun {
     cases
         .iter()
         .find(|c| c.case == case)
-        .map(|c| c.report.clone())
         .expect("every case runs before the studies")
 }
 

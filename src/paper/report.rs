@@ -347,13 +347,7 @@ impl PaperReport {
                 c.report.timings_ms.values().sum::<f64>(),
             );
         }
-        let checks = checks(
-            &truth_report,
-            &case_reports,
-            &convergence,
-            &studies,
-            config.iterations,
-        );
+        let checks = checks(&truth_report, &case_reports, &studies, config.iterations);
         Self {
             truth: truth_report,
             cases: case_reports,
@@ -375,7 +369,6 @@ impl PaperReport {
 fn checks(
     truth: &TruthReport,
     cases: &BTreeMap<String, CaseReport>,
-    conv: &ConvergenceReport,
     studies: &Studies,
     iterations: usize,
 ) -> Vec<Check> {
@@ -434,44 +427,41 @@ fn checks(
     // The grid mass is compared inside the arc region, where the data constrain the cells:
     // outside it the cells keep whatever the start gave them (the paper's "memory effect in the
     // unconstrained borders"). The field-wide mass is in the detail.
-    let field_rel = |m: f64| 100.0 * (m / truth.soft_mass_msun - 1.0);
-    let bad_field = RunSeries::at(&conv.bad_start.grid_mass_msun, &conv.iterations, iterations);
     let bad = studies.bad_start.as_ref();
-    for (name, region_mass, field_mass) in [
+    for (name, masses) in [
         (
             "reasonable",
-            Some(iii.grid_mass_region_msun),
-            Some(iii.grid_mass_msun),
+            Some((iii.grid_mass_region_msun, iii.grid_mass_msun)),
         ),
         (
             "bad",
-            bad.map(|b| b.grid_mass_region_msun),
-            bad.map(|b| b.grid_mass_msun).or(bad_field),
+            bad.map(|b| (b.grid_mass_region_msun, b.grid_mass_msun)),
         ),
     ] {
-        let rel = region_mass.map(|m| m / truth.soft_mass_region_msun - 1.0);
-        let Some(region_mass) = region_mass else {
+        let name = format!(
+            "grid mass within 15% of the soft mass inside the arc region at {iterations} iterations, {name} start"
+        );
+        let Some((region_mass, field_mass)) = masses else {
             push(
-                &format!("grid mass within 15% of the soft mass inside the arc region at {iterations} iterations, {name} start"),
+                &name,
                 false,
                 "not measured: the studies were skipped".to_string(),
             );
             continue;
         };
+        let rel = region_mass / truth.soft_mass_region_msun - 1.0;
         push(
-            &format!(
-                "grid mass within 15% of the soft mass inside the arc region at {iterations} iterations, {name} start"
-            ),
-            rel.is_some_and(|r| r.abs() <= GRID_MASS_TOLERANCE),
+            &name,
+            rel.abs() <= GRID_MASS_TOLERANCE,
             format!(
                 "inside r < {:.0}\": {:.3e} Msun vs soft {:.3e} Msun ({:+.1}%); whole field: {:.3e} vs {:.3e} ({:+.1}%)",
                 truth.arc_region_radius_arcsec,
                 region_mass,
                 truth.soft_mass_region_msun,
-                100.0 * rel.unwrap_or(f64::NAN),
-                field_mass.unwrap_or(f64::NAN),
+                100.0 * rel,
+                field_mass,
                 truth.soft_mass_msun,
-                field_rel(field_mass.unwrap_or(f64::NAN)),
+                100.0 * (field_mass / truth.soft_mass_msun - 1.0),
             ),
         );
     }

@@ -10,7 +10,7 @@
 
 use serde::{Deserialize, Serialize};
 
-use super::{run_one, CaseReport, LayerInput, PaperConfig, PaperError, Scorer};
+use super::{run_one, CaseRun, LayerInput, PaperConfig, PaperError, Scorer};
 use crate::catalog::parse_member_catalog;
 use crate::inversion::{Layer, MemberConfig, Weighting};
 use crate::simulate::Simulation;
@@ -79,8 +79,10 @@ const R_S_LAWS: [(&str, f64, f64); 3] = [
 pub(super) struct StudyInputs<'a> {
     pub layer_true: &'a Layer,
     pub layer_model: &'a Layer,
-    /// Scores of the default case (ii) run, reused for the default rows of the sweep.
-    pub case_ii: &'a CaseReport,
+    /// The default case (ii) run, reused for the default rows of the sweep ...
+    pub case_ii: &'a CaseRun,
+    /// ... and case (iii), which is the reasonable start of the start study.
+    pub case_iii: &'a CaseRun,
 }
 
 /// Runs the start study and the sweep.
@@ -95,6 +97,7 @@ pub(super) fn run_studies(
         layer_true,
         layer_model,
         case_ii,
+        case_iii,
     } = *inputs;
     let field = simulation.config.field_arcsec;
     let soft_per_cell = simulation.soft_mass_msun / (config.grid_cells * config.grid_cells) as f64;
@@ -111,16 +114,22 @@ pub(super) fn run_studies(
     ];
     let mut starts = Vec::new();
     for (label, mass, c0) in starts_spec {
-        let mut rc = config.reconstruct_config(field, config.iterations);
-        rc.solver.start_cell_mass_msun = mass;
-        rc.solver.start_c = c0;
-        let rec = run_one(
-            simulation,
-            LayerInput::Given(std::slice::from_ref(layer_true)),
-            &rc,
-            "start study",
-        )?;
-        let r = scorer.score(&rec, "start study")?.report;
+        let owned;
+        let (rec, r) = if label == "reasonable" {
+            // The same settings as case (iii): its run is reused.
+            (&case_iii.reconstruction, case_iii.report.clone())
+        } else {
+            let mut rc = config.reconstruct_config(field, config.iterations);
+            rc.solver.start_cell_mass_msun = mass;
+            rc.solver.start_c = c0;
+            owned = run_one(
+                simulation,
+                LayerInput::Given(std::slice::from_ref(layer_true)),
+                &rc,
+                "start study",
+            )?;
+            (&owned, scorer.score(&owned, "start study")?.report)
+        };
         let chi2 = 2.0 * r.objective + rec.system.theta_w_theta;
         let weight_sum: f64 = rec
             .system
@@ -159,7 +168,7 @@ pub(super) fn run_studies(
                 let rec = run_one(simulation, layers, &rc, "sweep")?;
                 scorer.score(&rec, "sweep")?.report
             }
-            None => case_ii.clone(),
+            None => case_ii.report.clone(),
         };
         say(&format!(
             "sweep, {parameter} = {value}: median deflection error {:.2}\", C {:?}",
