@@ -178,12 +178,6 @@ pub fn relative_errors(rec: &[f64], truth: &[f64]) -> Vec<f64> {
         .collect()
 }
 
-/// Projected mass inside the square map, Msun: `Sigma_cr_ref * sum(kappa) * pixel area`.
-pub fn map_mass_msun(kappa: &Map, sigma_cr_ref_msun_per_arcsec2: f64) -> f64 {
-    let g: MapGeometry = kappa.geometry;
-    kappa.data.iter().sum::<f64>() * g.pixel_arcsec().powi(2) * sigma_cr_ref_msun_per_arcsec2
-}
-
 /// Projected mass inside `region`, Msun: `Sigma_cr_ref * sum(kappa) * pixel area` over the map
 /// pixels whose centres lie in the region.
 pub fn region_mass_msun(
