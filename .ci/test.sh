@@ -38,6 +38,11 @@ run_step() {
 }
 
 export CHROMEDRIVER=/usr/bin/chromedriver
+# ChromeDriver leaves a ~40 MB browser profile in $TMPDIR for every wasm test binary (the
+# runner stops it without ending the session): keep them under target/ and delete them at exit.
+export TMPDIR="$ROOT/target/tmp/browsers"
+rm -rf "$TMPDIR" && mkdir -p "$TMPDIR"
+trap 'rm -rf "$TMPDIR"' EXIT
 export CARGO_TARGET_WASM32_UNKNOWN_UNKNOWN_RUNNER=wasm-bindgen-test-runner
 
 run_step "cargo fmt" cargo fmt --all -- --check
