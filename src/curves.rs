@@ -337,7 +337,7 @@ impl<F: Fn(usize) -> f64> EdgeGrid<F> {
 fn push_distinct(points: &mut Vec<DVec2>, p: DVec2) {
     if points
         .last()
-        .map_or(true, |q| q.distance(p) >= DUPLICATE_PIXELS)
+        .is_none_or(|q| q.distance(p) >= DUPLICATE_PIXELS)
     {
         points.push(p);
     }

@@ -149,7 +149,7 @@ pub(crate) fn is_reference_header(trimmed: &str) -> bool {
         && trimmed[key.len()..]
             .chars()
             .next()
-            .map_or(true, char::is_whitespace)
+            .is_none_or(char::is_whitespace)
 }
 
 /// Reads a `#REFERENCE mode [ra0 dec0]` header (see the module documentation).

@@ -301,7 +301,8 @@ fn tile_product<const FUSED: bool>(panel_a: &[f64], panel_b: &[f64]) -> [[f64; N
 #[cfg(all(target_arch = "wasm32", target_feature = "simd128"))]
 #[inline(never)]
 fn tile_product<const FUSED: bool>(panel_a: &[f64], panel_b: &[f64]) -> [[f64; NR]; MR] {
-    use core::arch::wasm32::{f64x2_add, f64x2_extract_lane, f64x2_mul, f64x2_splat, v128};
+    use super::wasm_simd::madd_f64x2;
+    use core::arch::wasm32::{f64x2_extract_lane, f64x2_splat, v128};
     const _: () = assert!(MR == 4 && NR == 4);
     let mut acc: [v128; MR * NR / 2] = [f64x2_splat(0.0); MR * NR / 2];
     for (av, bv) in panel_a.chunks_exact(MR).zip(panel_b.chunks_exact(NR)) {
@@ -313,7 +314,7 @@ fn tile_product<const FUSED: bool>(panel_a: &[f64], panel_b: &[f64]) -> [[f64; N
             let a = f64x2_splat(a_ii);
             for (q, bq) in b.iter().enumerate() {
                 let k = ii * NR / 2 + q;
-                acc[k] = f64x2_add(acc[k], f64x2_mul(a, *bq));
+                acc[k] = madd_f64x2(a, *bq, acc[k]);
             }
         }
     }

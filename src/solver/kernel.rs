@@ -175,6 +175,7 @@ fn flush(src: &mut [f32], dst: &mut [f64]) {
 }
 
 /// A chunk of [`CHUNK`] values by value.
+#[cfg(not(all(target_arch = "wasm32", target_feature = "simd128")))]
 #[inline(always)]
 fn chunk(s: &[f32]) -> [f32; CHUNK] {
     let mut v = [0.0; CHUNK];
@@ -183,6 +184,7 @@ fn chunk(s: &[f32]) -> [f32; CHUNK] {
 }
 
 /// `acc + p * q`, fused when the caller is compiled with FMA (otherwise a library call).
+#[cfg(not(all(target_arch = "wasm32", target_feature = "simd128")))]
 #[inline(always)]
 fn madd<const FUSED: bool>(p: f32, q: f32, acc: f32) -> f32 {
     if FUSED {
@@ -194,6 +196,7 @@ fn madd<const FUSED: bool>(p: f32, q: f32, acc: f32) -> f32 {
 
 /// Row sums `[a_0, c_0, a_1, c_1]` of two rows over their common columns, and their
 /// contributions `M_ij x_i` to the column sums.
+#[cfg(not(all(target_arch = "wasm32", target_feature = "simd128")))]
 #[inline(always)]
 fn pair_sums<const FUSED: bool>(
     rows: [&[f32]; 2],
@@ -247,4 +250,75 @@ fn pair_sums<const FUSED: bool>(
         }
         (s4[0] + s4[2]) + (s4[1] + s4[3])
     })
+}
+
+/// Columns a wasm row sum adds in f32 before going to f64: with one 4-lane sum per row (not
+/// the 16 lanes of the generic code) this keeps 32 terms per lane, as [`ROW_BLOCK`] does there.
+#[cfg(all(target_arch = "wasm32", target_feature = "simd128"))]
+const WASM_ROW_BLOCK: usize = ROW_BLOCK * 4 / CHUNK;
+#[cfg(all(target_arch = "wasm32", target_feature = "simd128"))]
+const _: () = assert!(WASM_ROW_BLOCK % CHUNK == 0);
+
+/// [`pair_sums`] in WebAssembly SIMD, 4 lanes at a time. Written out because the generic code,
+/// vectorised by LLVM, keeps 16 lanes of each of the four row sums, and 16 `v128` sums do not
+/// fit the 16 vector registers a browser has on x86-64: they spill on every step. Here the
+/// live values are 4 sums, 2 splats and the step's loads and products. `max(M, 0)` is
+/// `f32x4_pmax`, one instruction (the IEEE `f32x4_max` needs a NaN fix-up on x86-64; `M` has
+/// no NaN).
+#[cfg(all(target_arch = "wasm32", target_feature = "simd128"))]
+#[inline(always)]
+fn pair_sums<const FUSED: bool>(
+    rows: [&[f32]; 2],
+    x: &[f32],
+    [x0, x1]: [f32; 2],
+    col_a: &mut [f32],
+    col_c: &mut [f32],
+) -> [f64; 4] {
+    use super::wasm_simd::madd_f32x4 as madd4;
+    use core::arch::wasm32::{
+        f32x4_extract_lane, f32x4_pmax, f32x4_splat, f32x4_sub, v128, v128_load, v128_store,
+    };
+    const LANES: usize = 4;
+    // SAFETY (all loads and stores below): each pointer is the start of a `chunks_exact(4)`
+    // chunk of `f32`, so 16 valid bytes; `v128_load`/`v128_store` need no alignment.
+    let load = |s: &[f32]| unsafe { v128_load(s.as_ptr().cast::<v128>()) };
+    let lanes = |v: v128| {
+        f64::from(f32x4_extract_lane::<0>(v))
+            + f64::from(f32x4_extract_lane::<1>(v))
+            + (f64::from(f32x4_extract_lane::<2>(v)) + f64::from(f32x4_extract_lane::<3>(v)))
+    };
+    let zero = f32x4_splat(0.0);
+    let (x0, x1) = (f32x4_splat(x0), f32x4_splat(x1));
+    let mut total = [0.0f64; 4];
+    let len = x.len();
+    for b in (0..len).step_by(WASM_ROW_BLOCK) {
+        let e = (b + WASM_ROW_BLOCK).min(len);
+        let (mut a0, mut c0, mut a1, mut c1) = (zero, zero, zero, zero);
+        let steps = rows[0][b..e]
+            .chunks_exact(LANES)
+            .zip(rows[1][b..e].chunks_exact(LANES))
+            .zip(x[b..e].chunks_exact(LANES))
+            .zip(col_a[b..e].chunks_exact_mut(LANES))
+            .zip(col_c[b..e].chunks_exact_mut(LANES));
+        for ((((m0, m1), xv), ca), cc) in steps {
+            let (m0, m1, xv) = (load(m0), load(m1), load(xv));
+            let (p0, p1) = (f32x4_pmax(zero, m0), f32x4_pmax(zero, m1));
+            let (q0, q1) = (f32x4_sub(p0, m0), f32x4_sub(p1, m1));
+            a0 = madd4(p0, xv, a0);
+            c0 = madd4(q0, xv, c0);
+            a1 = madd4(p1, xv, a1);
+            c1 = madd4(q1, xv, c1);
+            let ca_v = madd4(p1, x1, madd4(p0, x0, load(ca)));
+            let cc_v = madd4(q1, x1, madd4(q0, x0, load(cc)));
+            // SAFETY: as for the loads.
+            unsafe {
+                v128_store(ca.as_mut_ptr().cast::<v128>(), ca_v);
+                v128_store(cc.as_mut_ptr().cast::<v128>(), cc_v);
+            }
+        }
+        for (t, acc) in total.iter_mut().zip([a0, c0, a1, c1]) {
+            *t += lanes(acc);
+        }
+    }
+    total
 }

@@ -17,6 +17,8 @@ mod kernel;
 mod nnls;
 mod qadp;
 mod sweep;
+#[cfg(all(target_arch = "wasm32", target_feature = "simd128"))]
+mod wasm_simd;
 
 use thiserror::Error;
 
