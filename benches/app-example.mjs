@@ -5,7 +5,8 @@
 //
 //   npm run build && cargo build --release && node benches/app-example.mjs
 //
-// Needs www/pkg (npm run build), target/release/wslap and /usr/bin/chromium (or CHROMIUM).
+// Needs www/pkg (npm run build), target/release/wslap (under CARGO_TARGET_DIR if set) and
+// /usr/bin/chromium (or CHROMIUM). `SIMD=baseline` measures the baseline-SIMD core.
 import { execFileSync } from 'node:child_process';
 import { mkdtempSync, readFileSync, statSync, writeFileSync } from 'node:fs';
 import { tmpdir } from 'node:os';
@@ -28,15 +29,17 @@ for (const [path, value] of Object.entries(example.settings)) {
 }
 const file = (role) => join(ROOT, 'www/examples', example.files.find((f) => f.role === role).path);
 
-const app = await openApp();
+const app = await openApp({ query: process.env.SIMD ? `?simd=${process.env.SIMD}` : '' });
 let worker;
 let paint;
 let workerStages;
+let core;
 try {
   const { page } = app;
   await waitStatus(page, /^Ready/);
   paint = await page.evaluate(() =>
     performance.getEntriesByName('first-contentful-paint')[0]?.startTime);
+  core = await page.textContent('#core-info');
   await page.click('#reconstruct');
   await waitStatus(page, /^Done in/, 600_000);
   const status = await page.textContent('#status');
@@ -53,7 +56,7 @@ const dir = mkdtempSync(join(tmpdir(), 'wslap-bench-'));
 const cfg = join(dir, 'config.json');
 writeFileSync(cfg, JSON.stringify(config));
 const t0 = process.hrtime.bigint();
-execFileSync(join(ROOT, 'target/release/wslap'), [
+execFileSync(join(process.env.CARGO_TARGET_DIR ?? join(ROOT, 'target'), 'release/wslap'), [
   'reconstruct', '--arcs', file('arcs'), '--members', file('members'),
   '--z-lens', String(example.z_lens), '--config', cfg, '--out', join(dir, 'out'),
 ], { stdio: 'ignore' });
@@ -61,10 +64,12 @@ const native = Number(process.hrtime.bigint() - t0) / 1e9;
 const nativeStages = JSON.parse(readFileSync(join(dir, 'out', 'summary.json'), 'utf8')).timings_ms;
 const stages = (t) => Object.entries(t).map(([k, v]) => `${k} ${(v / 1e3).toFixed(2)}`).join(', ');
 const wasm = statSync(join(ROOT, 'www/pkg/wslap_bg.wasm')).size;
+const wasmRelaxed = statSync(join(ROOT, 'www/pkg/wslap_relaxed_bg.wasm')).size;
 
 console.log(`example: ${example.id}, settings ${JSON.stringify(config)}`);
+console.log(core);
 console.log(`browser worker: ${worker.toFixed(1)} s (stages in s: ${stages(workerStages)})`);
 console.log(`native, one thread: ${native.toFixed(1)} s wall (stages in s: ${stages(nativeStages)})`);
 console.log(`ratio: ${(worker / native).toFixed(2)}x`);
 console.log(`first contentful paint: ${paint?.toFixed(0)} ms`);
-console.log(`wasm bundle: ${(wasm / 1e6).toFixed(2)} MB`);
+console.log(`wasm bundle: ${(wasm / 1e6).toFixed(2)} MB (baseline SIMD), ${(wasmRelaxed / 1e6).toFixed(2)} MB (relaxed SIMD); a browser loads one`);

@@ -2,6 +2,9 @@
 // back to their callers, and cancels by terminating the worker and starting a fresh one.
 
 const WORKER_URL = new URL('./worker.js', import.meta.url);
+// `?simd=baseline` on the page makes the worker use the baseline-SIMD core (see worker.js).
+const simdChoice = new URLSearchParams(globalThis.location?.search ?? '').get('simd');
+if (simdChoice) WORKER_URL.searchParams.set('simd', simdChoice);
 
 export class LensClient {
   constructor({ onReady, onCrash } = {}) {

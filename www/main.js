@@ -242,8 +242,10 @@ async function start() {
   }
   $('example-select').innerHTML = examples.map((e, k) => `<option value="${k}">${e.name}</option>`).join('');
   $('example-select').addEventListener('change', () => loadExample(examples[$('example-select').value]));
-  const version = (await client.ready).version;
+  const { version, simd } = await client.ready;
   setStatus(`Worker ready (wslap ${version}).`);
+  $('core-info').textContent = `Core: wslap ${version}, WebAssembly with ${
+    simd === 'relaxed' ? 'relaxed SIMD (fused multiply-add)' : 'SIMD'}.`;
   const saved = await loadProject();
   if (saved) {
     try {

@@ -3,6 +3,33 @@
 
 import init, * as core from './pkg/wslap.js';
 
+// The core is built twice (.ci/lib.sh): for relaxed SIMD (fused multiply-add in the solver's
+// kernels, faster) and for baseline SIMD. This 36-byte module, one function using the
+// relaxed-SIMD instruction i8x16.relaxed_swizzle, validates only where the browser has relaxed
+// SIMD. `?simd=baseline` on the page (passed on by lens-client.js) forces the baseline module.
+const RELAXED_SIMD_PROBE = new Uint8Array([
+  0, 97, 115, 109, 1, 0, 0, 0, 1, 5, 1, 96, 0, 1, 123, 3, 2, 1, 0, 10, 15, 1, 13, 0, 65, 1, 253,
+  15, 65, 2, 253, 15, 253, 128, 2, 11,
+]);
+const CORE = {
+  relaxed: new URL('./pkg/wslap_relaxed_bg.wasm', import.meta.url),
+  baseline: new URL('./pkg/wslap_bg.wasm', import.meta.url),
+};
+
+// Loads the relaxed-SIMD core where it can run, else (or if it fails to load) the baseline one;
+// returns which.
+async function loadCore() {
+  const forced = new URLSearchParams(self.location.search).get('simd');
+  if (forced !== 'baseline' && WebAssembly.validate(RELAXED_SIMD_PROBE)) {
+    try {
+      await init({ module_or_path: CORE.relaxed });
+      return 'relaxed';
+    } catch { /* e.g. a build without the second module: use the baseline one */ }
+  }
+  await init({ module_or_path: CORE.baseline });
+  return 'baseline';
+}
+
 let session = null;
 
 const handlers = {
@@ -33,9 +60,11 @@ function transferables(result) {
   return [];
 }
 
+let simd = null;
+
 async function start() {
   try {
-    await init();
+    simd = await loadCore();
     session = new core.AppSession();
   } catch (err) {
     postMessage({ type: 'fatal', message: String(err?.message ?? err) });
@@ -53,7 +82,7 @@ async function start() {
       postMessage({ id: msg.id, type: 'error', message: String(err?.message ?? err) });
     }
   };
-  postMessage({ type: 'ready', version: core.version() });
+  postMessage({ type: 'ready', version: core.version(), simd });
 }
 
 start();

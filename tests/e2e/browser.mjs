@@ -14,8 +14,9 @@ const CHROMIUM_FLAGS = [
   '--disable-component-update', '--disable-sync', '--no-first-run', '--disable-quic',
 ];
 
-/** Starts the server and the browser; returns { page, url, consoleErrors, close }. */
-export async function openApp({ width = 1280, height = 900 } = {}) {
+/** Starts the server and the browser and opens the page (with `query`, e.g. '?simd=baseline');
+ * returns { page, url, consoleErrors, close }. */
+export async function openApp({ width = 1280, height = 900, query = '' } = {}) {
   await mkdir(ARTIFACTS, { recursive: true });
   const server = await serve(join(ROOT, 'www'), 0, '127.0.0.1');
   const url = `http://127.0.0.1:${server.address().port}/`;
@@ -30,7 +31,7 @@ export async function openApp({ width = 1280, height = 900 } = {}) {
   // Nothing may leave the page's origin.
   const foreignRequests = [];
   page.on('request', (r) => { if (!r.url().startsWith(url) && !r.url().startsWith('data:') && !r.url().startsWith('blob:')) foreignRequests.push(r.url()); });
-  await page.goto(url);
+  await page.goto(url + query);
   return {
     page, url, consoleErrors, foreignRequests,
     async close() {
