@@ -258,3 +258,9 @@ async function start() {
 }
 
 start().catch((err) => showError(err.message));
+
+// Offline use once loaded (sw.js). Without it (an old browser, a file:// page) the app still
+// works online.
+if ('serviceWorker' in navigator) {
+  navigator.serviceWorker.register('sw.js').catch(() => {});
+}

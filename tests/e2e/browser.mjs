@@ -34,6 +34,11 @@ export async function openApp({ width = 1280, height = 900, query = '' } = {}) {
   await page.goto(url + query);
   return {
     page, url, consoleErrors, foreignRequests,
+    /** Stops the web server, as if the network had gone (the browser stays open). */
+    async stopServer() {
+      server.closeAllConnections();
+      await new Promise((r) => server.close(r));
+    },
     async close() {
       await browser.close();
       await new Promise((r) => server.close(r));

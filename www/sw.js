@@ -1,0 +1,54 @@
+// Service worker: keeps the app working offline once it has been loaded.
+//
+// Every same-origin GET goes to the network first, so a rebuilt app is used at once, and its
+// answer is kept in the cache; when the network fails, the cached answer is served. At install
+// the app's own files, both builds of the core (the worker picks one per browser) and the
+// built-in examples are cached, so one visit is enough to work offline afterwards.
+
+const CACHE = 'wslap-app';
+const APP_FILES = [
+  './',
+  'index.html',
+  'style.css',
+  'main.js',
+  'lens-client.js',
+  'worker.js',
+  'js/downloads.js',
+  'js/files.js',
+  'js/settings.js',
+  'js/store.js',
+  'js/views.js',
+  'pkg/wslap.js',
+  'pkg/wslap_bg.wasm',
+  'pkg/wslap_relaxed_bg.wasm',
+  'examples/index.json',
+];
+
+self.addEventListener('install', (event) => {
+  event.waitUntil((async () => {
+    const cache = await caches.open(CACHE);
+    await cache.addAll(APP_FILES);
+    const { examples } = await (await fetch('examples/index.json')).json();
+    await cache.addAll(examples.flatMap((e) => e.files.map((f) => `examples/${f.path}`)));
+    await self.skipWaiting();
+  })());
+});
+
+self.addEventListener('activate', (event) => event.waitUntil(self.clients.claim()));
+
+self.addEventListener('fetch', (event) => {
+  const { request } = event;
+  if (request.method !== 'GET' || new URL(request.url).origin !== self.location.origin) return;
+  event.respondWith((async () => {
+    try {
+      const response = await fetch(request);
+      if (response.ok) await (await caches.open(CACHE)).put(request, response.clone());
+      return response;
+    } catch (err) {
+      // `?simd=baseline` and the like: the same file.
+      const cached = await caches.match(request, { ignoreSearch: true });
+      if (cached) return cached;
+      throw err;
+    }
+  })());
+});
