@@ -47,6 +47,10 @@ async function refreshLoaded() {
 function describe(name, text) {
   $('project-name').textContent = name;
   $('project-description').textContent = text;
+  // The menu shows the example that is open, or its blank entry for anything else, so that
+  // choosing any example (also the first) is a change that loads it.
+  const k = examples.findIndex((e) => e.name === name);
+  $('example-select').value = k >= 0 ? String(k) : '';
 }
 
 async function render() {
@@ -240,7 +244,8 @@ async function start() {
   } catch (err) {
     showError(`could not read the examples: ${err.message}`);
   }
-  $('example-select').innerHTML = examples.map((e, k) => `<option value="${k}">${e.name}</option>`).join('');
+  $('example-select').innerHTML = '<option value="" disabled>(your data)</option>'
+    + examples.map((e, k) => `<option value="${k}">${e.name}</option>`).join('');
   $('example-select').addEventListener('change', () => loadExample(examples[$('example-select').value]));
   const { version, simd } = await client.ready;
   setStatus(`Worker ready (wslap ${version}).`);

@@ -48,6 +48,9 @@ test('after one visit the app reloads and reconstructs with the server gone', as
     await page.reload();
     await waitStatus(page, /^Restored your project/);
     assert.match(await page.textContent('#project-name'), /Teaching/);
+    // The example menu shows the restored example, not the first one.
+    assert.equal(await page.$eval('#example-select', (s) => s.selectedOptions[0]?.textContent),
+      'Teaching example: one halo, four sources');
     assert.match(await page.textContent('#core-info'), /^Core: wslap/);
     await page.click('#reconstruct');
     await waitStatus(page, /^Done in/);
