@@ -28,7 +28,8 @@ self.addEventListener('install', (event) => {
   event.waitUntil((async () => {
     const cache = await caches.open(CACHE);
     await cache.addAll(APP_FILES);
-    const { examples } = await (await fetch('examples/index.json')).json();
+    // The example list was just cached with the app's files: read it from there.
+    const { examples } = await (await cache.match('examples/index.json')).json();
     await cache.addAll(examples.flatMap((e) => e.files.map((f) => `examples/${f.path}`)));
     await self.skipWaiting();
   })());

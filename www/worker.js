@@ -60,9 +60,8 @@ function transferables(result) {
   return [];
 }
 
-let simd = null;
-
 async function start() {
+  let simd;
   try {
     simd = await loadCore();
     session = new core.AppSession();
