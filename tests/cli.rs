@@ -460,38 +460,20 @@ fn config_errors_say_file_line_and_column_once() {
     let dir = temp_dir("config-once");
     let images = shared("AS1063/lenstool_cats/cats_gold_mul_gold.cat");
     let config = dir.join("config.json");
-    fs::write(&config, "{\n  \"grid\": {\"cells\": 12,}\n}").unwrap();
-    let err = refused(
-        &dir,
-        "reconstruct",
-        &[
-            "--images",
-            &images,
-            "--z-lens",
-            "0.348",
-            "--config",
-            config.to_str().unwrap(),
-        ],
-    );
+    let with_config = |text: &str| {
+        fs::write(&config, text).unwrap();
+        let path = config.to_str().unwrap();
+        let args = ["--images", &images, "--z-lens", "0.348", "--config", path];
+        refused(&dir, "reconstruct", &args)
+    };
+    let err = with_config("{\n  \"grid\": {\"cells\": 12,}\n}");
     let expected = format!(
         "error: {}: line 2, column 24: trailing comma\n",
         config.display()
     );
     assert_eq!(err, expected);
     // A number beyond f64 (JSON has no NaN or inf).
-    fs::write(&config, "{\"products\": {\"z_source\": 1e999}}").unwrap();
-    let err = refused(
-        &dir,
-        "reconstruct",
-        &[
-            "--images",
-            &images,
-            "--z-lens",
-            "0.348",
-            "--config",
-            config.to_str().unwrap(),
-        ],
-    );
+    let err = with_config("{\"products\": {\"z_source\": 1e999}}");
     assert!(
         err.contains("config.json: line 1, column 31: number out of range"),
         "{err}"
@@ -615,29 +597,19 @@ fn catalogue_units_nan_and_empty_systems_name_file_and_line() {
     );
     // An arcs file with an empty image, and one with a system in front of the lens.
     let arcs = dir.join("arcs.json");
-    fs::write(
-        &arcs,
-        "{\"systems\": [\n {\"id\": \"a\", \"z\": 2, \"images\": [[[1, 2]], []]}]}",
-    )
-    .unwrap();
-    let err = refused(
-        &dir,
-        "reconstruct",
-        &["--arcs", arcs.to_str().unwrap(), "--z-lens", "0.3"],
-    );
+    let with_arcs = |text: &str| {
+        fs::write(&arcs, text).unwrap();
+        let args = ["--arcs", arcs.to_str().unwrap(), "--z-lens", "0.3"];
+        refused(&dir, "reconstruct", &args)
+    };
+    let err =
+        with_arcs("{\"systems\": [\n {\"id\": \"a\", \"z\": 2, \"images\": [[[1, 2]], []]}]}");
     assert!(
         err.contains("arcs.json: line 2: system a: no pixels in image 1"),
         "{err}"
     );
-    fs::write(
-        &arcs,
+    let err = with_arcs(
         "{\"systems\": [\n {\"id\": \"a\", \"z\": 0.2, \"images\": [[[1, 2]], [[-1, -2]]]}]}",
-    )
-    .unwrap();
-    let err = refused(
-        &dir,
-        "reconstruct",
-        &["--arcs", arcs.to_str().unwrap(), "--z-lens", "0.3"],
     );
     assert!(
         err.contains("arcs.json: system a: z_s = 0.2 is not behind the lens (z_lens = 0.3)"),
