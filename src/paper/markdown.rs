@@ -29,10 +29,7 @@ pub fn markdown(report: &PaperReport) -> String {
                 "| {key} | {:.3e} | {:.3e} | {} | {:.2} | {:.2} | {:.3} | {:.1} | {} | {:.1} | {} |",
                 c.grid_mass_msun,
                 c.grid_mass_region_msun,
-                c.c.iter()
-                    .map(|v| format!("{v:.3}"))
-                    .collect::<Vec<_>>()
-                    .join(", "),
+                c_list(&c.c),
                 c.deflection_error_median_arcsec,
                 c.deflection_error_p90_arcsec,
                 c.profile_max_rel_error,
@@ -132,10 +129,7 @@ fn studies_markdown(s: &mut String, studies: &Studies, t: &TruthReport) {
                 r.value,
                 if r.is_default { "yes" } else { "" },
                 if r.best { "yes" } else { "" },
-                r.c.iter()
-                    .map(|v| format!("{v:.3}"))
-                    .collect::<Vec<_>>()
-                    .join(", "),
+                c_list(&r.c),
                 r.deflection_error_median_arcsec,
                 r.deflection_error_p90_arcsec,
                 r.profile_max_rel_error,
@@ -143,4 +137,10 @@ fn studies_markdown(s: &mut String, studies: &Studies, t: &TruthReport) {
             );
         }
     }
+}
+
+/// Factors C, `"1.234, 0.567"` (also in the checks of `report.rs`).
+pub(super) fn c_list(c: &[f64]) -> String {
+    let each: Vec<String> = c.iter().map(|v| format!("{v:.3}")).collect();
+    each.join(", ")
 }

@@ -478,10 +478,7 @@ fn checks(
             format!(
                 "C from the {} starts: {}",
                 cs.len(),
-                cs.iter()
-                    .map(|c| format!("{c:.3}"))
-                    .collect::<Vec<_>>()
-                    .join(", ")
+                super::markdown::c_list(&cs)
             ),
         );
     }
