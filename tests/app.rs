@@ -395,8 +395,8 @@ fn arc_pixels_are_drawn_in_system_colours_and_the_legend_leaves_the_map_free() {
         .unwrap();
     s.run(RunKind::Forward, &mut |_| Control::Continue).unwrap();
     let r = s.result().unwrap();
-    assert_eq!(r.arcs.len(), 2);
-    assert_eq!(r.arc_pixel_mas, 500);
+    assert_eq!(r.marks.arcs.len(), 2);
+    assert_eq!(r.marks.arc_pixel_mas, 500);
     let below = ViewOptions::default();
     let bare = ViewOptions {
         show_observed: false,

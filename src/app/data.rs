@@ -96,6 +96,38 @@ pub struct ArcPixels {
     pub pixels_arcsec: Vec<DVec2>,
 }
 
+/// What the views draw of the loaded data (arcsec): catalogue images, the arc pixels of each
+/// system with their pixel side, and members.
+#[derive(Debug, Clone, PartialEq)]
+pub struct DataMarks {
+    /// Catalogue image positions (no arc pixels).
+    pub observed: Vec<DVec2>,
+    pub arcs: Vec<ArcPixels>,
+    /// Side of one arc pixel (milliarcsec), see [`ParsedData::arc_pixel_mas`].
+    pub arc_pixel_mas: u32,
+    pub members: Vec<DVec2>,
+}
+
+impl Default for DataMarks {
+    /// Nothing to draw.
+    fn default() -> Self {
+        Self {
+            observed: Vec::new(),
+            arcs: Vec::new(),
+            arc_pixel_mas: DEFAULT_ARC_PIXEL_MAS,
+            members: Vec::new(),
+        }
+    }
+}
+
+impl DataMarks {
+    /// The colour of system `id`'s arc pixels (`None` when it has none: catalogue systems).
+    pub fn system_rgb(&self, id: &str) -> Option<[u8; 3]> {
+        let k = self.arcs.iter().position(|a| a.id == id)?;
+        Some(super::views::system_rgb(k))
+    }
+}
+
 /// The warning for a FITS file of `len` bytes that the project file does not keep.
 fn too_large_to_keep(name: &str, len: usize) -> String {
     const MIB: f64 = 1024.0 * 1024.0;
@@ -133,10 +165,15 @@ impl ParsedData {
             .collect()
     }
 
-    /// Catalogue image positions only (no arc pixels), arcsec.
-    pub fn catalog_arcsec(&self) -> Vec<DVec2> {
-        let c = self.images.iter().flat_map(|c| c.images());
-        c.map(|i| i.position).collect()
+    /// What the views draw of this data.
+    pub fn marks(&self) -> DataMarks {
+        let catalog = self.images.iter().flat_map(|c| c.images());
+        DataMarks {
+            observed: catalog.map(|i| i.position).collect(),
+            arcs: self.arc_systems(),
+            arc_pixel_mas: self.arc_pixel_mas(),
+            members: self.members_arcsec(),
+        }
     }
 
     /// The arc pixels of each system (all its images together), in file order.

@@ -18,7 +18,8 @@ use thiserror::Error;
 
 pub use crate::reconstruct::ReconstructSummary;
 pub use data::{
-    ArcPixels, DataRole, LoadReport, LoadedData, NamedMap, NamedText, MAX_STORED_FITS_BYTES,
+    ArcPixels, DataMarks, DataRole, LoadReport, LoadedData, NamedMap, NamedText,
+    MAX_STORED_FITS_BYTES,
 };
 pub use project::{Project, ProjectResult, StoredFits, PROJECT_FORMAT, PROJECT_VERSION};
 pub use run::{RunKind, SessionResult};

@@ -18,7 +18,7 @@ use crate::reconstruct::{
 };
 use crate::solver::Control;
 
-use super::data::{ArcPixels, ParsedData, DEFAULT_ARC_PIXEL_MAS};
+use super::data::{DataMarks, ParsedData};
 use super::{AppError, Session};
 
 /// Map width of a forward model without a `products.size_arcsec` setting (arcsec).
@@ -58,12 +58,8 @@ pub struct ReconstructionResult {
 pub struct SessionResult {
     pub kind: RunKind,
     pub products: Products,
-    /// Catalogue images (arcsec), arc pixels per system and members (arcsec) of the data.
-    pub observed: Vec<DVec2>,
-    pub arcs: Vec<ArcPixels>,
-    /// Side of one arc pixel (milliarcsec), see [`ParsedData::arc_pixel_mas`].
-    pub arc_pixel_mas: u32,
-    pub members: Vec<DVec2>,
+    /// What the views draw of the data the result was made from.
+    pub marks: DataMarks,
     pub reconstruction: Option<ReconstructionResult>,
     /// Wall-clock time of the run in ms.
     pub elapsed_ms: f64,
@@ -159,10 +155,7 @@ impl Session {
         Ok(SessionResult {
             kind: RunKind::Reconstruct,
             products: r.products,
-            observed: parsed.catalog_arcsec(),
-            arcs: parsed.arc_systems(),
-            arc_pixel_mas: parsed.arc_pixel_mas(),
-            members: parsed.members_arcsec(),
+            marks: parsed.marks(),
             reconstruction: Some(ReconstructionResult {
                 config: r.config,
                 system: r.system,
@@ -229,10 +222,7 @@ impl Session {
         self.result = Some(SessionResult {
             kind: RunKind::Reconstruct,
             products,
-            observed: parsed.catalog_arcsec(),
-            arcs: parsed.arc_systems(),
-            arc_pixel_mas: parsed.arc_pixel_mas(),
-            members: parsed.members_arcsec(),
+            marks: parsed.marks(),
             reconstruction: Some(ReconstructionResult {
                 config,
                 system,
@@ -271,10 +261,7 @@ impl Session {
         Ok(SessionResult {
             kind: RunKind::Forward,
             products,
-            observed: parsed.catalog_arcsec(),
-            arcs: parsed.arc_systems(),
-            arc_pixel_mas: parsed.arc_pixel_mas(),
-            members: parsed.members_arcsec(),
+            marks: parsed.marks(),
             reconstruction: None,
             elapsed_ms: 0.0,
         })
@@ -298,10 +285,7 @@ impl Session {
         Ok(SessionResult {
             kind: RunKind::Lookup,
             products,
-            observed: Vec::new(),
-            arcs: Vec::new(),
-            arc_pixel_mas: DEFAULT_ARC_PIXEL_MAS,
-            members: Vec::new(),
+            marks: DataMarks::default(),
             reconstruction: None,
             elapsed_ms: 0.0,
         })

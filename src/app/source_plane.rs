@@ -9,7 +9,7 @@ use crate::render::OverlayPoints;
 use crate::render::{render_kappa_png, ColorScale, Colormap, KappaPlotOptions, Marker, Overlay};
 use crate::CriticalCurves;
 
-use super::views::{arc_overlays, system_rgb, ViewOptions, ViewPng, MEMBER_RGB, OBSERVED_RGB};
+use super::views::{arc_overlays, ViewOptions, ViewPng, MEMBER_RGB, OBSERVED_RGB};
 use super::{AppError, Session};
 
 /// Source-plane pixels a side.
@@ -104,10 +104,9 @@ impl Session {
         let sources = r.reconstruction.iter().flat_map(|x| x.sources.iter());
         let betas: Vec<DVec2> = sources.clone().map(|s| s.beta_arcsec).collect();
         // With arcs, each system's images mapped back in its colour (as its arc pixels).
-        let colour = |id: &str| r.arcs.iter().position(|a| a.id == id).map(system_rgb);
         let mut back: Vec<OverlayPoints> = Vec::new();
         for s in sources {
-            let rgb = colour(&s.id).unwrap_or(OBSERVED_RGB);
+            let rgb = r.marks.system_rgb(&s.id).unwrap_or(OBSERVED_RGB);
             let label = if back.is_empty() {
                 "images mapped back"
             } else {
@@ -158,10 +157,8 @@ impl Session {
     pub fn data_view(&self, opts: &ViewOptions) -> Result<ViewPng, AppError> {
         let parsed = self.data.parse()?;
         let observed = parsed.observed_arcsec();
-        let members = parsed.members_arcsec();
-        let catalog = parsed.catalog_arcsec();
-        let arcs = arc_overlays(&parsed.arc_systems(), parsed.arc_pixel_mas());
-        if observed.is_empty() && members.is_empty() {
+        let marks = parsed.marks();
+        if observed.is_empty() && marks.members.is_empty() {
             return Err(AppError::Missing("no catalogue is loaded".to_string()));
         }
         let g = square_around(observed.iter().copied(), 60.0, 64);
@@ -175,11 +172,16 @@ impl Session {
         };
         let overlay = Overlay {
             curves: None,
-            points: arcs
+            points: arc_overlays(&marks.arcs, marks.arc_pixel_mas)
                 .into_iter()
                 .chain([
-                    set("members", MEMBER_RGB, Marker::Circle, members),
-                    set("observed images", OBSERVED_RGB, Marker::Plus, catalog),
+                    set("members", MEMBER_RGB, Marker::Circle, marks.members),
+                    set(
+                        "observed images",
+                        OBSERVED_RGB,
+                        Marker::Plus,
+                        marks.observed,
+                    ),
                 ])
                 .collect(),
         };

@@ -138,16 +138,16 @@ impl Session {
         if opts.show_observed {
             overlay
                 .points
-                .extend(arc_overlays(&r.arcs, r.arc_pixel_mas));
+                .extend(arc_overlays(&r.marks.arcs, r.marks.arc_pixel_mas));
         }
         if opts.show_members {
-            let m = r.members.clone();
+            let m = r.marks.members.clone();
             overlay
                 .points
                 .push(points("members", MEMBER_RGB, Marker::Circle, m));
         }
         if opts.show_observed {
-            let o = r.observed.clone();
+            let o = r.marks.observed.clone();
             overlay
                 .points
                 .push(points("observed", OBSERVED_RGB, Marker::Plus, o));

@@ -168,10 +168,10 @@ impl AppSession {
         let mut rows = serde_json::to_value(&x.sources).map_err(err)?;
         for row in rows.as_array_mut().into_iter().flatten() {
             let id = row.get("id").and_then(|v| v.as_str()).unwrap_or_default();
-            let rgb = r.arcs.iter().position(|a| a.id == id).map(|k| {
-                let [red, green, blue] = crate::app::system_rgb(k);
-                format!("rgb({red}, {green}, {blue})")
-            });
+            let rgb = r
+                .marks
+                .system_rgb(id)
+                .map(|[red, green, blue]| format!("rgb({red}, {green}, {blue})"));
             if let Some(obj) = row.as_object_mut() {
                 obj.insert("rgb".to_string(), rgb.into());
             }
