@@ -35,7 +35,6 @@ pub use markdown::markdown as report_markdown;
 pub use report::{CaseReport, Check, ConvergenceReport, PaperReport, RunSeries, TruthReport};
 pub use studies::{StartRun, Studies, SweepRow};
 
-use crate::catalog::MemberCatalog;
 use crate::inversion::{ConstraintMode, ConstraintSource, Layer, Weighting};
 use crate::maps::LensMaps;
 use crate::model::ModelError;
@@ -319,7 +318,7 @@ pub fn run_paper(config: &PaperConfig, say: &mut dyn FnMut(&str)) -> Result<Pape
             Case::GalaxyTrue => std::slice::from_ref(&layer_true),
         };
         let rc = config.reconstruct_config(field, config.iterations);
-        let rec = run_one(&simulation, LayerInput::Given(layers), &rc, case.key())?;
+        let rec = run_one(&simulation, given(layers), &rc, case.key())?;
         let scored = scorer.score(&rec, case.key())?;
         let report = &scored.report;
         say(&format!(
@@ -384,7 +383,7 @@ pub fn run_paper(config: &PaperConfig, say: &mut dyn FnMut(&str)) -> Result<Pape
         // Only the convergence records are used: coarse product maps save time.
         rc.products.pixels = 64;
         let t = Clock::start();
-        let rec = run_one(&simulation, LayerInput::Given(layers), &rc, name)?;
+        let rec = run_one(&simulation, given(layers), &rc, name)?;
         let run = RunSeries::from_records(&rec, &truth_betas);
         say(&format!(
             "convergence, {name}: {} iterations, final grid mass {:.3e} Msun, C {:?} ({:.1} s)",
@@ -420,28 +419,24 @@ pub fn run_paper(config: &PaperConfig, say: &mut dyn FnMut(&str)) -> Result<Pape
     })
 }
 
-/// The galaxy layers of one run: given (the simulation's) or built from a member catalogue
-/// with `config.members`.
-#[derive(Clone, Copy)]
-enum LayerInput<'a> {
-    Given(&'a [Layer]),
-    Members(&'a MemberCatalog),
+/// Given galaxy layers as a run's layer source: none at all is the grid alone.
+fn given(layers: &[Layer]) -> LayerSource<'_> {
+    match layers {
+        [] => LayerSource::None,
+        layers => LayerSource::Given(layers),
+    }
 }
 
 /// One reconstruction of the simulated arcs with the given galaxy layers.
 fn run_one(
     simulation: &Simulation,
-    layers: LayerInput<'_>,
+    layers: LayerSource<'_>,
     config: &ReconstructConfig,
     name: &'static str,
 ) -> Result<Reconstruction, PaperError> {
     let inputs = Inputs {
         images: ConstraintSource::Arcs(&simulation.arcs),
-        layers: match layers {
-            LayerInput::Given([]) => LayerSource::None,
-            LayerInput::Given(layers) => LayerSource::Given(layers),
-            LayerInput::Members(catalog) => LayerSource::Members(catalog),
-        },
+        layers,
         plane: simulation.plane,
         reference: None,
         holdout: &[],

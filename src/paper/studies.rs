@@ -10,9 +10,10 @@
 
 use serde::{Deserialize, Serialize};
 
-use super::{run_one, CaseRun, LayerInput, PaperConfig, PaperError, Scorer};
+use super::{run_one, CaseRun, PaperConfig, PaperError, Scorer};
 use crate::catalog::parse_member_catalog;
 use crate::inversion::{Layer, MemberConfig, Weighting};
+use crate::reconstruct::LayerSource;
 use crate::simulate::Simulation;
 
 /// One run of the start study.
@@ -124,7 +125,7 @@ pub(super) fn run_studies(
             rc.solver.start_c = c0;
             owned = run_one(
                 simulation,
-                LayerInput::Given(std::slice::from_ref(layer_true)),
+                LayerSource::Given(std::slice::from_ref(layer_true)),
                 &rc,
                 "start study",
             )?;
@@ -187,7 +188,7 @@ pub(super) fn run_studies(
         });
         Ok::<(), PaperError>(())
     };
-    let model = LayerInput::Given(std::slice::from_ref(layer_model));
+    let model = LayerSource::Given(std::slice::from_ref(layer_model));
     for factor in CELL_SIGMA_FACTORS {
         let mut rc = defaults.clone();
         rc.grid.cell_sigma_factor = factor;
@@ -235,7 +236,7 @@ pub(super) fn run_studies(
             label.to_string(),
             is_default,
             Some(rc),
-            LayerInput::Members(&catalog),
+            LayerSource::Members(&catalog),
         )?;
     }
     mark_best(&mut sweep);
