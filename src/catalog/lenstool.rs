@@ -69,11 +69,7 @@ pub fn parse_image_catalog(
         }
         seen.insert(id, row.line);
         let shape = f.shape(table.coords)?;
-        positions.push(RowPosition {
-            line: row.line,
-            raw: shape.raw,
-            text: [row.fields[1], row.fields[2]],
-        });
+        positions.push(RowPosition::of(row, shape.raw));
         let z = f.redshift(6)?;
         let mag = f.optional(7)?;
         let image = Image {
@@ -139,11 +135,7 @@ pub fn parse_member_catalog(
         }
         seen.insert(id, row.line);
         let shape = f.shape(table.coords)?;
-        positions.push(RowPosition {
-            line: row.line,
-            raw: shape.raw,
-            text: [row.fields[1], row.fields[2]],
-        });
+        positions.push(RowPosition::of(row, shape.raw));
         members.push(Member {
             id: id.into(),
             position: shape.raw,

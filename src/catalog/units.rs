@@ -11,6 +11,7 @@
 use glam::DVec2;
 
 use super::frame::{mean_position, Coords};
+use super::rows::Row;
 use super::{CatalogError, CatalogWarning};
 use crate::sky::SkyReference;
 
@@ -28,6 +29,18 @@ pub(super) struct RowPosition<'a> {
     pub(super) line: usize,
     pub(super) raw: DVec2,
     pub(super) text: [&'a str; 2],
+}
+
+impl<'a> RowPosition<'a> {
+    /// The position of `row` (fields 1 and 2, the layout of both Lenstool catalogues), read as
+    /// `raw`.
+    pub(super) fn of(row: &Row<'a>, raw: DVec2) -> Self {
+        Self {
+            line: row.line,
+            raw,
+            text: [row.fields[1], row.fields[2]],
+        }
+    }
 }
 
 /// Checks that the positions fit one lensing field in the unit of `coords` (module docs).
