@@ -167,34 +167,28 @@ fn quiet(_: &wslap::reconstruct::ConvergenceRecord) -> Control {
     Control::Continue
 }
 
-#[cfg_attr(not(target_arch = "wasm32"), test)]
-#[cfg_attr(target_arch = "wasm32", wasm_bindgen_test::wasm_bindgen_test)]
-fn synthetic_lens_with_the_true_galaxy_layer() {
-    let truth = Truth::new();
-    let catalog = truth.catalog();
-    let n_images: usize = catalog.systems.iter().map(|s| s.images.len()).sum();
-    assert!(
-        catalog.systems.len() >= 8 && n_images >= 24,
-        "{} systems, {n_images} images",
-        catalog.systems.len()
-    );
-    let layers = [truth.galaxy_layer()];
+/// Reconstructs the synthetic lens from its arcs (16 x 16 cells, 8000 iterations) with the
+/// given layers; returns the result and the median deflection error at the observed images.
+fn reconstruct_synthetic(
+    truth: &Truth,
+    catalog: &ImageCatalog,
+    layers: &[Layer],
+) -> (wslap::reconstruct::Reconstruction, f64) {
     let mut config = ReconstructConfig::default();
     config.constraints.mode = ConstraintMode::Arcs;
-    let arcs = truth.arcs(&catalog);
+    let arcs = truth.arcs(catalog);
     config.grid.cells = 16;
     config.solver.iterations = 8000;
     config.products.pixels = 64;
     let inputs = Inputs {
         images: ConstraintSource::Arcs(&arcs),
-        layers: LayerSource::Given(&layers),
+        layers: LayerSource::Given(layers),
         plane: truth.plane,
         reference: None,
         holdout: &[],
-        catalog: Some(&catalog),
+        catalog: Some(catalog),
     };
     let r = reconstruct(&inputs, &config, &mut quiet).unwrap();
-    let c = r.layer_factors()[0];
     let true_lens = truth.lens();
     // A constant deflection is unobservable (every beta absorbs it), so compare after removing
     // the mean difference over the images.
@@ -208,11 +202,33 @@ fn synthetic_lens_with_the_true_galaxy_layer() {
     let mut errors: Vec<f64> = diffs.iter().map(|d| (*d - mean).length()).collect();
     errors.sort_by(f64::total_cmp);
     let median = errors[errors.len() / 2];
+    (r, median)
+}
+
+/// The issue asks for C within 10% of 1 here. It is not met, and this test does not claim it:
+/// these data do not pin down how the mass splits between the grid and the galaxy layer.
+/// Measured: C = 3.9 with 16 x 16 cells from the default start. With 12 x 12 cells (small
+/// enough for the exact solver), C went from 4.3 to 0.58 as the start cell mass went from 1e9
+/// to 1e12 Msun while the objective stayed within 3e-5 (relative) of the exact optimum, whose
+/// C is 0.39. The layer's normalisation is checked by
+/// `a_layer_holding_the_whole_lens_comes_back_at_c_one` instead.
+#[cfg_attr(not(target_arch = "wasm32"), test)]
+#[cfg_attr(target_arch = "wasm32", wasm_bindgen_test::wasm_bindgen_test)]
+fn synthetic_lens_with_the_true_galaxy_layer() {
+    let truth = Truth::new();
+    let catalog = truth.catalog();
+    let n_images: usize = catalog.systems.iter().map(|s| s.images.len()).sum();
+    assert!(
+        catalog.systems.len() >= 8 && n_images >= 24,
+        "{} systems, {n_images} images",
+        catalog.systems.len()
+    );
+    let (r, median) = reconstruct_synthetic(&truth, &catalog, &[truth.galaxy_layer()]);
+    let c = r.layer_factors()[0];
     let scatter: Vec<f64> = r.sources.iter().map(|s| s.scatter_arcsec).collect();
     let rms = r.image_plane_rms_arcsec(false).unwrap();
     println!(
-        "C = {c}, median deflection error {median} arcsec, worst {}, scatter {scatter:?}, image rms {rms}",
-        errors.last().unwrap()
+        "C = {c}, median deflection error {median} arcsec, scatter {scatter:?}, image rms {rms}"
     );
     assert!(c.is_finite() && c > 0.0, "C = {c}");
     assert!(
@@ -227,6 +243,23 @@ fn synthetic_lens_with_the_true_galaxy_layer() {
         rms <= IMAGE_PLANE_RMS_ARCSEC,
         "image-plane rms {rms} arcsec"
     );
+}
+
+/// When the layer is the whole true lens (halo and galaxies), nothing is left for the grid to
+/// trade against, and C must come back at 1: this checks the layer column's normalisation
+/// (`a_l` at C = 1 is the catalogue mass) end to end. Measured: C = 0.984, median deflection
+/// error 0.055 arcsec.
+#[cfg_attr(not(target_arch = "wasm32"), test)]
+#[cfg_attr(target_arch = "wasm32", wasm_bindgen_test::wasm_bindgen_test)]
+fn a_layer_holding_the_whole_lens_comes_back_at_c_one() {
+    let truth = Truth::new();
+    let catalog = truth.catalog();
+    let whole = Layer::from_components("true lens", truth.lens().components);
+    let (r, median) = reconstruct_synthetic(&truth, &catalog, &[whole]);
+    let c = r.layer_factors()[0];
+    println!("C = {c}, median deflection error {median} arcsec");
+    assert!((c - 1.0).abs() <= 0.1, "C = {c}");
+    assert!(median <= 0.2, "median deflection error {median} arcsec");
 }
 
 #[cfg(not(target_arch = "wasm32"))]
