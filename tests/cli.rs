@@ -608,11 +608,15 @@ fn catalogue_units_nan_and_empty_systems_name_file_and_line() {
         err.contains("arcs.json: line 2: system a: no pixels in image 1"),
         "{err}"
     );
-    let err = with_arcs(
-        "{\"systems\": [\n {\"id\": \"a\", \"z\": 0.2, \"images\": [[[1, 2]], [[-1, -2]]]}]}",
-    );
+    let err = with_arcs(concat!(
+        "{\"systems\": [\n",
+        " {\"id\": \"a\", \"z\": 2, \"images\": [[[1, 2]], [[-1, -2]]]},\n",
+        " {\"id\": \"b\", \"z\": 0.2, \"images\": [[[3, 2]], [[-3, -2]]]}]}"
+    ));
     assert!(
-        err.contains("arcs.json: system a: z_s = 0.2 is not behind the lens (z_lens = 0.3)"),
+        err.contains(
+            "arcs.json: line 3 (system b): z_s = 0.2 is not behind the lens (z_lens = 0.3)"
+        ),
         "{err}"
     );
 }

@@ -25,6 +25,9 @@ pub struct ArcSystem {
     pub z: Option<f64>,
     /// Pixel positions in arcsec, per image.
     pub images: Vec<Vec<DVec2>>,
+    /// Line of the file where the system's object starts (1-based; 0 when the system was
+    /// not read from a file).
+    pub line: usize,
 }
 
 /// Largest source redshift accepted (exclusive).
@@ -151,6 +154,7 @@ pub fn parse_arcs(text: &str, source_name: &str) -> Result<ArcCatalog, Constrain
                 .into_iter()
                 .map(|i| i.into_iter().map(|[x, y]| DVec2::new(x, y)).collect())
                 .collect(),
+            line,
         });
     }
     Ok(ArcCatalog {

@@ -341,7 +341,11 @@ fn check_source_redshifts(
         ConstraintSource::Arcs(arcs) => {
             for s in &arcs.systems {
                 if let Some(z) = s.z.filter(|&z| !behind(z)) {
-                    return Err(bad(&arcs.source_name, format!("system {}", s.id), z));
+                    let place = match s.line {
+                        0 => format!("system {}", s.id),
+                        line => format!("line {line} (system {})", s.id),
+                    };
+                    return Err(bad(&arcs.source_name, place, z));
                 }
             }
         }

@@ -291,6 +291,7 @@ impl Simulation {
                     .iter()
                     .map(|im| im.iter().map(|&k| grid.position(k)).collect())
                     .collect(),
+                line: 0,
             })
             .collect();
         sim.sources = placed.into_iter().map(|p| p.source).collect();

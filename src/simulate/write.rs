@@ -95,9 +95,10 @@ impl Simulation {
         out
     }
 
-    /// The arcs in the format of `parse_arcs`: one pixel list per image, arcsec.
+    /// The arcs in the format of `parse_arcs`: one pixel list per image, arcsec; one system
+    /// per line.
     pub fn arcs_json(&self) -> String {
-        let systems: Vec<serde_json::Value> = self
+        let systems: Vec<String> = self
             .arcs
             .systems
             .iter()
@@ -107,10 +108,11 @@ impl Simulation {
                     .iter()
                     .map(|im| im.iter().map(|p| [p.x, p.y]).collect())
                     .collect();
-                serde_json::json!({"id": s.id, "z": s.z, "images": images})
+                serde_json::json!({"id": s.id, "z": s.z, "images": images}).to_string()
             })
             .collect();
-        serde_json::json!({ "systems": systems }).to_string()
+        // One system per line, so that an error naming a line points at one system.
+        format!("{{\"systems\": [\n{}\n]}}\n", systems.join(",\n"))
     }
 
     /// Grey-scale PNG of the lensed image (asinh stretch; North up, East left), with a faint
