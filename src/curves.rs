@@ -28,6 +28,10 @@ pub struct CriticalCurves {
     /// `sqrt(area inside the tangential curves / pi)`, 0 when there is none.
     pub einstein_radius_arcsec: f64,
     pub tangential: Vec<Polyline>,
+    /// True when the region inside the tangential curves (`lambda_t < 0`) reaches the map
+    /// border: the Einstein radius then counts only the closed loops, so it is too small (or 0).
+    #[serde(default)]
+    pub tangential_leaves_map: bool,
     pub radial: Vec<Polyline>,
     pub caustics: Caustics,
 }
@@ -95,6 +99,14 @@ pub fn critical_curves(
         .map(|c| signed_area_arcsec2(&c.points))
         .sum::<f64>();
     let einstein_radius_arcsec = (area.max(0.0) / std::f64::consts::PI).sqrt();
+    // The region lambda_t < 0 reaches the border (also when no curve crosses the map at all
+    // because the whole map lies inside the critical curve).
+    let tangential_leaves_map = consistent
+        && (0..n).any(|a| {
+            [a, (n - 1) * n + a, a * n, a * n + n - 1]
+                .iter()
+                .any(|&i| 1.0 - f * (k[i] + shear(i)) < 0.0)
+        });
     let to_source = |curves: &[Contour]| -> Vec<Polyline> {
         curves
             .iter()
@@ -114,6 +126,7 @@ pub fn critical_curves(
     CriticalCurves {
         z_source,
         einstein_radius_arcsec,
+        tangential_leaves_map,
         tangential: points(tangential),
         radial: points(radial),
         caustics,

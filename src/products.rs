@@ -116,6 +116,11 @@ pub struct Products {
     pub maps: LensMaps,
     pub magnification: Map,
     pub curves: CriticalCurves,
+    /// Side in arcsec of the map on which `curves.einstein_radius_arcsec` was measured: the
+    /// products' own map, or a wider one (see [`EINSTEIN_MAP_WIDENING`]) when the tangential
+    /// curve leaves it. `None` when the curve left every map tried (the radius counts only the
+    /// closed loops then, so it is too small).
+    pub einstein_radius_map_arcsec: Option<f64>,
     pub profile: RadialProfile,
     pub timings: Timings,
 }
@@ -131,6 +136,9 @@ pub struct Summary {
     pub map_size_arcsec: f64,
     pub map_pixels: usize,
     pub einstein_radius_arcsec: f64,
+    /// See [`Products::einstein_radius_map_arcsec`]: `null` when the radius is a lower bound.
+    #[serde(default)]
+    pub einstein_radius_map_arcsec: Option<f64>,
     pub tangential_curves: usize,
     pub radial_curves: usize,
     pub kappa_max: f64,
@@ -138,6 +146,32 @@ pub struct Summary {
     /// leaves the map).
     pub mass_within_arcsec: Vec<(f64, Option<f64>)>,
     pub timings_ms: Timings,
+}
+
+/// When the tangential critical curve of a known lens leaves the products' map, its Einstein
+/// radius is measured again on maps this many times wider (same centre), in turn, until one
+/// holds the whole curve.
+pub const EINSTEIN_MAP_WIDENING: [f64; 2] = [2.0, 4.0];
+
+/// Pixels per side, at most, of those wider maps (they serve the Einstein radius only).
+const EINSTEIN_MAP_MAX_PIXELS: usize = 256;
+
+impl Summary {
+    /// The Einstein radius for a reader, saying on which map it was measured when that is not
+    /// the products' own, and that it is a lower bound when the curve left every map.
+    pub fn einstein_radius_text(&self) -> String {
+        let r = self.einstein_radius_arcsec;
+        match self.einstein_radius_map_arcsec {
+            Some(side) if side > self.map_size_arcsec => format!(
+                "{r:.2} arcsec (measured on a {side:.0} arcsec map: the tangential critical curve leaves the {:.0} arcsec map)",
+                self.map_size_arcsec
+            ),
+            Some(_) => format!("{r:.2} arcsec"),
+            None => format!(
+                "at least {r:.2} arcsec (the tangential critical curve leaves the map: only its closed loops count)"
+            ),
+        }
+    }
 }
 
 /// Radii of the enclosed masses reported in the summary, arcsec.
@@ -214,7 +248,16 @@ impl Products {
     ) -> Result<Self, ProductsError> {
         let t = Clock::start();
         let magnification = maps.magnification(f);
-        let curves = critical_curves(&maps, f, z_source, lens);
+        let mut curves = critical_curves(&maps, f, z_source, lens);
+        let einstein_radius_map_arcsec = match lens {
+            Some(lens) if curves.tangential_leaves_map => {
+                let (radius, map) =
+                    einstein_radius_on_wider_maps(lens, maps.geometry(), f, z_source);
+                curves.einstein_radius_arcsec = radius;
+                map
+            }
+            _ => (!curves.tangential_leaves_map).then_some(maps.geometry().size_arcsec),
+        };
         let curves_ms = t.ms();
         let t = Clock::start();
         let geometry = maps.geometry();
@@ -233,6 +276,7 @@ impl Products {
             maps,
             magnification,
             curves,
+            einstein_radius_map_arcsec,
             profile,
             timings: Timings {
                 maps_ms,
@@ -268,6 +312,7 @@ impl Products {
             map_size_arcsec: g.size_arcsec,
             map_pixels: g.pixels,
             einstein_radius_arcsec: self.curves.einstein_radius_arcsec,
+            einstein_radius_map_arcsec: self.einstein_radius_map_arcsec,
             tangential_curves: self.curves.tangential.len(),
             radial_curves: self.curves.radial.len(),
             kappa_max: self.maps.kappa.min_max().1,
@@ -380,4 +425,30 @@ fn now_ms() -> f64 {
 #[cfg(target_arch = "wasm32")]
 fn now_ms() -> f64 {
     js_sys::Date::now()
+}
+
+/// The Einstein radius of `lens` measured on the maps of [`EINSTEIN_MAP_WIDENING`] around
+/// `geometry`, and the side of the first map that holds the whole tangential curve (`None` when
+/// none does: the radius is then the widest map's closed loops only).
+fn einstein_radius_on_wider_maps(
+    lens: &dyn MassComponent,
+    geometry: MapGeometry,
+    f: f64,
+    z_source: f64,
+) -> (f64, Option<f64>) {
+    let mut radius = 0.0;
+    for widen in EINSTEIN_MAP_WIDENING {
+        let wide = MapGeometry {
+            pixels: geometry.pixels.min(EINSTEIN_MAP_MAX_PIXELS),
+            size_arcsec: geometry.size_arcsec * widen,
+            center: geometry.center,
+        };
+        let maps = LensMaps::from_lens(lens, wide);
+        let curves = critical_curves(&maps, f, z_source, None);
+        radius = curves.einstein_radius_arcsec;
+        if !curves.tangential_leaves_map {
+            return (radius, Some(wide.size_arcsec));
+        }
+    }
+    (radius, None)
 }

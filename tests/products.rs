@@ -558,3 +558,60 @@ fn radial_profile_rejects_bad_requests() {
         }
     );
 }
+
+/// When the tangential curve leaves the products' map, the Einstein radius is measured on a
+/// wider map (and said so); when it leaves every map tried, the summary says it is a lower
+/// bound. Before, such a lens reported 0.
+#[cfg_attr(not(target_arch = "wasm32"), test)]
+#[cfg_attr(target_arch = "wasm32", wasm_bindgen_test::wasm_bindgen_test)]
+fn an_einstein_curve_larger_than_the_map_is_measured_on_a_wider_one() {
+    use wslap::products::{ProductOptions, Products, EINSTEIN_MAP_WIDENING};
+    let plane = LensPlane::new(Cosmology::default(), 0.3).expect("plane");
+    let f = plane.distance_ratio(2.0).expect("f");
+    let r_true = f * THETA_E_ARCSEC;
+    let products = |size_arcsec: f64| {
+        let opts = ProductOptions {
+            size_arcsec,
+            pixels: 128,
+            ..ProductOptions::default()
+        };
+        Products::from_lens(&sis(), plane, None, &opts).expect("products")
+    };
+    // The map holds the circle: measured on it.
+    let inside = products(3.0 * r_true);
+    assert_eq!(inside.einstein_radius_map_arcsec, Some(3.0 * r_true));
+    assert_abs(
+        "radius, map holds it",
+        inside.curves.einstein_radius_arcsec,
+        r_true,
+        0.05,
+    );
+    // The map is narrower than the circle: measured on the first wider map that holds it.
+    let narrow = products(1.5 * r_true);
+    assert!(narrow.curves.tangential_leaves_map);
+    let side = narrow
+        .einstein_radius_map_arcsec
+        .expect("a wider map holds the curve");
+    assert_abs(
+        "wider map",
+        side,
+        EINSTEIN_MAP_WIDENING[0] * 1.5 * r_true,
+        1e-9,
+    );
+    let wide_pixel = side / 128.0;
+    assert_abs(
+        "radius on the wider map",
+        narrow.curves.einstein_radius_arcsec,
+        r_true,
+        0.1 * wide_pixel,
+    );
+    assert!(narrow
+        .summary()
+        .einstein_radius_text()
+        .contains("measured on a"));
+    // No map tried holds it: a lower bound, said so.
+    let tiny = products(0.4 * r_true);
+    assert_eq!(tiny.einstein_radius_map_arcsec, None);
+    let text = tiny.summary().einstein_radius_text();
+    assert!(text.starts_with("at least"), "{text}");
+}

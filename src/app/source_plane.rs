@@ -79,6 +79,7 @@ fn caustics_as_curves(c: &CriticalCurves) -> CriticalCurves {
     CriticalCurves {
         z_source: c.z_source,
         einstein_radius_arcsec: c.einstein_radius_arcsec,
+        tangential_leaves_map: c.tangential_leaves_map,
         tangential: c.caustics.tangential.clone(),
         radial: c.caustics.radial.clone(),
         caustics: Default::default(),

@@ -92,10 +92,10 @@ pub fn run(args: &MapsArgs) -> Result<(), String> {
     write_products(&products, args.scale.into(), &args.out)?;
     let s = products.summary();
     println!(
-        "wrote {} (Einstein radius at z_s = {}: {:.2} arcsec; {} tangential, {} radial critical curves)",
+        "wrote {} (Einstein radius at z_s = {}: {}; {} tangential, {} radial critical curves)",
         args.out.display(),
         s.z_source,
-        s.einstein_radius_arcsec,
+        s.einstein_radius_text(),
         s.tangential_curves,
         s.radial_curves
     );

@@ -172,7 +172,7 @@ pub(super) fn write_reconstruction(r: &Reconstruction, dir: &Path) -> Result<(),
 
 fn one_line(r: &Reconstruction, out: &Path) -> String {
     format!(
-        "wrote {} ({} systems, {} constraint pixels, {} iterations; C = {:?}; grid mass {:.3e} Msun; Einstein radius at z_s = {}: {:.2} arcsec; image-plane rms {})",
+        "wrote {} ({} systems, {} constraint pixels, {} iterations; C = {:?}; grid mass {:.3e} Msun; Einstein radius at z_s = {}: {}; image-plane rms {})",
         out.display(),
         r.system.constraints.systems.len(),
         r.system.constraints.pixels.len(),
@@ -180,7 +180,7 @@ fn one_line(r: &Reconstruction, out: &Path) -> String {
         r.layer_factors(),
         r.grid_mass_msun(),
         r.config.products.z_source,
-        r.products.curves.einstein_radius_arcsec,
+        r.products.summary().einstein_radius_text(),
         r.image_plane_rms_arcsec(false).map_or("n/a".to_string(), |v| format!("{v:.2} arcsec")),
     )
 }
