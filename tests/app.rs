@@ -191,7 +191,13 @@ fn a_higher_source_redshift_redraws_a_larger_einstein_radius_without_solving() {
         .clone();
     let r2 = s.result().unwrap().products.curves.einstein_radius_arcsec;
     s.set_z_source(6.0).unwrap();
-    let r6 = s.result().unwrap().products.curves.einstein_radius_arcsec;
+    let p = &s.result().unwrap().products;
+    let r6 = p.curves.einstein_radius_arcsec;
+    // The redraw has only the stored maps: the radius is measured on them, or is a lower bound.
+    assert_eq!(
+        p.einstein_radius_map_arcsec,
+        (!p.curves.tangential_leaves_map).then_some(p.maps.geometry().size_arcsec)
+    );
     assert!(
         r6 > r2 && r2 > 0.0,
         "Einstein radius {r2} at z_s = 2, {r6} at z_s = 6"

@@ -79,7 +79,9 @@ async function render() {
 function caption(info) {
   const s = info.summary.maps ?? info.summary;
   const status = info.status ? `${info.status}, ${info.iterations} iterations; ` : '';
-  $('summary').textContent = `${status}Einstein radius ${s.einstein_radius_arcsec.toFixed(1)}″ at ` +
+  // A null map side: the tangential curve leaves every map measured, the radius is a lower bound.
+  const bound = s.einstein_radius_map_arcsec === null ? '≥ ' : '';
+  $('summary').textContent = `${status}Einstein radius ${bound}${s.einstein_radius_arcsec.toFixed(1)}″ at ` +
     `z_s = ${s.z_source}; ${s.tangential_curves} tangential and ${s.radial_curves} radial critical curves.`;
 }
 

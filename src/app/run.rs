@@ -77,6 +77,9 @@ impl SessionResult {
         p.distance_ratio = f;
         p.magnification = p.maps.magnification(f);
         p.curves = critical_curves(&p.maps, f, z_source, None);
+        // Only the stored maps are at hand here: a curve that leaves them gives a lower bound.
+        p.einstein_radius_map_arcsec =
+            (!p.curves.tangential_leaves_map).then_some(p.maps.geometry().size_arcsec);
         Ok(())
     }
 
