@@ -28,8 +28,9 @@ pub struct CriticalCurves {
     /// `sqrt(area inside the tangential curves / pi)`, 0 when there is none.
     pub einstein_radius_arcsec: f64,
     pub tangential: Vec<Polyline>,
-    /// True when the region inside the tangential curves (`lambda_t < 0`) reaches the map
-    /// border: the Einstein radius then counts only the closed loops, so it is too small (or 0).
+    /// True when the region inside the tangential curves (`lambda_t < 0`) covers more than
+    /// [`TANGENTIAL_BORDER_SHARE`] of the map's border pixels: the Einstein radius then counts
+    /// only the closed loops, so it is too small (or 0).
     #[serde(default)]
     pub tangential_leaves_map: bool,
     pub radial: Vec<Polyline>,
@@ -54,6 +55,13 @@ pub struct Contour {
 /// Vertices closer than this (in pixels) are merged, e.g. where a contour passes exactly
 /// through a pixel centre and two cell edges give the same point.
 const DUPLICATE_PIXELS: f64 = 1.0e-9;
+
+/// Share of the map's border pixels inside the tangential curves (`lambda_t < 0`) above which
+/// the curve counts as leaving the map ([`CriticalCurves::tangential_leaves_map`]). A member
+/// galaxy's own small curve cut by the border covers a few pixels (0.2% of the border in the
+/// app's example); a cluster curve that leaves the map, much more (7% for AS1063 on its
+/// 108 arcsec field).
+pub const TANGENTIAL_BORDER_SHARE: f64 = 0.01;
 
 /// Critical curves and caustics for a source with `f = D_ls/D_s` at `z_source`.
 ///
@@ -99,14 +107,15 @@ pub fn critical_curves(
         .map(|c| signed_area_arcsec2(&c.points))
         .sum::<f64>();
     let einstein_radius_arcsec = (area.max(0.0) / std::f64::consts::PI).sqrt();
-    // The region lambda_t < 0 reaches the border (also when no curve crosses the map at all
-    // because the whole map lies inside the critical curve).
-    let tangential_leaves_map = consistent
-        && (0..n).any(|a| {
-            [a, (n - 1) * n + a, a * n, a * n + n - 1]
-                .iter()
-                .any(|&i| 1.0 - f * (k[i] + shear(i)) < 0.0)
-        });
+    // The region lambda_t < 0 reaches the border along more than a few pixels (also when no
+    // curve crosses the map because the whole map lies inside the critical curve).
+    let tangential_leaves_map = consistent && {
+        let negative = (0..n)
+            .flat_map(|a| [a, (n - 1) * n + a, a * n, a * n + n - 1])
+            .filter(|&i| 1.0 - f * (k[i] + shear(i)) < 0.0)
+            .count();
+        negative as f64 > TANGENTIAL_BORDER_SHARE * (4 * n) as f64
+    };
     let to_source = |curves: &[Contour]| -> Vec<Polyline> {
         curves
             .iter()

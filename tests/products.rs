@@ -614,4 +614,17 @@ fn an_einstein_curve_larger_than_the_map_is_measured_on_a_wider_one() {
     assert_eq!(tiny.einstein_radius_map_arcsec, None);
     let text = tiny.summary().einstein_radius_text();
     assert!(text.starts_with("at least"), "{text}");
+    // A small lens cut by the border of a map that holds the main curve: its few pixels do
+    // not make the main curve "leave" the map.
+    let size = 3.0 * r_true;
+    let small = Sis::from_theta_e(DVec2::new(0.5 * size, 0.0), 1.0).expect("small SIS");
+    let lens = wslap::profiles::Lens::new(vec![Box::new(sis()), Box::new(small)]);
+    let opts = ProductOptions {
+        size_arcsec: size,
+        pixels: 128,
+        ..ProductOptions::default()
+    };
+    let with_small = Products::from_lens(&lens, plane, None, &opts).expect("products");
+    assert!(!with_small.curves.tangential_leaves_map);
+    assert_eq!(with_small.einstein_radius_map_arcsec, Some(size));
 }
