@@ -13,6 +13,8 @@ let examples = [];
 let resultKind = null; // kind of the shown result, null before any
 let lastProject = null; // the worker's project.json after the last change (restored on cancel)
 let settings = null;
+// The session's name once your own files have replaced an example.
+const OWN_DATA = 'Your data';
 
 const client = new LensClient({ onCrash: (m) => showError(m) });
 const ask = (type, payload = {}, onProgress) => client.request(type, payload, onProgress);
@@ -171,8 +173,35 @@ async function loadExample(ex) {
   setStatus('Ready: press Reconstruct.');
 }
 
+// The example that is open (the session carries its name), if any.
+function openExample() {
+  return examples.find((e) => e.name === $('project-name').textContent);
+}
+
+// Your own file replaces the open example: the example's files of other roles are removed, and
+// so are the settings it set that still have its values (settings you changed stay). Called
+// after your file has loaded, so a bad file leaves the example as it was.
+async function leaveExample(ex, role) {
+  for (const f of ex.files) if (f.role !== role) await ask('clear', { role: f.role });
+  const current = await ask('settings');
+  const defaults = await ask('defaultSettings');
+  const at = (tree, path) => path.split('.').reduce((node, key) => node?.[key], tree);
+  for (const [path, value] of Object.entries({ z_lens: ex.z_lens, ...ex.settings })) {
+    if (at(current, path) === value) await ask('setField', { path, value: at(defaults, path) });
+  }
+  await ask('setName', { name: OWN_DATA });
+  describe(OWN_DATA, `Your files replace the example "${ex.name}": its other files and the ` +
+    'settings it had set are gone (settings you changed stay). Check z_lens before you run.');
+  settings = await askSettings('settings');
+  showSettings(settings, { force: true });
+  $('z-curves').value = settings.reconstruct.products.z_source;
+  const loaded = await refreshLoaded();
+  for (const { role: r } of ROLES) if (r !== role && !loaded[r]) setFileStatus(r, '');
+}
+
 async function onFile(role, file) {
   clearError();
+  const example = role === 'project' ? undefined : openExample();
   try {
     let report;
     if (role === 'project') {
@@ -189,6 +218,7 @@ async function onFile(role, file) {
     }
     const warn = report.warnings.length ? ` (${report.warnings.length} warnings: ${report.warnings.join('; ')})` : '';
     setFileStatus(role, `${report.name}: ${report.summary}${warn}`);
+    if (example) await leaveExample(example, role);
     await refreshLoaded();
     await persist();
     if (!resultKind) await render();

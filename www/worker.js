@@ -37,6 +37,10 @@ const handlers = {
   clear: (m) => session.clear(m.role),
   loadFits: (m) => session.load_fits(m.axis, m.name, new Uint8Array(m.bytes)),
   settings: () => session.settings(),
+  defaultSettings: () => {
+    const fresh = new core.AppSession();
+    try { return fresh.settings(); } finally { fresh.free(); }
+  },
   setField: (m) => session.set_field(m.path, m.value),
   setName: (m) => session.set_name(m.name),
   // Throttled progress (at most every 100 ms) is posted from inside the Rust loop.
