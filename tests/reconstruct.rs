@@ -278,9 +278,9 @@ pub(crate) mod real {
     /// model's. The issue asks for 25%; with point constraints and the default member prior this
     /// reconstruction gives +33% (39.5 vs 29.8 arcsec, measured), an open point of the
     /// inversion issue. This bound catches regressions beyond that. Measured with `wslap
-    /// reconstruct` on a 160 arcsec map: 35-40 arcsec with the members for 16-32 cells and
-    /// 3000-8000 iterations (C = 3.1-3.9), 33-34 arcsec without them: every setting tried lies
-    /// above the published model.
+    /// reconstruct` on maps of 160 arcsec or more: 35-40 arcsec with the members (24 or 32
+    /// cells, 3000-50000 iterations, other starts, bcg/brightest:3 layers, M/L 60; C = 2.0-3.9),
+    /// 34 arcsec without them: every setting tried lies above the published model.
     const EINSTEIN_RADIUS_RTOL: f64 = 0.40;
     /// Share of the systems whose images lie on both sides of the tangential critical curve
     /// of their own redshift (measured 0.63 with the quick settings).
