@@ -92,9 +92,10 @@ pub fn critical_curves(
         .all(|m| m.geometry == geometry && m.data.len() == n * n);
     let (k, g1, g2) = (&maps.kappa.data, &maps.gamma1.data, &maps.gamma2.data);
     let shear = |i: usize| (g1[i] * g1[i] + g2[i] * g2[i]).sqrt();
+    let lambda_t = |i: usize| 1.0 - f * (k[i] + shear(i));
     let (tangential, radial) = if consistent {
         (
-            contours_of(geometry, |i| 1.0 - f * (k[i] + shear(i))),
+            contours_of(geometry, lambda_t),
             contours_of(geometry, |i| 1.0 - f * (k[i] - shear(i))),
         )
     } else {
@@ -112,7 +113,7 @@ pub fn critical_curves(
     let tangential_leaves_map = consistent && {
         let negative = (0..n)
             .flat_map(|a| [a, (n - 1) * n + a, a * n, a * n + n - 1])
-            .filter(|&i| 1.0 - f * (k[i] + shear(i)) < 0.0)
+            .filter(|&i| lambda_t(i) < 0.0)
             .count();
         negative as f64 > TANGENTIAL_BORDER_SHARE * (4 * n) as f64
     };

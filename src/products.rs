@@ -256,7 +256,7 @@ impl Products {
                 curves.einstein_radius_arcsec = radius;
                 map
             }
-            _ => (!curves.tangential_leaves_map).then_some(maps.geometry().size_arcsec),
+            _ => own_map_side(&curves, maps.geometry()),
         };
         let curves_ms = t.ms();
         let t = Clock::start();
@@ -425,6 +425,12 @@ fn now_ms() -> f64 {
 #[cfg(target_arch = "wasm32")]
 fn now_ms() -> f64 {
     js_sys::Date::now()
+}
+
+/// [`Products::einstein_radius_map_arcsec`] when the curves were traced on `geometry` alone:
+/// its side, or `None` when the tangential curve leaves it.
+pub(crate) fn own_map_side(curves: &CriticalCurves, geometry: MapGeometry) -> Option<f64> {
+    (!curves.tangential_leaves_map).then_some(geometry.size_arcsec)
 }
 
 /// The Einstein radius of `lens` measured on the maps of [`EINSTEIN_MAP_WIDENING`] around

@@ -569,14 +569,15 @@ fn an_einstein_curve_larger_than_the_map_is_measured_on_a_wider_one() {
     let plane = LensPlane::new(Cosmology::default(), 0.3).expect("plane");
     let f = plane.distance_ratio(2.0).expect("f");
     let r_true = f * THETA_E_ARCSEC;
-    let products = |size_arcsec: f64| {
+    let products_of = |lens: &dyn MassComponent, size_arcsec: f64| {
         let opts = ProductOptions {
             size_arcsec,
             pixels: 128,
             ..ProductOptions::default()
         };
-        Products::from_lens(&sis(), plane, None, &opts).expect("products")
+        Products::from_lens(lens, plane, None, &opts).expect("products")
     };
+    let products = |size_arcsec: f64| products_of(&sis(), size_arcsec);
     // The map holds the circle: measured on it.
     let inside = products(3.0 * r_true);
     assert_eq!(inside.einstein_radius_map_arcsec, Some(3.0 * r_true));
@@ -619,12 +620,7 @@ fn an_einstein_curve_larger_than_the_map_is_measured_on_a_wider_one() {
     let size = 3.0 * r_true;
     let small = Sis::from_theta_e(DVec2::new(0.5 * size, 0.0), 1.0).expect("small SIS");
     let lens = wslap::profiles::Lens::new(vec![Box::new(sis()), Box::new(small)]);
-    let opts = ProductOptions {
-        size_arcsec: size,
-        pixels: 128,
-        ..ProductOptions::default()
-    };
-    let with_small = Products::from_lens(&lens, plane, None, &opts).expect("products");
+    let with_small = products_of(&lens, size);
     assert!(!with_small.curves.tangential_leaves_map);
     assert_eq!(with_small.einstein_radius_map_arcsec, Some(size));
 }

@@ -10,7 +10,7 @@ use crate::inversion::{
     LinearSystem,
 };
 use crate::model::ModelFile;
-use crate::products::{ProductOptions, Products};
+use crate::products::{own_map_side, ProductOptions, Products};
 use crate::profiles::Lens;
 use crate::reconstruct::{
     reconstruct, ConvergenceRecord, Inputs, LayerSource, ReconstructConfig, SourceReport,
@@ -78,8 +78,7 @@ impl SessionResult {
         p.magnification = p.maps.magnification(f);
         p.curves = critical_curves(&p.maps, f, z_source, None);
         // Only the stored maps are at hand here: a curve that leaves them gives a lower bound.
-        p.einstein_radius_map_arcsec =
-            (!p.curves.tangential_leaves_map).then_some(p.maps.geometry().size_arcsec);
+        p.einstein_radius_map_arcsec = own_map_side(&p.curves, p.maps.geometry());
         Ok(())
     }
 
