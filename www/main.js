@@ -137,10 +137,15 @@ async function cancel() {
   setStatus('Cancelled. The loaded data and the previous result are kept.');
 }
 
-async function afterOpen(report) {
+// Shows the worker's settings after they changed there (an open, or leaving an example).
+async function showSessionSettings() {
   settings = await askSettings('settings');
   showSettings(settings, { force: true });
   $('z-curves').value = settings.reconstruct.products.z_source;
+}
+
+async function afterOpen(report) {
+  await showSessionSettings();
   const loaded = await refreshLoaded();
   for (const { role } of ROLES) setFileStatus(role, loaded[role] ? `${loaded[role]}: loaded` : '');
   resultKind = null;
@@ -182,7 +187,11 @@ function openExample() {
 // so are the settings it set that still have its values (settings you changed stay). Called
 // after your file has loaded, so a bad file leaves the example as it was.
 async function leaveExample(ex, role) {
-  for (const f of ex.files) if (f.role !== role) await ask('clear', { role: f.role });
+  for (const f of ex.files) {
+    if (f.role === role) continue;
+    await ask('clear', { role: f.role });
+    setFileStatus(f.role, '');
+  }
   const current = await ask('settings');
   const defaults = await ask('defaultSettings');
   const at = (tree, path) => path.split('.').reduce((node, key) => node?.[key], tree);
@@ -192,11 +201,7 @@ async function leaveExample(ex, role) {
   await ask('setName', { name: OWN_DATA });
   describe(OWN_DATA, `Your files replace the example "${ex.name}": its other files and the ` +
     'settings it had set are gone (settings you changed stay). Check z_lens before you run.');
-  settings = await askSettings('settings');
-  showSettings(settings, { force: true });
-  $('z-curves').value = settings.reconstruct.products.z_source;
-  const loaded = await refreshLoaded();
-  for (const { role: r } of ROLES) if (r !== role && !loaded[r]) setFileStatus(r, '');
+  await showSessionSettings();
 }
 
 async function onFile(role, file) {
