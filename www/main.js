@@ -232,6 +232,15 @@ async function onFile(role, file) {
   }
 }
 
+// Files are taken one at a time, in the order they came (a drop of several files, or a picker
+// used while a file still loads): each must see what the one before it left. Two at once both
+// saw the example open, and each one's leaveExample cleared the file the other had just loaded.
+let fileQueue = Promise.resolve();
+function queueFile(role, file) {
+  fileQueue = fileQueue.then(() => onFile(role, file)).catch((err) => showError(err.message));
+  return fileQueue;
+}
+
 async function applySetting(path, value) {
   if (path === 'reconstruct.products.z_source') return setZ(value);
   settings = await askSettings('setField', { path, value });
@@ -261,7 +270,7 @@ const app = {
 };
 
 async function start() {
-  buildFileRows($('file-rows'), $('drop-zone'), onFile);
+  buildFileRows($('file-rows'), $('drop-zone'), queueFile);
   buildSettings($('settings-form'), applySetting);
   wireViews(app);
   $('reconstruct').addEventListener('click', () => run('reconstruct'));

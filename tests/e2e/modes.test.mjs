@@ -102,6 +102,12 @@ test('catalogues dropped on the drop zone load in their roles', async () => {
       .test(document.getElementById('status-members').textContent));
     assert.equal(await page.$eval('#drop-zone', (el) => el.classList.contains('over')), false);
     assert.equal(await page.isDisabled('#reconstruct'), false);
+    // The files were taken one after the other: the first replaced the example, and the second
+    // was not cleared by it (taken at once, each cleared the other's role now and then).
+    await page.waitForFunction(() => document.getElementById('project-name').textContent === 'Your data');
+    assert.equal(await page.textContent('#status-arcs'), '');
+    assert.match(await page.textContent('#status-images'), /19 systems, 50 images/);
+    assert.match(await page.textContent('#status-members'), /members/);
     assert.deepEqual(app.consoleErrors, []);
   } finally {
     await app.close();

@@ -45,7 +45,10 @@ export function buildFileRows(container, dropZone, onFile) {
   dropZone.addEventListener('dragleave', over(false));
   dropZone.addEventListener('drop', async (e) => {
     over(false)(e);
-    for (const file of e.dataTransfer.files) onFile(await guessRole(file), file);
+    // Roles are guessed for all files first: the drop's file list is only readable now.
+    const files = [...e.dataTransfer.files];
+    const roles = await Promise.all(files.map(guessRole));
+    files.forEach((file, k) => onFile(roles[k], file));
   });
 }
 
