@@ -640,6 +640,15 @@ fn arc_files_parse_and_report_errors() {
 /// A 4 x 4 grid, one true layer (a truncated NFW and an NFW) and the member layers of
 /// `split`, and the ellipse pixels of the three systems.
 fn small_system(split: &str, config: &SystemConfig) -> LinearSystem {
+    small_system_with_prior(split, config, None)
+}
+
+/// [`small_system`] with `c_prior_sigma` on the member layers (the true layer has none).
+fn small_system_with_prior(
+    split: &str,
+    config: &SystemConfig,
+    c_prior_sigma: Option<f64>,
+) -> LinearSystem {
     let plane = plane();
     let constraints = build_constraints(
         ConstraintSource::Catalog(&three_systems()),
@@ -669,6 +678,7 @@ fn small_system(split: &str, config: &SystemConfig) -> LinearSystem {
     let member_config = MemberConfig {
         layers: split.parse().unwrap(),
         mag_star: Some(19.0),
+        c_prior_sigma,
         ..MemberConfig::default()
     };
     let mut layers = vec![truth];
@@ -916,6 +926,15 @@ fn bad_settings_give_their_errors() {
     .validate()
     .unwrap_err();
     assert!(err.to_string().contains("mass_to_light = -1"), "{err}");
+    for sigma in [0.0, -0.5, f64::NAN, 1e3] {
+        let err = MemberConfig {
+            c_prior_sigma: Some(sigma),
+            ..MemberConfig::default()
+        }
+        .validate()
+        .unwrap_err();
+        assert!(err.to_string().contains("c_prior_sigma"), "{err}");
+    }
     for bad in ["brightest:0", "brightest", "all", "brightest:x"] {
         assert!(
             matches!(
@@ -1079,5 +1098,95 @@ fn export_writes_gamma_theta_weights_and_columns() {
     assert_eq!(json["mass_unit_msun"], 1e12);
     assert_eq!(json["theta_shift_arcsec"], sys.theta_shift_arcsec);
     assert_eq!(json["systems"][1]["id"], "2");
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+/// `chi^2(X) = X^T A X + 2 b^T X + Theta^T W Theta` from the normal equations.
+fn chi2(sys: &LinearSystem, x: &[f64]) -> f64 {
+    let n = sys.n_columns();
+    let quad: f64 = (0..n)
+        .map(|i| x[i] * (0..n).map(|j| sys.a[i * n + j] * x[j]).sum::<f64>())
+        .sum();
+    let lin: f64 = sys.b.iter().zip(x).map(|(b, x)| b * x).sum();
+    quad + 2.0 * lin + sys.theta_w_theta
+}
+
+#[cfg_attr(not(target_arch = "wasm32"), test)]
+#[cfg_attr(target_arch = "wasm32", wasm_bindgen_test::wasm_bindgen_test)]
+fn a_prior_on_c_adds_one_row_per_member_layer() {
+    let sigma = 0.2;
+    let w = 1.0 / (sigma * sigma);
+    let free = small_system("bcg", &SystemConfig::default());
+    let held = small_system_with_prior("bcg", &SystemConfig::default(), Some(sigma));
+    let n = free.n_columns();
+    // Columns: the true layer (no prior), then "bcg" and "rest".
+    let member_columns: Vec<usize> = held.layer_columns().skip(1).collect();
+    assert_eq!(member_columns.len(), 2);
+    assert_eq!(held.n_rows, free.n_rows + 2);
+    let prior = held.prior_rows();
+    assert_eq!(prior.weights, vec![w, w]);
+    assert_eq!(prior.theta, vec![1.0, 1.0]);
+    for (k, &c) in member_columns.iter().enumerate() {
+        let row = &prior.gamma[k * n..(k + 1) * n];
+        assert!(row
+            .iter()
+            .enumerate()
+            .all(|(j, &v)| v == if j == c { 1.0 } else { 0.0 }));
+    }
+    // The normal equations change on the prior columns' diagonal and in b, nowhere else.
+    for i in 0..n {
+        let on = member_columns.contains(&i);
+        for j in 0..n {
+            let want = if on && i == j { w } else { 0.0 };
+            let d = held.a[i * n + j] - free.a[i * n + j];
+            assert!(
+                (d - want).abs() <= 1e-9 * (1.0 + free.a[i * n + j].abs()),
+                "A[{i},{j}]"
+            );
+        }
+        let want = if on { -w } else { 0.0 };
+        let d = held.b[i] - free.b[i];
+        assert!((d - want).abs() <= 1e-9 * (1.0 + free.b[i].abs()), "b[{i}]");
+    }
+    // chi^2 grows by ((C - 1) / sigma)^2 per member layer.
+    let mut x = random_x(&held, 5);
+    let (c_bcg, c_rest) = (1.5, 0.7);
+    x[member_columns[0]] = c_bcg;
+    x[member_columns[1]] = c_rest;
+    let added = ((c_bcg - 1.0f64) / sigma).powi(2) + ((c_rest - 1.0f64) / sigma).powi(2);
+    let d = chi2(&held, &x) - chi2(&free, &x);
+    assert!(
+        (d - added).abs() <= 1e-6 * chi2(&free, &x),
+        "{d} vs {added}"
+    );
+}
+
+#[cfg(not(target_arch = "wasm32"))]
+#[test]
+fn export_ends_with_the_prior_rows() {
+    let sys = small_system_with_prior("single", &SystemConfig::default(), Some(0.5));
+    let dir = std::env::temp_dir().join(format!("wslap-export-prior-{}", std::process::id()));
+    wslap::inversion::export_system(&sys, &dir).unwrap();
+    let n = sys.n_columns();
+    let read = |name: &str| -> Vec<f64> {
+        let bytes = std::fs::read(dir.join(name)).unwrap();
+        let header = bytes.iter().position(|&b| b == b'\n').unwrap() + 1;
+        bytes[header..]
+            .chunks_exact(8)
+            .map(|c| f64::from_le_bytes(c.try_into().unwrap()))
+            .collect()
+    };
+    let (gamma, theta, weights) = (read("gamma.npy"), read("theta.npy"), read("weights.npy"));
+    assert_eq!(sys.n_rows, 2 * sys.constraints.pixels.len() + 1);
+    assert_eq!(gamma.len(), sys.n_rows * n);
+    let last = &gamma[(sys.n_rows - 1) * n..];
+    let c = sys.layer_columns().last().unwrap();
+    assert!(last
+        .iter()
+        .enumerate()
+        .all(|(j, &v)| v == if j == c { 1.0 } else { 0.0 }));
+    assert_eq!(theta.last(), Some(&1.0));
+    assert_eq!(weights.last(), Some(&4.0));
+    assert_eq!(theta.len(), sys.n_rows);
     std::fs::remove_dir_all(&dir).unwrap();
 }

@@ -163,6 +163,11 @@ pub struct MemberConfig {
     /// Members farther than this fraction of the field width outside the grid are dropped
     /// with a warning (default 0.1). Allowed [0, 10].
     pub outside_margin_fraction: f64,
+    /// Width of a Gaussian prior on every layer factor `C_l` around 1 (the M/L law as set):
+    /// each layer adds the row `(C_l - 1) / c_prior_sigma = 0` to the system. Default none:
+    /// `C_l` is free, as in the paper. Worth setting when the constraints are few (a catalogue
+    /// of point images), which leave `C_l` to the start of QADP. Allowed (0, 100].
+    pub c_prior_sigma: Option<f64>,
 }
 
 /// Bisection steps for the parent concentration (`log c` over [1e-3, 1e3]: 2^-100 of that
@@ -184,6 +189,7 @@ impl Default for MemberConfig {
             r_s_lstar_kpc: 10.0,
             size_exponent: 1.0 / 3.0,
             outside_margin_fraction: 0.1,
+            c_prior_sigma: None,
         }
     }
 }
@@ -213,6 +219,9 @@ impl MemberConfig {
         check("r_trunc_lstar_kpc", self.r_trunc_lstar_kpc, 0.0, 1e4, true)?;
         check("r_s_lstar_kpc", self.r_s_lstar_kpc, 0.0, 1e4, true)?;
         check("size_exponent", self.size_exponent, 0.0, 2.0, false)?;
+        if let Some(sigma) = self.c_prior_sigma {
+            check("c_prior_sigma", sigma, 0.0, 100.0, true)?;
+        }
         check(
             "outside_margin_fraction",
             self.outside_margin_fraction,
@@ -291,6 +300,9 @@ pub struct Layer {
     pub members: Vec<usize>,
     /// The summed halos at `D_ls/D_s = 1`, shared with reconstructed lenses.
     pub lens: Arc<Lens>,
+    /// Width of the Gaussian prior on this layer's factor `C_l` around 1, if any
+    /// ([`MemberConfig::c_prior_sigma`]).
+    pub prior_sigma: Option<f64>,
 }
 
 impl Layer {
@@ -300,6 +312,7 @@ impl Layer {
             name: name.to_string(),
             members: Vec::new(),
             lens: Arc::new(Lens::new(components)),
+            prior_sigma: None,
         }
     }
 
@@ -464,7 +477,10 @@ pub fn build_member_layers(
             r_trunc_arcsec,
         });
     }
-    let layers = split_layers(config.layers, &halos, components);
+    let mut layers = split_layers(config.layers, &halos, components);
+    for layer in &mut layers {
+        layer.prior_sigma = config.c_prior_sigma;
+    }
     Ok(MemberModel {
         halos,
         layers,
@@ -499,6 +515,7 @@ fn split_layers(
             name,
             members: vec![halos[k].member],
             lens: Arc::new(Lens::new(slots[k].take().into_iter().collect())),
+            prior_sigma: None,
         });
     }
     let mut rest: Vec<usize> = order[n_alone..].to_vec();
@@ -511,6 +528,7 @@ fn split_layers(
             lens: Arc::new(Lens::new(
                 rest.iter().filter_map(|&k| slots[k].take()).collect(),
             )),
+            prior_sigma: None,
         });
     }
     layers

@@ -150,6 +150,10 @@ pub fn export_system(system: &LinearSystem, dir: &Path) -> Result<(), NpyError> 
         weights.extend_from_slice(&block.weights);
         start = end;
     }
+    let prior = system.prior_rows();
+    write_f64s(&mut w, &prior.gamma).map_err(&io)?;
+    theta.extend_from_slice(&prior.theta);
+    weights.extend_from_slice(&prior.weights);
     w.flush().map_err(&io)?;
     write_npy(&dir.join("theta.npy"), &[system.n_rows], &theta)?;
     write_npy(&dir.join("weights.npy"), &[system.n_rows], &weights)?;
@@ -157,7 +161,8 @@ pub fn export_system(system: &LinearSystem, dir: &Path) -> Result<(), NpyError> 
         n_rows: system.n_rows,
         n_columns: system.n_columns(),
         rows: "row 2i is theta_x + shift of pixel i, row 2i+1 theta_y + shift; \
-               weights in 1/arcsec^2",
+               weights in 1/arcsec^2; then one row C_l = 1 (weight 1/sigma^2) per layer with \
+               a prior on its factor",
         theta_shift_arcsec: system.theta_shift_arcsec,
         mass_unit_msun: system.mass_unit_msun,
         d_l_mpc: system.d_l_mpc,

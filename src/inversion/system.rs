@@ -137,7 +137,7 @@ pub enum ColumnInfo {
     BetaY { system: usize, id: String },
 }
 
-/// Rows of `Gamma` for a range of pixels: `gamma` row-major (`2 n_pixels x n_columns`),
+/// Rows of `Gamma` for a range of pixels (or the prior rows): `gamma` row-major (`rows x n_columns`),
 /// `theta` the shifted positions and `weights` the row weights (1/arcsec^2).
 #[derive(Debug, Clone, Default, PartialEq)]
 pub struct RowBlock {
@@ -151,7 +151,7 @@ pub struct RowBlock {
 #[derive(Debug, Clone)]
 pub struct LinearSystem {
     pub columns: Vec<ColumnInfo>,
-    /// `2 x` number of pixels.
+    /// Rows of `Gamma`: `2 x` number of pixels, then one per layer with a prior on `C_l`.
     pub n_rows: usize,
     /// Frame shift `S` in arcsec.
     pub theta_shift_arcsec: f64,
@@ -248,7 +248,8 @@ impl LinearSystem {
             ((config.block_mbytes * 1e6 / bytes_per_pixel).floor() as usize).max(1);
         let mut system = Self {
             columns,
-            n_rows: 2 * constraints.pixels.len(),
+            n_rows: 2 * constraints.pixels.len()
+                + layers.iter().filter(|l| l.prior_sigma.is_some()).count(),
             theta_shift_arcsec,
             mass_unit_msun: config.mass_unit_msun,
             a: Vec::new(),
@@ -366,6 +367,23 @@ impl LinearSystem {
         Ok(())
     }
 
+    /// The rows after the pixels' rows: `C_l = 1` with weight `1 / sigma_l^2` for each layer
+    /// `l` that has a prior (`Layer::prior_sigma`), in layer order.
+    pub fn prior_rows(&self) -> RowBlock {
+        let n_cols = self.n_columns();
+        let mut out = RowBlock::default();
+        for (column, layer) in self.layer_columns().zip(&self.layers) {
+            if let Some(sigma) = layer.prior_sigma {
+                let mut row = vec![0.0; n_cols];
+                row[column] = 1.0;
+                out.gamma.extend(row);
+                out.theta.push(1.0);
+                out.weights.push(1.0 / (sigma * sigma));
+            }
+        }
+        out
+    }
+
     /// Fills `a`, `b` and `theta_w_theta` from blocks of rows.
     fn accumulate_normal(&mut self) -> Result<(), SystemError> {
         let n = self.n_columns();
@@ -386,6 +404,9 @@ impl LinearSystem {
                 .sum::<f64>();
             start = end;
         }
+        let prior = self.prior_rows();
+        acc.add_rows(&prior.gamma, &prior.weights, &prior.theta)?;
+        theta_w_theta += prior.weights.iter().sum::<f64>();
         let (a, b) = acc.finish();
         self.a = a;
         self.b = b;
