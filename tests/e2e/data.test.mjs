@@ -28,11 +28,18 @@ test('uploading the AS1063 catalogues reconstructs them', async () => {
     await page.setInputFiles('#file-members', join(AS1063, 'cats_gold_ref_potential_w_clumpNE.cat'));
     await page.waitForFunction(() => /members/.test(document.getElementById('status-members').textContent));
     await setField(page, '#set-z_lens', 0.348);
-    await setField(page, '#set-reconstruct-solver-iterations', 300);
+    // 50 point images do not fix the member factor C: a prior holds it near the M/L of 20
+    // (tests/reconstruct.rs measures the same run natively). Default iterations (8000).
+    await setField(page, '#set-reconstruct-members-c_prior_sigma', 0.1);
     await setField(page, '#set-reconstruct-products-size_arcsec', '');
     await page.click('#reconstruct');
     await waitStatus(page, /^Done in/, 120_000);
     await page.waitForFunction(() => document.getElementById('view-image').dataset.view === 'kappa');
+    // The published CATS model's Einstein radius at z_s = 2 is 29.8 arcsec (tests/reconstruct.rs
+    // evaluates it); the issue asks for 25%.
+    const caption = await page.textContent('#summary');
+    const thetaE = Number(caption.match(/Einstein radius (?:≥ )?([\d.]+)/)[1]);
+    assert.ok(Math.abs(thetaE - 29.8) <= 0.25 * 29.8, caption);
     const stats = await imageStats(page, '#view-image');
     assert.ok(stats.distinctColours > 200, `only ${stats.distinctColours} distinct colours`);
     assert.ok(stats.white > 100, `members not drawn (${stats.white} white pixels)`);

@@ -66,7 +66,9 @@ test('settings changed in quick succession all stick and survive a reload', asyn
     // Once more, two fields through the test helper back to back.
     await setField(page, '#set-h0', 68);
     await setField(page, '#set-reconstruct-grid-cells', 22);
+    await setField(page, '#set-reconstruct-members-c_prior_sigma', 0.2);
     want['#set-reconstruct-grid-cells'] = '22';
+    want['#set-reconstruct-members-c_prior_sigma'] = '0.2';
     want['#set-h0'] = '68';
     await waitAccepted(page, want);
     await page.reload();

@@ -11,6 +11,8 @@ export const FIELDS = [
   { path: 'reconstruct.members.mass_to_light', label: 'Members M/L [Msun/Lsun]', type: 'number', step: 1 },
   { path: 'reconstruct.members.layers', label: 'Member layers', type: 'text',
     hint: 'none, single, bcg or brightest:N' },
+  { path: 'reconstruct.members.c_prior_sigma', label: 'Prior width on the member factor C (empty: C free)', type: 'optional',
+    hint: 'e.g. 0.1 holds C near 1 (the M/L above); helps with few point images' },
   { path: 'reconstruct.constraints.mode', label: 'Constraint mode', type: 'select',
     options: ['ellipse', 'point', 'arcs'] },
   { path: 'reconstruct.solver.iterations', label: 'QADP iterations', type: 'int' },
