@@ -458,3 +458,44 @@ fn arc_pixels_are_drawn_in_system_colours_and_the_legend_leaves_the_map_free() {
         "no legend text under the map ({dark} dark pixels)"
     );
 }
+
+#[cfg_attr(not(target_arch = "wasm32"), test)]
+#[cfg_attr(target_arch = "wasm32", wasm_bindgen_test::wasm_bindgen_test)]
+fn the_data_view_follows_the_show_toggles() {
+    let mut s = Session::new();
+    s.load_text(DataRole::Arcs, "arcs.json", TWO_ARCS_JSON)
+        .unwrap();
+    s.load_text(
+        DataRole::Members,
+        "members.cat",
+        "#REFERENCE 3 0 0\n1 0.0 0.0 1 1 0 17.0 1\n2 -8.0 -6.0 1 1 0 18.5 1\n",
+    )
+    .unwrap();
+    let all = ViewOptions::default();
+    let png = |o: &ViewOptions| s.data_view(o).unwrap().png;
+    let no_members = ViewOptions {
+        show_members: false,
+        ..all
+    };
+    let no_images = ViewOptions {
+        show_observed: false,
+        ..all
+    };
+    let nothing = ViewOptions {
+        show_members: false,
+        show_observed: false,
+        ..all
+    };
+    let views = [png(&all), png(&no_members), png(&no_images), png(&nothing)];
+    for (i, a) in views.iter().enumerate() {
+        for b in &views[i + 1..] {
+            assert_ne!(a, b, "two settings of the toggles draw the same view");
+        }
+    }
+    // Same figure size: toggling does not move the field.
+    let size = |p: &[u8]| {
+        let pm = tiny_skia::Pixmap::decode_png(p).unwrap();
+        (pm.width(), pm.height())
+    };
+    assert_eq!(size(&views[0][..]).0, size(&views[3][..]).0);
+}

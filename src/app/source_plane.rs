@@ -153,8 +153,9 @@ impl Session {
         })
     }
 
-    /// The loaded data before any result: images (or arc pixels) and members on the field
-    /// a reconstruction would use (1.3 x their extent, at least 60 arcsec).
+    /// The loaded data before any result: images (or arc pixels) and members, as `opts`
+    /// selects, on the field a reconstruction would use (1.3 x their extent, at least 60
+    /// arcsec).
     pub fn data_view(&self, opts: &ViewOptions) -> Result<ViewPng, AppError> {
         let parsed = self.data.parse()?;
         let observed = parsed.observed_arcsec();
@@ -171,20 +172,25 @@ impl Session {
             geometry: g,
             data: vec![0.0; g.pixels * g.pixels],
         };
+        // The Show toggles as in the kappa view; the field stays that of all the data.
+        let mut points = Vec::new();
+        if opts.show_observed {
+            points.extend(arc_overlays(&marks.arcs, marks.arc_pixel_mas));
+        }
+        if opts.show_members {
+            points.push(set("members", MEMBER_RGB, Marker::Circle, marks.members));
+        }
+        if opts.show_observed {
+            points.push(set(
+                "observed images",
+                OBSERVED_RGB,
+                Marker::Plus,
+                marks.observed,
+            ));
+        }
         let overlay = Overlay {
             curves: None,
-            points: arc_overlays(&marks.arcs, marks.arc_pixel_mas)
-                .into_iter()
-                .chain([
-                    set("members", MEMBER_RGB, Marker::Circle, marks.members),
-                    set(
-                        "observed images",
-                        OBSERVED_RGB,
-                        Marker::Plus,
-                        marks.observed,
-                    ),
-                ])
-                .collect(),
+            points,
         };
         let plot = KappaPlotOptions {
             vmin: Some(-1.0),
