@@ -83,8 +83,11 @@ function caption(info) {
   const status = info.status ? `${info.status}, ${info.iterations} iterations; ` : '';
   // A null map side: the tangential curve leaves every map measured, the radius is a lower bound.
   const bound = s.einstein_radius_map_arcsec === null ? '≥ ' : '';
+  // A reconstruction's member factors C: 1 is the M/L of the settings.
+  const c = info.summary.c_per_layer ?? [];
+  const factors = c.length ? `member factor C = ${c.map((v) => v.toFixed(2)).join(', ')}; ` : '';
   $('summary').textContent = `${status}Einstein radius ${bound}${s.einstein_radius_arcsec.toFixed(1)}″ at ` +
-    `z_s = ${s.z_source}; ${s.tangential_curves} tangential and ${s.radial_curves} radial critical curves.`;
+    `z_s = ${s.z_source}; ${factors}${s.tangential_curves} tangential and ${s.radial_curves} radial critical curves.`;
 }
 
 async function showResult(info) {

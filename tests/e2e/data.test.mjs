@@ -40,6 +40,9 @@ test('uploading the AS1063 catalogues reconstructs them', async () => {
     const caption = await page.textContent('#summary');
     const thetaE = Number(caption.match(/Einstein radius (?:≥ )?([\d.]+)/)[1]);
     assert.ok(Math.abs(thetaE - 29.8) <= 0.25 * 29.8, caption);
+    // The caption gives the member factor, which the prior holds near 1 (1.04 natively).
+    const c = Number(caption.match(/member factor C = ([\d.]+)/)[1]);
+    assert.ok(Math.abs(c - 1) < 0.2, caption);
     const stats = await imageStats(page, '#view-image');
     assert.ok(stats.distinctColours > 200, `only ${stats.distinctColours} distinct colours`);
     assert.ok(stats.white > 100, `members not drawn (${stats.white} white pixels)`);
