@@ -113,6 +113,15 @@ fn a_bad_setting_is_refused_and_the_old_value_kept() {
     s.set_field("reconstruct.grid.width_arcsec", json!(null))
         .unwrap();
     assert_eq!(s.settings.reconstruct.grid.width_arcsec, None);
+    let err = s
+        .set_field("reconstruct.members.c_prior_sigma", json!(-0.1))
+        .unwrap_err()
+        .to_string();
+    assert!(err.contains("c_prior_sigma"), "{err}");
+    assert_eq!(s.settings.reconstruct.members.c_prior_sigma, None);
+    s.set_field("reconstruct.members.c_prior_sigma", json!(0.1))
+        .unwrap();
+    assert_eq!(s.settings.reconstruct.members.c_prior_sigma, Some(0.1));
     assert_eq!(
         s.settings.reconstruct.products.pixels,
         wslap::app::APP_MAP_PIXELS
