@@ -623,4 +623,24 @@ fn an_einstein_curve_larger_than_the_map_is_measured_on_a_wider_one() {
     let with_small = products_of(&lens, size);
     assert!(!with_small.curves.tangential_leaves_map);
     assert_eq!(with_small.einstein_radius_map_arcsec, Some(size));
+    // The main curve leaves through a narrow gap: the circle crosses the top row of pixel
+    // centres along 3 pixels (0.6% of the border, under TANGENTIAL_BORDER_SHARE), yet the
+    // open curve bounds nearly the whole disc, so the radius is measured on the wider map.
+    let pixel = size / 128.0;
+    let top_row = 0.5 * size - 0.5 * pixel;
+    let half_chord = 1.5 * pixel;
+    let centre_y = top_row + half_chord * half_chord / (2.0 * r_true) - r_true;
+    let gap = Sis::from_theta_e(DVec2::new(0.0, centre_y), THETA_E_ARCSEC).expect("SIS");
+    let through_gap = products_of(&gap, size);
+    assert!(through_gap.curves.tangential_leaves_map);
+    assert_eq!(
+        through_gap.einstein_radius_map_arcsec,
+        Some(EINSTEIN_MAP_WIDENING[0] * size)
+    );
+    assert_abs(
+        "radius through a gap",
+        through_gap.curves.einstein_radius_arcsec,
+        r_true,
+        0.1 * EINSTEIN_MAP_WIDENING[0] * pixel,
+    );
 }
