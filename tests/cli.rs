@@ -620,3 +620,35 @@ fn catalogue_units_nan_and_empty_systems_name_file_and_line() {
         "{err}"
     );
 }
+
+#[test]
+fn config_prints_every_setting_and_reads_back_as_the_defaults() {
+    use wslap::reconstruct::ReconstructConfig;
+    let out = wslap(&["config"]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let text = String::from_utf8(out.stdout).unwrap();
+    let read = ReconstructConfig::from_json_str(&text, "config output").unwrap();
+    assert_eq!(read, ReconstructConfig::default());
+    // Every field is written, the unset ones as null.
+    let json: serde_json::Value = serde_json::from_str(&text).unwrap();
+    assert_eq!(json["members"]["c_prior_sigma"], serde_json::Value::Null);
+    assert_eq!(json["solver"]["iterations"], 8000);
+    let fields: usize = json
+        .as_object()
+        .unwrap()
+        .values()
+        .map(|block| block.as_object().unwrap().len())
+        .sum();
+    let defaults = serde_json::to_value(ReconstructConfig::default()).unwrap();
+    let expected: usize = defaults
+        .as_object()
+        .unwrap()
+        .values()
+        .map(|block| block.as_object().unwrap().len())
+        .sum();
+    assert_eq!(fields, expected);
+}

@@ -25,6 +25,7 @@ struct Cli {
 enum Command {
     Maps(maps::MapsArgs),
     Reconstruct(reconstruct::ReconstructArgs),
+    Config(reconstruct::ConfigArgs),
     Simulate(simulate::SimulateArgs),
     Paper(paper::PaperArgs),
 }
@@ -35,6 +36,7 @@ pub fn run() -> ExitCode {
     let result = match cli.command {
         Command::Maps(args) => maps::run(&args),
         Command::Reconstruct(args) => reconstruct::run(&args),
+        Command::Config(_) => reconstruct::print_config(),
         Command::Simulate(args) => simulate::run(&args),
         Command::Paper(args) => paper::run(&args),
     };

@@ -41,7 +41,8 @@ pub struct ReconstructArgs {
     /// Lens redshift.
     #[arg(long)]
     z_lens: f64,
-    /// Settings (JSON); every field is optional, see README.md.
+    /// Settings (JSON); every field is optional. `wslap config` prints them all with their
+    /// defaults.
     #[arg(long, value_name = "CONFIG.json")]
     config: Option<PathBuf>,
     /// Systems to leave out of the fit and predict, e.g. 3,7.
@@ -65,6 +66,22 @@ pub struct ReconstructArgs {
     /// Output folder (created if missing).
     #[arg(long, value_name = "DIR")]
     out: PathBuf,
+}
+
+/// Prints every setting of `wslap reconstruct --config` with its default value.
+///
+/// The output is a complete CONFIG.json: save it, change what you need and pass it back with
+/// `--config` (fields left out keep these defaults; `null` means "not set", e.g. an automatic
+/// field width or no prior on C). What each field means and its allowed range: README.md and the
+/// `summary.json` of a run, which repeats the settings used.
+#[derive(Debug, Args)]
+pub struct ConfigArgs {}
+
+pub fn print_config() -> Result<(), String> {
+    let json = serde_json::to_string_pretty(&ReconstructConfig::default())
+        .map_err(|e| format!("writing the default settings: {e}"))?;
+    println!("{json}");
+    Ok(())
 }
 
 pub fn run(args: &ReconstructArgs) -> Result<(), String> {
