@@ -117,7 +117,7 @@ fn studies_markdown(s: &mut String, studies: &Studies, t: &TruthReport) {
         let _ = writeln!(s, "\n## The open defaults, measured (case ii)\n");
         let _ = writeln!(
             s,
-            "Each row changes one setting of case (ii) (galaxy-model layer; the member rows build the layer from members.cat instead). \"best\" = lowest median deflection error of its group; \"default\" = this run's setting (cell width and weighting of `wslap paper`; the member law of `wslap reconstruct`).\n"
+            "Each row changes one setting of case (ii) (galaxy-model layer; the member rows build the layer from members.cat instead; the c_prior_sigma rows add a prior on C around 1 of that width, which `wslap reconstruct` leaves off). \"best\" = lowest median deflection error of its group; \"default\" = this run's setting (cell width and weighting of `wslap paper`; the member law of `wslap reconstruct`).\n"
         );
         let _ = writeln!(s, "| setting | value | default | best | C | defl. err. median (\") | p90 (\") | max profile rel. err. | theta_E z=3 (\") |");
         let _ = writeln!(s, "|---|---|---|---|---|---|---|---|---|");

@@ -5,8 +5,9 @@
 //!   how much the answer depends on the start, and whether a lower chi2 means a truer mass.
 //! - **Sweep**: the defaults METHOD.md leaves open — the cell width (Gaussian sigma over the
 //!   cell size), the row weights, and the member scale-radius law of a layer built from the
-//!   member catalogue — scored by case (ii)'s median deflection error in the arc region (the
-//!   realistic case: galaxy positions known, masses not).
+//!   member catalogue — and the optional prior on C (`members.c_prior_sigma`, off by default),
+//!   scored by case (ii)'s median deflection error in the arc region (the realistic case:
+//!   galaxy positions known, masses not).
 
 use serde::{Deserialize, Serialize};
 
@@ -75,6 +76,9 @@ const R_S_LAWS: [(&str, f64, f64); 3] = [
     ("r_s = 20 kpc (M/M*)^(1/3)", 20.0, 1.0 / 3.0),
     ("r_s = 10 kpc (M/M*)^(1/2)", 10.0, 0.5),
 ];
+
+/// Widths of the prior on C in the sweep (besides none, the default).
+const C_PRIOR_SIGMAS: [f64; 2] = [0.3, 0.1];
 
 /// The layers and default-run scores the studies start from.
 pub(super) struct StudyInputs<'a> {
@@ -161,6 +165,14 @@ pub(super) fn run_studies(
     let bad_start = starts.iter().find(|r| r.label == "bad").cloned();
 
     let defaults = config.reconstruct_config(field, config.iterations);
+    // The galaxy-model layer with a prior on C of each width (made here: the rows borrow them).
+    let held_layers: Vec<Layer> = C_PRIOR_SIGMAS
+        .iter()
+        .map(|&sigma| Layer {
+            prior_sigma: Some(sigma),
+            ..layer_model.clone()
+        })
+        .collect();
     let mut sweep = Vec::new();
     // `rc = None`: the default case (ii) run, already scored.
     let mut row = |parameter: &str, value: String, is_default: bool, rc: Option<_>, layers| {
@@ -216,6 +228,17 @@ pub(super) fn run_studies(
         let is_default = w == defaults.constraints.weighting;
         let rc = (!is_default).then_some(rc);
         row("weighting", name, is_default, rc, model)?;
+    }
+    // The prior on C: the galaxy-model layer with a prior of each width ("none" is case ii).
+    row("c_prior_sigma", "none".to_string(), true, None, model)?;
+    for (sigma, held) in C_PRIOR_SIGMAS.iter().zip(&held_layers) {
+        row(
+            "c_prior_sigma",
+            format!("{sigma}"),
+            false,
+            Some(defaults.clone()),
+            LayerSource::Given(std::slice::from_ref(held)),
+        )?;
     }
     // The member layer from members.cat (what a user of `wslap reconstruct --members` gets).
     let (catalog, _) = parse_member_catalog(
