@@ -235,14 +235,16 @@ async function onFile(role, file) {
   }
 }
 
-// Files are taken one at a time, in the order they came (a drop of several files, or a picker
-// used while a file still loads): each must see what the one before it left. Two at once both
-// saw the example open, and each one's leaveExample cleared the file the other had just loaded.
-let fileQueue = Promise.resolve();
-function queueFile(role, file) {
-  fileQueue = fileQueue.then(() => onFile(role, file)).catch((err) => showError(err.message));
-  return fileQueue;
+// Files and examples are opened one at a time, in the order they came (a drop of several
+// files, a picker or the example menu used while a file still loads): each must see what the
+// one before it left. Two files at once both saw the example open, and each one's leaveExample
+// cleared the file the other had just loaded.
+let openQueue = Promise.resolve();
+function enqueue(task) {
+  openQueue = openQueue.then(task).catch((err) => showError(err.message));
+  return openQueue;
 }
+function queueFile(role, file) { return enqueue(() => onFile(role, file)); }
 
 async function applySetting(path, value) {
   if (path === 'reconstruct.products.z_source') return setZ(value);
@@ -295,7 +297,10 @@ async function start() {
   }
   $('example-select').innerHTML = '<option value="" disabled>(your data)</option>'
     + examples.map((e, k) => `<option value="${k}">${e.name}</option>`).join('');
-  $('example-select').addEventListener('change', () => loadExample(examples[$('example-select').value]));
+  $('example-select').addEventListener('change', () => {
+    const ex = examples[$('example-select').value];
+    enqueue(() => loadExample(ex));
+  });
   const { version, simd } = await client.ready;
   setStatus(`Worker ready (wslap ${version}).`);
   $('core-info').textContent = `Core: wslap ${version}, WebAssembly with ${

@@ -57,6 +57,31 @@ test('uploading the AS1063 catalogues reconstructs them', async () => {
   }
 });
 
+test('a file chosen while an example opens replaces that example once it is open', async () => {
+  const app = await openApp();
+  try {
+    const { page } = app;
+    await waitStatus(page, /^Ready/);
+    // The teaching example and, at once, a member catalogue: they are taken in that order, so
+    // the catalogue replaces the whole teaching example (not the example open before it, and
+    // not half of the teaching one).
+    await page.selectOption('#example-select', '1');
+    await page.setInputFiles('#file-members', join(AS1063, 'cats_gold_ref_potential_w_clumpNE.cat'));
+    const replaced = () => document.getElementById('project-name').textContent === 'Your data'
+      && /members/.test(document.getElementById('status-members').textContent);
+    await page.waitForFunction(replaced);
+    // Nothing queued behind it changes the session afterwards.
+    await page.waitForTimeout(1000);
+    assert.ok(await page.evaluate(replaced), await page.textContent('#project-name'));
+    for (const role of ['images', 'model', 'arcs']) {
+      assert.equal(await page.textContent(`#status-${role}`), '', `${role} of an example is left`);
+    }
+    assert.deepEqual(app.consoleErrors, []);
+  } finally {
+    await app.close();
+  }
+});
+
 test('a malformed catalogue shows its line and keeps the previous data', async () => {
   const app = await openApp();
   try {
