@@ -4,7 +4,7 @@
 import { LensClient } from './lens-client.js';
 import { loadProject, saveProject } from './js/store.js';
 import { buildFileRows, setFileStatus, ROLES } from './js/files.js';
-import { buildSettings, showSettings } from './js/settings.js';
+import { buildSettings, showSettings, valueAt } from './js/settings.js';
 import { wireViews, showPng, showSystems, viewOptions, currentView, refreshReadout } from './js/views.js';
 import { showDownloads } from './js/downloads.js';
 
@@ -197,9 +197,8 @@ async function leaveExample(ex, role) {
   }
   const current = await ask('settings');
   const defaults = await ask('defaultSettings');
-  const at = (tree, path) => path.split('.').reduce((node, key) => node?.[key], tree);
   for (const [path, value] of Object.entries({ z_lens: ex.z_lens, ...ex.settings })) {
-    if (at(current, path) === value) await ask('setField', { path, value: at(defaults, path) });
+    if (valueAt(current, path) === value) await ask('setField', { path, value: valueAt(defaults, path) });
   }
   await ask('setName', { name: OWN_DATA });
   describe(OWN_DATA, `Your files replace the example "${ex.name}": its other files and the ` +

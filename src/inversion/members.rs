@@ -477,10 +477,7 @@ pub fn build_member_layers(
             r_trunc_arcsec,
         });
     }
-    let mut layers = split_layers(config.layers, &halos, components);
-    for layer in &mut layers {
-        layer.prior_sigma = config.c_prior_sigma;
-    }
+    let layers = split_layers(config.layers, &halos, components, config.c_prior_sigma);
     Ok(MemberModel {
         halos,
         layers,
@@ -488,11 +485,13 @@ pub fn build_member_layers(
     })
 }
 
-/// Groups the halos (with their components, in the same order) into layers.
+/// Groups the halos (with their components, in the same order) into layers, each with the
+/// prior `prior_sigma` on its factor.
 fn split_layers(
     split: LayerSplit,
     halos: &[MemberHalo],
     components: Vec<Box<dyn MassComponent>>,
+    prior_sigma: Option<f64>,
 ) -> Vec<Layer> {
     let n_alone = match split {
         LayerSplit::None => return Vec::new(),
@@ -515,7 +514,7 @@ fn split_layers(
             name,
             members: vec![halos[k].member],
             lens: Arc::new(Lens::new(slots[k].take().into_iter().collect())),
-            prior_sigma: None,
+            prior_sigma,
         });
     }
     let mut rest: Vec<usize> = order[n_alone..].to_vec();
@@ -528,7 +527,7 @@ fn split_layers(
             lens: Arc::new(Lens::new(
                 rest.iter().filter_map(|&k| slots[k].take()).collect(),
             )),
-            prior_sigma: None,
+            prior_sigma,
         });
     }
     layers

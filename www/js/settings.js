@@ -31,7 +31,8 @@ let shown = -1; // revision of the settings the form shows
 const busy = new Map(); // input -> { edited: typed since its last change, waiting: number of its change in flight }
 const id = (path) => `set-${path.replaceAll('.', '-')}`;
 
-function get(obj, path) {
+/** The value at dot path `path` (e.g. 'reconstruct.grid.cells') of `obj`, or undefined. */
+export function valueAt(obj, path) {
   return path.split('.').reduce((o, k) => (o == null ? undefined : o[k]), obj);
 }
 
@@ -95,7 +96,7 @@ function refresh(settings) {
   for (const f of FIELDS) {
     const input = document.getElementById(id(f.path));
     if (!input) continue;
-    const v = get(settings, f.path);
+    const v = valueAt(settings, f.path);
     const text = v == null ? '' : String(v);
     input.dataset.good = text;
     const state = busy.get(input);
