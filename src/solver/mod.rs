@@ -7,11 +7,15 @@
 //!   multi-threaded natively), [`gram_weighted`] does it in one call.
 //! - [`QadpProblem`] runs the multiplicative update of Sha, Saul & Lee (2002) (QADP), the
 //!   paper's solver; the number of iterations is the regulariser.
+//! - [`accelerated_gradient`] is an accelerated projected gradient for the same problem: it
+//!   approaches the minimiser itself, which QADP's early stop avoids (for reports, and as a
+//!   solver option).
 //! - [`nnqp_exact`] is an exact active-set solver (Lawson–Hanson in QP form) for small problems,
 //!   the reference the tests compare QADP with.
 //!
 //! All matrices are dense, row-major `&[f64]` of `n * n` values.
 
+mod accelerated;
 mod gram;
 mod kernel;
 mod nnls;
@@ -22,6 +26,7 @@ mod wasm_simd;
 
 use thiserror::Error;
 
+pub use accelerated::accelerated_gradient;
 pub use gram::{gram_weighted, NormalEquations};
 pub use nnls::{nnqp_exact, NNQP_EXACT_MAX_UNKNOWNS};
 pub use qadp::{Control, Progress, QadpProblem, QadpSettings, SolveOutcome, SolveStatus};
