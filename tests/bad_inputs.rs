@@ -34,6 +34,11 @@ fn assert_place_once(message: &str) {
 fn config_syntax_errors_say_the_place_once() {
     let err = config_err("{\n  \"grid\": {\"cells\": }\n}");
     assert_eq!(err, "config.json: line 2, column 21: expected value");
+    let err = config_err("{\"solver\": {\"method\": \"newton\"}}");
+    assert!(
+        err.starts_with("config.json: line 1, column 30: unknown variant `newton`, expected `qadp` or `accelerated_gradient`"),
+        "{err}"
+    );
     let err = config_err("{\"solver\": {\"iterations\": 10, \"speed\": 2}}");
     assert!(
         err.starts_with("config.json: line 1, column 37: unknown field `speed`"),

@@ -12,7 +12,7 @@ use glam::DVec2;
 use serde::{Deserialize, Serialize};
 use thiserror::Error;
 
-pub use config::{ProductConfig, ReconstructConfig, SolverConfig};
+pub use config::{ProductConfig, ReconstructConfig, SolverConfig, SolverMethod};
 pub use sources::{ImageReport, SourceReport};
 pub use summary::{ReconstructSummary, Solved};
 
@@ -26,7 +26,7 @@ use crate::inversion::{
 use crate::products::{ProductOptions, Products, ProductsError};
 use crate::profiles::Lens;
 use crate::sky::SkyReference;
-use crate::solver::{Control, QadpProblem, SolveStatus, SolverError};
+use crate::solver::{accelerated_gradient, Control, QadpProblem, SolveStatus, SolverError};
 
 /// What can stop a reconstruction.
 #[derive(Debug, Error)]
@@ -202,7 +202,6 @@ pub fn reconstruct(
         timings.system_ms += t.ms();
         let t = crate::products::Clock::start();
         let x0 = start_values(&system, &config.solver);
-        let problem = QadpProblem::new(&system.a, &system.b, system.n_columns())?;
         let cells = system.cell_columns();
         let layer_cols = system.layer_columns();
         let unit = system.mass_unit_msun;
@@ -225,7 +224,15 @@ pub fn reconstruct(
             convergence.push(record);
             control
         };
-        let outcome = problem.run(&x0, &settings, &mut callback)?;
+        let n = system.n_columns();
+        let outcome = match config.solver.method {
+            SolverMethod::Qadp => {
+                QadpProblem::new(&system.a, &system.b, n)?.run(&x0, &settings, &mut callback)?
+            }
+            SolverMethod::AcceleratedGradient => {
+                accelerated_gradient(&system.a, &system.b, n, &x0, &settings, &mut callback)?
+            }
+        };
         timings.solve_ms += t.ms();
         if level < config.grid.refinements && outcome.status == SolveStatus::Completed {
             let masses = system.cell_masses_msun(&outcome.x)?;
