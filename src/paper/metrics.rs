@@ -9,7 +9,9 @@ use serde::{Deserialize, Serialize};
 
 use crate::curves::CriticalCurves;
 use crate::grid::{Map, MapGeometry};
+use crate::inversion::ConstraintSet;
 use crate::maps::LensMaps;
+use crate::profiles::MassComponent;
 
 /// The region that holds arcs: the disc around the field centre out to the outermost constraint
 /// pixel (the lensing data constrain nothing beyond it).
@@ -176,6 +178,35 @@ pub fn relative_errors(rec: &[f64], truth: &[f64]) -> Vec<f64> {
         .zip(truth)
         .map(|(r, t)| if *t != 0.0 { (r - t) / t } else { f64::NAN })
         .collect()
+}
+
+/// The weighted squared residual of the lens equation that the inversion minimises,
+/// `sum_i w_i |theta_i - f_s alpha(theta_i) - beta_s|^2` (both axes), for any `lens`, each
+/// system's `beta_s` its best for that lens (the weighted mean of `theta_i - f_s alpha`).
+/// For the reconstructed lens it is `2 phi + Theta^T W Theta` of the linear system.
+pub fn lens_equation_chi2(
+    constraints: &ConstraintSet,
+    distance_ratios: &[f64],
+    lens: &dyn MassComponent,
+) -> f64 {
+    let mut sums = vec![(DVec2::ZERO, 0.0); constraints.systems.len()];
+    let residuals: Vec<(usize, DVec2, f64)> = constraints
+        .pixels
+        .iter()
+        .map(|p| {
+            let u = p.position - distance_ratios[p.system] * lens.deflection(p.position);
+            sums[p.system].0 += p.weight * u;
+            sums[p.system].1 += p.weight;
+            (p.system, u, p.weight)
+        })
+        .collect();
+    residuals
+        .iter()
+        .map(|&(s, u, w)| {
+            let (sum, weight) = sums[s];
+            w * (u - sum / weight).length_squared()
+        })
+        .sum()
 }
 
 /// Projected mass inside `region`, Msun: `Sigma_cr_ref * sum(kappa) * pixel area` over the map

@@ -18,8 +18,14 @@
 //! (C 0.17, three times the soft mass in the arc region, 17" deflection errors) reaches the
 //! lowest chi2 of the four — source-plane residuals shrink with a more massive, more
 //! demagnifying lens, the paper's drift towards the "point-source solution" that the iteration
-//! count is there to stop. The grid mass depends on the start too; it is compared with the
-//! truth inside the arc region, where the data constrain it.
+//! count is there to stop. The studies measure it directly: the objective minimised much
+//! further (accelerated projected gradient, 10000 iterations) reaches chi2 56-57 from both
+//! the reasonable and the bad start, against 104 for the simulated lens itself and 422 for
+//! case (iii); it holds twice the soft mass in the arc region, and C = 0.03 or 0.72 depending
+//! on the start. So the truth is not the data's best fit, and no solver that converges can
+//! return it from every start; C ~ 1 and the soft mass can only come from where QADP is
+//! stopped. The grid mass is compared with the truth inside the arc region, where the data
+//! constrain it.
 
 mod figures;
 mod markdown;
@@ -33,7 +39,7 @@ use thiserror::Error;
 pub use figures::{render_figures, Figure};
 pub use markdown::markdown as report_markdown;
 pub use report::{CaseReport, Check, ConvergenceReport, PaperReport, RunSeries, TruthReport};
-pub use studies::{StartRun, Studies, SweepRow};
+pub use studies::{BestFit, StartRun, Studies, SweepRow};
 
 use crate::inversion::{ConstraintMode, ConstraintSource, Layer, Weighting};
 use crate::maps::LensMaps;
@@ -120,8 +126,11 @@ pub struct PaperConfig {
     /// Report every this many iterations.
     pub report_every: usize,
     /// Also run the studies of `report.md` (C from several starts, the bad start at
-    /// `iterations`, the sweep of the open defaults); default true.
+    /// `iterations`, the data's best fit, the sweep of the open defaults); default true.
     pub studies: bool,
+    /// Iterations of the accelerated projected gradient that finds the data's best fit in the
+    /// studies (default 10000: chi2 within ~5% of its limit, 4 s natively).
+    pub best_fit_iterations: usize,
 }
 
 impl Default for PaperConfig {
@@ -141,6 +150,7 @@ impl Default for PaperConfig {
             reasonable_start_c: solver.start_c,
             report_every: 100,
             studies: true,
+            best_fit_iterations: 10_000,
         }
     }
 }
@@ -218,10 +228,12 @@ impl PaperConfig {
             value,
             reason,
         };
-        if self.iterations == 0 || self.long_iterations == 0 {
+        if self.iterations == 0 || self.long_iterations == 0 || self.best_fit_iterations == 0 {
             return Err(bad(
                 "iterations",
-                self.iterations.min(self.long_iterations) as f64,
+                self.iterations
+                    .min(self.long_iterations)
+                    .min(self.best_fit_iterations) as f64,
                 "must be at least 1",
             ));
         }
