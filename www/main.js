@@ -80,7 +80,10 @@ async function render() {
 
 function caption(info) {
   const s = info.summary.maps ?? info.summary;
-  const status = info.status ? `${info.status}, ${info.iterations} iterations; ` : '';
+  // The solver, when it is not the paper's QADP.
+  const best = info.summary.settings?.solver?.method === 'accelerated_gradient'
+    ? ' of the accelerated gradient (the best fit, not QADP)' : '';
+  const status = info.status ? `${info.status}, ${info.iterations} iterations${best}; ` : '';
   // A null map side: the tangential curve leaves every map measured, the radius is a lower bound.
   const bound = s.einstein_radius_map_arcsec === null ? '≥ ' : '';
   // A reconstruction's member factors C: 1 is the M/L of the settings.

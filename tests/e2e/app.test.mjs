@@ -124,6 +124,13 @@ test('the teaching example loads from the menu and reconstructs', async () => {
     await page.waitForSelector('#systems table');
     assert.equal(await page.locator('#systems tbody tr').count(), 4);
     await page.screenshot({ path: join(ARTIFACTS, 'app-teaching.png'), fullPage: true });
+    assert.doesNotMatch(await page.textContent('#summary'), /accelerated gradient/);
+    // The solver setting: the best fit's run says so in the caption.
+    await setField(page, '#set-reconstruct-solver-method', 'accelerated_gradient');
+    assert.equal(await page.$eval('#set-reconstruct-solver-method', (el) => el.selectedOptions[0].textContent), 'best fit');
+    await page.click('#reconstruct');
+    await waitStatus(page, /^Done in/);
+    await page.waitForFunction(() => /accelerated gradient/.test(document.getElementById('summary').textContent));
     assert.deepEqual(app.consoleErrors, []);
   } finally {
     await app.close();

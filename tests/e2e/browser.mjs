@@ -73,11 +73,20 @@ export async function imageStats(page, selector, { rgb = [0, 0, 0], tol = -1 } =
   }, [rgb, tol]);
 }
 
-/** Types `value` into the input `selector` and commits it (a change event). */
+/** Types `value` into the input `selector` (or picks the option of that value of a select) and
+ * commits it (a change event). */
 export async function setField(page, selector, value) {
-  await page.$eval(selector, (el) => { const d = el.closest('details'); if (d) d.open = true; });
-  await page.locator(selector).fill(String(value));
-  await page.locator(selector).dispatchEvent('change');
+  const tag = await page.$eval(selector, (el) => {
+    const d = el.closest('details');
+    if (d) d.open = true;
+    return el.tagName;
+  });
+  if (tag === 'SELECT') {
+    await page.locator(selector).selectOption(String(value));
+  } else {
+    await page.locator(selector).fill(String(value));
+    await page.locator(selector).dispatchEvent('change');
+  }
   // Settings inputs remember the last accepted value in data-good; wait for it (or an error).
   const isSetting = await page.$eval(selector, (el) => el.id.startsWith('set-'));
   if (!isSetting) return;

@@ -15,7 +15,10 @@ export const FIELDS = [
     hint: 'e.g. 0.1 holds C near 1 (the M/L above); helps with few point images' },
   { path: 'reconstruct.constraints.mode', label: 'Constraint mode', type: 'select',
     options: ['ellipse', 'point', 'arcs'] },
-  { path: 'reconstruct.solver.iterations', label: 'QADP iterations', type: 'int' },
+  { path: 'reconstruct.solver.method', label: 'Solver', type: 'select',
+    options: [['qadp', 'QADP (paper)'], ['accelerated_gradient', 'best fit']],
+    hint: 'QADP stopped early is the paper\'s method (the iteration count regularises); the best fit (accelerated gradient) over-fits extended arcs: too much mass, shrunken sources' },
+  { path: 'reconstruct.solver.iterations', label: 'Iterations', type: 'int' },
   { path: 'reconstruct.products.z_source', label: 'z_s of the curves', type: 'number', step: 0.1 },
   { path: 'reconstruct.products.pixels', label: 'Map pixels per side', type: 'int' },
   { path: 'reconstruct.products.size_arcsec', label: 'Map width [arcsec] (empty: the field)', type: 'optional' },
@@ -50,7 +53,9 @@ export function buildSettings(form, apply) {
     const row = document.createElement('div');
     row.className = 'field';
     const control = f.type === 'select'
-      ? `<select id="${id(f.path)}">${f.options.map((o) => `<option>${o}</option>`).join('')}</select>`
+      ? `<select id="${id(f.path)}">${f.options.map((o) => (Array.isArray(o)
+        ? `<option value="${o[0]}">${o[1]}</option>`
+        : `<option>${o}</option>`)).join('')}</select>`
       : `<input id="${id(f.path)}" type="${f.type === 'text' ? 'text' : 'number'}" ${f.step ? `step="${f.step}"` : ''}>`;
     row.innerHTML = `<label for="${id(f.path)}">${f.label}</label>${control}
       ${f.hint ? `<small class="hint">${f.hint}</small>` : ''}
