@@ -240,18 +240,24 @@ fn zero_start_component_stays_zero() {
     assert_eq!(outcome.x[k], 0.0);
 }
 
-#[cfg_attr(not(target_arch = "wasm32"), test)]
-#[cfg_attr(target_arch = "wasm32", wasm_bindgen_test::wasm_bindgen_test)]
-fn zero_rows_go_to_zero_or_stay() {
-    // Unknown 1 has a zero row: b_1 > 0 sends it to 0; unknown 3 (zero row, b_3 = 0) keeps
-    // its start. The others solve the 2x2 problem of `two_by_two_with_active_bound`.
+/// Unknown 1 has a zero row: `b_1 > 0` sends it to 0; unknown 3 (zero row, `b_3 = 0`) keeps
+/// its start. Unknowns 0 and 2 solve the 2x2 problem of `two_by_two_with_active_bound`
+/// (`x = (0.5, 0)`).
+fn zero_row_problem() -> (Vec<f64>, [f64; 4]) {
     let n = 4;
     let mut a = vec![0.0; n * n];
     a[0] = 2.0;
     a[2] = 1.0;
     a[2 * n] = 1.0;
     a[2 * n + 2] = 2.0;
-    let b = [-1.0, 3.0, 1.0, 0.0];
+    (a, [-1.0, 3.0, 1.0, 0.0])
+}
+
+#[cfg_attr(not(target_arch = "wasm32"), test)]
+#[cfg_attr(target_arch = "wasm32", wasm_bindgen_test::wasm_bindgen_test)]
+fn zero_rows_go_to_zero_or_stay() {
+    let n = 4;
+    let (a, b) = zero_row_problem();
     let problem = QadpProblem::new(&a, &b, n).expect("valid problem");
     let outcome = problem
         .run(&[1.0, 1.0, 1.0, 0.7], &QadpSettings::default(), &mut |_| {
@@ -548,14 +554,8 @@ fn accelerated_gradient_goes_further_than_qadp_per_iteration() {
 #[cfg_attr(not(target_arch = "wasm32"), test)]
 #[cfg_attr(target_arch = "wasm32", wasm_bindgen_test::wasm_bindgen_test)]
 fn accelerated_gradient_cancels_and_handles_zero_rows() {
-    // The problem of `zero_rows_go_to_zero_or_stay`.
     let n = 4;
-    let mut a = vec![0.0; n * n];
-    a[0] = 2.0;
-    a[2] = 1.0;
-    a[2 * n] = 1.0;
-    a[2 * n + 2] = 2.0;
-    let b = [-1.0, 3.0, 1.0, 0.0];
+    let (a, b) = zero_row_problem();
     let settings = QadpSettings::default();
     let outcome = accelerated_gradient(&a, &b, n, &[1.0, 1.0, 1.0, 0.7], &settings, &mut |_| {
         Control::Continue

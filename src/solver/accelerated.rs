@@ -21,7 +21,7 @@
 //! One product with `A` (f64, the whole matrix) per iteration; natively its rows are shared
 //! between threads, on wasm32 it runs on one.
 
-use super::qadp::{Control, Progress, QadpSettings, SolveOutcome, SolveStatus};
+use super::qadp::{drive, Control, Progress, QadpSettings, SolveOutcome};
 use super::{check_finite, check_len, validate_system, SolverError};
 
 /// Power-iteration steps for the largest eigenvalue of the scaled Hessian.
@@ -95,36 +95,10 @@ pub fn accelerated_gradient(
     let mut y_next = vec![0.0; n];
     let mut grad = vec![0.0; n];
     let mut t = 1.0f64;
-    let mut outcome = SolveOutcome {
-        x: vec![0.0; n],
-        iterations: 0,
-        objective: 0.0,
-        status: SolveStatus::Completed,
-    };
-    to_x(&y, &mut outcome.x);
-    outcome.objective = objective_at(&outcome.x);
-    if !outcome.objective.is_finite() {
-        return Err(SolverError::NonFinite {
-            what: "objective at x0",
-            index: 0,
-            value: outcome.objective,
-        });
-    }
-    loop {
-        let progress = Progress {
-            iteration: outcome.iterations,
-            objective: outcome.objective,
-            x: &outcome.x,
-        };
-        if callback(&progress) == Control::Cancel {
-            outcome.status = SolveStatus::Cancelled;
-            return Ok(outcome);
-        }
-        let done = outcome.iterations;
-        if done >= settings.iterations {
-            return Ok(outcome);
-        }
-        let steps = settings.report_every.min(settings.iterations - done);
+    let mut x_start = vec![0.0; n];
+    to_x(&y, &mut x_start);
+    let objective0 = objective_at(&x_start);
+    drive(x_start, objective0, settings, callback, &mut |_, steps| {
         for _ in 0..steps {
             m_times(&v, &mut grad);
             let mut against = 0.0;
@@ -155,14 +129,8 @@ pub fn accelerated_gradient(
         let mut x = vec![0.0; n];
         to_x(&y, &mut x);
         let objective = objective_at(&x);
-        if !objective.is_finite() || x.iter().any(|x| !x.is_finite()) {
-            outcome.status = SolveStatus::Diverged;
-            return Ok(outcome);
-        }
-        outcome.x = x;
-        outcome.iterations = done + steps;
-        outcome.objective = objective;
-    }
+        Some((x, objective))
+    })
 }
 
 /// Threads for the products: `requested`, or all available when 0, at most one per

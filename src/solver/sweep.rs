@@ -12,7 +12,7 @@ use std::ops::Range;
 use std::sync::atomic::{AtomicU64, AtomicUsize, Ordering};
 
 use super::kernel::{band_pass, PassSums, UpperTriangle};
-use super::qadp::{Control, Progress, QadpSettings, SolveOutcome, SolveStatus};
+use super::qadp::{drive, Control, Progress, QadpSettings, SolveOutcome};
 use super::SolverError;
 
 /// Entries of the unit-diagonal matrix below this are stored as 0: they change a sum by less
@@ -170,52 +170,22 @@ pub(crate) fn run_chunks(
     run_chunk(p, &shared, &mut bands, true, 0, 0);
     let objective_of =
         |bands: &[Band]| p.objective_scale * bands.iter().map(|b| b.partial_objective).sum::<f64>();
-    let mut outcome = SolveOutcome {
-        x: x0.to_vec(),
-        iterations: 0,
-        objective: objective_of(&bands),
-        status: SolveStatus::Completed,
-    };
-    if !outcome.objective.is_finite() {
-        return Err(SolverError::NonFinite {
-            what: "objective at x0",
-            index: 0,
-            value: outcome.objective,
-        });
-    }
-    let mut next_x = vec![0.0; n];
-    loop {
-        let progress = Progress {
-            iteration: outcome.iterations,
-            objective: outcome.objective,
-            x: &outcome.x,
-        };
-        if callback(&progress) == Control::Cancel {
-            outcome.status = SolveStatus::Cancelled;
-            return Ok(outcome);
-        }
-        let t = outcome.iterations;
-        if t >= settings.iterations {
-            return Ok(outcome);
-        }
-        let steps = settings.report_every.min(settings.iterations - t);
-        run_chunk(p, &shared, &mut bands, false, steps, t % 2);
-        let objective = objective_of(&bands);
-        for ((x, z), s) in next_x
-            .iter_mut()
-            .zip(&shared.z[(t + steps) % 2])
-            .zip(&p.to_scaled)
-        {
-            *x = f64::from_bits(z.load(Ordering::Relaxed)) / s;
-        }
-        if !objective.is_finite() || next_x.iter().any(|x| !x.is_finite()) {
-            outcome.status = SolveStatus::Diverged;
-            return Ok(outcome);
-        }
-        std::mem::swap(&mut outcome.x, &mut next_x);
-        outcome.iterations = t + steps;
-        outcome.objective = objective;
-    }
+    let objective0 = objective_of(&bands);
+    drive(
+        x0.to_vec(),
+        objective0,
+        settings,
+        callback,
+        &mut |done, steps| {
+            run_chunk(p, &shared, &mut bands, false, steps, done % 2);
+            let x = shared.z[(done + steps) % 2]
+                .iter()
+                .zip(&p.to_scaled)
+                .map(|(z, s)| f64::from_bits(z.load(Ordering::Relaxed)) / s)
+                .collect();
+            Some((x, objective_of(&bands)))
+        },
+    )
 }
 
 /// `steps` updates starting from version `parity` of `Z` (preceded by a pass if `initial`),
