@@ -47,8 +47,8 @@ pub struct PaperArgs {
     /// Row weighting: equal_per_image, equal_per_pixel or equal_per_system.
     #[arg(long)]
     weighting: Option<String>,
-    /// Skip the studies of report.md (C from several starts, the sweep of the open defaults):
-    /// about half the run time.
+    /// Skip the studies of report.md (C from several starts, the data's best fit, the sweep of
+    /// the open defaults): about half the run time.
     #[arg(long)]
     no_studies: bool,
 }
