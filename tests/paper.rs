@@ -132,6 +132,16 @@ fn reduced_paper_run_reproduces_the_orderings() {
         );
     }
     assert!(context.contains("The truth is not the best fit of its own arcs"));
+    let c_check = r
+        .checks
+        .iter()
+        .find(|c| c.name.starts_with("(iii) C within 10%"))
+        .unwrap();
+    assert!(
+        c_check.detail.contains("the data's best fit: C = "),
+        "{}",
+        c_check.detail
+    );
     // The truth's chi2 is computed from a lens, each system's beta its best: for the lens of
     // case (iii) it must equal the linear system's chi2 at case (iii)'s masses with those betas.
     let rec = &run
