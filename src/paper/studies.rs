@@ -324,13 +324,7 @@ fn row_weight_sum(rec: &Reconstruction) -> f64 {
 }
 
 /// A run of case (iii)'s data from a start (`mass`, `c0`), with its scores `r`.
-pub(super) fn start_run(
-    label: &str,
-    mass: f64,
-    c0: f64,
-    rec: &Reconstruction,
-    r: &CaseReport,
-) -> StartRun {
+fn start_run(label: &str, mass: f64, c0: f64, rec: &Reconstruction, r: &CaseReport) -> StartRun {
     // In f64: QADP's own report of the objective comes from its single-precision pass, and
     // chi2 is a small difference of large terms (the frame shift's constant).
     let objective = crate::solver::objective(&rec.system.a, &rec.system.b, &rec.x);
