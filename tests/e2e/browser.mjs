@@ -8,6 +8,11 @@ import { serve } from '../../.ci/serve.mjs';
 
 export const ROOT = join(dirname(fileURLToPath(import.meta.url)), '..', '..');
 export const ARTIFACTS = join(ROOT, 'test-artifacts');
+/** How long a setting may take to be accepted by the worker (ms). The worker takes messages in
+ * turn, so a setting waits for the jobs sent before it (the views drawn after a file loaded),
+ * which on a loaded machine can take well over 15 s; the limit only turns a hang into a
+ * failure, it measures nothing. */
+export const SETTLE_TIMEOUT_MS = 60_000;
 
 const CHROMIUM_FLAGS = [
   '--headless', '--no-sandbox', '--disable-gpu', '--disable-background-networking',
@@ -96,7 +101,7 @@ export async function setField(page, selector, value) {
       const err = document.getElementById(`${el.id}-error`);
       if (err && err.textContent) throw new Error(`${sel}: ${err.textContent}`);
       return el.dataset.good === v && el.value === v;
-    }, [selector, String(value)], { timeout: 15_000 });
+    }, [selector, String(value)], { timeout: SETTLE_TIMEOUT_MS });
   } catch (err) {
     const [shown, good] = await page.$eval(selector, (el) => [el.value, el.dataset.good]);
     const status = await page.textContent('#status');

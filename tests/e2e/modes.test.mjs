@@ -6,7 +6,7 @@ import assert from 'node:assert/strict';
 import { join } from 'node:path';
 import { readFile, writeFile, mkdtemp } from 'node:fs/promises';
 import { tmpdir } from 'node:os';
-import { openApp, imageStats, ARTIFACTS, ROOT, setField, waitStatus } from './browser.mjs';
+import { openApp, imageStats, ARTIFACTS, ROOT, SETTLE_TIMEOUT_MS, setField, waitStatus } from './browser.mjs';
 
 const AS1063 = join(ROOT, '..', 'shared', 'data', 'AS1063', 'lenstool_cats');
 const TEACHING_MODEL = join(ROOT, 'www', 'examples', 'teaching', 'model.json');
@@ -26,7 +26,7 @@ async function waitAccepted(page, want) {
   await page.waitForFunction((w) => Object.entries(w).every(([sel, v]) => {
     const el = document.querySelector(sel);
     return el.value === v && el.dataset.good === v;
-  }), want, { timeout: 15_000 });
+  }), want, { timeout: SETTLE_TIMEOUT_MS });
 }
 
 test('settings changed in quick succession all stick and survive a reload', async () => {
