@@ -2,8 +2,11 @@
 //
 // Every same-origin GET goes to the network first, so a rebuilt app is used at once, and its
 // answer is kept in the cache; when the network fails, the cached answer is served. At install
-// the app's own files, both builds of the core (the worker picks one per browser) and the
-// built-in examples are cached, so one visit is enough to work offline afterwards.
+// the app's own files, the build of the core this browser runs (js/simd.js: the worker makes
+// the same choice; the other build is 1.7 MB this browser never needs) and the built-in
+// examples are cached, so one visit is enough to work offline afterwards.
+
+importScripts('js/simd.js');
 
 const CACHE = 'wslap-app';
 const APP_FILES = [
@@ -16,11 +19,11 @@ const APP_FILES = [
   'js/downloads.js',
   'js/files.js',
   'js/settings.js',
+  'js/simd.js',
   'js/store.js',
   'js/views.js',
   'pkg/wslap.js',
-  'pkg/wslap_bg.wasm',
-  'pkg/wslap_relaxed_bg.wasm',
+  self.wslapCore.hasRelaxedSimd() ? self.wslapCore.relaxed : self.wslapCore.baseline,
   'examples/index.json',
 ];
 

@@ -2,25 +2,20 @@
 // AppSession; one message switch on `msg.type`; every job answers `result` or `error` by id.
 
 import init, * as core from './pkg/wslap.js';
+import './js/simd.js';
 
-// The core is built twice (.ci/lib.sh): for relaxed SIMD (fused multiply-add in the solver's
-// kernels, faster) and for baseline SIMD. This 36-byte module, one function using the
-// relaxed-SIMD instruction i8x16.relaxed_swizzle, validates only where the browser has relaxed
-// SIMD. `?simd=baseline` on the page (passed on by lens-client.js) forces the baseline module.
-const RELAXED_SIMD_PROBE = new Uint8Array([
-  0, 97, 115, 109, 1, 0, 0, 0, 1, 5, 1, 96, 0, 1, 123, 3, 2, 1, 0, 10, 15, 1, 13, 0, 65, 1, 253,
-  15, 65, 2, 253, 15, 253, 128, 2, 11,
-]);
+// The two builds of the core (js/simd.js). `?simd=baseline` on the page (passed on by
+// lens-client.js) forces the baseline module.
 const CORE = {
-  relaxed: new URL('./pkg/wslap_relaxed_bg.wasm', import.meta.url),
-  baseline: new URL('./pkg/wslap_bg.wasm', import.meta.url),
+  relaxed: new URL(self.wslapCore.relaxed, import.meta.url),
+  baseline: new URL(self.wslapCore.baseline, import.meta.url),
 };
 
 // Loads the relaxed-SIMD core where it can run, else (or if it fails to load) the baseline one;
 // returns which.
 async function loadCore() {
   const forced = new URLSearchParams(self.location.search).get('simd');
-  if (forced !== 'baseline' && WebAssembly.validate(RELAXED_SIMD_PROBE)) {
+  if (forced !== 'baseline' && self.wslapCore.hasRelaxedSimd()) {
     try {
       await init({ module_or_path: CORE.relaxed });
       return 'relaxed';
