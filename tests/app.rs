@@ -7,7 +7,10 @@ mod common;
 use glam::DVec2;
 use serde_json::json;
 use wslap::app::examples::{teaching_image_catalog, TEACHING_SOURCES};
-use wslap::app::{system_rgb, DataRole, RunKind, Session, ViewOptions, MAX_STORED_FITS_BYTES};
+use wslap::app::{
+    system_rgb, DataRole, RunKind, Session, ViewOptions, MAX_STORED_FITS_BYTES,
+    SHOWN_MIN_MAGNIFICATION,
+};
 use wslap::demo::TEACHING_MODEL_JSON;
 use wslap::render::{LegendPlace, PIXEL_ALPHA};
 use wslap::solver::Control;
@@ -211,6 +214,41 @@ fn reconstruction_gives_curves_views_hover_and_the_cli_files() {
         header.contains("NAXIS1  =                   64"),
         "{header}"
     );
+}
+
+/// The map draws the predicted images down to `|mu|` = [`SHOWN_MIN_MAGNIFICATION`]; the
+/// demagnified central images below it stay in `sources.json`.
+#[cfg_attr(not(target_arch = "wasm32"), test)]
+#[cfg_attr(target_arch = "wasm32", wasm_bindgen_test::wasm_bindgen_test)]
+fn the_map_leaves_out_the_demagnified_predicted_images() {
+    let s = solved();
+    let r = s.result().unwrap();
+    let all: Vec<_> = r
+        .reconstruction
+        .iter()
+        .flat_map(|rec| rec.sources.iter())
+        .flat_map(|src| src.predicted.iter())
+        .collect();
+    let faint = all
+        .iter()
+        .filter(|p| p.magnification.abs() < SHOWN_MIN_MAGNIFICATION)
+        .count();
+    let shown = r.predicted();
+    println!("{} predicted, {faint} fainter than the limit", all.len());
+    assert!(faint > 0, "the teaching lens predicts no demagnified image");
+    assert_eq!(shown.len(), all.len() - faint);
+    for p in &shown {
+        let image = all.iter().find(|a| a.position_arcsec == *p).unwrap();
+        assert!(image.magnification.abs() >= SHOWN_MIN_MAGNIFICATION);
+    }
+    let sources: serde_json::Value = serde_json::from_str(&r.sources_json().unwrap()).unwrap();
+    let listed: usize = sources
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|src| src["predicted"].as_array().unwrap().len())
+        .sum();
+    assert_eq!(listed, all.len());
 }
 
 #[cfg_attr(not(target_arch = "wasm32"), test)]

@@ -22,7 +22,7 @@ pub use data::{
     MAX_STORED_FITS_BYTES,
 };
 pub use project::{Project, ProjectResult, StoredFits, PROJECT_FORMAT, PROJECT_VERSION};
-pub use run::{RunKind, SessionResult};
+pub use run::{RunKind, SessionResult, SHOWN_MIN_MAGNIFICATION};
 pub use settings::{AppSettings, APP_MAP_PIXELS};
 pub use views::{system_rgb, HoverReadout, ViewOptions, ViewPng, SYSTEM_RGB};
 

@@ -10,7 +10,7 @@ use crate::render::{
 };
 
 use super::data::ArcPixels;
-use super::{AppError, Session};
+use super::{AppError, Session, SHOWN_MIN_MAGNIFICATION};
 
 /// Observed images: magenta plus signs.
 pub const OBSERVED_RGB: [u8; 3] = [255, 60, 255];
@@ -154,9 +154,10 @@ impl Session {
         }
         if opts.show_predicted {
             let p = r.predicted();
+            let label = format!("predicted, |μ| >= {SHOWN_MIN_MAGNIFICATION}");
             overlay
                 .points
-                .push(points("predicted", PREDICTED_RGB, Marker::Cross, p));
+                .push(points(&label, PREDICTED_RGB, Marker::Cross, p));
         }
         Ok(overlay)
     }

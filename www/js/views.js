@@ -83,7 +83,7 @@ export function showSystems(sources) {
     <td>${s.observed.map((o) => `${o.id}: ${f(o.offset_arcsec)}`).join('<br>')}</td>
     <td>${f(s.image_plane_rms_arcsec)}</td></tr>`).join('');
   box.innerHTML = sources.length === 0 ? '<p class="hint">No systems: not a reconstruction.</p>'
-    : `<div class="table-scroll"><table><caption>Per system: redshift, solved source position β, source-plane scatter, images observed / predicted, offsets of the observed images from the nearest predicted one (arcsec)</caption>
+    : `<div class="table-scroll"><table><caption>Per system: redshift, solved source position β, source-plane scatter, images observed / predicted (all of them; the map leaves out the demagnified ones, |μ| &lt; 0.1), offsets of the observed images from the nearest predicted one (arcsec)</caption>
     <thead><tr><th scope="col">system</th><th scope="col">z</th><th scope="col">β [″]</th><th scope="col">scatter [″]</th>
     <th scope="col">images</th><th scope="col">offsets [″]</th><th scope="col">rms [″]</th></tr></thead><tbody>${rows}</tbody></table></div>`;
   box.hidden = false;
