@@ -33,6 +33,9 @@ pub mod metrics;
 mod report;
 mod studies;
 
+use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
+use std::sync::Mutex;
+
 use glam::DVec2;
 use thiserror::Error;
 
@@ -322,54 +325,17 @@ pub fn run_paper(config: &PaperConfig, say: &mut dyn FnMut(&str)) -> Result<Pape
         bins: &bins,
         plane,
     };
-    let mut cases = Vec::new();
-    for case in Case::ALL {
-        let layers: &[Layer] = match case {
+    // The three cases and the convergence study (the galaxy-true layer from the reasonable and
+    // the bad start, and the grid alone, each for `long_iterations`) run as one batch.
+    let case_layers = |case: Case| -> &[Layer] {
+        match case {
             Case::NoGalaxies => &[],
             Case::GalaxyModel => std::slice::from_ref(&layer_model),
             Case::GalaxyTrue => std::slice::from_ref(&layer_true),
-        };
-        let rc = config.reconstruct_config(field, config.iterations);
-        let rec = run_one(&simulation, given(layers), &rc, case.key())?;
-        let scored = scorer.score(&rec, case.key())?;
-        let report = &scored.report;
-        say(&format!(
-            "{}: grid mass {:.3e} Msun ({:.3e} inside the arc region), C {:?}, deflection error median {:.2}\" p90 {:.2}\", theta_E(z=3) {:.1}\" ({:.1} s)",
-            case.label(),
-            report.grid_mass_msun,
-            report.grid_mass_region_msun,
-            report.c,
-            report.deflection_error_median_arcsec,
-            report.deflection_error_p90_arcsec,
-            report.einstein_radius_arcsec_z3,
-            (rec.timings.system_ms + rec.timings.solve_ms + rec.timings.products_ms + rec.timings.sources_ms) / 1e3
-        ));
-        cases.push(CaseRun {
-            case,
-            profile: scored.profile,
-            soft_kappa: scored.soft_kappa,
-            deflection_error: scored.deflection_error,
-            report: scored.report,
-            reconstruction: rec,
-        });
-    }
-    let studies = if config.studies {
-        let inputs = studies::StudyInputs {
-            layer_true: &layer_true,
-            layer_model: &layer_model,
-            case_ii: case_run(&cases, Case::GalaxyModel),
-            case_iii: case_run(&cases, Case::GalaxyTrue),
-        };
-        studies::run_studies(config, &simulation, &scorer, &inputs, say)?
-    } else {
-        Studies::default()
+        }
     };
-
-    // The convergence study: the galaxy-true layer from the reasonable and the bad start, and
-    // the grid alone, each for `long_iterations`.
     let soft_per_cell = simulation.soft_mass_msun / (config.grid_cells * config.grid_cells) as f64;
-    let mut series = Vec::new();
-    for (name, layers, start_mass, start_c) in [
+    let long_runs = [
         (
             "reasonable",
             std::slice::from_ref(&layer_true),
@@ -388,24 +354,98 @@ pub fn run_paper(config: &PaperConfig, say: &mut dyn FnMut(&str)) -> Result<Pape
             config.reasonable_start_cell_mass_msun,
             config.reasonable_start_c,
         ),
-    ] {
+    ];
+    let mut jobs: Vec<Job> = Case::ALL
+        .iter()
+        .map(|&case| Job {
+            layers: given(case_layers(case)),
+            config: config.reconstruct_config(field, config.iterations),
+            name: case.key(),
+        })
+        .collect();
+    for (name, layers, start_mass, start_c) in long_runs {
         let mut rc = config.reconstruct_config(field, config.long_iterations);
         rc.solver.start_cell_mass_msun = start_mass;
         rc.solver.start_c = start_c;
         // Only the convergence records are used: coarse product maps save time.
         rc.products.pixels = 64;
-        let t = Clock::start();
-        let rec = run_one(&simulation, given(layers), &rc, name)?;
-        let run = RunSeries::from_records(&rec, &truth_betas);
-        say(&format!(
-            "convergence, {name}: {} iterations, final grid mass {:.3e} Msun, C {:?} ({:.1} s)",
-            config.long_iterations,
-            run.grid_mass_msun.last().copied().unwrap_or(f64::NAN),
-            run.c.last(),
-            t.ms() / 1e3
-        ));
-        series.push((name, run, rec.convergence));
+        jobs.push(Job {
+            layers: given(layers),
+            config: rc,
+            name,
+        });
     }
+    enum Done {
+        Case(Box<Scored>, Box<Reconstruction>),
+        Long(RunSeries, Vec<ConvergenceRecord>, f64),
+    }
+    let done = run_all(&simulation, jobs, |k, rec| {
+        Ok(match Case::ALL.get(k) {
+            Some(case) => Done::Case(Box::new(scorer.score(&rec, case.key())?), Box::new(rec)),
+            None => Done::Long(
+                RunSeries::from_records(&rec, &truth_betas),
+                rec.convergence.clone(),
+                run_seconds(&rec),
+            ),
+        })
+    })?;
+    let mut cases = Vec::new();
+    let mut series = Vec::new();
+    for (k, done) in done.into_iter().enumerate() {
+        match done {
+            Done::Case(scored, rec) => {
+                let case = Case::ALL[k];
+                let report = &scored.report;
+                say(&format!(
+                    "{}: grid mass {:.3e} Msun ({:.3e} inside the arc region), C {:?}, deflection error median {:.2}\" p90 {:.2}\", theta_E(z=3) {:.1}\" ({:.1} s)",
+                    case.label(),
+                    report.grid_mass_msun,
+                    report.grid_mass_region_msun,
+                    report.c,
+                    report.deflection_error_median_arcsec,
+                    report.deflection_error_p90_arcsec,
+                    report.einstein_radius_arcsec_z3,
+                    run_seconds(&rec)
+                ));
+                let Scored {
+                    report,
+                    profile,
+                    soft_kappa,
+                    deflection_error,
+                } = *scored;
+                cases.push(CaseRun {
+                    case,
+                    profile,
+                    soft_kappa,
+                    deflection_error,
+                    report,
+                    reconstruction: *rec,
+                });
+            }
+            Done::Long(run, records, seconds) => {
+                let name = long_runs[k - Case::ALL.len()].0;
+                say(&format!(
+                    "convergence, {name}: {} iterations, final grid mass {:.3e} Msun, C {:?} ({seconds:.1} s)",
+                    config.long_iterations,
+                    run.grid_mass_msun.last().copied().unwrap_or(f64::NAN),
+                    run.c.last(),
+                ));
+                series.push((name, run, records));
+            }
+        }
+    }
+    let studies = if config.studies {
+        let inputs = studies::StudyInputs {
+            layer_true: &layer_true,
+            layer_model: &layer_model,
+            case_ii: case_run(&cases, Case::GalaxyModel),
+            case_iii: case_run(&cases, Case::GalaxyTrue),
+        };
+        studies::run_studies(config, &simulation, &scorer, &inputs, say)?
+    } else {
+        Studies::default()
+    };
+
     let convergence = ConvergenceReport::from_runs(series);
     let report = PaperReport::assemble(
         config,
@@ -459,6 +499,77 @@ fn run_one(
         case: name,
         source: Box::new(e),
     })
+}
+
+/// One reconstruction of the simulated arcs to run: its layers, settings and name (in errors).
+pub(super) struct Job<'a> {
+    pub layers: LayerSource<'a>,
+    pub config: ReconstructConfig,
+    pub name: &'static str,
+}
+
+/// Runs `jobs` and hands each reconstruction, with its job's index, to `finish` on the thread
+/// that ran it (so that only what `finish` keeps stays in memory); returns `finish`'s results in
+/// the jobs' order, or the first error in that order.
+///
+/// With more than one core the jobs run side by side, one thread each: at the paper's size
+/// (n = 1085 unknowns) QADP's passes gain nothing from a second thread (BENCHMARKS.md: the
+/// barriers wait whenever the other thread is descheduled), while two runs at once use both
+/// cores. A job that fails stops the others from starting.
+fn run_all<T: Send>(
+    simulation: &Simulation,
+    mut jobs: Vec<Job<'_>>,
+    finish: impl Fn(usize, Reconstruction) -> Result<T, PaperError> + Sync,
+) -> Result<Vec<T>, PaperError> {
+    let workers = std::thread::available_parallelism()
+        .map_or(1, |n| n.get())
+        .min(jobs.len());
+    if workers <= 1 {
+        return jobs
+            .iter()
+            .enumerate()
+            .map(|(k, job)| finish(k, run_one(simulation, job.layers, &job.config, job.name)?))
+            .collect();
+    }
+    for job in &mut jobs {
+        job.config.system.threads = 1;
+    }
+    let next = AtomicUsize::new(0);
+    let failed = AtomicBool::new(false);
+    let results: Vec<Mutex<Option<Result<T, PaperError>>>> =
+        jobs.iter().map(|_| Mutex::new(None)).collect();
+    std::thread::scope(|scope| {
+        for _ in 0..workers {
+            scope.spawn(|| {
+                while !failed.load(Ordering::Relaxed) {
+                    let k = next.fetch_add(1, Ordering::Relaxed);
+                    let Some(job) = jobs.get(k) else { break };
+                    let result = run_one(simulation, job.layers, &job.config, job.name)
+                        .and_then(|rec| finish(k, rec));
+                    if result.is_err() {
+                        failed.store(true, Ordering::Relaxed);
+                    }
+                    *results[k].lock().unwrap_or_else(|e| e.into_inner()) = Some(result);
+                }
+            });
+        }
+    });
+    // Jobs start in index order, so every job before the first failure ran; the collection
+    // stops at the first error, before any job that did not start.
+    results
+        .into_iter()
+        .map(|slot| {
+            slot.into_inner()
+                .unwrap_or_else(|e| e.into_inner())
+                .expect("every job before the first failure ran")
+        })
+        .collect()
+}
+
+/// Seconds a reconstruction took (its stages, from its own timings).
+fn run_seconds(rec: &Reconstruction) -> f64 {
+    let t = &rec.timings;
+    (t.system_ms + t.solve_ms + t.products_ms + t.sources_ms) / 1e3
 }
 
 /// The scores of `case` (every case is run before the studies).

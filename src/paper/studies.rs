@@ -15,10 +15,10 @@
 use serde::{Deserialize, Serialize};
 
 use super::metrics::lens_equation_chi2;
-use super::{run_one, CaseReport, CaseRun, PaperConfig, PaperError, Scorer};
+use super::{run_all, CaseReport, CaseRun, Job, PaperConfig, PaperError, Scorer};
 use crate::catalog::parse_member_catalog;
 use crate::inversion::{Layer, MemberConfig, Weighting};
-use crate::reconstruct::{LayerSource, Reconstruction, SolverMethod};
+use crate::reconstruct::{LayerSource, ReconstructConfig, Reconstruction, SolverMethod};
 use crate::simulate::Simulation;
 
 /// One run of the start study.
@@ -136,60 +136,160 @@ pub(super) fn run_studies(
             config.bad_start_c,
         ),
     ];
-    let mut starts = Vec::new();
-    for (label, mass, c0) in starts_spec {
-        let owned;
-        let (rec, r) = if label == "reasonable" {
-            // The same settings as case (iii): its run is reused.
-            (&case_iii.reconstruction, case_iii.report.clone())
-        } else {
-            let mut rc = config.reconstruct_config(field, config.iterations);
-            rc.solver.start_cell_mass_msun = mass;
-            rc.solver.start_c = c0;
-            owned = run_one(
-                simulation,
-                LayerSource::Given(std::slice::from_ref(layer_true)),
-                &rc,
-                "start study",
-            )?;
-            (&owned, scorer.score(&owned, "start study")?.report)
-        };
-        let run = start_run(label, mass, c0, rec, &r);
-        say(&format!(
-            "start study, {label}: C {:.3}, chi2 {:.4e} (source-plane rms {:.3}\"), grid mass in the arc region {:.3e} Msun",
-            run.c, run.chi2, run.source_rms_arcsec, run.grid_mass_region_msun
-        ));
-        starts.push(run);
-    }
-    let bad_start = starts.iter().find(|r| r.label == "bad").cloned();
+    let defaults = config.reconstruct_config(field, config.iterations);
+    let truth_layer = LayerSource::Given(std::slice::from_ref(layer_true));
+    let model = LayerSource::Given(std::slice::from_ref(layer_model));
+    // The galaxy-model layer with a prior on C of each width (made here: the jobs borrow them).
+    let held_layers: Vec<Layer> = C_PRIOR_SIGMAS
+        .iter()
+        .map(|&sigma| Layer {
+            prior_sigma: Some(sigma),
+            ..layer_model.clone()
+        })
+        .collect();
+    // The member layer from members.cat (what a user of `wslap reconstruct --members` gets).
+    let (catalog, _) = parse_member_catalog(
+        &simulation.member_catalog_text(),
+        "members.cat",
+        Some(simulation.reference),
+    )
+    .map_err(|e| PaperError::Members(Box::new(e)))?;
 
-    // The data's best fit: the same objective minimised much further, from both starts.
-    let mut best_runs = Vec::new();
+    // Every run of the studies, in report order; the runs they share with the cases (the
+    // reasonable start is case iii, the default row of each sweep group case ii) are reused.
+    let mut plan: Vec<(Row, Option<Job>)> = Vec::new();
+    for (label, mass, c0) in starts_spec {
+        let row = Row::Start { label, mass, c0 };
+        if label == "reasonable" {
+            plan.push((row, None));
+            continue;
+        }
+        let mut rc = defaults.clone();
+        rc.solver.start_cell_mass_msun = mass;
+        rc.solver.start_c = c0;
+        plan.push((row, Some(job(truth_layer, rc, "start study"))));
+    }
     for (label, mass, c0) in [starts_spec[1], starts_spec[3]] {
         let mut rc = config.reconstruct_config(field, config.best_fit_iterations);
         rc.solver.method = SolverMethod::AcceleratedGradient;
         rc.solver.start_cell_mass_msun = mass;
         rc.solver.start_c = c0;
-        let rec = run_one(
-            simulation,
-            LayerSource::Given(std::slice::from_ref(layer_true)),
-            &rc,
-            "best fit",
-        )?;
-        let r = scorer.score(&rec, "best fit")?.report;
-        let run = start_run(
-            &format!("best fit from the {label} start"),
-            mass,
-            c0,
-            &rec,
-            &r,
-        );
-        say(&format!(
-            "best fit, {label} start ({} iterations): C {:.3}, chi2 {:.4e}, grid mass in the arc region {:.3e} Msun",
-            config.best_fit_iterations, run.c, run.chi2, run.grid_mass_region_msun
-        ));
-        best_runs.push(run);
+        let row = Row::BestFit { label, mass, c0 };
+        plan.push((row, Some(job(truth_layer, rc, "best fit"))));
     }
+    let sweep_row = |parameter, value: String, is_default| Row::Sweep {
+        parameter,
+        value,
+        is_default,
+    };
+    for factor in CELL_SIGMA_FACTORS {
+        let mut rc = defaults.clone();
+        rc.grid.cell_sigma_factor = factor;
+        let is_default = factor == defaults.grid.cell_sigma_factor;
+        let row = sweep_row("cell_sigma_factor", format!("{factor}"), is_default);
+        plan.push((row, (!is_default).then(|| job(model, rc, "sweep"))));
+    }
+    for w in [
+        Weighting::EqualPerPixel,
+        Weighting::EqualPerImage,
+        Weighting::EqualPerSystem,
+    ] {
+        let mut rc = defaults.clone();
+        rc.constraints.weighting = w;
+        let name = serde_json::to_value(w)
+            .ok()
+            .and_then(|v| v.as_str().map(str::to_string))
+            .unwrap_or_else(|| format!("{w:?}"));
+        let is_default = w == defaults.constraints.weighting;
+        let row = sweep_row("weighting", name, is_default);
+        plan.push((row, (!is_default).then(|| job(model, rc, "sweep"))));
+    }
+    // The prior on C: the galaxy-model layer with a prior of each width ("none" is case ii).
+    plan.push((sweep_row("c_prior_sigma", "none".to_string(), true), None));
+    for (sigma, held) in C_PRIOR_SIGMAS.iter().zip(&held_layers) {
+        let layers = LayerSource::Given(std::slice::from_ref(held));
+        let row = sweep_row("c_prior_sigma", format!("{sigma}"), false);
+        plan.push((row, Some(job(layers, defaults.clone(), "sweep"))));
+    }
+    let default_members = MemberConfig::default();
+    for (label, r_s, exponent) in R_S_LAWS {
+        let mut rc = defaults.clone();
+        rc.members.r_s_lstar_kpc = r_s;
+        rc.members.size_exponent = exponent;
+        let is_default =
+            r_s == default_members.r_s_lstar_kpc && exponent == default_members.size_exponent;
+        let row = sweep_row("member_r_s_law", label.to_string(), is_default);
+        plan.push((row, Some(job(LayerSource::Members(&catalog), rc, "sweep"))));
+    }
+
+    // Run what is new (side by side), keeping each run's scores and its f64 chi2.
+    let (rows, jobs): (Vec<Row>, Vec<Option<Job>>) = plan.into_iter().unzip();
+    let ran_rows: Vec<usize> = (0..rows.len()).filter(|&k| jobs[k].is_some()).collect();
+    let ran = run_all(
+        simulation,
+        jobs.into_iter().flatten().collect(),
+        |k, rec| {
+            let name = ran_rows.get(k).map_or("study", |&r| rows[r].job_name());
+            let report = scorer.score(&rec, name)?.report;
+            Ok(Scores::of(&rec, report))
+        },
+    )?;
+    let mut ran = ran.into_iter();
+    let mut starts = Vec::new();
+    let mut best_runs = Vec::new();
+    let mut sweep = Vec::new();
+    for (k, row) in rows.into_iter().enumerate() {
+        let scores = if ran_rows.contains(&k) {
+            ran.next().expect("one result per job")
+        } else if matches!(row, Row::Start { .. }) {
+            Scores::of(&case_iii.reconstruction, case_iii.report.clone())
+        } else {
+            Scores::of(&case_ii.reconstruction, case_ii.report.clone())
+        };
+        match row {
+            Row::Start { label, mass, c0 } => {
+                let run = scores.start_run(label.to_string(), mass, c0);
+                say(&format!(
+                    "start study, {label}: C {:.3}, chi2 {:.4e} (source-plane rms {:.3}\"), grid mass in the arc region {:.3e} Msun",
+                    run.c, run.chi2, run.source_rms_arcsec, run.grid_mass_region_msun
+                ));
+                starts.push(run);
+            }
+            Row::BestFit { label, mass, c0 } => {
+                let run = scores.start_run(format!("best fit from the {label} start"), mass, c0);
+                say(&format!(
+                    "best fit, {label} start ({} iterations): C {:.3}, chi2 {:.4e}, grid mass in the arc region {:.3e} Msun",
+                    config.best_fit_iterations, run.c, run.chi2, run.grid_mass_region_msun
+                ));
+                best_runs.push(run);
+            }
+            Row::Sweep {
+                parameter,
+                value,
+                is_default,
+            } => {
+                let r = &scores.report;
+                say(&format!(
+                    "sweep, {parameter} = {value}: median deflection error {:.2}\", C {:?}",
+                    r.deflection_error_median_arcsec, r.c
+                ));
+                sweep.push(SweepRow {
+                    parameter: parameter.to_string(),
+                    value,
+                    is_default,
+                    best: false,
+                    c: r.c.clone(),
+                    deflection_error_median_arcsec: r.deflection_error_median_arcsec,
+                    deflection_error_p90_arcsec: r.deflection_error_p90_arcsec,
+                    profile_max_rel_error: r.profile_max_rel_error,
+                    einstein_radius_arcsec_z3: r.einstein_radius_arcsec_z3,
+                });
+            }
+        }
+    }
+    let bad_start = starts.iter().find(|r| r.label == "bad").cloned();
+
+    // The data's best fit against the simulated lens itself, on case (iii)'s rows.
     let system = &case_iii.reconstruction.system;
     let truth_lens = simulation
         .truth_model()
@@ -205,105 +305,6 @@ pub(super) fn run_studies(
     say(&format!(
         "best fit: the truth's own chi2 is {truth_chi2:.4e}"
     ));
-
-    let defaults = config.reconstruct_config(field, config.iterations);
-    // The galaxy-model layer with a prior on C of each width (made here: the rows borrow them).
-    let held_layers: Vec<Layer> = C_PRIOR_SIGMAS
-        .iter()
-        .map(|&sigma| Layer {
-            prior_sigma: Some(sigma),
-            ..layer_model.clone()
-        })
-        .collect();
-    let mut sweep = Vec::new();
-    // `rc = None`: the default case (ii) run, already scored.
-    let mut row = |parameter: &str, value: String, is_default: bool, rc: Option<_>, layers| {
-        let r = match rc {
-            Some(rc) => {
-                let rec = run_one(simulation, layers, &rc, "sweep")?;
-                scorer.score(&rec, "sweep")?.report
-            }
-            None => case_ii.report.clone(),
-        };
-        say(&format!(
-            "sweep, {parameter} = {value}: median deflection error {:.2}\", C {:?}",
-            r.deflection_error_median_arcsec, r.c
-        ));
-        sweep.push(SweepRow {
-            parameter: parameter.to_string(),
-            value,
-            is_default,
-            best: false,
-            c: r.c,
-            deflection_error_median_arcsec: r.deflection_error_median_arcsec,
-            deflection_error_p90_arcsec: r.deflection_error_p90_arcsec,
-            profile_max_rel_error: r.profile_max_rel_error,
-            einstein_radius_arcsec_z3: r.einstein_radius_arcsec_z3,
-        });
-        Ok::<(), PaperError>(())
-    };
-    let model = LayerSource::Given(std::slice::from_ref(layer_model));
-    for factor in CELL_SIGMA_FACTORS {
-        let mut rc = defaults.clone();
-        rc.grid.cell_sigma_factor = factor;
-        let is_default = factor == defaults.grid.cell_sigma_factor;
-        let rc = (!is_default).then_some(rc);
-        row(
-            "cell_sigma_factor",
-            format!("{factor}"),
-            is_default,
-            rc,
-            model,
-        )?;
-    }
-    for w in [
-        Weighting::EqualPerPixel,
-        Weighting::EqualPerImage,
-        Weighting::EqualPerSystem,
-    ] {
-        let mut rc = defaults.clone();
-        rc.constraints.weighting = w;
-        let name = serde_json::to_value(w)
-            .ok()
-            .and_then(|v| v.as_str().map(str::to_string))
-            .unwrap_or_else(|| format!("{w:?}"));
-        let is_default = w == defaults.constraints.weighting;
-        let rc = (!is_default).then_some(rc);
-        row("weighting", name, is_default, rc, model)?;
-    }
-    // The prior on C: the galaxy-model layer with a prior of each width ("none" is case ii).
-    row("c_prior_sigma", "none".to_string(), true, None, model)?;
-    for (sigma, held) in C_PRIOR_SIGMAS.iter().zip(&held_layers) {
-        row(
-            "c_prior_sigma",
-            format!("{sigma}"),
-            false,
-            Some(defaults.clone()),
-            LayerSource::Given(std::slice::from_ref(held)),
-        )?;
-    }
-    // The member layer from members.cat (what a user of `wslap reconstruct --members` gets).
-    let (catalog, _) = parse_member_catalog(
-        &simulation.member_catalog_text(),
-        "members.cat",
-        Some(simulation.reference),
-    )
-    .map_err(|e| PaperError::Members(Box::new(e)))?;
-    let default_members = MemberConfig::default();
-    for (label, r_s, exponent) in R_S_LAWS {
-        let mut rc = defaults.clone();
-        rc.members.r_s_lstar_kpc = r_s;
-        rc.members.size_exponent = exponent;
-        let is_default =
-            r_s == default_members.r_s_lstar_kpc && exponent == default_members.size_exponent;
-        row(
-            "member_r_s_law",
-            label.to_string(),
-            is_default,
-            Some(rc),
-            LayerSource::Members(&catalog),
-        )?;
-    }
     mark_best(&mut sweep);
     Ok(Studies {
         starts,
@@ -323,24 +324,86 @@ fn row_weight_sum(rec: &Reconstruction) -> f64 {
         .sum()
 }
 
-/// A run of case (iii)'s data from a start (`mass`, `c0`), with its scores `r`.
-fn start_run(label: &str, mass: f64, c0: f64, rec: &Reconstruction, r: &CaseReport) -> StartRun {
-    // In f64: QADP's own report of the objective comes from its single-precision pass, and
-    // chi2 is a small difference of large terms (the frame shift's constant).
-    let objective = crate::solver::objective(&rec.system.a, &rec.system.b, &rec.x);
-    let chi2 = 2.0 * objective + rec.system.theta_w_theta;
-    StartRun {
-        label: label.to_string(),
-        start_cell_mass_msun: mass,
-        start_c: c0,
-        c: r.c.first().copied().unwrap_or(f64::NAN),
-        objective,
-        chi2,
-        source_rms_arcsec: (chi2.max(0.0) / row_weight_sum(rec)).sqrt(),
-        image_plane_rms_arcsec: rec.image_plane_rms_arcsec(false),
-        grid_mass_msun: r.grid_mass_msun,
-        grid_mass_region_msun: r.grid_mass_region_msun,
-        deflection_error_median_arcsec: r.deflection_error_median_arcsec,
+/// One row of the studies: which table it belongs to and what it varies.
+enum Row {
+    /// Case (iii) from a start (cell mass, C0) at the case iteration count.
+    Start {
+        label: &'static str,
+        mass: f64,
+        c0: f64,
+    },
+    /// Case (iii)'s objective minimised from a start.
+    BestFit {
+        label: &'static str,
+        mass: f64,
+        c0: f64,
+    },
+    /// A value of one open default (case ii's data).
+    Sweep {
+        parameter: &'static str,
+        value: String,
+        is_default: bool,
+    },
+}
+
+impl Row {
+    fn job_name(&self) -> &'static str {
+        match self {
+            Row::Start { .. } => "start study",
+            Row::BestFit { .. } => "best fit",
+            Row::Sweep { .. } => "sweep",
+        }
+    }
+}
+
+fn job<'a>(layers: LayerSource<'a>, config: ReconstructConfig, name: &'static str) -> Job<'a> {
+    Job {
+        layers,
+        config,
+        name,
+    }
+}
+
+/// What the studies keep of a run: its scores and its lens-equation fit.
+struct Scores {
+    report: CaseReport,
+    /// Final objective `phi` in f64. In f64 because QADP's own report of the objective comes
+    /// from its single-precision pass, and chi2 is a small difference of large terms (the frame
+    /// shift's constant).
+    objective: f64,
+    chi2: f64,
+    row_weight_sum: f64,
+    image_plane_rms_arcsec: Option<f64>,
+}
+
+impl Scores {
+    fn of(rec: &Reconstruction, report: CaseReport) -> Self {
+        let objective = crate::solver::objective(&rec.system.a, &rec.system.b, &rec.x);
+        Self {
+            report,
+            objective,
+            chi2: 2.0 * objective + rec.system.theta_w_theta,
+            row_weight_sum: row_weight_sum(rec),
+            image_plane_rms_arcsec: rec.image_plane_rms_arcsec(false),
+        }
+    }
+
+    /// The run as a row of the start study (or of the best fit) from (`mass`, `c0`).
+    fn start_run(&self, label: String, mass: f64, c0: f64) -> StartRun {
+        let r = &self.report;
+        StartRun {
+            label,
+            start_cell_mass_msun: mass,
+            start_c: c0,
+            c: r.c.first().copied().unwrap_or(f64::NAN),
+            objective: self.objective,
+            chi2: self.chi2,
+            source_rms_arcsec: (self.chi2.max(0.0) / self.row_weight_sum).sqrt(),
+            image_plane_rms_arcsec: self.image_plane_rms_arcsec,
+            grid_mass_msun: r.grid_mass_msun,
+            grid_mass_region_msun: r.grid_mass_region_msun,
+            deflection_error_median_arcsec: r.deflection_error_median_arcsec,
+        }
     }
 }
 
