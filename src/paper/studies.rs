@@ -169,7 +169,10 @@ pub(super) fn run_studies(
         rc.solver.start_c = c0;
         plan.push((row, Some(job(truth_layer, rc, "start study"))));
     }
-    for (label, mass, c0) in [starts_spec[1], starts_spec[3]] {
+    let best_fit_starts = starts_spec
+        .into_iter()
+        .filter(|(label, ..)| matches!(*label, "reasonable" | "bad"));
+    for (label, mass, c0) in best_fit_starts {
         let mut rc = config.reconstruct_config(field, config.best_fit_iterations);
         rc.solver.method = SolverMethod::AcceleratedGradient;
         rc.solver.start_cell_mass_msun = mass;
