@@ -8,8 +8,8 @@ use glam::DVec2;
 use serde_json::json;
 use wslap::app::examples::{teaching_image_catalog, TEACHING_SOURCES};
 use wslap::app::{
-    system_rgb, DataRole, RunKind, Session, ViewOptions, MAX_STORED_FITS_BYTES,
-    SHOWN_MIN_MAGNIFICATION,
+    system_rgb, DataRole, RunKind, Session, ViewOptions, MAX_STORED_FITS_BYTES, OBSERVED_RGB,
+    PREDICTED_RGB, SHOWN_MIN_MAGNIFICATION,
 };
 use wslap::demo::TEACHING_MODEL_JSON;
 use wslap::render::{LegendPlace, PIXEL_ALPHA};
@@ -463,6 +463,45 @@ const TWO_ARCS_JSON: &str = r#"{"systems": [
 fn rgb(pm: &tiny_skia::Pixmap, (x, y): (f32, f32)) -> [u8; 3] {
     let p = pm.pixel(x as u32, y as u32).expect("inside the figure");
     [p.red(), p.green(), p.blue()]
+}
+
+/// Where a predicted image lands on an observed one (a good fit), the observed image's marker
+/// (the data) is drawn on top: the centre of every observed marker has the observed colour.
+#[cfg_attr(not(target_arch = "wasm32"), test)]
+#[cfg_attr(target_arch = "wasm32", wasm_bindgen_test::wasm_bindgen_test)]
+fn observed_images_are_drawn_over_the_predicted_ones() {
+    let s = solved();
+    let r = s.result().unwrap();
+    let opts = ViewOptions {
+        show_members: false,
+        ..ViewOptions::default()
+    };
+    let frame = s.kappa_frame(&opts).unwrap();
+    let map = tiny_skia::Pixmap::decode_png(&s.kappa_view(&opts).unwrap().png).unwrap();
+    let predicted: Vec<_> = r
+        .predicted()
+        .iter()
+        .map(|&p| frame.arcsec_to_screen(p))
+        .collect();
+    let mut covered = 0;
+    for &o in &r.marks.observed {
+        let at = frame.arcsec_to_screen(o);
+        // A predicted cross within 2 screen pixels also covers this centre.
+        if predicted
+            .iter()
+            .any(|p| (p.0 - at.0).hypot(p.1 - at.1) < 2.0)
+        {
+            covered += 1;
+        }
+        assert_eq!(rgb(&map, at), OBSERVED_RGB, "observed image at {o}");
+    }
+    assert_ne!(OBSERVED_RGB, PREDICTED_RGB);
+    // The test means something only if some predicted images do land on observed ones.
+    println!(
+        "{covered} of {} observed images have a predicted image on them",
+        r.marks.observed.len()
+    );
+    assert!(covered > 0);
 }
 
 #[cfg_attr(not(target_arch = "wasm32"), test)]

@@ -24,7 +24,9 @@ pub use data::{
 pub use project::{Project, ProjectResult, StoredFits, PROJECT_FORMAT, PROJECT_VERSION};
 pub use run::{RunKind, SessionResult, SHOWN_MIN_MAGNIFICATION};
 pub use settings::{AppSettings, APP_MAP_PIXELS};
-pub use views::{system_rgb, HoverReadout, ViewOptions, ViewPng, SYSTEM_RGB};
+pub use views::{
+    system_rgb, HoverReadout, ViewOptions, ViewPng, OBSERVED_RGB, PREDICTED_RGB, SYSTEM_RGB,
+};
 
 /// What the app reports to the user; every message names the file, line or setting.
 #[derive(Debug, Error)]

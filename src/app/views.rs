@@ -146,18 +146,20 @@ impl Session {
                 .points
                 .push(points("members", MEMBER_RGB, Marker::Circle, m));
         }
-        if opts.show_observed {
-            let o = r.marks.observed.clone();
-            overlay
-                .points
-                .push(points("observed", OBSERVED_RGB, Marker::Plus, o));
-        }
+        // Predicted before observed: markers are drawn in this order, and the observed images
+        // (the data) stay visible where a predicted image lands on them.
         if opts.show_predicted {
             let p = r.predicted();
             let label = format!("predicted, |μ| >= {SHOWN_MIN_MAGNIFICATION}");
             overlay
                 .points
                 .push(points(&label, PREDICTED_RGB, Marker::Cross, p));
+        }
+        if opts.show_observed {
+            let o = r.marks.observed.clone();
+            overlay
+                .points
+                .push(points("observed", OBSERVED_RGB, Marker::Plus, o));
         }
         Ok(overlay)
     }
