@@ -77,12 +77,16 @@ test('the built-in example reconstructs and shows a map with critical curves', a
       await page.waitForFunction((t) => document.getElementById('view-image').dataset.view === t, tab);
       const s = await imageStats(page, '#view-image');
       assert.ok(s.distinctColours > 20, `${tab}: ${s.distinctColours} colours`);
+      // The mass map's options and read-out do not apply here.
+      assert.ok(await page.isDisabled('#scale') && await page.isDisabled('#show-members'), tab);
+      assert.equal(await page.textContent('#readout'), '');
       await page.screenshot({ path: join(ARTIFACTS, `app-view-${tab}.png`), fullPage: true });
     }
     await page.click('#tab-systems');
     await page.waitForSelector('#systems table');
     assert.equal(await page.locator('#systems tbody tr').count(), 30);
     await page.click('#tab-kappa');
+    assert.ok(await page.isEnabled('#scale') && await page.isEnabled('#show-members'));
 
     // The FITS download parses with the map size.
     await page.click('#downloads-panel summary');

@@ -53,6 +53,13 @@ function selectTab(name) {
     tab.setAttribute('aria-selected', String(tab.dataset.view === name));
     tab.tabIndex = tab.dataset.view === name ? 0 : -1;
   }
+  // The colour scale and the "Show" boxes belong to the mass map (and the data before a run);
+  // the other views ignore them, so they are greyed out there. So is the read-out, which is of
+  // the mass map.
+  const map = name === 'kappa';
+  document.getElementById('scale').disabled = !map;
+  document.getElementById('show-options').disabled = !map;
+  if (!map) document.getElementById('readout').textContent = '';
 }
 
 /** Shows PNG `bytes` as the view `name`. */
