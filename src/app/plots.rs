@@ -6,8 +6,10 @@ use crate::render::{compose_grid, Axis, LinePlot, RenderError, Series, PALETTE};
 use super::views::ViewPng;
 use super::{AppError, Session};
 
-/// One panel's size in pixels.
-const PANEL_PX: (u32, u32) = (440, 330);
+/// One panel's size in pixels: 400 high gives the text two font units (readable at the
+/// view's width); the panels are stacked in one column (they share the x axis in the
+/// convergence view), so the image is as wide as one panel.
+const PANEL_PX: (u32, u32) = (720, 400);
 /// Gap between panels in pixels.
 const GAP_PX: u32 = 8;
 
@@ -30,7 +32,7 @@ fn compose(name: &str, plots: &[LinePlot]) -> Result<ViewPng, AppError> {
         .map(|p| p.render_pixmap())
         .collect::<Result<Vec<_>, _>>()
         .map_err(render)?;
-    let png = compose_grid(&panels, plots.len(), GAP_PX)
+    let png = compose_grid(&panels, 1, GAP_PX)
         .map_err(render)?
         .encode_png()
         .map_err(|e| AppError::Run(format!("rendering {name}: {e}")))?;
