@@ -408,6 +408,21 @@ fn det_a(f: f64, h: [f64; 3]) -> f64 {
     (1.0 - f * h[0]) * (1.0 - f * h[2]) - f * f * h[1] * h[1]
 }
 
+/// `1 / det A`, or [`MAGNIFICATION_CLAMP`] with the sign of `det A` on a critical line.
+fn clamped_magnification(det: f64) -> f64 {
+    if det.abs() >= 1.0 / MAGNIFICATION_CLAMP {
+        1.0 / det
+    } else {
+        MAGNIFICATION_CLAMP.copysign(det)
+    }
+}
+
+/// The signed magnification `1 / det A` of the lens at `theta` (arcsec) for a source with
+/// `f = D_ls/D_s`, clamped to `|mu| <= MAGNIFICATION_CLAMP` on a critical line.
+pub fn magnification_at(lens: &dyn MassComponent, f: f64, theta: DVec2) -> f64 {
+    clamped_magnification(det_a(f, lens.hessian(theta)))
+}
+
 /// Newton start points over the whole grid.
 fn candidates(g: &MapGeometry, offsets: &[DVec2]) -> Vec<DVec2> {
     let n = g.pixels;
@@ -516,11 +531,7 @@ impl Search<'_> {
             return None;
         }
         let det = det_a(self.f, h);
-        let magnification = if det.abs() >= 1.0 / MAGNIFICATION_CLAMP {
-            1.0 / det
-        } else {
-            MAGNIFICATION_CLAMP.copysign(det)
-        };
+        let magnification = clamped_magnification(det);
         let trace = 2.0 - self.f * (h[0] + h[2]);
         let (parity, kind) = if det < 0.0 {
             (Parity::Negative, ImageKind::Saddle)

@@ -249,6 +249,42 @@ fn synthetic_lens_with_the_true_galaxy_layer() {
         rms <= IMAGE_PLANE_RMS_ARCSEC,
         "image-plane rms {rms} arcsec"
     );
+    // Each observed image reports the model's magnification at its position (exact lens). Where
+    // the predicted image is close (< 0.35 arcsec) it has the same parity, and away from the
+    // critical curves (|mu| < 5) about the same magnification (found on the interpolated maps,
+    // a little way off). Measured: 13 such images, within 11%.
+    let mut compared = 0;
+    for src in &r.sources {
+        for o in &src.observed {
+            let mu = o
+                .magnification
+                .expect("magnification at the observed image");
+            let Some(offset) = o.offset_arcsec.filter(|&d| d < 0.35) else {
+                continue;
+            };
+            let pred = src
+                .predicted
+                .iter()
+                .find(|p| Some(p.position_arcsec) == o.predicted_arcsec)
+                .unwrap()
+                .magnification;
+            assert_eq!(
+                mu.signum(),
+                pred.signum(),
+                "{}: mu {mu}, predicted {pred}",
+                o.id
+            );
+            if mu.abs() < 5.0 {
+                compared += 1;
+                assert!(
+                    (mu - pred).abs() <= 0.15 * pred.abs() + 0.05,
+                    "{}: mu {mu} at the observed image, {pred} at the predicted one {offset} arcsec away",
+                    o.id
+                );
+            }
+        }
+    }
+    assert!(compared >= 5, "{compared} images compared");
 }
 
 /// When the layer is the whole true lens (halo and galaxies), nothing is left for the grid to

@@ -5,7 +5,7 @@
 use glam::DVec2;
 use serde::{Deserialize, Serialize};
 
-use crate::images::{find_images, source_position, ImageSearch, SearchGrid};
+use crate::images::{find_images, magnification_at, source_position, ImageSearch, SearchGrid};
 use crate::inversion::LinearSystem;
 use crate::maps::LensMaps;
 use crate::products::Products;
@@ -54,6 +54,13 @@ pub struct ImageReport {
     pub predicted_arcsec: Option<DVec2>,
     /// Distance to it in arcsec.
     pub offset_arcsec: Option<f64>,
+    /// The model's signed magnification at the observed position, at the system's redshift.
+    /// A large offset where `|mu|` is high usually means that the image lies near a critical
+    /// curve and its source just outside the model's caustic: the pair it belongs to has
+    /// merged, and the nearest predicted image is elsewhere. (Absent in results saved before
+    /// it was added.)
+    #[serde(default)]
+    pub magnification: Option<f64>,
 }
 
 /// One predicted image.
@@ -251,6 +258,7 @@ fn finish(
                 beta_arcsec: source_position(lens, f, position),
                 predicted_arcsec: nearest,
                 offset_arcsec: nearest.map(|p| p.distance(position)),
+                magnification: Some(magnification_at(lens, f, position)),
             }
         })
         .collect();

@@ -51,6 +51,10 @@ test('uploading the AS1063 catalogues reconstructs them', async () => {
     await page.waitForSelector('#systems table');
     // The AS1063 systems, not the example's 30.
     assert.equal(await page.locator('#systems tbody tr').count(), 19);
+    // Every observed image's offset comes with the model's magnification there.
+    const offsets = await page.locator('#systems tbody td:nth-child(6)').allTextContents();
+    assert.ok(offsets.every((t) => /^(\S+: [\d.]+ \(μ -?[\d.]+\))+$/.test(t)), offsets.join(' | '));
+    await page.screenshot({ path: join(ARTIFACTS, 'app-as1063-systems.png'), fullPage: true });
     assert.deepEqual(app.consoleErrors, []);
   } finally {
     await app.close();

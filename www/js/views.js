@@ -87,12 +87,12 @@ export function showSystems(sources) {
   const rows = sources.map((s) => `<tr><th scope="row">${swatch(s)}${s.id}${s.held_out ? ' (held out)' : ''}</th>
     <td>${f(s.z, 3)}${s.z_assumed ? '*' : ''}</td><td>${f(s.beta_arcsec[0])}, ${f(s.beta_arcsec[1])}</td>
     <td>${f(s.scatter_arcsec)}</td><td>${s.observed.length} / ${s.predicted.length}</td>
-    <td>${s.observed.map((o) => `${o.id}: ${f(o.offset_arcsec)}`).join('<br>')}</td>
+    <td>${s.observed.map((o) => `${o.id}: ${f(o.offset_arcsec)}${o.magnification == null ? '' : ` (μ ${f(o.magnification, 1)})`}`).join('<br>')}</td>
     <td>${f(s.image_plane_rms_arcsec)}</td></tr>`).join('');
   box.innerHTML = sources.length === 0 ? '<p class="hint">No systems: not a reconstruction.</p>'
-    : `<div class="table-scroll"><table><caption>Per system: redshift, solved source position β, source-plane scatter, images observed / predicted (all of them; the map leaves out the demagnified ones, |μ| &lt; 0.1), offsets of the observed images from the nearest predicted one (arcsec)</caption>
+    : `<div class="table-scroll"><table><caption>Per system: redshift, solved source position β, source-plane scatter, images observed / predicted (all of them; the map leaves out the demagnified ones, |μ| &lt; 0.1), offsets of the observed images from the nearest predicted one (arcsec) and the model's magnification μ at each observed image: a large offset where |μ| is high usually means the image lies near a critical curve with its source just outside the model's caustic, so its pair has merged</caption>
     <thead><tr><th scope="col">system</th><th scope="col">z</th><th scope="col">β [″]</th><th scope="col">scatter [″]</th>
-    <th scope="col">images</th><th scope="col">offsets [″]</th><th scope="col">rms [″]</th></tr></thead><tbody>${rows}</tbody></table></div>`;
+    <th scope="col">images</th><th scope="col">offsets [″] (μ)</th><th scope="col">rms [″]</th></tr></thead><tbody>${rows}</tbody></table></div>`;
   box.hidden = false;
   document.getElementById('figure').hidden = true;
 }
