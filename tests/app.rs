@@ -186,6 +186,20 @@ fn reconstruction_gives_curves_views_hover_and_the_cli_files() {
     }
     let sources: serde_json::Value = serde_json::from_str(&r.sources_json().unwrap()).unwrap();
     assert_eq!(sources.as_array().unwrap().len(), TEACHING_SOURCES.len());
+    // The summary's median image offset is the median of sources.json's offsets.
+    let mut offsets: Vec<f64> = sources
+        .as_array()
+        .unwrap()
+        .iter()
+        .flat_map(|s| s["observed"].as_array().unwrap().iter())
+        .filter_map(|o| o["offset_arcsec"].as_f64())
+        .collect();
+    offsets.sort_by(f64::total_cmp);
+    let n = offsets.len();
+    assert!(n >= 6, "{n} offsets");
+    let median = summary["image_offset_median_arcsec"].as_f64().unwrap();
+    assert_eq!(median, 0.5 * (offsets[(n - 1) / 2] + offsets[n / 2]));
+    assert!(median <= summary["image_plane_rms_arcsec"].as_f64().unwrap());
     let opts = ViewOptions::default();
     for view in [
         s.kappa_view(&opts).unwrap(),

@@ -89,8 +89,14 @@ function caption(info) {
   // A reconstruction's member factors C: 1 is the M/L of the settings.
   const c = info.summary.c_per_layer ?? [];
   const factors = c.length ? `member factor C = ${c.map((v) => v.toFixed(2)).join(', ')}; ` : '';
+  // Observed images against the predicted ones: the median (the typical image) and the rms
+  // (which one image whose pair has merged can dominate).
+  const median = info.summary.image_offset_median_arcsec;
+  const rms = info.summary.image_plane_rms_arcsec;
+  const offsets = median == null || rms == null ? ''
+    : `image offsets median ${median.toFixed(2)}″, rms ${rms.toFixed(2)}″; `;
   $('summary').textContent = `${status}Einstein radius ${bound}${s.einstein_radius_arcsec.toFixed(1)}″ at ` +
-    `z_s = ${s.z_source}; ${factors}${s.tangential_curves} tangential and ${s.radial_curves} radial critical curves.`;
+    `z_s = ${s.z_source}; ${factors}${offsets}${s.tangential_curves} tangential and ${s.radial_curves} radial critical curves.`;
 }
 
 async function showResult(info) {

@@ -189,7 +189,7 @@ pub(super) fn write_reconstruction(r: &Reconstruction, dir: &Path) -> Result<(),
 
 fn one_line(r: &Reconstruction, out: &Path) -> String {
     format!(
-        "wrote {} ({} systems, {} constraint pixels, {} iterations; C = {:?}; grid mass {:.3e} Msun; Einstein radius at z_s = {}: {}; image-plane rms {})",
+        "wrote {} ({} systems, {} constraint pixels, {} iterations; C = {:?}; grid mass {:.3e} Msun; Einstein radius at z_s = {}: {}; image offsets: rms {}, median {})",
         out.display(),
         r.system.constraints.systems.len(),
         r.system.constraints.pixels.len(),
@@ -199,6 +199,7 @@ fn one_line(r: &Reconstruction, out: &Path) -> String {
         r.config.products.z_source,
         r.products.summary().einstein_radius_text(),
         r.image_plane_rms_arcsec(false).map_or("n/a".to_string(), |v| format!("{v:.2} arcsec")),
+        r.image_offset_median_arcsec(false).map_or("n/a".to_string(), |v| format!("{v:.2} arcsec")),
     )
 }
 

@@ -157,6 +157,11 @@ impl Reconstruction {
         self.solved().image_plane_rms_arcsec(held_out)
     }
 
+    /// See [`Solved::image_offset_median_arcsec`].
+    pub fn image_offset_median_arcsec(&self, held_out: bool) -> Option<f64> {
+        self.solved().image_offset_median_arcsec(held_out)
+    }
+
     /// `summary.json` (what `wslap reconstruct` writes).
     pub fn summary(&self) -> ReconstructSummary<'_> {
         self.solved()

@@ -36,17 +36,33 @@ impl<'a> Solved<'a> {
         cells.iter().sum::<f64>() * self.system.mass_unit_msun
     }
 
-    /// Root mean square of the offsets between observed and predicted images, arcsec, over the
-    /// fitted (or, with `held_out`, the held-out) systems; `None` when no image was matched.
-    pub fn image_plane_rms_arcsec(&self, held_out: bool) -> Option<f64> {
-        let offsets: Vec<f64> = self
-            .sources
+    /// The offsets (arcsec) between observed images and their nearest predicted images over the
+    /// fitted (or, with `held_out`, the held-out) systems.
+    fn image_offsets_arcsec(&self, held_out: bool) -> Vec<f64> {
+        self.sources
             .iter()
             .filter(|s| s.held_out == held_out)
             .flat_map(|s| s.observed.iter().filter_map(|i| i.offset_arcsec))
-            .collect();
+            .collect()
+    }
+
+    /// Root mean square of the offsets between observed and predicted images, arcsec, over the
+    /// fitted (or, with `held_out`, the held-out) systems; `None` when no image was matched.
+    pub fn image_plane_rms_arcsec(&self, held_out: bool) -> Option<f64> {
+        let offsets = self.image_offsets_arcsec(held_out);
         (!offsets.is_empty())
             .then(|| (offsets.iter().map(|o| o * o).sum::<f64>() / offsets.len() as f64).sqrt())
+    }
+
+    /// Median of the same offsets, arcsec (the mean of the middle two for an even count). The
+    /// rms answers for the worst images: one whose source lies just outside the model's caustic
+    /// has no predicted image near it, and its offset of many arcsec dominates the rms (AS1063:
+    /// rms 4.1, median 0.2 arcsec). The median says how well the typical image is reproduced.
+    pub fn image_offset_median_arcsec(&self, held_out: bool) -> Option<f64> {
+        let mut offsets = self.image_offsets_arcsec(held_out);
+        offsets.sort_by(f64::total_cmp);
+        let n = offsets.len();
+        (n > 0).then(|| 0.5 * (offsets[(n - 1) / 2] + offsets[n / 2]))
     }
 
     /// `summary.json`, with `status` as written ("Completed", "Cancelled", ...) and the map
@@ -82,6 +98,8 @@ impl<'a> Solved<'a> {
             mass_within_arcsec: maps.mass_within_arcsec.clone(),
             image_plane_rms_arcsec: self.image_plane_rms_arcsec(false),
             holdout_image_plane_rms_arcsec: self.image_plane_rms_arcsec(true),
+            image_offset_median_arcsec: self.image_offset_median_arcsec(false),
+            holdout_image_offset_median_arcsec: self.image_offset_median_arcsec(true),
             warnings: self.warnings,
             maps,
             timings_ms: self.timings,
@@ -110,6 +128,8 @@ pub struct ReconstructSummary<'a> {
     pub mass_within_arcsec: Vec<(f64, Option<f64>)>,
     pub image_plane_rms_arcsec: Option<f64>,
     pub holdout_image_plane_rms_arcsec: Option<f64>,
+    pub image_offset_median_arcsec: Option<f64>,
+    pub holdout_image_offset_median_arcsec: Option<f64>,
     pub warnings: &'a [String],
     pub maps: Summary,
     pub timings_ms: StageTimings,

@@ -43,6 +43,10 @@ test('uploading the AS1063 catalogues reconstructs them', async () => {
     // The caption gives the member factor, which the prior holds near 1 (1.04 natively).
     const c = Number(caption.match(/member factor C = ([\d.]+)/)[1]);
     assert.ok(Math.abs(c - 1) < 0.2, caption);
+    // And how well the images are reproduced: the typical one well (0.21 arcsec natively), the
+    // rms pulled up by a few whose pair has merged.
+    const [median, rms] = caption.match(/image offsets median ([\d.]+)″, rms ([\d.]+)″/).slice(1).map(Number);
+    assert.ok(median < 1 && rms >= median, caption);
     const stats = await imageStats(page, '#view-image');
     assert.ok(stats.distinctColours > 200, `only ${stats.distinctColours} distinct colours`);
     assert.ok(stats.white > 100, `members not drawn (${stats.white} white pixels)`);
