@@ -109,6 +109,18 @@ export async function setField(page, selector, value) {
   }
 }
 
+/** Starts recording the page's long tasks (main-thread tasks over 50 ms, Chromium's Long Tasks
+ * API); returns an async function that gives those recorded so far as [start ms, duration ms]. */
+export async function watchLongTasks(page) {
+  await page.evaluate(() => {
+    window.__longTasks = [];
+    new PerformanceObserver((list) => {
+      for (const e of list.getEntries()) window.__longTasks.push([Math.round(e.startTime), Math.round(e.duration)]);
+    }).observe({ type: 'longtask' });
+  });
+  return () => page.evaluate(() => window.__longTasks);
+}
+
 /** Waits until the status line matches `pattern` (fails with the error shown, if any). */
 export async function waitStatus(page, pattern, timeout = 60_000) {
   try {
