@@ -92,6 +92,8 @@ test('the built-in example reconstructs and shows a map with critical curves', a
     assert.equal(await page.locator('#systems tbody tr').count(), 30);
     await page.click('#tab-kappa');
     assert.ok(await page.isEnabled('#scale') && await page.isEnabled('#show-members'));
+    // Neither did the redraws, the hover read-out and the views since.
+    assert.deepEqual(await longTasks(), [], 'main-thread tasks over 50 ms [start, duration]');
 
     // The FITS download parses with the map size.
     await page.click('#downloads-panel summary');
