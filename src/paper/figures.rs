@@ -300,12 +300,12 @@ fn convergence(run: &PaperRun) -> Result<Vec<u8>, PaperError> {
             vec![
                 Reference {
                     value: run.simulation.soft_mass_msun,
-                    label: "Soft (true)".to_string(),
+                    label: "Soft mass (true)".to_string(),
                     color: [0, 0, 0],
                 },
                 Reference {
                     value: m_gal,
-                    label: "Galx (true)".to_string(),
+                    label: "Galaxies (true)".to_string(),
                     color: [110, 110, 110],
                 },
             ],
