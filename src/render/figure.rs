@@ -5,7 +5,7 @@ use tiny_skia::{Color, Paint, PathBuilder, Pixmap, Rect, Stroke, Transform};
 
 use super::axes::nice_ticks;
 use super::colormap::{color_limits, value_rgb};
-use super::font::{draw_text, text_width, Anchor, CAP};
+use super::font::{draw_text, fit, text_width, Anchor, CAP};
 use super::overlay::{below_height, draw_legend, draw_overlay, legend_entries, Key};
 use super::{check_map, KappaPlotOptions, Overlay, RenderError};
 use super::{ColorScale, LegendPlace};
@@ -250,8 +250,25 @@ pub fn render_kappa_png(
     draw_overlay(&mut pm, &layout, &g, overlay, opts.show_caustics);
     draw_legend(&mut pm, &layout, &legend, opts.legend);
     if let Some(title) = &opts.title {
-        let at = (layout.left + layout.m / 2.0, 4.0 * s as f32 + 4.0);
-        draw_text(&mut pm, title, at, s, Color::BLACK, Anchor::TopCenter, true);
+        // Centred over the map, within the figure: a long title is drawn smaller, down to
+        // scale 1, and only then shortened.
+        let centre = layout.left + layout.m / 2.0;
+        let room = 2.0 * centre.min(layout.width as f32 - centre) - 8.0;
+        let mut ts = s;
+        while ts > 1 && text_width(title, ts) > room {
+            ts -= 1;
+        }
+        let text = fit(title, room, ts);
+        let at = (centre, 4.0 * s as f32 + 4.0);
+        draw_text(
+            &mut pm,
+            &text,
+            at,
+            ts,
+            Color::BLACK,
+            Anchor::TopCenter,
+            true,
+        );
     }
     pm.encode_png().map_err(|e| RenderError::Png(e.to_string()))
 }

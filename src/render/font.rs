@@ -100,6 +100,27 @@ const GLYPHS: &[(char, &str)] = &[
     ('?', ".###. #...# ....# ...#. ..#.. ..... ..#.."),
 ];
 
+/// `text` shortened with "..." to at most `max_px` pixels wide at scale `s` (empty when not
+/// even one character and the dots fit).
+pub(crate) fn fit(text: &str, max_px: f32, s: u32) -> String {
+    if text_width(text, s) <= max_px {
+        return text.to_string();
+    }
+    let mut out: String = String::new();
+    for c in text.chars() {
+        let next = format!("{out}{c}...");
+        if text_width(&next, s) > max_px {
+            break;
+        }
+        out.push(c);
+    }
+    if out.is_empty() {
+        String::new()
+    } else {
+        out + "..."
+    }
+}
+
 /// Rows of the glyph for `c`; unknown characters are drawn as `?`.
 fn glyph(c: char) -> &'static str {
     GLYPHS

@@ -312,3 +312,35 @@ fn sample_figure() {
         std::fs::write(&path, &png).unwrap_or_else(|e| panic!("writing {path}: {e}"));
     }
 }
+
+/// A title wider than the figure is drawn smaller (then shortened) so that it stays inside it:
+/// its dark pixels lie above the map and clear of the figure's left and right edges.
+#[cfg_attr(not(target_arch = "wasm32"), test)]
+#[cfg_attr(target_arch = "wasm32", wasm_bindgen_test::wasm_bindgen_test)]
+fn a_long_title_stays_inside_the_figure() {
+    let map = figure_map();
+    let title = "Deflection error, case (ii), z_s = 3: median 3.34\", p90 7.25\" inside r < 71\"";
+    let opts = KappaPlotOptions {
+        map_pixels_on_screen: 256,
+        title: Some(title.into()),
+        ..KappaPlotOptions::default()
+    };
+    let frame = kappa_figure_frame(&map, &opts).unwrap();
+    let pm = decode(&render_kappa_png(&map, &Overlay::default(), &opts).unwrap());
+    let dark = |x: u32, y: u32| rgb_at(&pm, x as f32, y as f32).iter().all(|&c| c < 80);
+    let band = 0..frame.map_top as u32 - 2;
+    let columns: Vec<u32> = (0..pm.width())
+        .filter(|&x| band.clone().any(|y| dark(x, y)))
+        .collect();
+    assert!(
+        columns.len() > 100,
+        "title not drawn ({} dark columns)",
+        columns.len()
+    );
+    let (first, last) = (columns[0], *columns.last().unwrap());
+    assert!(
+        first >= 2 && last < pm.width() - 2,
+        "title spans columns {first}..={last} of {}",
+        pm.width()
+    );
+}

@@ -10,32 +10,13 @@ use super::layout::Plan;
 use super::scale::PlotFrame;
 use super::{LinePlot, LineStyle, Series};
 use crate::render::figure::{color, frame, paint};
+pub(super) use crate::render::font::fit;
 use crate::render::font::{draw_text, text_width, Anchor};
 
 /// Light grey of the grid lines at the major ticks.
 const GRID_RGB: [u8; 3] = [225, 225, 225];
 /// How far outside the plot area (pixels) lines are cut before the mask clips them exactly.
 const CLIP_SLACK_PX: f64 = 64.0;
-
-/// `text` shortened with "..." to at most `max_px` pixels wide at scale `s`.
-pub(super) fn fit(text: &str, max_px: f32, s: u32) -> String {
-    if text_width(text, s) <= max_px {
-        return text.to_string();
-    }
-    let mut out: String = String::new();
-    for c in text.chars() {
-        let next = format!("{out}{c}...");
-        if text_width(&next, s) > max_px {
-            break;
-        }
-        out.push(c);
-    }
-    if out.is_empty() {
-        String::new()
-    } else {
-        out + "..."
-    }
-}
 
 pub(super) fn fill(pm: &mut Pixmap, x: f32, y: f32, w: f32, h: f32, rgb: [u8; 3], alpha: f32) {
     if let Some(r) = Rect::from_xywh(x, y, w, h) {
