@@ -9,6 +9,7 @@ use crate::render::{
     LineStyle, Marker, Overlay, OverlayPoints, Reference, Series, PALETTE,
 };
 
+use super::metrics::quantile;
 use super::{Case, PaperError, PaperRun};
 
 /// One figure: its file name and PNG bytes.
@@ -219,7 +220,7 @@ fn soft_component(run: &PaperRun) -> Result<Vec<u8>, PaperError> {
     let lo = run.truth_soft_kappa.min_max().0;
     let mut sorted = run.truth_soft_kappa.data.clone();
     sorted.sort_by(f64::total_cmp);
-    let hi = sorted[((sorted.len() - 1) as f64 * SOFT_SCALE_QUANTILE) as usize];
+    let hi = quantile(&sorted, SOFT_SCALE_QUANTILE);
     let opts = |title: &str| KappaPlotOptions {
         scale: ColorScale::Linear,
         vmin: Some(lo.max(0.0)),
