@@ -642,3 +642,91 @@ fn config_prints_every_setting_and_reads_back_as_the_defaults() {
         serde_json::to_value(ReconstructConfig::default()).unwrap()
     );
 }
+
+/// A DS9 region file (fk5) as arcs: the teaching example's images drawn as 0.4-arcsec circles
+/// labelled `text={1.1 z=1.5}`. Without a member catalogue the frame's origin is the regions'
+/// mean position (said on stderr); the lens found fits the images.
+#[test]
+fn reconstruct_from_a_ds9_region_file() {
+    let dir = temp_dir("regions");
+    let cat = wslap::app::examples::teaching_image_catalog().unwrap();
+    let (catalog, _) = wslap::catalog::parse_image_catalog(&cat, "images.cat", None).unwrap();
+    let sky = catalog.reference.unwrap();
+    let mut reg = String::from("# Region file format: DS9 version 4.1\nfk5\n");
+    for s in &catalog.systems {
+        for im in &s.images {
+            let (ra, dec) = sky.offset_to_radec(im.position);
+            let z = s.z.unwrap();
+            // Image ids as letters (1.1 -> 1.a): sources.json must keep the labels' ids.
+            let (system, image) = im.id.split_once('.').unwrap();
+            let letter = (b'a' + image.parse::<u8>().unwrap() - 1) as char;
+            reg += &format!("circle({ra:.8},{dec:.8},0.4\") # text={{{system}.{letter} z={z}}}\n");
+        }
+    }
+    let regions = dir.join("arcs.reg");
+    fs::write(&regions, reg).unwrap();
+    let config = dir.join("config.json");
+    fs::write(
+        &config,
+        r#"{"grid": {"cells": 16}, "products": {"pixels": 64, "size_arcsec": 60}}"#,
+    )
+    .unwrap();
+    let out_dir = dir.join("out");
+    let out = wslap(&[
+        "reconstruct",
+        "--arcs",
+        regions.to_str().unwrap(),
+        "--z-lens",
+        "0.3",
+        "--config",
+        config.to_str().unwrap(),
+        "--iterations",
+        "1000",
+        "--out",
+        out_dir.to_str().unwrap(),
+    ]);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "{stderr}");
+    assert!(
+        stderr.contains("arcs.reg: the frame's origin is the regions' mean position"),
+        "{stderr}"
+    );
+    let s = summary(&out_dir);
+    let n_images: usize = catalog.systems.iter().map(|s| s.images.len()).sum();
+    // About pi 0.4^2 / 0.2^2 = 12.6 lattice points per circle.
+    let pixels = s["constraint_pixels"].as_u64().unwrap() as usize;
+    assert!(
+        (8 * n_images..=16 * n_images).contains(&pixels),
+        "{pixels} pixels"
+    );
+    assert_eq!(s["settings"]["constraints"]["mode"], "arcs");
+    let median = s["image_offset_median_arcsec"].as_f64().unwrap();
+    assert!(median < 0.5, "median image offset {median} arcsec");
+    let sources: serde_json::Value =
+        serde_json::from_str(&fs::read_to_string(out_dir.join("sources.json")).unwrap()).unwrap();
+    let ids: Vec<&str> = sources
+        .as_array()
+        .unwrap()
+        .iter()
+        .flat_map(|s| s["observed"].as_array().unwrap())
+        .map(|o| o["id"].as_str().unwrap())
+        .collect();
+    assert!(
+        ids.len() == n_images
+            && ids
+                .iter()
+                .all(|id| id.ends_with(".a") || id.ends_with(".b")),
+        "{ids:?}"
+    );
+    // A bad region names its file and line.
+    fs::write(&regions, "fk5\ncircle(150,2.2,1\")\n").unwrap();
+    let err = refused(
+        &dir,
+        "reconstruct",
+        &["--arcs", regions.to_str().unwrap(), "--z-lens", "0.3"],
+    );
+    assert!(
+        err.contains("arcs.reg: line 2: a region without a label"),
+        "{err}"
+    );
+}

@@ -153,6 +153,7 @@ impl Truth {
                     id: s.id.clone(),
                     z: s.z,
                     images,
+                    image_ids: Vec::new(),
                     line: 0,
                 }
             })

@@ -123,7 +123,7 @@ pub(crate) fn check_requested(
 
 /// Mean (RA, Dec) of absolute positions in degrees, RA averaged as offsets from the first
 /// position wrapped to `[-180, 180)` so that a field across RA = 0 averages correctly.
-pub(super) fn mean_position(raw: &[DVec2]) -> SkyReference {
+pub(crate) fn mean_position(raw: &[DVec2]) -> SkyReference {
     let ra_first = raw[0].x;
     let n = raw.len() as f64;
     let d_ra_mean = raw

@@ -207,6 +207,11 @@ fn group_systems(
     Ok(systems)
 }
 
+/// Whether two images' redshifts can be one source's: `|a - b| <= Z_AGREEMENT_TOL (1 + min)`.
+pub fn redshifts_agree(a: f64, b: f64) -> bool {
+    (a - b).abs() <= Z_AGREEMENT_TOL * (1.0 + a.min(b))
+}
+
 /// The redshift of one system from its images' `(line, z)`: `None` when all are unknown,
 /// otherwise the mean of the known ones, which must agree within [`Z_AGREEMENT_TOL`].
 fn system_redshift(
@@ -229,7 +234,7 @@ fn system_redshift(
         });
     };
     let (first, second) = if lo.0 < hi.0 { (lo, hi) } else { (hi, lo) };
-    if hi.1 - lo.1 > Z_AGREEMENT_TOL * (1.0 + lo.1) {
+    if !redshifts_agree(lo.1, hi.1) {
         return Err(CatalogError::InconsistentRedshift {
             source_name: source_name.into(),
             system: id.into(),

@@ -17,7 +17,8 @@ mod rows;
 mod units;
 
 pub use error::{CatalogError, CatalogWarning};
-pub use lenstool::{parse_image_catalog, parse_member_catalog, Z_AGREEMENT_TOL};
+pub(crate) use frame::mean_position;
+pub use lenstool::{parse_image_catalog, parse_member_catalog, redshifts_agree, Z_AGREEMENT_TOL};
 pub use units::{DEGREE_LOOKALIKE, FIELD_ERROR_DEG, FIELD_WARN_DEG};
 
 /// One observed image of a multiply-lensed source.

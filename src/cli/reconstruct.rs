@@ -6,7 +6,9 @@ use std::path::{Path, PathBuf};
 use clap::Args;
 use serde::Serialize;
 use wslap::catalog::{parse_image_catalog, parse_member_catalog};
-use wslap::inversion::{export_system, parse_arcs, ConstraintMode, ConstraintSource};
+use wslap::inversion::{
+    arcs_from_regions, export_system, is_region_file, parse_arcs, ConstraintMode, ConstraintSource,
+};
 use wslap::limits::InputKind;
 use wslap::reconstruct::{
     reconstruct, ConvergenceRecord, Inputs, LayerSource, ReconstructConfig, Reconstruction,
@@ -31,9 +33,11 @@ pub struct ReconstructArgs {
     /// Lenstool multiple-image catalogue (id x y a b theta z mag).
     #[arg(long, value_name = "IMAGES.cat")]
     images: Option<PathBuf>,
-    /// Arc pixels instead of a catalogue (JSON: {"systems": [{"id", "z", "images": [[[x, y], ...], ...]}]},
-    /// arcsec); sets the constraint mode to "arcs".
-    #[arg(long, value_name = "ARCS.json")]
+    /// Arc pixels instead of a catalogue; sets the constraint mode to "arcs". Either JSON
+    /// ({"systems": [{"id", "z", "images": [[[x, y], ...], ...]}]}, arcsec) or a DS9 region file
+    /// in fk5: one region per image (polygon, circle, ellipse, box or point) labelled
+    /// text={1.1 z=2.5}, sampled at constraints.pixel_arcsec; '-' regions cut pixels out.
+    #[arg(long, value_name = "ARCS.json|ARCS.reg")]
     arcs: Option<PathBuf>,
     /// Lenstool member catalogue (potfile: id x y a b theta mag lum).
     #[arg(long, value_name = "MEMBERS.cat")]
@@ -101,22 +105,18 @@ pub fn run(args: &ReconstructArgs) -> Result<(), String> {
     }
     let cosmology = Cosmology::new(args.h0, args.omega_m).map_err(|e| e.to_string())?;
     let plane = LensPlane::new(cosmology, args.z_lens).map_err(|e| e.to_string())?;
-    let (catalog, arcs, mut warnings) = match (&args.images, &args.arcs) {
-        (Some(path), _) => {
+    let mut warnings = Vec::new();
+    let catalog = match &args.images {
+        Some(path) => {
             let (c, w) =
                 parse_image_catalog(&read_text(path, InputKind::Catalog)?, &name(path), None)
                     .map_err(|e| e.to_string())?;
-            (Some(c), None, w)
+            warnings.extend(w);
+            Some(c)
         }
-        (None, Some(path)) => {
-            config.constraints.mode = ConstraintMode::Arcs;
-            let a = parse_arcs(&read_text(path, InputKind::Arcs)?, &name(path))
-                .map_err(|e| e.to_string())?;
-            (None, Some(a), Vec::new())
-        }
-        (None, None) => return Err("give --images or --arcs".to_string()),
+        None => None,
     };
-    let reference = catalog.as_ref().and_then(|c| c.reference);
+    let mut reference = catalog.as_ref().and_then(|c| c.reference);
     let members = match &args.members {
         Some(path) => {
             let (m, w) = parse_member_catalog(
@@ -129,6 +129,37 @@ pub fn run(args: &ReconstructArgs) -> Result<(), String> {
             Some(m)
         }
         None => None,
+    };
+    reference = reference.or(members.as_ref().and_then(|m| m.reference));
+    let arcs = match (&catalog, &args.arcs) {
+        (None, Some(path)) => {
+            config.constraints.mode = ConstraintMode::Arcs;
+            let text = read_text(path, InputKind::Arcs)?;
+            Some(if is_region_file(&text) {
+                let r = arcs_from_regions(
+                    &text,
+                    &name(path),
+                    reference,
+                    config.constraints.pixel_arcsec,
+                    &|_| None,
+                )
+                .map_err(|e| e.to_string())?;
+                if r.reference_from_regions {
+                    eprintln!(
+                        "note: {}: the frame's origin is the regions' mean position, RA {:.6}, Dec {:.6} deg (give --members to use its catalogue's)",
+                        name(path),
+                        r.reference.ra_deg,
+                        r.reference.dec_deg
+                    );
+                }
+                reference = Some(r.reference);
+                r.arcs
+            } else {
+                parse_arcs(&text, &name(path)).map_err(|e| e.to_string())?
+            })
+        }
+        (None, None) => return Err("give --images or --arcs".to_string()),
+        (Some(_), _) => None,
     };
     for w in &warnings {
         eprintln!("warning: {w}");
@@ -144,7 +175,7 @@ pub fn run(args: &ReconstructArgs) -> Result<(), String> {
             .as_ref()
             .map_or(LayerSource::None, LayerSource::Members),
         plane,
-        reference: reference.or(members.as_ref().and_then(|m| m.reference)),
+        reference,
         holdout: &args.holdout,
         catalog: catalog.as_ref(),
     };

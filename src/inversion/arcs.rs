@@ -25,13 +25,16 @@ pub struct ArcSystem {
     pub z: Option<f64>,
     /// Pixel positions in arcsec, per image.
     pub images: Vec<Vec<DVec2>>,
+    /// The images' ids (from a DS9 region file's labels); empty: `system.1`, `system.2`, ...
+    /// in order.
+    pub image_ids: Vec<String>,
     /// Line of the file where the system's object starts (1-based; 0 when the system was
     /// not read from a file).
     pub line: usize,
 }
 
 /// Largest source redshift accepted (exclusive).
-const MAX_Z: f64 = 20.0;
+pub(crate) const MAX_Z: f64 = 20.0;
 
 #[derive(Deserialize)]
 #[serde(untagged)]
@@ -154,6 +157,7 @@ pub fn parse_arcs(text: &str, source_name: &str) -> Result<ArcCatalog, Constrain
                 .into_iter()
                 .map(|i| i.into_iter().map(|[x, y]| DVec2::new(x, y)).collect())
                 .collect(),
+            image_ids: Vec::new(),
             line,
         });
     }

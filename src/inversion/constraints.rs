@@ -59,6 +59,19 @@ pub enum ConstraintError {
     },
     #[error(transparent)]
     TooLarge(#[from] crate::limits::TooLarge),
+    /// A DS9 region file that does not parse (the message names the file and line).
+    #[error(transparent)]
+    Regions(crate::ds9::Ds9Error),
+    /// One region of a DS9 region file used as arcs.
+    #[error("{source_name}: line {line}: {reason}")]
+    RegionLine {
+        source_name: String,
+        line: usize,
+        reason: String,
+    },
+    /// A DS9 region file as a whole.
+    #[error("{source_name}: {reason}")]
+    RegionFile { source_name: String, reason: String },
     #[error("{source_name}: line {line}: image {id}: {field} = {value} is not allowed ({reason})")]
     BadImage {
         source_name: String,
@@ -380,9 +393,13 @@ pub fn build_constraints(
                 .map(|s| Candidate {
                     id: s.id.clone(),
                     z: s.z,
-                    image_ids: (1..=s.images.len())
-                        .map(|k| format!("{}.{k}", s.id))
-                        .collect(),
+                    image_ids: if s.image_ids.len() == s.images.len() {
+                        s.image_ids.clone()
+                    } else {
+                        (1..=s.images.len())
+                            .map(|k| format!("{}.{k}", s.id))
+                            .collect()
+                    },
                     images: s.images.clone(),
                     single_is_one_image: false,
                 })

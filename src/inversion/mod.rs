@@ -8,6 +8,7 @@ mod grid;
 mod grid_fft;
 mod members;
 mod npy;
+mod regions;
 mod system;
 
 pub use arcs::{parse_arcs, ArcCatalog, ArcSystem};
@@ -23,4 +24,5 @@ pub use members::{
     MembersError,
 };
 pub use npy::{export_system, npy_header, write_f64s, write_npy, NpyError};
+pub use regions::{arcs_from_regions, is_region_file, RegionArcs};
 pub use system::{ColumnInfo, LinearSystem, RowBlock, ScaledLens, SystemConfig, SystemError};

@@ -291,6 +291,7 @@ impl Simulation {
                     .iter()
                     .map(|im| im.iter().map(|&k| grid.position(k)).collect())
                     .collect(),
+                image_ids: Vec::new(),
                 line: 0,
             })
             .collect();

@@ -1,0 +1,460 @@
+//! Arc pixels from a SAOImage DS9 region file: the arcs as people mark them on an HST image,
+//! one region per image, labelled with its id (and redshift).
+//!
+//! ```text
+//! # Region file format: DS9 version 4.1
+//! fk5
+//! polygon(197.8779,-1.3338,197.8781,-1.3335,197.8776,-1.3331) # text={1.1 z=3.04}
+//! ellipse(197.8701,-1.3402,2.1",0.6",35) # text={1.2}
+//! circle(197.8712,-1.3399,0.4") # text={2.1 z=1.8}
+//! point(197.8688,-1.3381) # text={2.2}
+//! -circle(197.8700,-1.3401,0.3")
+//! ```
+//!
+//! - Each included region with an inside (`polygon`, `circle`, `ellipse`, `box`) becomes the
+//!   centres of the square lattice of pitch `pixel_arcsec` (the `constraints.pixel_arcsec`
+//!   setting, aligned on the frame's origin) that fall inside it, or its centre when none does;
+//!   a `point` is one pixel at its position. Regions with the same label add up to one image
+//!   (each pixel once).
+//! - The label is the region's `text={...}`: the image id `system.image` (the system is the
+//!   text before the first '.', as in a Lenstool catalogue), then optionally `z=VALUE`. The
+//!   images of a system must agree on z ([`redshifts_agree`], as in a catalogue; the first z
+//!   given is used); a system with no z takes it from the caller's lookup (the app: the loaded
+//!   image catalogue's system of that id), or is left without one (`--default-z`, or left out
+//!   with a warning).
+//! - An excluded region (a leading `-`, e.g. a foreground galaxy on the arc) removes its
+//!   pixels from every image.
+//! - Positions must be sky coordinates (`fk5`, `icrs`, `j2000`): image-pixel regions are
+//!   refused, since the image they were drawn on is not at hand. They are taken into the
+//!   frame of the given sky reference, or, without one, of the mean position of the regions.
+//!   DS9's angles (counter-clockwise from the first axis) are used as angles from +x (West),
+//!   which is the same axis for a north-up image.
+//!
+//! Errors name the file and line. The pixel count is limited like an arcs file's
+//! ([`MAX_ARC_PIXELS`]), and checked from each region's area before any pixel is made.
+
+use std::collections::{HashMap, HashSet};
+
+use glam::DVec2;
+
+use super::arcs::{ArcCatalog, ArcSystem, MAX_Z};
+use super::constraints::ConstraintError;
+use crate::catalog::redshifts_agree;
+use crate::ds9::{read_regions, Ds9Frame, Region, Shape};
+use crate::limits::{InputKind, TooLarge, MAX_ARC_PIXELS};
+use crate::sky::SkyReference;
+
+/// Whether `text` is a DS9 region file rather than an arcs JSON file: its first
+/// non-blank character is not `{`.
+pub fn is_region_file(text: &str) -> bool {
+    text.trim_start().chars().next().is_some_and(|c| c != '{')
+}
+
+/// Arcs read from a region file, and the frame they are in.
+#[derive(Debug, Clone, PartialEq)]
+pub struct RegionArcs {
+    pub arcs: ArcCatalog,
+    /// The frame's sky reference: the one given, or the regions' mean position.
+    pub reference: SkyReference,
+    /// Whether `reference` is the regions' mean position (no reference was given).
+    pub reference_from_regions: bool,
+}
+
+/// Reads the arcs of a DS9 region file (see the module's documentation). `reference` is the
+/// frame to use (e.g. the image or member catalogue's), `pixel_arcsec` the lattice pitch,
+/// `catalog_z` the redshift of a system whose labels give none.
+pub fn arcs_from_regions(
+    text: &str,
+    source_name: &str,
+    reference: Option<SkyReference>,
+    pixel_arcsec: f64,
+    catalog_z: &dyn Fn(&str) -> Option<f64>,
+) -> Result<RegionArcs, ConstraintError> {
+    TooLarge::check_bytes(source_name, InputKind::Arcs, text.len() as u64)?;
+    if !(pixel_arcsec.is_finite() && pixel_arcsec > 0.0) {
+        return Err(ConstraintError::BadParameter {
+            field: "pixel_arcsec",
+            value: pixel_arcsec,
+            reason: "must be finite and > 0",
+        });
+    }
+    let at = |line: usize, reason: String| ConstraintError::RegionLine {
+        source_name: source_name.to_string(),
+        line,
+        reason,
+    };
+    let regions = read_regions(text, source_name).map_err(ConstraintError::Regions)?;
+    if let Some(r) = regions.iter().find(|r| r.frame == Ds9Frame::Image) {
+        return Err(at(
+            r.line,
+            "is in image pixels: the image it was drawn on is not at hand here; save the \
+             regions in sky coordinates (DS9: Region > Save..., coordinate system fk5)"
+                .into(),
+        ));
+    }
+    if !regions.iter().any(|r| r.include) {
+        return Err(ConstraintError::RegionFile {
+            source_name: source_name.to_string(),
+            reason: "holds no region to use as an arc (polygon, circle, ellipse, box or point)"
+                .into(),
+        });
+    }
+    let (reference, reference_from_regions) = match reference {
+        Some(r) => (r, false),
+        None => (
+            mean_position(&regions).map_err(|(line, e)| at(line, e))?,
+            true,
+        ),
+    };
+    let mut labelled: Vec<(Label, &Region, Shape)> = Vec::new();
+    let mut excluded: Vec<Shape> = Vec::new();
+    for r in &regions {
+        let shape = r
+            .to_frame_arcsec(Some(reference), None)
+            .map_err(|e| at(r.line, e.to_string()))?;
+        if let Shape::Polyline(_) = shape {
+            return Err(at(
+                r.line,
+                "an open line has no inside: draw the arc as a polygon".into(),
+            ));
+        }
+        if r.include {
+            let label = Label::parse(r.text.as_deref()).map_err(|e| at(r.line, e))?;
+            labelled.push((label, r, shape));
+        } else {
+            excluded.push(shape);
+        }
+    }
+    let lattice = Lattice {
+        pitch: pixel_arcsec,
+    };
+    let mut total = 0u64;
+    for (_, r, shape) in &labelled {
+        total = total.saturating_add(lattice.estimate(shape));
+        if total > MAX_ARC_PIXELS as u64 {
+            return Err(at(
+                r.line,
+                format!(
+                    "the regions up to here hold up to {total} pixels of {pixel_arcsec} arcsec, \
+                     more than the limit of {MAX_ARC_PIXELS} for arcs; use a larger \
+                     constraints.pixel_arcsec or smaller regions"
+                ),
+            ));
+        }
+    }
+    let mut systems: Vec<SystemBuild> = Vec::new();
+    for (label, r, shape) in &labelled {
+        let k = match systems.iter().position(|s| s.id == label.system) {
+            Some(k) => k,
+            None => {
+                systems.push(SystemBuild::new(&label.system, r.line));
+                systems.len() - 1
+            }
+        };
+        let s = &mut systems[k];
+        if let Some(z) = label.z {
+            if !(z > 0.0 && z < MAX_Z) {
+                return Err(at(r.line, format!("z = {z} must be in (0, {MAX_Z})")));
+            }
+            if let Some((z0, line0)) = s.z {
+                if !redshifts_agree(z, z0) {
+                    return Err(at(
+                        r.line,
+                        format!(
+                            "image {}: z = {z}, but line {line0} gives system {} z = {z0}",
+                            label.image, label.system
+                        ),
+                    ));
+                }
+            } else {
+                s.z = Some((z, r.line));
+            }
+        }
+        let pixels = lattice.inside(shape, &excluded);
+        s.add(&label.image, r.line, pixels);
+    }
+    let mut out = Vec::with_capacity(systems.len());
+    for s in systems {
+        let mut images = Vec::with_capacity(s.images.len());
+        let mut image_ids = Vec::with_capacity(s.images.len());
+        for (id, line, pixels) in s.images {
+            if pixels.is_empty() {
+                return Err(at(
+                    line,
+                    format!("image {id}: an excluded region covers all of its pixels"),
+                ));
+            }
+            images.push(pixels);
+            image_ids.push(id);
+        }
+        let z = s.z.map(|(z, _)| z).or_else(|| catalog_z(&s.id));
+        out.push(ArcSystem {
+            id: s.id,
+            z,
+            images,
+            image_ids,
+            line: s.line,
+        });
+    }
+    Ok(RegionArcs {
+        arcs: ArcCatalog {
+            source_name: source_name.to_string(),
+            systems: out,
+        },
+        reference,
+        reference_from_regions,
+    })
+}
+
+/// A region's label: `system.image` and an optional `z=VALUE`.
+#[derive(Debug, Clone, PartialEq)]
+struct Label {
+    system: String,
+    image: String,
+    z: Option<f64>,
+}
+
+impl Label {
+    fn parse(text: Option<&str>) -> Result<Self, String> {
+        const HOW: &str = "label each arc with its image id, e.g. text={1.1} or text={1.1 z=2.5}";
+        let text = text.unwrap_or("").trim();
+        let mut tokens = text.split_whitespace();
+        let Some(image) = tokens.next() else {
+            return Err(format!("a region without a label: {HOW}"));
+        };
+        let system = match image.split_once('.') {
+            Some((system, rest)) if !system.is_empty() && !rest.is_empty() => system,
+            _ => {
+                return Err(format!(
+                    "label '{text}': '{image}' is not an image id of the form system.image; {HOW}"
+                ))
+            }
+        };
+        let mut z = None;
+        for t in tokens {
+            let value = t
+                .strip_prefix("z=")
+                .ok_or_else(|| format!("label '{text}': '{t}' is not z=VALUE; {HOW}"))?;
+            let v: f64 = value
+                .parse()
+                .ok()
+                .filter(|v: &f64| v.is_finite())
+                .ok_or_else(|| format!("label '{text}': z = '{value}' is not a number"))?;
+            z = Some(v);
+        }
+        Ok(Self {
+            system: system.to_string(),
+            image: image.to_string(),
+            z,
+        })
+    }
+}
+
+/// A system being read: its images (id, first line, pixel positions) in file order.
+struct SystemBuild {
+    id: String,
+    line: usize,
+    z: Option<(f64, usize)>,
+    images: Vec<(String, usize, Vec<DVec2>)>,
+    /// The pixels of each image so far (bit patterns: a lattice point is always computed
+    /// the same way), so that overlapping regions count each pixel once.
+    seen: HashMap<String, HashSet<[u64; 2]>>,
+}
+
+impl SystemBuild {
+    fn new(id: &str, line: usize) -> Self {
+        Self {
+            id: id.to_string(),
+            line,
+            z: None,
+            images: Vec::new(),
+            seen: HashMap::new(),
+        }
+    }
+
+    /// Adds the pixels of one region to the image `id` (each pixel once).
+    fn add(&mut self, id: &str, line: usize, pixels: Vec<DVec2>) {
+        let k = match self.images.iter().position(|(i, _, _)| i == id) {
+            Some(k) => k,
+            None => {
+                self.images.push((id.to_string(), line, Vec::new()));
+                self.images.len() - 1
+            }
+        };
+        let seen = self.seen.entry(id.to_string()).or_default();
+        let image = &mut self.images[k].2;
+        image.extend(
+            pixels
+                .into_iter()
+                .filter(|p| seen.insert([p.x.to_bits(), p.y.to_bits()])),
+        );
+    }
+}
+
+/// The square lattice of pixel centres `(i, j) * pitch` in the frame.
+struct Lattice {
+    pitch: f64,
+}
+
+impl Lattice {
+    fn position(&self, (i, j): (i64, i64)) -> DVec2 {
+        DVec2::new(i as f64, j as f64) * self.pitch
+    }
+
+    fn index(&self, p: DVec2) -> (i64, i64) {
+        let q = (p / self.pitch).round();
+        (q.x as i64, q.y as i64)
+    }
+
+    /// Lattice points in the shape's bounding box: an upper bound of its pixel count.
+    fn estimate(&self, shape: &Shape) -> u64 {
+        let (lo, hi) = bounds(shape);
+        let n = ((hi - lo) / self.pitch).ceil() + DVec2::ONE;
+        (n.x.max(1.0) * n.y.max(1.0)).min(u64::MAX as f64) as u64
+    }
+
+    /// The lattice points inside `shape` and outside every `excluded` shape; the shape's
+    /// centre (exactly) when no lattice point is inside (a point, or a region smaller than a
+    /// pixel), unless that is excluded.
+    fn inside(&self, shape: &Shape, excluded: &[Shape]) -> Vec<DVec2> {
+        let kept = |p: DVec2| !excluded.iter().any(|e| contains(e, p));
+        let (lo, hi) = bounds(shape);
+        let (i0, j0) = self.index(lo);
+        let (i1, j1) = self.index(hi);
+        let mut out = Vec::new();
+        if !matches!(shape, Shape::Point(_)) {
+            for j in j0..=j1 {
+                for i in i0..=i1 {
+                    let p = self.position((i, j));
+                    if contains(shape, p) && kept(p) {
+                        out.push(p);
+                    }
+                }
+            }
+        }
+        if out.is_empty() {
+            let c = match shape {
+                Shape::Point(p) => *p,
+                _ => 0.5 * (lo + hi),
+            };
+            if kept(c) {
+                out.push(c);
+            }
+        }
+        out
+    }
+}
+
+/// The bounding box `(min, max)` of a shape (arcsec).
+fn bounds(shape: &Shape) -> (DVec2, DVec2) {
+    let corners = |pts: &[DVec2]| {
+        let lo = pts.iter().copied().fold(DVec2::INFINITY, DVec2::min);
+        let hi = pts.iter().copied().fold(DVec2::NEG_INFINITY, DVec2::max);
+        (lo, hi)
+    };
+    match shape {
+        Shape::Polygon(v) | Shape::Polyline(v) => corners(v),
+        Shape::Point(p) => (*p, *p),
+        Shape::Circle { center, radius } => (
+            *center - DVec2::splat(*radius),
+            *center + DVec2::splat(*radius),
+        ),
+        Shape::Ellipse {
+            center,
+            radii,
+            angle_deg,
+        } => {
+            let (s, c) = angle_deg.to_radians().sin_cos();
+            let half = DVec2::new(
+                (radii.x * c).hypot(radii.y * s),
+                (radii.x * s).hypot(radii.y * c),
+            );
+            (*center - half, *center + half)
+        }
+        Shape::Box {
+            center,
+            size,
+            angle_deg,
+        } => {
+            let (s, c) = angle_deg.to_radians().sin_cos();
+            let h = 0.5 * *size;
+            let half = DVec2::new(
+                (h.x * c).abs() + (h.y * s).abs(),
+                (h.x * s).abs() + (h.y * c).abs(),
+            );
+            (*center - half, *center + half)
+        }
+    }
+}
+
+/// Whether `p` lies inside `shape` (polygons by the even-odd rule; lines and points have no
+/// inside).
+fn contains(shape: &Shape, p: DVec2) -> bool {
+    // The offset from `center` in the frame of an axis at `angle_deg`.
+    let along = |center: DVec2, angle_deg: f64| {
+        let (s, c) = angle_deg.to_radians().sin_cos();
+        let d = p - center;
+        DVec2::new(d.x * c + d.y * s, -d.x * s + d.y * c)
+    };
+    match shape {
+        Shape::Polygon(v) => {
+            let mut inside = false;
+            for k in 0..v.len() {
+                let (a, b) = (v[k], v[(k + 1) % v.len()]);
+                if (a.y > p.y) != (b.y > p.y) {
+                    let x = a.x + (p.y - a.y) / (b.y - a.y) * (b.x - a.x);
+                    if p.x < x {
+                        inside = !inside;
+                    }
+                }
+            }
+            inside
+        }
+        Shape::Polyline(_) | Shape::Point(_) => false,
+        Shape::Circle { center, radius } => p.distance_squared(*center) <= radius * radius,
+        Shape::Ellipse {
+            center,
+            radii,
+            angle_deg,
+        } => (along(*center, *angle_deg) / *radii).length_squared() <= 1.0,
+        Shape::Box {
+            center,
+            size,
+            angle_deg,
+        } => {
+            let d = along(*center, *angle_deg).abs();
+            d.x <= 0.5 * size.x && d.y <= 0.5 * size.y
+        }
+    }
+}
+
+/// The mean sky position of the included regions (their centres, or the mean of a polygon's
+/// vertices; fk5 degrees), as a reference, averaged as the catalogues average absolute
+/// positions ([`crate::catalog::mean_position`]: RA across 0/360 correctly). A position that is
+/// not on the sky is an error with its line.
+fn mean_position(regions: &[Region]) -> Result<SkyReference, (usize, String)> {
+    let mut points = Vec::new();
+    for r in regions.iter().filter(|r| r.include) {
+        let p = match &r.shape {
+            Shape::Polygon(v) | Shape::Polyline(v) => {
+                let c = crate::catalog::mean_position(v);
+                DVec2::new(c.ra_deg, c.dec_deg)
+            }
+            Shape::Point(p)
+            | Shape::Circle { center: p, .. }
+            | Shape::Ellipse { center: p, .. }
+            | Shape::Box { center: p, .. } => *p,
+        };
+        if SkyReference::new(p.x, p.y).is_none() {
+            return Err((
+                r.line,
+                format!(
+                    "({}, {}) is not a sky position (RA, Dec in degrees)",
+                    p.x, p.y
+                ),
+            ));
+        }
+        points.push(p);
+    }
+    Ok(crate::catalog::mean_position(&points))
+}
