@@ -90,18 +90,57 @@ function caption(info) {
   const c = info.summary.c_per_layer ?? [];
   const factors = c.length ? `member factor C = ${c.map((v) => v.toFixed(2)).join(', ')}; ` : '';
   // Observed images against the predicted ones: the median (the typical image) and the rms
-  // (which one image whose pair has merged can dominate).
-  const median = info.summary.image_offset_median_arcsec;
-  const rms = info.summary.image_plane_rms_arcsec;
-  const offsets = median == null || rms == null ? ''
-    : `image offsets median ${median.toFixed(2)}″, rms ${rms.toFixed(2)}″; `;
+  // (which one image whose pair has merged can dominate); then the same for the held-out
+  // systems: how well the model predicts images it was not given.
+  const sum = info.summary;
+  const offsetText = (what, median, rms) => (median == null || rms == null ? ''
+    : `${what} median ${median.toFixed(2)}″, rms ${rms.toFixed(2)}″; `);
+  const offsets = offsetText('image offsets', sum.image_offset_median_arcsec, sum.image_plane_rms_arcsec);
+  const held = offsetText('held-out images:', sum.holdout_image_offset_median_arcsec,
+    sum.holdout_image_plane_rms_arcsec);
   $('summary').textContent = `${status}Einstein radius ${bound}${s.einstein_radius_arcsec.toFixed(1)}″ at ` +
-    `z_s = ${s.z_source}; ${factors}${offsets}${s.tangential_curves} tangential and ${s.radial_curves} radial critical curves.`;
+    `z_s = ${s.z_source}; ${factors}${offsets}${held}${s.tangential_curves} tangential and ${s.radial_curves} radial critical curves.`;
+}
+
+// Why a system was left out of the fit (summary.json's `systems_excluded` reasons).
+const LEFT_OUT = { UnknownRedshift: 'no redshift', SingleImage: 'a single image', HeldOut: 'held out' };
+
+/** Under the views: the systems a run left out of the fit and its warnings (collapsed: a
+ * member catalogue wider than the field gives one per member). Built from text nodes. */
+function runNotes(summary) {
+  const box = $('run-notes');
+  box.replaceChildren();
+  const left = (summary?.systems_excluded ?? []).map((s) => {
+    const m = s.match(/^(.*) \((\w+)\)$/);
+    return m ? `${m[1]} (${LEFT_OUT[m[2]] ?? m[2]})` : s;
+  });
+  if (left.length) {
+    const p = document.createElement('p');
+    p.id = 'left-out';
+    p.textContent = `Left out of the fit: ${left.join(', ')}.`;
+    box.append(p);
+  }
+  const warnings = summary?.warnings ?? [];
+  if (warnings.length) {
+    const details = document.createElement('details');
+    details.id = 'run-warnings';
+    const head = document.createElement('summary');
+    head.textContent = `${warnings.length} warning${warnings.length === 1 ? '' : 's'} from the run`;
+    const list = document.createElement('ul');
+    for (const w of warnings) {
+      const li = document.createElement('li');
+      li.textContent = w;
+      list.append(li);
+    }
+    details.append(head, list);
+    box.append(details);
+  }
 }
 
 async function showResult(info) {
   resultKind = info.kind;
   caption(info);
+  runNotes(info.summary);
   showDownloads(info.kind, app);
 }
 
@@ -162,7 +201,7 @@ async function afterOpen(report) {
   for (const { role } of ROLES) setFileStatus(role, loaded[role] ? `${loaded[role]}: loaded` : '');
   resultKind = null;
   if (report?.result === 'restored' || report?.result === 'recomputed') await showResult(await ask('resultInfo'));
-  else $('summary').textContent = '';
+  else { $('summary').textContent = ''; runNotes(null); }
   await render();
 }
 
@@ -215,6 +254,12 @@ async function leaveExample(ex, role) {
   await showSessionSettings();
 }
 
+/** The status line of a loaded file: its LoadReport's summary and warnings. */
+function reportText(report) {
+  const warn = report.warnings.length ? ` (${report.warnings.length} warnings: ${report.warnings.join('; ')})` : '';
+  return `${report.name}: ${report.summary}${warn}`;
+}
+
 async function onFile(role, file) {
   clearError();
   const example = role === 'project' ? undefined : openExample();
@@ -232,8 +277,7 @@ async function onFile(role, file) {
     } else {
       report = await ask('loadText', { role, name: file.name, text: await file.text() });
     }
-    const warn = report.warnings.length ? ` (${report.warnings.length} warnings: ${report.warnings.join('; ')})` : '';
-    setFileStatus(role, `${report.name}: ${report.summary}${warn}`);
+    setFileStatus(role, reportText(report));
     if (example) await leaveExample(example, role);
     await refreshLoaded();
     await persist();
@@ -257,6 +301,11 @@ function queueFile(role, file) { return enqueue(() => onFile(role, file)); }
 async function applySetting(path, value) {
   if (path === 'reconstruct.products.z_source') return setZ(value);
   settings = await askSettings('setField', { path, value });
+  // A DS9 region file's arc pixels follow the constraint pixel: say how many there are now.
+  if (path === 'reconstruct.constraints.pixel_arcsec') {
+    const report = await ask('reload', { role: 'arcs' });
+    if (report) setFileStatus('arcs', reportText(report));
+  }
   await persist();
   return settings;
 }

@@ -49,6 +49,7 @@ const handlers = {
   fitsFiles: () => session.fits_files(),
   openProject: (m) => session.open_project(m.text, m.name),
   loaded: () => session.loaded(),
+  reload: (m) => session.reload(m.role),
   // A fresh session (used after a cancel restarted the worker, or to start over).
   reset: () => { session = new core.AppSession(); return {}; },
 };

@@ -7,7 +7,7 @@ use serde::{Deserialize, Serialize};
 use crate::catalog::{parse_image_catalog, parse_member_catalog, ImageCatalog, MemberCatalog};
 use crate::fits::read_image;
 use crate::grid::Map;
-use crate::inversion::{parse_arcs, ArcCatalog};
+use crate::inversion::{arcs_from_regions, is_region_file, parse_arcs, ArcCatalog};
 use crate::model::ModelFile;
 use crate::sky::SkyReference;
 
@@ -147,14 +147,18 @@ pub struct ParsedData {
     pub images: Option<ImageCatalog>,
     pub arcs: Option<ArcCatalog>,
     pub members: Option<MemberCatalog>,
+    /// The frame of arcs read from a DS9 region file without a catalogue to give one (the
+    /// regions' mean position).
+    pub arcs_reference: Option<SkyReference>,
     pub warnings: Vec<String>,
 }
 
 impl ParsedData {
-    /// The frame's sky reference (images first, else members).
+    /// The frame's sky reference (images first, else members, else the region file's).
     pub fn reference(&self) -> Option<SkyReference> {
         let images = self.images.as_ref().and_then(|c| c.reference);
-        images.or(self.members.as_ref().and_then(|m| m.reference))
+        let members = self.members.as_ref().and_then(|m| m.reference);
+        images.or(members).or(self.arcs_reference)
     }
 
     /// Observed image positions (catalogue positions, or every arc pixel), arcsec.
@@ -234,13 +238,33 @@ fn describe_images(c: &ImageCatalog) -> String {
     format!("{} systems, {} images", c.systems.len(), c.image_count())
 }
 
+/// Arcs from a DS9 region file (see [`arcs_from_regions`]) in the frame of `reference`, pixels
+/// at `pixel_arcsec`; systems without a redshift in their labels take the one of the same
+/// system in `images`.
+fn region_arcs(
+    text: &str,
+    name: &str,
+    reference: Option<SkyReference>,
+    pixel_arcsec: f64,
+    images: Option<&ImageCatalog>,
+) -> Result<crate::inversion::RegionArcs, AppError> {
+    let catalog_z = |id: &str| {
+        let systems = images.into_iter().flat_map(|c| c.systems.iter());
+        systems.filter(|s| s.id == id).find_map(|s| s.z)
+    };
+    arcs_from_regions(text, name, reference, pixel_arcsec, &catalog_z)
+        .map_err(|e| AppError::File(e.to_string()))
+}
+
 impl LoadedData {
     /// Checks `text` as a file of `role` and keeps it; an error leaves everything as it was.
+    /// `arc_pixel_arcsec` is the pixel of arcs drawn as DS9 regions.
     pub fn load_text(
         &mut self,
         role: DataRole,
         name: &str,
         text: &str,
+        arc_pixel_arcsec: f64,
     ) -> Result<LoadReport, AppError> {
         let file = |e: &dyn std::fmt::Display| AppError::File(e.to_string());
         let (summary, warnings) = match role {
@@ -260,10 +284,23 @@ impl LoadedData {
                 )
             }
             DataRole::Arcs => {
-                let a = parse_arcs(text, name).map_err(|e| file(&e))?;
+                let regions = is_region_file(text);
+                let a = if regions {
+                    region_arcs(text, name, None, arc_pixel_arcsec, None)?.arcs
+                } else {
+                    parse_arcs(text, name).map_err(|e| file(&e))?
+                };
                 let pixels: usize = a.systems.iter().flat_map(|s| &s.images).map(Vec::len).sum();
                 let n = a.systems.len();
-                (format!("{n} systems, {pixels} arc pixels"), Vec::new())
+                let from = if regions {
+                    format!(" (DS9 regions at {arc_pixel_arcsec} arcsec)")
+                } else {
+                    String::new()
+                };
+                (
+                    format!("{n} systems, {pixels} arc pixels{from}"),
+                    Vec::new(),
+                )
             }
             DataRole::Model => {
                 let m = ModelFile::from_json_str(text, name).map_err(|e| file(&e))?;
@@ -274,13 +311,7 @@ impl LoadedData {
                 )
             }
         };
-        let slot = match role {
-            DataRole::Images => &mut self.images,
-            DataRole::Members => &mut self.members,
-            DataRole::Arcs => &mut self.arcs,
-            DataRole::Model => &mut self.model,
-        };
-        *slot = Some(NamedText {
+        *self.slot(role) = Some(NamedText {
             name: name.to_string(),
             text: text.to_string(),
         });
@@ -292,13 +323,43 @@ impl LoadedData {
         })
     }
 
+    /// Whether loaded DS9 region arcs can be sampled at `pixel_arcsec` (within the arcs' pixel
+    /// limit); `Ok` when the arcs are not a region file.
+    pub fn check_region_arcs(&self, pixel_arcsec: f64) -> Result<(), AppError> {
+        match &self.arcs {
+            Some(f) if is_region_file(&f.text) => {
+                region_arcs(&f.text, &f.name, None, pixel_arcsec, None).map(|_| ())
+            }
+            _ => Ok(()),
+        }
+    }
+
+    /// Loads the kept file of `role` again (see [`Self::load_text`]); `None` when there is
+    /// none.
+    pub fn reload(
+        &mut self,
+        role: DataRole,
+        arc_pixel_arcsec: f64,
+    ) -> Result<Option<LoadReport>, AppError> {
+        let Some(NamedText { name, text }) = self.slot(role).clone() else {
+            return Ok(None);
+        };
+        self.load_text(role, &name, &text, arc_pixel_arcsec)
+            .map(Some)
+    }
+
     /// Forgets the file of `role`.
     pub fn clear(&mut self, role: DataRole) {
+        *self.slot(role) = None;
+    }
+
+    /// Where the file of `role` is kept.
+    fn slot(&mut self, role: DataRole) -> &mut Option<NamedText> {
         match role {
-            DataRole::Images => self.images = None,
-            DataRole::Members => self.members = None,
-            DataRole::Arcs => self.arcs = None,
-            DataRole::Model => self.model = None,
+            DataRole::Images => &mut self.images,
+            DataRole::Members => &mut self.members,
+            DataRole::Arcs => &mut self.arcs,
+            DataRole::Model => &mut self.model,
         }
     }
 
@@ -345,8 +406,10 @@ impl LoadedData {
         })
     }
 
-    /// The catalogues parsed into one frame (images first, members in their frame).
-    pub fn parse(&self) -> Result<ParsedData, AppError> {
+    /// The catalogues parsed into one frame (images first, members in their frame, then arcs:
+    /// DS9 regions in that frame, or their own mean position without a catalogue, with pixels
+    /// of `arc_pixel_arcsec`).
+    pub fn parse(&self, arc_pixel_arcsec: f64) -> Result<ParsedData, AppError> {
         let file = |e: &dyn std::fmt::Display| AppError::File(e.to_string());
         let mut out = ParsedData::default();
         if let Some(f) = &self.images {
@@ -354,14 +417,33 @@ impl LoadedData {
             out.warnings.extend(w.iter().map(|w| w.to_string()));
             out.images = Some(c);
         }
-        if let Some(f) = &self.arcs {
-            out.arcs = Some(parse_arcs(&f.text, &f.name).map_err(|e| file(&e))?);
-        }
         if let Some(f) = &self.members {
             let frame = out.images.as_ref().and_then(|c| c.reference);
             let (m, w) = parse_member_catalog(&f.text, &f.name, frame).map_err(|e| file(&e))?;
             out.warnings.extend(w.iter().map(|w| w.to_string()));
             out.members = Some(m);
+        }
+        if let Some(f) = &self.arcs {
+            out.arcs = Some(if is_region_file(&f.text) {
+                let frame = out.reference();
+                let r = region_arcs(
+                    &f.text,
+                    &f.name,
+                    frame,
+                    arc_pixel_arcsec,
+                    out.images.as_ref(),
+                )?;
+                if frame.is_none() {
+                    out.arcs_reference = Some(r.reference);
+                    out.warnings.push(format!(
+                        "{}: no catalogue gives a frame, so its origin is the regions' mean position (RA {:.6}, Dec {:.6} deg): the maps are centred there",
+                        f.name, r.reference.ra_deg, r.reference.dec_deg
+                    ));
+                }
+                r.arcs
+            } else {
+                parse_arcs(&f.text, &f.name).map_err(|e| file(&e))?
+            });
         }
         Ok(out)
     }

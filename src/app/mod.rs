@@ -2,7 +2,7 @@
 //! a project file can store them), the settings and the last result; it loads files without
 //! losing what was loaded before, runs a reconstruction, a forward model or a look-up of
 //! deflection maps, redraws curves at another source redshift from the stored maps, renders
-//! the views and answers hover read-outs. `wasm.rs` is a thin shell around it.
+//! the views and answers hover read-outs. `src/wasm/` is a thin shell around it.
 
 mod data;
 pub mod examples;
@@ -18,7 +18,7 @@ use thiserror::Error;
 
 pub use crate::reconstruct::ReconstructSummary;
 pub use data::{
-    ArcPixels, DataMarks, DataRole, LoadReport, LoadedData, NamedMap, NamedText,
+    ArcPixels, DataMarks, DataRole, LoadReport, LoadedData, NamedMap, NamedText, ParsedData,
     MAX_STORED_FITS_BYTES,
 };
 pub use project::{Project, ProjectResult, StoredFits, PROJECT_FORMAT, PROJECT_VERSION};
@@ -68,7 +68,14 @@ impl Session {
         name: &str,
         text: &str,
     ) -> Result<LoadReport, AppError> {
-        self.data.load_text(role, name, text)
+        let pixel = self.settings.reconstruct.constraints.pixel_arcsec;
+        self.data.load_text(role, name, text, pixel)
+    }
+
+    /// The loaded files parsed into one frame (see [`LoadedData::parse`]).
+    pub fn parsed(&self) -> Result<ParsedData, AppError> {
+        self.data
+            .parse(self.settings.reconstruct.constraints.pixel_arcsec)
     }
 
     /// Loads one deflection FITS map (`axis` 0 for x, 1 for y); nothing changes on an error.
@@ -81,10 +88,26 @@ impl Session {
         self.data.load_fits(axis, name, bytes)
     }
 
-    /// Sets one setting (see [`AppSettings::with_field`]); the old value stays on an error.
+    /// Sets one setting (see [`AppSettings::with_field`]); the old value stays on an error. A
+    /// new constraint pixel must also suit loaded DS9 region arcs (their pixel count is
+    /// limited).
     pub fn set_field(&mut self, path: &str, value: serde_json::Value) -> Result<(), AppError> {
-        self.settings = self.settings.with_field(path, value)?;
+        let next = self.settings.with_field(path, value)?;
+        let pixel = next.reconstruct.constraints.pixel_arcsec;
+        if pixel != self.settings.reconstruct.constraints.pixel_arcsec {
+            self.data
+                .check_region_arcs(pixel)
+                .map_err(|e| AppError::Setting(format!("{path}: {e}")))?;
+        }
+        self.settings = next;
         Ok(())
+    }
+
+    /// Checks the loaded file of `role` again with the current settings (a DS9 region file's
+    /// pixels follow the constraint pixel) and reports on it; `None` when none is loaded.
+    pub fn reload(&mut self, role: DataRole) -> Result<Option<LoadReport>, AppError> {
+        let pixel = self.settings.reconstruct.constraints.pixel_arcsec;
+        self.data.reload(role, pixel)
     }
 
     /// The last result, or an error saying that nothing was computed yet.

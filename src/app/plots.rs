@@ -1,8 +1,18 @@
 //! Line-plot views: the radial profile (kappa and enclosed mass against radius) and the QADP
 //! convergence (objective, grid mass and `C` per layer against iteration).
 
-use crate::render::{compose_grid, Axis, LinePlot, RenderError, Series, PALETTE};
+use std::cell::RefCell;
+use std::hash::{DefaultHasher, Hash, Hasher};
 
+use glam::DVec2;
+
+use crate::grid::{Map, MapGeometry};
+use crate::model::ModelFile;
+use crate::profiles::MassComponent;
+use crate::radial::{radial_profile, RadialBins, RadialProfile};
+use crate::render::{compose_grid, Axis, LinePlot, LineStyle, RenderError, Series, PALETTE};
+
+use super::run::{RunKind, SessionResult};
 use super::views::ViewPng;
 use super::{AppError, Session};
 
@@ -42,23 +52,58 @@ fn compose(name: &str, plots: &[LinePlot]) -> Result<ViewPng, AppError> {
     })
 }
 
+/// Pixels per side, at most, of the model's convergence map behind its profile. The view's
+/// bins are two product pixels wide, so at 256 product pixels a 128-pixel map has one pixel per
+/// bin; against a 512-pixel map of the built-in example's true lens its profile differs by at
+/// most 1.2% in kappa and 0.8% in enclosed mass (a line width on the plot), and it takes a
+/// quarter of the time (175 ms natively for 97 elliptical NFW halos, against 700 ms).
+const MODEL_PROFILE_MAX_PIXELS: usize = 128;
+
+/// A model file's name and its profile.
+pub type NamedProfile = (String, RadialProfile);
+
+/// A model profile computed for one result and one model file (keyed by a hash of the file's
+/// name and text), so that switching views does not compute it again.
+#[derive(Debug, Default)]
+pub(crate) struct ModelProfileCache(RefCell<Option<(u64, Option<NamedProfile>)>>);
+
+/// Points `(x, y)` of a plotted line.
+type Points = Vec<(f64, f64)>;
+
+/// The profile's `(r, kappa)` and `(r, M(<r))` points.
+fn profile_points(p: &RadialProfile) -> (Points, Points) {
+    let kappa = p.r_arcsec.iter().copied().zip(p.kappa.iter().copied());
+    let mass = p.r_edges_arcsec.iter().copied();
+    let mass = mass.zip(p.enclosed_mass_msun.iter().copied());
+    (kappa.collect(), mass.collect())
+}
+
 impl Session {
     /// The radial profile about (0, 0): area-weighted mean kappa (`D_ls/D_s = 1`) per annulus and
-    /// the projected mass inside each radius (Msun), both on log10 axes.
+    /// the projected mass inside each radius (Msun), both on log10 axes. Over a reconstruction,
+    /// the loaded model file's profile in the same bins, dashed (see [`Self::model_profile`]).
     pub fn radial_view(&self) -> Result<ViewPng, AppError> {
-        let p = &self.result()?.products.profile;
-        let kappa: Vec<(f64, f64)> = p
-            .r_arcsec
-            .iter()
-            .copied()
-            .zip(p.kappa.iter().copied())
-            .collect();
-        let mass: Vec<(f64, f64)> = p
-            .r_edges_arcsec
-            .iter()
-            .copied()
-            .zip(p.enclosed_mass_msun.iter().copied())
-            .collect();
+        let result = self.result()?;
+        let (kappa, mass) = profile_points(&result.products.profile);
+        let (mut kappa_series, mut mass_series) = match result.kind {
+            RunKind::Reconstruct => (
+                vec![Series::line("reconstruction", kappa, PALETTE[0])],
+                vec![Series::line("reconstruction", mass, PALETTE[0])],
+            ),
+            _ => (
+                vec![Series::line("kappa", kappa, PALETTE[0])],
+                vec![Series::line("M(<r)", mass, PALETTE[1])],
+            ),
+        };
+        if let Some((name, model)) = self.model_profile(result)? {
+            let (kappa, mass) = profile_points(&model);
+            let dashed = |points| Series {
+                style: LineStyle::Dashed,
+                ..Series::line(format!("loaded model ({name})"), points, PALETTE[1])
+            };
+            kappa_series.push(dashed(kappa));
+            mass_series.push(dashed(mass));
+        }
         compose(
             "radial-profile.png",
             &[
@@ -66,16 +111,69 @@ impl Session {
                     "mean kappa in annuli",
                     Axis::linear("r [arcsec]"),
                     Axis::log("kappa"),
-                    vec![Series::line("kappa", kappa, PALETTE[0])],
+                    kappa_series,
                 ),
                 panel(
                     "enclosed projected mass",
                     Axis::linear("r [arcsec]"),
                     Axis::log("M(<r) [Msun]"),
-                    vec![Series::line("M(<r)", mass, PALETTE[1])],
+                    mass_series,
                 ),
             ],
         )
+    }
+
+    /// The radial profile of the loaded model file (the true lens of the built-in examples) in
+    /// the bins of a reconstruction's profile, about the same sky position, with the file's
+    /// name; `None` for other results, without a model file, or when the model's lens plane
+    /// (`z_lens`, cosmology) is not the reconstruction's: its kappa and masses would not
+    /// compare. When both frames have a sky reference the model's map is centred on the
+    /// reconstruction's origin (the small rotation between the two tangent planes is ignored).
+    /// The model's map has at most [`MODEL_PROFILE_MAX_PIXELS`] per side.
+    pub fn model_profile(&self, result: &SessionResult) -> Result<Option<NamedProfile>, AppError> {
+        let (RunKind::Reconstruct, Some(file)) = (result.kind, &self.data.model) else {
+            return Ok(None);
+        };
+        let mut hasher = DefaultHasher::new();
+        (&file.name, &file.text).hash(&mut hasher);
+        let key = hasher.finish();
+        if let Some((k, cached)) = &*result.model_profile.0.borrow() {
+            if *k == key {
+                return Ok(cached.clone());
+            }
+        }
+        let profile = self.compute_model_profile(result, &file.name, &file.text)?;
+        *result.model_profile.0.borrow_mut() = Some((key, profile.clone()));
+        Ok(profile)
+    }
+
+    fn compute_model_profile(
+        &self,
+        result: &SessionResult,
+        name: &str,
+        text: &str,
+    ) -> Result<Option<NamedProfile>, AppError> {
+        let run = |e: &dyn std::fmt::Display| AppError::Run(format!("{name}: {e}"));
+        let model = ModelFile::from_json_str(text, name).map_err(|e| run(&e))?;
+        let plane = result.products.plane;
+        if model.z_lens != plane.z_lens || model.cosmology != plane.cosmology {
+            return Ok(None);
+        }
+        let lens = model.build_lens().map_err(|e| run(&e))?;
+        let center = match (result.products.reference, model.reference) {
+            (Some(ours), Some(theirs)) => theirs.to_offset_arcsec(ours.ra_deg, ours.dec_deg),
+            _ => DVec2::ZERO,
+        };
+        let bins = RadialBins::Edges(result.products.profile.r_edges_arcsec.clone());
+        let g = result.products.maps.geometry();
+        let geometry = MapGeometry {
+            center: center + g.center,
+            pixels: g.pixels.min(MODEL_PROFILE_MAX_PIXELS),
+            ..g
+        };
+        let kappa = Map::from_fn(geometry, |p| lens.kappa(p));
+        let profile = radial_profile(&kappa, center, &bins, &plane).map_err(|e| run(&e))?;
+        Ok(Some((name.to_string(), profile)))
     }
 
     /// The QADP history: objective, grid mass (Msun) and `C` of every layer against iteration

@@ -19,6 +19,7 @@ use crate::reconstruct::{
 use crate::solver::Control;
 
 use super::data::{DataMarks, ParsedData};
+use super::plots::ModelProfileCache;
 use super::{AppError, Session};
 
 /// Map width of a forward model without a `products.size_arcsec` setting (arcsec).
@@ -63,6 +64,8 @@ pub struct SessionResult {
     pub reconstruction: Option<ReconstructionResult>,
     /// Wall-clock time of the run in ms.
     pub elapsed_ms: f64,
+    /// The loaded model file's radial profile for the profile view, once computed.
+    pub(crate) model_profile: ModelProfileCache,
 }
 
 impl SessionResult {
@@ -145,7 +148,7 @@ impl Session {
         &self,
         progress: &mut dyn FnMut(&ConvergenceRecord) -> Control,
     ) -> Result<SessionResult, AppError> {
-        let parsed = self.data.parse()?;
+        let parsed = self.parsed()?;
         let plane = self.settings.lens_plane()?;
         let mut config = self.settings.reconstruct.clone();
         let images = constraint_source(&parsed, &mut config)?;
@@ -157,7 +160,7 @@ impl Session {
                 .map_or(LayerSource::None, LayerSource::Members),
             plane,
             reference: parsed.reference(),
-            holdout: &[],
+            holdout: &self.settings.holdout,
             catalog: parsed.images.as_ref(),
         };
         let r =
@@ -181,6 +184,7 @@ impl Session {
                 lens: r.lens,
             }),
             elapsed_ms: 0.0,
+            model_profile: ModelProfileCache::default(),
         })
     }
 
@@ -197,7 +201,7 @@ impl Session {
     ) -> Result<(), AppError> {
         let t = crate::products::Clock::start();
         let run = |e: &dyn std::fmt::Display| AppError::Run(e.to_string());
-        let parsed = self.data.parse()?;
+        let parsed = self.parsed()?;
         let plane = self.settings.lens_plane()?;
         let mut config = self.settings.reconstruct.clone();
         if config.grid.refinements > 0 {
@@ -206,8 +210,8 @@ impl Session {
             ));
         }
         let source = constraint_source(&parsed, &mut config)?;
-        let constraints =
-            build_constraints(source, &config.constraints, &[]).map_err(|e| run(&e))?;
+        let constraints = build_constraints(source, &config.constraints, &self.settings.holdout)
+            .map_err(|e| run(&e))?;
         let positions: Vec<DVec2> = constraints.pixels.iter().map(|p| p.position).collect();
         let grid = CellGrid::from_config(&config.grid, &positions).map_err(|e| run(&e))?;
         let mut warnings = parsed.warnings.clone();
@@ -248,6 +252,7 @@ impl Session {
                 lens,
             }),
             elapsed_ms: t.ms(),
+            model_profile: ModelProfileCache::default(),
         });
         Ok(())
     }
@@ -269,13 +274,14 @@ impl Session {
         };
         let products =
             Products::from_model(&model, &opts).map_err(|e| AppError::Run(e.to_string()))?;
-        let parsed = self.data.parse().unwrap_or_default();
+        let parsed = self.parsed().unwrap_or_default();
         Ok(SessionResult {
             kind: RunKind::Forward,
             products,
             marks: parsed.marks(),
             reconstruction: None,
             elapsed_ms: 0.0,
+            model_profile: ModelProfileCache::default(),
         })
     }
 
@@ -300,6 +306,7 @@ impl Session {
             marks: DataMarks::default(),
             reconstruction: None,
             elapsed_ms: 0.0,
+            model_profile: ModelProfileCache::default(),
         })
     }
 

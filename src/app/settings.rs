@@ -24,6 +24,8 @@ pub struct AppSettings {
     /// The reconstruction settings (`CONFIG.json` of `wslap reconstruct`); the app's default
     /// map side is [`APP_MAP_PIXELS`].
     pub reconstruct: ReconstructConfig,
+    /// Systems left out of the fit and predicted (`wslap reconstruct --holdout`), by id.
+    pub holdout: Vec<String>,
 }
 
 impl Default for AppSettings {
@@ -35,14 +37,28 @@ impl Default for AppSettings {
             h0: 70.0,
             omega_m: 0.3,
             reconstruct,
+            holdout: Vec::new(),
         }
     }
 }
 
 impl AppSettings {
-    /// Checks the cosmology, the lens redshift and every block of the reconstruction settings.
+    /// Checks the cosmology, the lens redshift, every block of the reconstruction settings and
+    /// the hold-out ids (non-empty, each once; whether the data has them is checked by a run).
     pub fn validate(&self) -> Result<(), AppError> {
         self.lens_plane()?;
+        for (k, id) in self.holdout.iter().enumerate() {
+            if id.is_empty() || id.trim() != id {
+                return Err(AppError::Setting(format!(
+                    "holdout: '{id}' is not a system id (no spaces around it, not empty)"
+                )));
+            }
+            if self.holdout[..k].contains(id) {
+                return Err(AppError::Setting(format!(
+                    "holdout: system '{id}' is given twice"
+                )));
+            }
+        }
         self.reconstruct
             .validate()
             .map_err(|e| AppError::Setting(e.to_string()))

@@ -157,7 +157,7 @@ impl Session {
     /// selects, on the field a reconstruction would use (1.3 x their extent, at least 60
     /// arcsec).
     pub fn data_view(&self, opts: &ViewOptions) -> Result<ViewPng, AppError> {
-        let parsed = self.data.parse()?;
+        let parsed = self.parsed()?;
         let observed = parsed.observed_arcsec();
         let marks = parsed.marks();
         if observed.is_empty() && marks.members.is_empty() {

@@ -61,6 +61,13 @@ impl AppSession {
         to_js(&self.inner.load_text(role, name, text).map_err(err)?)
     }
 
+    /// Checks the loaded file of `role` again with the current settings: its `LoadReport`, or
+    /// `null` when none is loaded.
+    pub fn reload(&mut self, role: &str) -> Result<JsValue, JsError> {
+        let role = DataRole::parse(role).map_err(err)?;
+        to_js(&self.inner.reload(role).map_err(err)?)
+    }
+
     /// Forgets the file of `role`.
     pub fn clear(&mut self, role: &str) -> Result<(), JsError> {
         self.inner.data.clear(DataRole::parse(role).map_err(err)?);

@@ -82,6 +82,11 @@ test('the built-in example reconstructs and shows a map with critical curves', a
       await page.waitForFunction((t) => document.getElementById('view-image').dataset.view === t, tab);
       const s = await imageStats(page, '#view-image');
       assert.ok(s.distinctColours > 20, `${tab}: ${s.distinctColours} colours`);
+      if (tab === 'radial') {
+        // The example's true model (its model.json), dashed in vermillion next to the result.
+        const model = await imageStats(page, '#view-image', { rgb: [213, 94, 0], tol: 12 });
+        assert.ok(model.near > 200, `${model.near} pixels of the model's profile`);
+      }
       // The mass map's options and read-out do not apply here.
       assert.ok(await page.isDisabled('#scale') && await page.isDisabled('#show-members'), tab);
       assert.equal(await page.textContent('#readout'), '');
@@ -147,6 +152,20 @@ test('the teaching example loads from the menu and reconstructs', async () => {
     await page.click('#reconstruct');
     await waitStatus(page, /^Done in/);
     await page.waitForFunction(() => /accelerated gradient/.test(document.getElementById('summary').textContent));
+    // A held-out system is predicted, not fitted: marked in the table, summarised in the caption.
+    await setField(page, '#set-reconstruct-solver-method', 'qadp');
+    await setField(page, '#set-holdout', '2');
+    assert.equal(await page.inputValue('#set-holdout'), '2');
+    await page.click('#reconstruct');
+    await waitStatus(page, /^Done in/);
+    await page.waitForFunction(() => /held-out images: median \d+\.\d\d″, rms \d+\.\d\d″/
+      .test(document.getElementById('summary').textContent));
+    await page.click('#tab-systems');
+    await page.waitForSelector('#systems table');
+    assert.equal(await page.textContent('#left-out'), 'Left out of the fit: 2 (held out).');
+    const heads = await page.$$eval('#systems tbody th', (ths) => ths.map((th) => th.textContent));
+    assert.deepEqual(heads.filter((t) => /held out/.test(t)), ['2 (held out)']);
+    await page.screenshot({ path: join(ARTIFACTS, 'app-teaching-holdout.png'), fullPage: true });
     assert.deepEqual(app.consoleErrors, []);
   } finally {
     await app.close();

@@ -47,6 +47,13 @@ test('uploading the AS1063 catalogues reconstructs them', async () => {
     // rms pulled up by a few whose pair has merged.
     const [median, rms] = caption.match(/image offsets median ([\d.]+)″, rms ([\d.]+)″/).slice(1).map(Number);
     assert.ok(median < 1 && rms >= median, caption);
+    // The members outside the field are left out, one warning each, listed under the views.
+    const warned = Number((await page.textContent('#run-warnings summary')).match(/^(\d+) warnings from the run$/)[1]);
+    assert.ok(warned > 50, `${warned} warnings`);
+    assert.equal(await page.locator('#run-warnings li').count(), warned);
+    const items = await page.locator('#run-warnings li').allTextContents();
+    const outside = items.filter((t) => /cats_gold_ref_potential_w_clumpNE\.cat: line \d+: member \S+ at .* lies outside the field/.test(t));
+    assert.ok(outside.length > 50, items.slice(0, 3).join(' | '));
     const stats = await imageStats(page, '#view-image');
     assert.ok(stats.distinctColours > 200, `only ${stats.distinctColours} distinct colours`);
     assert.ok(stats.white > 100, `members not drawn (${stats.white} white pixels)`);

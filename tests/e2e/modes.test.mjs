@@ -81,7 +81,7 @@ test('settings changed in quick succession all stick and survive a reload', asyn
   }
 });
 
-test('catalogues dropped on the drop zone load in their roles', async () => {
+test('catalogues and DS9 regions dropped on the drop zone load in their roles', async () => {
   const app = await openApp();
   try {
     const { page } = app;
@@ -90,6 +90,10 @@ test('catalogues dropped on the drop zone load in their roles', async () => {
       ['cats_gold_mul_gold.cat', await readFile(join(AS1063, 'cats_gold_mul_gold.cat'), 'utf8')],
       ['cats_gold_ref_potential_w_clumpNE.cat',
         await readFile(join(AS1063, 'cats_gold_ref_potential_w_clumpNE.cat'), 'utf8')],
+      // Arcs drawn in DS9 around two of its systems (redshifts from the catalogue).
+      ['arcs.reg', '# Region file format: DS9 version 4.1\nfk5\n'
+        + 'circle(342.1945,-44.526998,0.5") # text={1.1}\ncircle(342.1959,-44.528965,0.5") # text={1.2}\n'
+        + 'ellipse(342.1927,-44.531135,1",0.4",20) # text={2.1}\ncircle(342.17989,-44.521567,0.5") # text={2.3}\n'],
     ];
     const dataTransfer = await page.evaluateHandle((list) => {
       const dt = new DataTransfer();
@@ -107,7 +111,15 @@ test('catalogues dropped on the drop zone load in their roles', async () => {
     // The files were taken one after the other: the first replaced the example, and the second
     // was not cleared by it (taken at once, each cleared the other's role now and then).
     await page.waitForFunction(() => document.getElementById('project-name').textContent === 'Your data');
-    assert.equal(await page.textContent('#status-arcs'), '');
+    await page.waitForFunction(() => /arcs\.reg: 2 systems, \d+ arc pixels \(DS9 regions at 0\.2 arcsec\)/
+      .test(document.getElementById('status-arcs').textContent));
+    // The constraint pixel resamples them: half the pixel, about four times the pixels.
+    const pixels = async () => Number((await page.textContent('#status-arcs')).match(/(\d+) arc pixels/)[1]);
+    const coarse = await pixels();
+    await setField(page, '#set-reconstruct-constraints-pixel_arcsec', 0.1);
+    await page.waitForFunction(() => /DS9 regions at 0\.1 arcsec/.test(document.getElementById('status-arcs').textContent));
+    const fine = await pixels();
+    assert.ok(fine > 3 * coarse && fine < 5 * coarse, `${coarse} -> ${fine} arc pixels`);
     assert.match(await page.textContent('#status-images'), /19 systems, 50 images/);
     assert.match(await page.textContent('#status-members'), /members/);
     assert.deepEqual(app.consoleErrors, []);

@@ -8,6 +8,8 @@ export const FIELDS = [
   { path: 'reconstruct.grid.cells', label: 'Grid cells per side', type: 'int' },
   { path: 'reconstruct.grid.cell_sigma_factor', label: 'Cell width (Gaussian σ / cell size)', type: 'number', step: 0.05 },
   { path: 'reconstruct.grid.width_arcsec', label: 'Field width [arcsec] (empty: automatic)', type: 'optional' },
+  { path: 'reconstruct.grid.refinements', label: 'Grid refinements (0 to 4)', type: 'int',
+    hint: 'multi-resolution grid: after each solution the quarter of the cells with the most mass are split in four and the fit runs again' },
   { path: 'reconstruct.members.mass_to_light', label: 'Members M/L [Msun/Lsun]', type: 'number', step: 1 },
   { path: 'reconstruct.members.layers', label: 'Member layers', type: 'text',
     hint: 'none, single, bcg or brightest:N' },
@@ -15,10 +17,14 @@ export const FIELDS = [
     hint: 'e.g. 0.1 holds C near 1 (the M/L above); helps with few point images' },
   { path: 'reconstruct.constraints.mode', label: 'Constraint mode', type: 'select',
     options: ['ellipse', 'point', 'arcs'] },
+  { path: 'reconstruct.constraints.pixel_arcsec', label: 'Constraint pixel [arcsec]', type: 'number', step: 0.01,
+    hint: 'the lattice that fills catalogue ellipses and DS9 region arcs (0.2: an HST pixel)' },
   { path: 'reconstruct.solver.method', label: 'Solver', type: 'select',
     options: [['qadp', 'QADP (paper)'], ['accelerated_gradient', 'best fit']],
     hint: 'QADP stopped early is the paper\'s method (the iteration count regularises); the best fit (accelerated gradient) over-fits extended arcs: too much mass, shrunken sources' },
   { path: 'reconstruct.solver.iterations', label: 'Iterations', type: 'int' },
+  { path: 'holdout', label: 'Hold out systems (ids, e.g. 3, 7)', type: 'list',
+    hint: 'left out of the fit, then predicted by the model: their image offsets show how well it finds images it was not given' },
   { path: 'reconstruct.products.z_source', label: 'z_s of the curves', type: 'number', step: 0.1 },
   { path: 'reconstruct.products.pixels', label: 'Map pixels per side', type: 'int' },
   { path: 'reconstruct.products.size_arcsec', label: 'Map width [arcsec] (empty: the field)', type: 'optional' },
@@ -41,6 +47,7 @@ export function valueAt(obj, path) {
 
 function parse(field, raw) {
   if (field.type === 'text' || field.type === 'select') return raw;
+  if (field.type === 'list') return raw.split(/[\s,]+/).filter((t) => t !== '');
   if (field.type === 'optional' && raw.trim() === '') return null;
   const v = Number(raw);
   if (raw.trim() === '' || !Number.isFinite(v)) return raw; // let the core name the problem
@@ -56,7 +63,7 @@ export function buildSettings(form, apply) {
       ? `<select id="${id(f.path)}">${f.options.map((o) => (Array.isArray(o)
         ? `<option value="${o[0]}">${o[1]}</option>`
         : `<option>${o}</option>`)).join('')}</select>`
-      : `<input id="${id(f.path)}" type="${f.type === 'text' ? 'text' : 'number'}" ${f.step ? `step="${f.step}"` : ''}>`;
+      : `<input id="${id(f.path)}" type="${['text', 'list'].includes(f.type) ? 'text' : 'number'}" ${f.step ? `step="${f.step}"` : ''}>`;
     row.innerHTML = `<label for="${id(f.path)}">${f.label}</label>${control}
       ${f.hint ? `<small class="hint">${f.hint}</small>` : ''}
       <span class="field-error" id="${id(f.path)}-error" role="alert"></span>`;
@@ -102,7 +109,7 @@ function refresh(settings) {
     const input = document.getElementById(id(f.path));
     if (!input) continue;
     const v = valueAt(settings, f.path);
-    const text = v == null ? '' : String(v);
+    const text = v == null ? '' : Array.isArray(v) ? v.join(', ') : String(v);
     input.dataset.good = text;
     const state = busy.get(input);
     if (!state || (!state.edited && !state.waiting)) input.value = text;
