@@ -51,9 +51,20 @@ export async function openApp({ width = 1280, height = 900, query = '' } = {}) {
   };
 }
 
+/** Waits until the image `selector` has loaded and has a size. */
+export async function imageLoaded(page, selector) {
+  await page.waitForFunction((sel) => {
+    const img = document.querySelector(sel);
+    return img && img.complete && img.naturalWidth > 0;
+  }, selector);
+}
+
 /** Statistics of the rendered image `selector` read back through a canvas in the page;
- * `near` counts the pixels within `tol` (per channel) of the colour `rgb`. */
+ * `near` counts the pixels within `tol` (per channel) of the colour `rgb`. The app sets an
+ * image's `src` and `data-view` together, and the browser decodes it later, so this first
+ * waits until the image has loaded (reading it before gives a 0 x 0 canvas). */
 export async function imageStats(page, selector, { rgb = [0, 0, 0], tol = -1 } = {}) {
+  await imageLoaded(page, selector);
   return page.$eval(selector, (img, [want, tol]) => {
     const c = document.createElement('canvas');
     c.width = img.naturalWidth;

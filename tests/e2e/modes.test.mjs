@@ -6,7 +6,7 @@ import assert from 'node:assert/strict';
 import { join } from 'node:path';
 import { readFile, writeFile, mkdtemp } from 'node:fs/promises';
 import { tmpdir } from 'node:os';
-import { openApp, imageStats, ARTIFACTS, ROOT, SETTLE_TIMEOUT_MS, setField, waitStatus } from './browser.mjs';
+import { openApp, imageLoaded, imageStats, ARTIFACTS, ROOT, SETTLE_TIMEOUT_MS, setField, waitStatus } from './browser.mjs';
 
 const AS1063 = join(ROOT, '..', 'shared', 'data', 'AS1063', 'lenstool_cats');
 const TEACHING_MODEL = join(ROOT, 'www', 'examples', 'teaching', 'model.json');
@@ -158,6 +158,7 @@ test('forward mode draws a model file; the PNG download and the read-out follow'
       'the magnification did not change with z_s');
 
     // PNG download of the view: a PNG of the size shown.
+    await imageLoaded(page, '#view-image');
     const [w, h] = await page.$eval('#view-image', (el) => [el.naturalWidth, el.naturalHeight]);
     await page.click('#downloads-panel summary');
     const [download] = await Promise.all([page.waitForEvent('download'), page.click('#dl-kappa-png')]);
