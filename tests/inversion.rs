@@ -1339,6 +1339,15 @@ fn region_files_report_their_errors_by_line() {
     .unwrap();
     assert_eq!(ok.arcs.systems[0].z, Some(3.3));
     assert_eq!(ok.arcs.systems[1].z, None);
+    // Labels whose z agree within the tolerance: the system's z is their mean, as in a
+    // Lenstool catalogue.
+    let mean = read(&format!(
+        "circle({},1\") # text={{1.1 z=2.000}}\ncircle({},1\") # text={{1.2 z=2.002}}",
+        c(0.0),
+        c(10.0)
+    ))
+    .unwrap();
+    assert!((mean.arcs.systems[0].z.unwrap() - 2.001).abs() < 1e-12);
 
     let message = |body: String| read(&body).unwrap_err().to_string();
     let cases = [
@@ -1349,6 +1358,18 @@ fn region_files_report_their_errors_by_line() {
                 c(5.0)
             ),
             "arcs.reg: line 3: image 1.2: z = 2.5, but line 2 gives system 1 z = 2",
+        ),
+        (
+            // Each agrees with the first (tolerance 1e-3 (1 + z) = 0.003), but the last two
+            // are 0.004 apart: one source cannot have both.
+            format!(
+                "circle({},1\") # text={{1.1 z=2.000}}\ncircle({},1\") # text={{1.2 z=2.002}}\n\
+                 circle({},1\") # text={{1.3 z=1.998}}",
+                c(0.0),
+                c(5.0),
+                c(10.0)
+            ),
+            "line 4: image 1.3: z = 1.998, but line 3 gives system 1 z = 2.002",
         ),
         (
             format!("circle({},1\")", c(0.0)),

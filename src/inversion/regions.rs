@@ -18,8 +18,8 @@
 //!   (each pixel once).
 //! - The label is the region's `text={...}`: the image id `system.image` (the system is the
 //!   text before the first '.', as in a Lenstool catalogue), then optionally `z=VALUE`. The
-//!   images of a system must agree on z ([`redshifts_agree`], as in a catalogue; the first z
-//!   given is used); a system with no z takes it from the caller's lookup (the app: the loaded
+//!   images of a system must agree on z ([`redshifts_agree`]) and the system's z is the mean
+//!   of its labels', as in a catalogue; a system with no z takes it from the caller's lookup (the app: the loaded
 //!   image catalogue's system of that id), or is left without one (`--default-z`, or left out
 //!   with a warning).
 //! - An excluded region (a leading `-`, e.g. a foreground galaxy on the arc) removes its
@@ -156,7 +156,8 @@ pub fn arcs_from_regions(
             if !(z > 0.0 && z < MAX_Z) {
                 return Err(at(r.line, format!("z = {z} must be in (0, {MAX_Z})")));
             }
-            if let Some((z0, line0)) = s.z {
+            // Against the lowest and the highest z so far: then every pair agrees.
+            for &(z0, line0) in s.z_range.iter().flat_map(|(lo, hi)| [lo, hi]) {
                 if !redshifts_agree(z, z0) {
                     return Err(at(
                         r.line,
@@ -166,9 +167,16 @@ pub fn arcs_from_regions(
                         ),
                     ));
                 }
-            } else {
-                s.z = Some((z, r.line));
             }
+            s.z_range = Some(match s.z_range {
+                None => ((z, r.line), (z, r.line)),
+                Some((lo, hi)) => (
+                    if z < lo.0 { (z, r.line) } else { lo },
+                    if z > hi.0 { (z, r.line) } else { hi },
+                ),
+            });
+            s.z_sum += z;
+            s.z_count += 1;
         }
         let pixels = lattice.inside(shape, &excluded);
         s.add(&label.image, r.line, pixels);
@@ -187,7 +195,11 @@ pub fn arcs_from_regions(
             images.push(pixels);
             image_ids.push(id);
         }
-        let z = s.z.map(|(z, _)| z).or_else(|| catalog_z(&s.id));
+        let z = if s.z_count > 0 {
+            Some(s.z_sum / s.z_count as f64)
+        } else {
+            catalog_z(&s.id)
+        };
         out.push(ArcSystem {
             id: s.id,
             z,
@@ -254,7 +266,11 @@ impl Label {
 struct SystemBuild {
     id: String,
     line: usize,
-    z: Option<(f64, usize)>,
+    /// The lowest and the highest z of its labels so far, with their lines.
+    z_range: Option<((f64, usize), (f64, usize))>,
+    /// Sum and count of the labels' z: the system's z is their mean, as in a catalogue.
+    z_sum: f64,
+    z_count: usize,
     images: Vec<(String, usize, Vec<DVec2>)>,
     /// The pixels of each image so far (bit patterns: a lattice point is always computed
     /// the same way), so that overlapping regions count each pixel once.
@@ -266,7 +282,9 @@ impl SystemBuild {
         Self {
             id: id.to_string(),
             line,
-            z: None,
+            z_range: None,
+            z_sum: 0.0,
+            z_count: 0,
             images: Vec::new(),
             seen: HashMap::new(),
         }
