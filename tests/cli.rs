@@ -308,6 +308,11 @@ fn reconstruct_writes_every_product_and_marks_held_out_systems() {
     assert_eq!(held, ["2", "7"]);
     let s = summary(&out_dir);
     assert_eq!(s["systems_fitted"].as_array().unwrap().len(), 17);
+    // Left out, and why, in words.
+    assert_eq!(
+        s["systems_excluded"],
+        serde_json::json!(["2 (held out)", "7 (held out)"])
+    );
     assert_eq!(s["c_per_layer"].as_array().unwrap().len(), 1);
     let convergence: serde_json::Value =
         serde_json::from_str(&fs::read_to_string(out_dir.join("convergence.json")).unwrap())
@@ -581,7 +586,7 @@ fn catalogue_units_nan_and_empty_systems_name_file_and_line() {
     );
     assert!(
         err.contains("single.cat: no system is left")
-            && err.contains("1 (SingleImage, line 2), 2 (SingleImage, line 3)"),
+            && err.contains("1 (a single image, line 2), 2 (a single image, line 3)"),
         "{err}"
     );
     // A source in front of the lens.

@@ -102,18 +102,13 @@ function caption(info) {
     `z_s = ${s.z_source}; ${factors}${offsets}${held}${s.tangential_curves} tangential and ${s.radial_curves} radial critical curves.`;
 }
 
-// Why a system was left out of the fit (summary.json's `systems_excluded` reasons).
-const LEFT_OUT = { UnknownRedshift: 'no redshift', SingleImage: 'a single image', HeldOut: 'held out' };
-
 /** Under the views: the systems a run left out of the fit and its warnings (collapsed: a
  * member catalogue wider than the field gives one per member). Built from text nodes. */
 function runNotes(summary) {
   const box = $('run-notes');
   box.replaceChildren();
-  const left = (summary?.systems_excluded ?? []).map((s) => {
-    const m = s.match(/^(.*) \((\w+)\)$/);
-    return m ? `${m[1]} (${LEFT_OUT[m[2]] ?? m[2]})` : s;
-  });
+  // summary.json's `systems_excluded`: "id (why)", the reason in words.
+  const left = summary?.systems_excluded ?? [];
   if (left.length) {
     const p = document.createElement('p');
     p.id = 'left-out';

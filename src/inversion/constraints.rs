@@ -225,6 +225,17 @@ pub enum Exclusion {
     HeldOut,
 }
 
+/// In words, for messages and `summary.json` ("1 (no redshift)").
+impl std::fmt::Display for Exclusion {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(match self {
+            Self::UnknownRedshift => "no redshift",
+            Self::SingleImage => "a single image",
+            Self::HeldOut => "held out",
+        })
+    }
+}
+
 /// A system left out, and why.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct ExcludedSystem {
@@ -462,8 +473,8 @@ pub fn build_constraints(
             .excluded
             .iter()
             .map(|e| match first_line(source, &e.id) {
-                Some(line) => format!("{} ({:?}, line {line})", e.id, e.reason),
-                None => format!("{} ({:?})", e.id, e.reason),
+                Some(line) => format!("{} ({}, line {line})", e.id, e.reason),
+                None => format!("{} ({})", e.id, e.reason),
             })
             .collect();
         return Err(ConstraintError::NoSystems {

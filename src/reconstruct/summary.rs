@@ -84,7 +84,7 @@ impl<'a> Solved<'a> {
                 .constraints
                 .excluded
                 .iter()
-                .map(|e| format!("{} ({:?})", e.id, e.reason))
+                .map(|e| format!("{} ({})", e.id, e.reason))
                 .collect(),
             layers: s.layers.iter().map(|l| l.name.as_str()).collect(),
             c_per_layer: self.layer_factors(),
