@@ -174,6 +174,60 @@ pub fn polyline_is_open(line: &[DVec2], geometry: &MapGeometry) -> bool {
         && first.distance(last) > 2.0 * median.max(pixel)
 }
 
+/// The start of a written region file (the version line, `comment` lines, the `global` line
+/// and the coordinate system) and how positions and lengths are written in it: `fk5` in degrees
+/// and arcsec when `reference` is known, else `image` pixels of `geometry`.
+struct RegionText<'a> {
+    out: String,
+    reference: Option<SkyReference>,
+    geometry: &'a MapGeometry,
+}
+
+impl<'a> RegionText<'a> {
+    fn new(comment: &str, reference: Option<SkyReference>, geometry: &'a MapGeometry) -> Self {
+        let mut out = String::from("# Region file format: DS9 version 4.1\n");
+        for line in comment.lines() {
+            let _ = writeln!(out, "# {line}");
+        }
+        out.push_str(
+            "global color=green dashlist=8 3 width=2 font=\"helvetica 10 normal roman\" select=1 \
+             highlite=1 dash=0 fixed=0 edit=1 move=1 delete=1 include=1 source=1\n",
+        );
+        out.push_str(if reference.is_some() {
+            "fk5\n"
+        } else {
+            "image\n"
+        });
+        Self {
+            out,
+            reference,
+            geometry,
+        }
+    }
+
+    /// A position (arcsec in the frame) as written: `ra,dec` or `x,y` (1-based pixels).
+    fn coord(&self, p: DVec2) -> String {
+        match self.reference {
+            Some(r) => {
+                let (ra, dec) = r.offset_to_radec(p);
+                format!("{ra:.8},{dec:.8}")
+            }
+            None => {
+                let q = self.geometry.arcsec_to_pixel(p) + DVec2::ONE;
+                format!("{:.4},{:.4}", q.x, q.y)
+            }
+        }
+    }
+
+    /// A length (arcsec) as written: `0.5"` or pixels.
+    fn length(&self, arcsec: f64) -> String {
+        match self.reference {
+            Some(_) => format!("{arcsec}\""),
+            None => format!("{:.4}", arcsec / self.geometry.pixel_arcsec()),
+        }
+    }
+}
+
 /// DS9 region text for the critical curves and caustics (module docs): `fk5` in degrees when
 /// `reference` is known, else `image` pixels of `geometry` (the map the curves were traced on).
 /// Non-finite points are dropped and curves of fewer than 2 points skipped.
@@ -182,31 +236,14 @@ pub fn write_regions(
     reference: Option<SkyReference>,
     geometry: &MapGeometry,
 ) -> String {
-    let mut out = String::from("# Region file format: DS9 version 4.1\n");
-    let _ = writeln!(
-        out,
-        "# WSLAP+ critical curves and caustics, z_source = {}, Einstein radius = {:.3} arcsec",
-        curves.z_source, curves.einstein_radius_arcsec
+    let mut text = RegionText::new(
+        &format!(
+            "WSLAP+ critical curves and caustics, z_source = {}, Einstein radius = {:.3} arcsec",
+            curves.z_source, curves.einstein_radius_arcsec
+        ),
+        reference,
+        geometry,
     );
-    out.push_str(
-        "global color=green dashlist=8 3 width=2 font=\"helvetica 10 normal roman\" select=1 \
-         highlite=1 dash=0 fixed=0 edit=1 move=1 delete=1 include=1 source=1\n",
-    );
-    out.push_str(if reference.is_some() {
-        "fk5\n"
-    } else {
-        "image\n"
-    });
-    let coord = |p: DVec2| match reference {
-        Some(r) => {
-            let (ra, dec) = r.offset_to_radec(p);
-            format!("{ra:.8},{dec:.8}")
-        }
-        None => {
-            let q = geometry.arcsec_to_pixel(p) + DVec2::ONE;
-            format!("{:.4},{:.4}", q.x, q.y)
-        }
-    };
     let z = curves.z_source;
     let groups: [(&[Polyline], &str, String, &str); 4] = [
         (
@@ -243,19 +280,56 @@ pub fn write_regions(
             }
             let open = line.len() < 3 || polyline_is_open(&line, geometry);
             let shape = if open { "segment" } else { "polygon" };
-            let coords: Vec<String> = line.iter().map(|&p| coord(p)).collect();
-            let text = if first {
+            let coords: Vec<String> = line.iter().map(|&p| text.coord(p)).collect();
+            let label_text = if first {
                 format!(" text={{{label}}}")
             } else {
                 String::new()
             };
             first = false;
             let _ = writeln!(
-                out,
-                "{shape}({}) # color={color}{dash} tag={{{label}}}{text}",
+                text.out,
+                "{shape}({}) # color={color}{dash} tag={{{label}}}{label_text}",
                 coords.join(",")
             );
         }
     }
-    out
+    text.out
+}
+
+/// One position marked by a circle in [`write_marks`].
+#[derive(Debug, Clone, PartialEq)]
+pub struct Mark {
+    /// Arcsec in the frame of METHOD.md section 1.
+    pub position_arcsec: DVec2,
+    /// The `text={...}` label (no braces).
+    pub label: String,
+    /// A DS9 colour name.
+    pub color: &'static str,
+    /// The `tag={...}`: what kind of mark it is.
+    pub tag: &'static str,
+    pub dashed: bool,
+}
+
+/// DS9 region text with a circle of `radius_arcsec` about each mark (non-finite positions are
+/// skipped), after `comment` lines; frames as in [`write_regions`].
+pub fn write_marks(
+    comment: &str,
+    marks: &[Mark],
+    radius_arcsec: f64,
+    reference: Option<SkyReference>,
+    geometry: &MapGeometry,
+) -> String {
+    let mut text = RegionText::new(comment, reference, geometry);
+    let radius = text.length(radius_arcsec);
+    for m in marks.iter().filter(|m| m.position_arcsec.is_finite()) {
+        let coord = text.coord(m.position_arcsec);
+        let dash = if m.dashed { " dash=1" } else { "" };
+        let _ = writeln!(
+            text.out,
+            "circle({coord},{radius}) # color={}{dash} tag={{{}}} text={{{}}}",
+            m.color, m.tag, m.label
+        );
+    }
+    text.out
 }

@@ -289,7 +289,7 @@ fn reconstruct_writes_every_product_and_marks_held_out_systems() {
     );
     for name in PRODUCT_FILES
         .iter()
-        .chain(&["sources.json", "convergence.json"])
+        .chain(&["sources.json", "images.reg", "convergence.json"])
     {
         assert!(out_dir.join(name).exists(), "{name} missing");
     }
@@ -306,6 +306,56 @@ fn reconstruct_writes_every_product_and_marks_held_out_systems() {
         .map(|s| s["id"].as_str().unwrap())
         .collect();
     assert_eq!(held, ["2", "7"]);
+    // images.reg: a green circle on each catalogue image, at its RA and Dec (the catalogue is
+    // in absolute degrees), and a dashed magenta one on each predicted image.
+    let regions = wslap::ds9::read_regions(
+        &fs::read_to_string(out_dir.join("images.reg")).unwrap(),
+        "images.reg",
+    )
+    .unwrap();
+    let catalogue =
+        fs::read_to_string(shared("AS1063/lenstool_cats/cats_gold_mul_gold.cat")).unwrap();
+    let rows: Vec<Vec<&str>> = catalogue
+        .lines()
+        .map(|l| l.split_whitespace().collect::<Vec<_>>())
+        .filter(|f| f.len() >= 3 && !f[0].starts_with('#'))
+        .collect();
+    let observed: Vec<_> = regions
+        .iter()
+        .filter(|r| r.color.as_deref() == Some("green"))
+        .collect();
+    assert_eq!(observed.len(), rows.len());
+    for r in &observed {
+        let label = r.text.as_deref().unwrap();
+        let id = label.trim_end_matches(" (held out)");
+        assert_eq!(
+            label.ends_with("(held out)"),
+            id.starts_with("2.") || id.starts_with("7.")
+        );
+        let row = rows.iter().find(|f| f[0] == id).expect(label);
+        let wslap::ds9::Shape::Circle { center, radius } = r.shape else {
+            panic!("{r:?}")
+        };
+        let (ra, dec): (f64, f64) = (row[1].parse().unwrap(), row[2].parse().unwrap());
+        assert!(
+            (center.x - ra).abs() < 1e-7 && (center.y - dec).abs() < 1e-7,
+            "{id}: {center} vs {ra}, {dec}"
+        );
+        assert_eq!(radius, 0.5);
+    }
+    let predicted = sources
+        .as_array()
+        .unwrap()
+        .iter()
+        .flat_map(|s| s["predicted"].as_array().unwrap())
+        .filter(|p| p["magnification"].as_f64().unwrap().abs() >= 0.1)
+        .count();
+    assert!(predicted > 0);
+    assert_eq!(regions.len(), observed.len() + predicted);
+    assert!(regions
+        .iter()
+        .filter(|r| r.color.as_deref() == Some("magenta"))
+        .all(|r| r.text.as_deref().unwrap().contains(": predicted, mu=")));
     let s = summary(&out_dir);
     assert_eq!(s["systems_fitted"].as_array().unwrap().len(), 17);
     // Left out, and why, in words.

@@ -17,12 +17,13 @@ mod views;
 use thiserror::Error;
 
 pub use crate::reconstruct::ReconstructSummary;
+pub use crate::reconstruct::SHOWN_MIN_MAGNIFICATION;
 pub use data::{
     ArcPixels, DataMarks, DataRole, LoadReport, LoadedData, NamedMap, NamedText, ParsedData,
     MAX_STORED_FITS_BYTES,
 };
 pub use project::{Project, ProjectResult, StoredFits, PROJECT_FORMAT, PROJECT_VERSION};
-pub use run::{RunKind, SessionResult, SHOWN_MIN_MAGNIFICATION};
+pub use run::{RunKind, SessionResult};
 pub use settings::{AppSettings, APP_MAP_PIXELS};
 pub use views::{
     system_rgb, HoverReadout, ViewOptions, ViewPng, OBSERVED_RGB, PREDICTED_RGB, SYSTEM_RGB,

@@ -1,9 +1,10 @@
 //! The downloadable files of a result, with the content `wslap reconstruct` writes:
-//! `summary.json`, `sources.json`, `convergence.json`, and the map files of the products.
+//! `summary.json`, `sources.json`, `images.reg`, `convergence.json`, and the map files of the
+//! products.
 
 use serde::Serialize;
 
-use crate::reconstruct::Solved;
+use crate::reconstruct::{image_regions, Solved};
 
 use super::run::ReconstructionResult;
 use super::{AppError, SessionResult};
@@ -41,6 +42,16 @@ impl SessionResult {
             Some(r) => pretty(&r.sources),
             None => Ok("[]".to_string()),
         }
+    }
+
+    /// `images.reg`: DS9 circles at the observed and predicted images (see
+    /// [`crate::reconstruct::image_regions`]); an error without a reconstruction.
+    pub fn images_regions(&self) -> Result<String, AppError> {
+        let r = self.reconstruction.as_ref().ok_or_else(|| {
+            AppError::Missing("images.reg needs a reconstruction: press Reconstruct".to_string())
+        })?;
+        let p = &self.products;
+        Ok(image_regions(&r.sources, p.reference, &p.maps.geometry()))
     }
 
     /// `convergence.json` (empty list without a reconstruction).

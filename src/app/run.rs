@@ -14,7 +14,7 @@ use crate::products::{own_map_side, ProductOptions, Products};
 use crate::profiles::Lens;
 use crate::reconstruct::{
     reconstruct, ConvergenceRecord, Inputs, LayerSource, ReconstructConfig, SourceReport,
-    StageTimings,
+    StageTimings, SHOWN_MIN_MAGNIFICATION,
 };
 use crate::solver::Control;
 
@@ -96,13 +96,6 @@ impl SessionResult {
             .collect()
     }
 }
-
-/// Predicted images fainter than this (`|mu|`, i.e. more than 2.5 magnitudes fainter than the
-/// unlensed source) are left off the map: they are mostly the demagnified central images of the
-/// cluster core, which observations almost never show (the built-in example, 8000 iterations:
-/// 129 predicted images for 90 observed, 23 of them with `|mu| < 0.1`). `sources.json` and the
-/// systems table keep them all.
-pub const SHOWN_MIN_MAGNIFICATION: f64 = 0.1;
 
 /// The constraint source of the data with the configuration's mode (arcs force mode "arcs"
 /// when they are the only constraints, as in the CLI).

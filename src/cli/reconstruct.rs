@@ -11,7 +11,8 @@ use wslap::inversion::{
 };
 use wslap::limits::InputKind;
 use wslap::reconstruct::{
-    reconstruct, ConvergenceRecord, Inputs, LayerSource, ReconstructConfig, Reconstruction,
+    image_regions, reconstruct, ConvergenceRecord, Inputs, LayerSource, ReconstructConfig,
+    Reconstruction,
 };
 use wslap::render::ColorScale;
 use wslap::solver::Control;
@@ -24,8 +25,9 @@ use super::maps::write_products;
 ///
 /// Writes into DIR the map files of `wslap maps` (kappa.fits, ..., kappa.png) for the
 /// reconstructed lens, plus sources.json (per system: z, beta, scatter, observed and predicted
-/// images, offsets; held-out systems marked), convergence.json (objective, grid mass and C per
-/// report) and summary.json (settings, C per layer, grid mass, enclosed masses, Einstein
+/// images, offsets; held-out systems marked), images.reg (DS9 circles: observed images green,
+/// predicted ones magenta), convergence.json (objective, grid mass and C per report) and
+/// summary.json (settings, C per layer, grid mass, enclosed masses, Einstein
 /// radius, image-plane rms, timings).
 #[derive(Debug, Args)]
 #[command(group(clap::ArgGroup::new("constraints").required(true).args(["images", "arcs"])))]
@@ -205,7 +207,8 @@ fn name(path: &Path) -> String {
     path.display().to_string()
 }
 
-/// Writes the map files, sources.json, convergence.json and summary.json into `dir`.
+/// Writes the map files, sources.json, images.reg (DS9), convergence.json and summary.json
+/// into `dir`.
 pub(super) fn write_reconstruction(r: &Reconstruction, dir: &Path) -> Result<(), String> {
     write_products(&r.products, ColorScale::Log, dir)?;
     let write = |file: &str, text: String| -> Result<(), String> {
@@ -213,6 +216,11 @@ pub(super) fn write_reconstruction(r: &Reconstruction, dir: &Path) -> Result<(),
         fs::write(&path, text).map_err(|e| format!("{}: {e}", path.display()))
     };
     write("sources.json", json(&r.sources)?)?;
+    let geometry = r.products.maps.geometry();
+    write(
+        "images.reg",
+        image_regions(&r.sources, r.products.reference, &geometry),
+    )?;
     write("convergence.json", json(&r.convergence)?)?;
     write("summary.json", json(&r.summary())?)?;
     Ok(())

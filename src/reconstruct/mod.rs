@@ -13,7 +13,9 @@ use serde::{Deserialize, Serialize};
 use thiserror::Error;
 
 pub use config::{ProductConfig, ReconstructConfig, SolverConfig, SolverMethod};
-pub use sources::{ImageReport, SourceReport};
+pub use sources::{
+    image_regions, ImageReport, SourceReport, IMAGE_REGION_RADIUS_ARCSEC, SHOWN_MIN_MAGNIFICATION,
+};
 pub use summary::{ReconstructSummary, Solved};
 
 use crate::catalog::{ImageCatalog, MemberCatalog};

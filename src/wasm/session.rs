@@ -186,8 +186,8 @@ impl AppSession {
         to_js(&rows)
     }
 
-    /// A download: `summary.json`, `sources.json`, `convergence.json`, `critical-curves.json`,
-    /// `critical-curves.reg` or `project.json` as text.
+    /// A download: `summary.json`, `sources.json`, `images.reg`, `convergence.json`,
+    /// `critical-curves.json`, `critical-curves.reg` or `project.json` as text.
     pub fn text_file(&self, name: &str) -> Result<String, JsError> {
         if name == "project.json" {
             return self.inner.project_json().map_err(err);
@@ -199,6 +199,7 @@ impl AppSession {
             "convergence.json" => r.convergence_json().map_err(err),
             "critical-curves.json" => Ok(r.products.curves_json()),
             "critical-curves.reg" => Ok(r.products.regions()),
+            "images.reg" => r.images_regions().map_err(err),
             other => Err(JsError::new(&format!("unknown file '{other}'"))),
         }
     }

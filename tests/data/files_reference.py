@@ -9,6 +9,9 @@
    world coordinates of a few pixel centres.
 3. Reads our DS9 region files (files_ours_fk5.reg, files_ours_image.reg) with the `regions`
    package and records the polygons it sees (it skips DS9 `segment`, i.e. open curves).
+4. Reads our marks files (files_ours_marks_fk5.reg, files_ours_marks_image.reg: circles, as in
+   `images.reg`) with `regions` and records each circle's centre (degrees, or 0-based pixels),
+   radius (arcsec or pixels), colour, label and whether it is dashed.
 
 Writes files.json. Needs astropy and regions (pip install astropy regions).
 """
@@ -123,6 +126,29 @@ def regions_of(name):
     return {"polygons": polygons, "colors": colors, "warnings": [str(w.message) for w in caught]}
 
 
+def marks_of(name):
+    from regions import CirclePixelRegion, CircleSkyRegion, Regions
+
+    out = []
+    for r in Regions.read(path(name), format="ds9"):
+        if isinstance(r, CircleSkyRegion):
+            x, y, radius = r.center.ra.deg, r.center.dec.deg, r.radius.to_value("arcsec")
+        elif isinstance(r, CirclePixelRegion):
+            x, y, radius = r.center.x, r.center.y, r.radius
+        else:
+            raise RuntimeError(f"unexpected region {r}")
+        out.append({
+            "x": float(x),
+            "y": float(y),
+            "radius": float(radius),
+            "color": r.visual.get("edgecolor", r.visual.get("color")),
+            # `regions` reads a label such as 1.1 as a number.
+            "text": str(r.meta["text"]),
+            "dashed": "linestyle" in r.visual,
+        })
+    return out
+
+
 def main():
     out = {
         "astropy_f32": astropy_f32(),
@@ -130,6 +156,8 @@ def main():
         "ours": ours(),
         "regions_fk5": regions_of("files_ours_fk5.reg"),
         "regions_image": regions_of("files_ours_image.reg"),
+        "marks_fk5": marks_of("files_ours_marks_fk5.reg"),
+        "marks_image": marks_of("files_ours_marks_image.reg"),
     }
     with open(path("files.json"), "w") as f:
         json.dump(out, f, indent=1)

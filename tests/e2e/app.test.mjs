@@ -108,6 +108,18 @@ test('the built-in example reconstructs and shows a map with critical curves', a
     const [dl2] = await Promise.all([page.waitForEvent('download'), page.click('#dl-summary-json')]);
     const summary = JSON.parse(await readFile(await dl2.path(), 'utf8'));
     assert.equal(summary.settings.solver.iterations, QUICK_ITERATIONS);
+    // The images as DS9 circles: one per observed image of each system, and the predicted ones.
+    const [dl3] = await Promise.all([page.waitForEvent('download'), page.click('#dl-images-reg')]);
+    const regions = (await readFile(await dl3.path(), 'utf8')).split('\n');
+    const [dl4] = await Promise.all([page.waitForEvent('download'), page.click('#dl-sources-json')]);
+    const sources = JSON.parse(await readFile(await dl4.path(), 'utf8'));
+    const count = (tag) => regions.filter((l) => l.startsWith('circle(') && l.includes(`tag={${tag}}`)).length;
+    assert.equal(regions[0], '# Region file format: DS9 version 4.1');
+    assert.equal(count('observed'), sources.reduce((n, s) => n + s.observed.length, 0));
+    // (Not the demagnified ones, |μ| < 0.1, as on the map.)
+    const shown = (s) => s.predicted.filter((p) => Math.abs(p.magnification) >= 0.1).length;
+    assert.equal(count('predicted'), sources.reduce((n, s) => n + shown(s), 0));
+    assert.ok(count('observed') >= 60, `${count('observed')} observed images`);
 
     // Reload: the project comes back from IndexedDB without solving again.
     await page.reload();

@@ -2,12 +2,119 @@
 
 use super::*;
 use crate::common::assert_abs;
-use wslap::ds9::{polyline_is_open, read_regions, write_regions, Ds9Error, Ds9Frame, Shape};
+use wslap::ds9::{
+    polyline_is_open, read_regions, write_marks, write_regions, Ds9Error, Ds9Frame, Mark, Shape,
+};
 
 fn vertices(shape: &Shape) -> &[DVec2] {
     match shape {
         Shape::Polygon(v) | Shape::Polyline(v) => v,
         other => panic!("expected a polygon or polyline, got {other:?}"),
+    }
+}
+
+/// The marks of [`written_marks_parse_back_as_circles`]: an observed and a predicted image and
+/// one with no position.
+fn marks() -> Vec<Mark> {
+    let mark = |x: f64, y: f64, label: &str, dashed: bool| Mark {
+        position_arcsec: DVec2::new(x, y),
+        label: label.to_string(),
+        color: if dashed { "magenta" } else { "green" },
+        tag: if dashed { "predicted" } else { "observed" },
+        dashed,
+    };
+    vec![
+        mark(3.25, -7.5, "1.1", false),
+        mark(-12.0, 4.75, "1: predicted, mu=-2.3", true),
+        mark(f64::NAN, 0.0, "lost", false),
+    ]
+}
+
+/// Marked positions (the observed and predicted images of `images.reg`) come back as circles
+/// of the given radius at the same places, with their labels, colours and dashes, in both
+/// frames; a non-finite position is left out. The files are committed
+/// (tests/data/files_ours_marks_*.reg) for the `regions` package's check below.
+#[cfg_attr(not(target_arch = "wasm32"), test)]
+#[cfg_attr(target_arch = "wasm32", wasm_bindgen_test::wasm_bindgen_test)]
+fn written_marks_parse_back_as_circles() {
+    let g = small_map().geometry;
+    let marks = marks();
+    for (reference, committed, file) in [
+        (Some(sky()), OURS_MARKS_FK5_REG, "files_ours_marks_fk5.reg"),
+        (None, OURS_MARKS_IMAGE_REG, "files_ours_marks_image.reg"),
+    ] {
+        let text = write_marks("line one\nline two", &marks, 0.5, reference, &g);
+        maybe_make_ref(file, text.as_bytes());
+        assert_eq!(text, committed, "{file} differs (MAKE_REF=1 regenerates)");
+        assert!(text.starts_with("# Region file format: DS9 version 4.1\n# line one\n# line two\n"));
+        let regions = read_regions(&text, file).unwrap();
+        assert_eq!(regions.len(), 2, "{text}");
+        for (region, m) in regions.iter().zip(&marks) {
+            let frame = if reference.is_some() {
+                Ds9Frame::Fk5
+            } else {
+                Ds9Frame::Image
+            };
+            assert_eq!(region.frame, frame);
+            let Shape::Circle { center, radius } =
+                region.to_frame_arcsec(reference, Some(&g)).unwrap()
+            else {
+                panic!("not a circle: {region:?}");
+            };
+            // 8 decimals in degrees (fk5) or 4 in pixels of 0.5 arcsec (image).
+            assert!(
+                (center - m.position_arcsec).length() < 1e-3,
+                "{center} vs {}",
+                m.position_arcsec
+            );
+            assert_abs("radius (arcsec)", radius, 0.5, 1e-4);
+            assert_eq!(region.text.as_deref(), Some(m.label.as_str()));
+            assert_eq!(region.color.as_deref(), Some(m.color));
+        }
+        let predicted = text.lines().find(|l| l.contains("predicted")).unwrap();
+        assert!(
+            predicted.contains("dash=1") && predicted.contains("tag={predicted}"),
+            "{predicted}"
+        );
+        assert!(!text
+            .lines()
+            .find(|l| l.contains("{1.1}"))
+            .unwrap()
+            .contains("dash=1"));
+    }
+}
+
+/// The `regions` package (tests/data/files_reference.py) reads the marks files as circles at
+/// our positions, with our radii, colours, labels and dashes.
+#[cfg_attr(not(target_arch = "wasm32"), test)]
+#[cfg_attr(target_arch = "wasm32", wasm_bindgen_test::wasm_bindgen_test)]
+fn regions_package_reads_our_marks_like_we_do() {
+    let json = reference();
+    let g = small_map().geometry;
+    let marks = marks();
+    for (name, reference) in [("marks_fk5", Some(sky())), ("marks_image", None)] {
+        let theirs = json[name].as_array().unwrap();
+        assert_eq!(theirs.len(), 2, "{name}: circles");
+        for (t, m) in theirs.iter().zip(&marks) {
+            let f = |k: &str| t[k].as_f64().unwrap();
+            // Their centre in our frame: fk5 degrees, or 0-based pixels (DS9 files: 1-based).
+            let (center, radius_arcsec) = match reference {
+                Some(r) => (r.to_offset_arcsec(f("x"), f("y")), f("radius")),
+                None => (
+                    g.pixel_to_arcsec(f("x"), f("y")),
+                    f("radius") * g.pixel_arcsec(),
+                ),
+            };
+            let what = format!("{name} {}", m.label);
+            assert!(
+                (center - m.position_arcsec).length() < 1e-3,
+                "{what}: {center}"
+            );
+            assert_abs(&format!("{what}: radius"), radius_arcsec, 0.5, 1e-4);
+            assert_eq!(t["color"].as_str(), Some(m.color), "{what}");
+            assert_eq!(t["text"].as_str(), Some(m.label.as_str()), "{what}");
+            assert_eq!(t["dashed"].as_bool(), Some(m.dashed), "{what}");
+        }
     }
 }
 

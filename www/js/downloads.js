@@ -4,6 +4,7 @@
 const TEXT_FILES = [
   ['summary.json', 'application/json'],
   ['sources.json', 'application/json'],
+  ['images.reg', 'text/plain'],
   ['convergence.json', 'application/json'],
   ['critical-curves.json', 'application/json'],
   ['critical-curves.reg', 'text/plain'],
@@ -48,7 +49,7 @@ export function showDownloads(kind, app) {
   const fail = (err) => app.showError(err.message);
   group('Maps (FITS, HFF style)', FITS.map((name) => button(name, `dl-${name.replaceAll('.', '-')}`, () =>
     app.fitsFile(name).then((bytes) => save(name, new Blob([bytes], { type: 'application/fits' })), fail))));
-  const texts = kind === 'reconstruct' ? TEXT_FILES : TEXT_FILES.filter(([n]) => !/sources|convergence/.test(n));
+  const texts = kind === 'reconstruct' ? TEXT_FILES : TEXT_FILES.filter(([n]) => !/sources|images|convergence/.test(n));
   group('Results', texts.map(([name, type]) => button(name, `dl-${name.replaceAll('.', '-')}`, () =>
     app.textFile(name).then((text) => save(name, new Blob([text], { type })), fail))));
   const views = kind === 'reconstruct' ? VIEWS : VIEWS.filter(([v]) => v !== 'convergence');
