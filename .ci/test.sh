@@ -48,6 +48,7 @@ export CARGO_TARGET_WASM32_UNKNOWN_UNKNOWN_RUNNER=wasm-bindgen-test-runner
 run_step "cargo fmt" cargo fmt --all -- --check
 run_step "clippy native" cargo clippy --all-targets -- -D warnings
 run_step "clippy wasm32" cargo clippy --all-targets --target wasm32-unknown-unknown -- -D warnings
+run_step "docs" env RUSTDOCFLAGS="-D warnings" cargo doc --no-deps
 run_step "native tests" cargo test
 run_step "wasm tests in a worker" cargo test --target wasm32-unknown-unknown --test '*'
 run_step "wasm build" build_wasm

@@ -194,8 +194,8 @@ impl ParsedData {
     }
 
     /// Side of one arc pixel in milliarcsec: the median distance from a pixel to its nearest
-    /// neighbour in the same image ([`DEFAULT_ARC_PIXEL_MAS`] if no image has two pixels).
-    /// Of an image with more than [`ARC_PIXEL_SAMPLES`] pixels only that many, evenly spaced
+    /// neighbour in the same image (`DEFAULT_ARC_PIXEL_MAS` if no image has two pixels).
+    /// Of an image with more than `ARC_PIXEL_SAMPLES` pixels only that many, evenly spaced
     /// in file order, are measured (against all of its pixels), so the cost grows linearly with
     /// the pixel count: every pixel of a 20000-pixel arc took 1.7 s, and each view of the data
     /// asks again. Arc pixels lie on a regular grid, where the sample's median is the same.

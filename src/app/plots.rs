@@ -129,7 +129,7 @@ impl Session {
     /// (`z_lens`, cosmology) is not the reconstruction's: its kappa and masses would not
     /// compare. When both frames have a sky reference the model's map is centred on the
     /// reconstruction's origin (the small rotation between the two tangent planes is ignored).
-    /// The model's map has at most [`MODEL_PROFILE_MAX_PIXELS`] per side.
+    /// The model's map has at most `MODEL_PROFILE_MAX_PIXELS` per side.
     pub fn model_profile(&self, result: &SessionResult) -> Result<Option<NamedProfile>, AppError> {
         let (RunKind::Reconstruct, Some(file)) = (result.kind, &self.data.model) else {
             return Ok(None);

@@ -5,7 +5,7 @@
 //! bad start, and without galaxies).
 //!
 //! [`run_paper`] does the work and scores every case against the truth ([`metrics`]);
-//! [`report`] holds `report.json`, `markdown` writes `report.md`, [`figures`] the PNG figures,
+//! `report` holds `report.json`, `markdown` writes `report.md`, `figures` the PNG figures,
 //! `studies` the extra runs (C from several starts, the sweep of the open defaults). Writing
 //! files is the CLI's job.
 //!

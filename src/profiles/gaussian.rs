@@ -31,7 +31,7 @@ pub struct Gaussian {
 }
 
 impl Gaussian {
-    /// A Gaussian of total mass `mass_msun` [Msun] and width `sigma_arcsec` [arcsec] on `plane`.
+    /// A Gaussian of total mass `mass_msun` (Msun) and width `sigma_arcsec` (arcsec) on `plane`.
     pub fn new(
         center: DVec2,
         mass_msun: f64,

@@ -28,14 +28,14 @@ pub struct PointMass {
 }
 
 impl PointMass {
-    /// A point of `mass_msun` [Msun] on `plane`: `theta_E,ref^2 = K m / D_l` (METHOD.md section 1).
+    /// A point of `mass_msun` (Msun) on `plane`: `theta_E,ref^2 = K m / D_l` (METHOD.md section 1).
     pub fn new(center: DVec2, mass_msun: f64, plane: &LensPlane) -> Result<Self, ProfileError> {
         let mass_msun = require_positive("point", "mass", mass_msun)?;
         let theta_e2 = point_mass_deflection_arcsec2() * mass_msun / plane.d_l_mpc;
         Self::from_theta_e(center, theta_e2.sqrt())
     }
 
-    /// A point mass with reference Einstein radius `theta_e_ref_arcsec` [arcsec].
+    /// A point mass with reference Einstein radius `theta_e_ref_arcsec` (arcsec).
     pub fn from_theta_e(center: DVec2, theta_e_ref_arcsec: f64) -> Result<Self, ProfileError> {
         let theta_e = require_positive("point", "theta_e", theta_e_ref_arcsec)?;
         Ok(Self {

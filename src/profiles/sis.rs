@@ -34,7 +34,7 @@ impl Sis {
         Self::from_theta_e(center, sis_theta_e_arcsec(sigma_v_km_s))
     }
 
-    /// An SIS with reference Einstein radius `theta_e_ref_arcsec` [arcsec] (`D_ls/D_s = 1`).
+    /// An SIS with reference Einstein radius `theta_e_ref_arcsec` (arcsec, `D_ls/D_s = 1`).
     pub fn from_theta_e(center: DVec2, theta_e_ref_arcsec: f64) -> Result<Self, ProfileError> {
         Ok(Self {
             center: require_finite_center("sis", center)?,

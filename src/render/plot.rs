@@ -92,7 +92,7 @@ impl Series {
 /// One axis: its title, scale and data range.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct Axis {
-    /// Axis title (units in brackets, e.g. "r [arcsec]"); empty for none.
+    /// Axis title (units in brackets, e.g. "r \[arcsec\]"); empty for none.
     pub label: String,
     pub scale: AxisScale,
     /// Shown range `(lo, hi)`, `lo < hi` (both positive on a log axis). None: the range of

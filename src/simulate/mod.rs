@@ -3,11 +3,11 @@
 //!
 //! A cluster at `z_l = 0.185` made of 94 elliptical NFW galaxy halos ("galaxy-true") and a
 //! smooth three-component halo ("soft") with three times their projected mass inside the
-//! 198 arcsec field, 2.58e14 Msun/h in total ([`cluster`]); a perturbed copy of the galaxies
+//! 198 arcsec field, 2.58e14 Msun/h in total (`cluster`); a perturbed copy of the galaxies
 //! ("galaxy-model", ~20% in mass and scale radius); and 30 elliptical Sérsic sources at
 //! A1689-like redshifts ray-traced through the truth lens on a 0.5 arcsec pixel grid, every
-//! pixel above 1% of its source's peak brightness being one constraint ([`raytrace`],
-//! [`sources`]). Everything is deterministic for a seed (own SplitMix64 generator) and runs
+//! pixel above 1% of its source's peak brightness being one constraint (`raytrace`,
+//! `sources`). Everything is deterministic for a seed (own SplitMix64 generator) and runs
 //! without threads or files, so the same simulation is made in the browser.
 
 use glam::DVec2;
