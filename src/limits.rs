@@ -105,21 +105,49 @@ impl TooLarge {
     }
 }
 
-/// Line, column and reason of a `serde_json` error, the reason without the
-/// `" at line L column C"` that its `Display` appends (so that a message says them once).
-/// Line and column are 1-based; both are 0 when serde_json does not know them.
-pub fn json_error_parts(e: &serde_json::Error) -> (usize, usize, String) {
+/// Line, column and reason of a `serde_json` error in `text` (the text it parsed), the reason
+/// without the `" at line L column C"` that its `Display` appends (so that a message says them
+/// once), and with a hint when the value there is `NaN` or `Infinity`, which JSON does not have
+/// but Python's `json.dump` writes. Line and column are 1-based; both are 0 when serde_json
+/// does not know them.
+pub fn json_error_parts(text: &str, e: &serde_json::Error) -> (usize, usize, String) {
     let (line, column) = (e.line(), e.column());
     let full = e.to_string();
     let suffix = format!(" at line {line} column {column}");
-    let reason = full.strip_suffix(&suffix).unwrap_or(&full).to_string();
+    let mut reason = full.strip_suffix(&suffix).unwrap_or(&full).to_string();
+    if let Some(word) = non_json_number(text, line, column) {
+        reason.push_str(&format!(
+            ": '{word}' is not a number in JSON (Python's json.dump writes NaN and Infinity \
+             for such values; leave them out)"
+        ));
+    }
     (line, column, reason)
 }
 
-/// `"line L, column C: reason"` for a `serde_json` error (only the reason when serde_json
-/// does not know the place).
-pub fn json_error_message(e: &serde_json::Error) -> String {
-    match json_error_parts(e) {
+/// The word at 1-based `line` and `column` of `text` (serde_json stops on it or just after
+/// its first letters) when it is a NaN or an infinity.
+fn non_json_number(text: &str, line: usize, column: usize) -> Option<&str> {
+    let row = text.lines().nth(line.checked_sub(1)?)?;
+    let at = column.checked_sub(1)?.min(row.len());
+    let part = |c: char| c.is_ascii_alphanumeric() || matches!(c, '-' | '+' | '.');
+    let start = row[..at]
+        .char_indices()
+        .rev()
+        .take_while(|&(_, c)| part(c))
+        .last()
+        .map_or(at, |(i, _)| i);
+    let end = row[start..]
+        .find(|c: char| !part(c))
+        .map_or(row.len(), |k| start + k);
+    let word = &row[start..end];
+    let bare = word.trim_start_matches(['-', '+']).to_ascii_lowercase();
+    matches!(bare.as_str(), "nan" | "inf" | "infinity").then_some(word)
+}
+
+/// `"line L, column C: reason"` for a `serde_json` error in `text` (only the reason when
+/// serde_json does not know the place); see [`json_error_parts`].
+pub fn json_error_message(text: &str, e: &serde_json::Error) -> String {
+    match json_error_parts(text, e) {
         (0, _, reason) => reason,
         (line, column, reason) => format!("line {line}, column {column}: {reason}"),
     }
@@ -131,10 +159,38 @@ mod tests {
 
     #[test]
     fn json_place_is_said_once() {
-        let e = serde_json::from_str::<serde_json::Value>("{\n  \"a\": }").unwrap_err();
-        let m = json_error_message(&e);
+        let text = "{\n  \"a\": }";
+        let e = serde_json::from_str::<serde_json::Value>(text).unwrap_err();
+        let m = json_error_message(text, &e);
         assert_eq!(m, "line 2, column 8: expected value");
         assert_eq!(m.matches("line").count(), 1);
+    }
+
+    /// NaN and infinities, as Python writes them (and as people type them), are named; other
+    /// words are not.
+    #[test]
+    fn nan_and_infinity_are_named() {
+        for (text, word) in [
+            ("[1, NaN]", "NaN"),
+            ("[1, -Infinity]", "-Infinity"),
+            ("[1, Infinity]", "Infinity"),
+            ("[1,\n  nan]", "nan"),
+            ("{\"a\": -inf}", "-inf"),
+        ] {
+            let e = serde_json::from_str::<serde_json::Value>(text).unwrap_err();
+            let m = json_error_message(text, &e);
+            assert!(
+                m.contains(&format!("'{word}' is not a number in JSON")),
+                "{text}: {m}"
+            );
+        }
+        for text in ["[1, none]", "[1, 2", "[1, x]"] {
+            let e = serde_json::from_str::<serde_json::Value>(text).unwrap_err();
+            assert!(
+                !json_error_message(text, &e).contains("not a number"),
+                "{text}"
+            );
+        }
     }
 
     #[test]

@@ -321,7 +321,7 @@ impl ModelFile {
 /// Turns a serde_json error into a [`ModelError`] with line and column. If the text is valid
 /// JSON and a component fails to parse on its own, the error also names that component.
 fn syntax_error(text: &str, source_name: &str, e: &serde_json::Error) -> ModelError {
-    let (line, column, message) = json_error_parts(e);
+    let (line, column, message) = json_error_parts(text, e);
     // Attribute the error to a component only if that component fails on its own with the
     // same message (so a bad top-level field before it is not blamed on it).
     match failing_component(text) {

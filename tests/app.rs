@@ -326,6 +326,9 @@ fn a_project_reopens_with_the_maps_rebuilt_from_x() {
         .open_project("{\"format\": \"other\", \"version\": 1}", "q.json")
         .unwrap_err();
     assert!(err.to_string().contains("q.json"), "{err}");
+    // Not JSON: the place is said once.
+    let err = t.open_project("{\"format\": wslap}", "r.json").unwrap_err();
+    assert_eq!(err.to_string(), "r.json: line 1, column 12: expected value");
     assert!(t.result.is_some());
 }
 

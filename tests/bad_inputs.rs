@@ -107,6 +107,15 @@ fn arcs_errors_name_the_line_of_the_system() {
         "{err}"
     );
     assert_place_once(&err);
+    // NaN, as Python's json.dump writes a missing value: named, with where it came from.
+    let text = "{\"systems\": [\n  {\"id\": \"a\", \"z\": 2, \"pixels\": [[0, NaN]]}]}";
+    let err = arcs_err(text);
+    assert_eq!(
+        err,
+        "arcs.json: line 2, column 38: expected value: 'NaN' is not a number in JSON \
+         (Python's json.dump writes NaN and Infinity for such values; leave them out)"
+    );
+    assert_place_once(&err);
     let text = "{\"systems\": [{\"id\": \"a\", \"z\": 1e30, \"pixels\": [[0, 1]]}]}";
     assert_eq!(
         arcs_err(text),

@@ -16,6 +16,7 @@
 
 use serde::{Deserialize, Serialize};
 
+use crate::limits::json_error_message;
 use crate::reconstruct::{ConvergenceRecord, SourceReport};
 
 use super::data::{NamedText, MAX_STORED_FITS_BYTES};
@@ -163,11 +164,7 @@ impl Session {
         source_name: &str,
     ) -> Result<ReopenReport, AppError> {
         let p: Project = serde_json::from_str(text).map_err(|e| {
-            AppError::File(format!(
-                "{source_name}: line {}, column {}: {e}",
-                e.line(),
-                e.column()
-            ))
+            AppError::File(format!("{source_name}: {}", json_error_message(text, &e)))
         })?;
         if p.format != PROJECT_FORMAT || p.version != PROJECT_VERSION {
             return Err(AppError::File(format!(

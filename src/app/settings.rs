@@ -4,6 +4,7 @@
 use serde::{Deserialize, Serialize};
 
 use crate::cosmology::{Cosmology, LensPlane};
+use crate::limits::json_error_message;
 use crate::reconstruct::ReconstructConfig;
 
 use super::AppError;
@@ -91,11 +92,7 @@ impl AppSettings {
     /// Parses settings JSON (missing fields take their defaults); errors name the line.
     pub fn from_json_str(text: &str, source_name: &str) -> Result<Self, AppError> {
         let s: Self = serde_json::from_str(text).map_err(|e| {
-            AppError::Setting(format!(
-                "{source_name}: line {}, column {}: {e}",
-                e.line(),
-                e.column()
-            ))
+            AppError::Setting(format!("{source_name}: {}", json_error_message(text, &e)))
         })?;
         s.validate()?;
         Ok(s)

@@ -78,8 +78,9 @@ struct ArcsJson<'a> {
 /// [`crate::limits::MAX_ARCS_BYTES`] of text.
 pub fn parse_arcs(text: &str, source_name: &str) -> Result<ArcCatalog, ConstraintError> {
     TooLarge::check_bytes(source_name, InputKind::Arcs, text.len() as u64)?;
-    let syntax = |e: serde_json::Error, at: (usize, usize)| {
-        let (line, column, message) = json_error_parts(&e);
+    // `part` is the text serde_json parsed, which starts at `at` in the file.
+    let syntax = |e: serde_json::Error, part: &str, at: (usize, usize)| {
+        let (line, column, message) = json_error_parts(part, &e);
         // Lines and columns of an error inside one system count from the system's start.
         let (line, column) = match (line, at) {
             (0, _) => at,
@@ -93,13 +94,13 @@ pub fn parse_arcs(text: &str, source_name: &str) -> Result<ArcCatalog, Constrain
             message,
         }
     };
-    let raw: ArcsJson = serde_json::from_str(text).map_err(|e| syntax(e, (1, 1)))?;
+    let raw: ArcsJson = serde_json::from_str(text).map_err(|e| syntax(e, text, (1, 1)))?;
     let mut systems: Vec<ArcSystem> = Vec::with_capacity(raw.systems.len());
     let mut total_pixels = 0usize;
     for raw_system in raw.systems {
         let (line, column) = place(text, raw_system.get());
-        let s: ArcSystemJson =
-            serde_json::from_str(raw_system.get()).map_err(|e| syntax(e, (line, column)))?;
+        let s: ArcSystemJson = serde_json::from_str(raw_system.get())
+            .map_err(|e| syntax(e, raw_system.get(), (line, column)))?;
         let id = match s.id {
             IdJson::Text(t) => t,
             IdJson::Number(n) => n.to_string(),

@@ -101,7 +101,7 @@ impl ReconstructConfig {
         TooLarge::check_bytes(source_name, InputKind::Config, text.len() as u64)?;
         let config: Self = serde_json::from_str(text).map_err(|e| ReconstructError::Config {
             source_name: source_name.to_string(),
-            message: json_error_message(&e),
+            message: json_error_message(text, &e),
         })?;
         config.validate().map_err(|e| ReconstructError::Config {
             source_name: source_name.to_string(),
