@@ -125,6 +125,26 @@ fn a_bad_setting_is_refused_and_the_old_value_kept() {
     s.set_field("reconstruct.members.c_prior_sigma", json!(0.1))
         .unwrap();
     assert_eq!(s.settings.reconstruct.members.c_prior_sigma, Some(0.1));
+    // The curves' source behind the lens, whichever of the two redshifts is changed.
+    let z_lens = s.settings.z_lens;
+    let err = s
+        .set_field("reconstruct.products.z_source", json!(z_lens))
+        .unwrap_err()
+        .to_string();
+    assert!(
+        err.starts_with("reconstruct.products.z_source: the curves' z_s = ")
+            && err.contains("is not behind the lens"),
+        "{err}"
+    );
+    let z_s = s.settings.reconstruct.products.z_source;
+    assert!(z_s > z_lens);
+    let err = s.set_field("z_lens", json!(z_s + 0.5)).unwrap_err();
+    assert!(
+        err.to_string().starts_with("z_lens: the curves' z_s"),
+        "{err}"
+    );
+    assert_eq!(s.settings.z_lens, z_lens);
+    assert_eq!(s.settings.reconstruct.products.z_source, z_s);
     assert_eq!(
         s.settings.reconstruct.products.pixels,
         wslap::app::APP_MAP_PIXELS
