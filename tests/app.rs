@@ -8,8 +8,8 @@ use glam::DVec2;
 use serde_json::json;
 use wslap::app::examples::{teaching_image_catalog, TEACHING_SOURCES};
 use wslap::app::{
-    system_rgb, DataRole, RunKind, Session, ViewOptions, MAX_STORED_FITS_BYTES, OBSERVED_RGB,
-    PREDICTED_RGB, SHOWN_MIN_MAGNIFICATION,
+    profile_relative_differences, system_rgb, DataRole, RunKind, Session, ViewOptions,
+    MAX_STORED_FITS_BYTES, OBSERVED_RGB, PREDICTED_RGB, SHOWN_MIN_MAGNIFICATION,
 };
 use wslap::demo::TEACHING_MODEL_JSON;
 use wslap::render::{LegendPlace, PIXEL_ALPHA};
@@ -726,6 +726,65 @@ fn the_profile_view_compares_a_reconstruction_with_the_loaded_model() {
         "the model's dashed lines: {} pixels",
         count_near(&with, palette_1)
     );
+    // A third panel, of the relative differences, below the two.
+    let panel = (without.height() + 8) / 2;
+    assert_eq!(with.height(), 3 * panel - 8);
+    assert_eq!(with.width(), without.width());
+    let lower = with
+        .clone_rect(
+            tiny_skia::IntRect::from_xywh(0, 2 * panel as i32, with.width(), panel - 8).unwrap(),
+        )
+        .unwrap();
+    assert!(
+        count_near(&lower, wslap::render::PALETTE[2]) > 200,
+        "the enclosed mass's relative difference: {} pixels",
+        count_near(&lower, wslap::render::PALETTE[2])
+    );
+    // Its values: the reconstruction against the model, bin by bin.
+    let (kappa, mass) = profile_relative_differences(&r.products.profile, &profile);
+    assert_eq!(kappa.len(), profile.kappa.len());
+    for ((rk, dk), (&r0, (&ours, &theirs))) in kappa.iter().zip(
+        r.products
+            .profile
+            .r_arcsec
+            .iter()
+            .zip(r.products.profile.kappa.iter().zip(&profile.kappa)),
+    ) {
+        assert_eq!(*rk, r0);
+        assert!((dk - (ours / theirs - 1.0)).abs() < 1e-12);
+    }
+    assert_eq!(
+        mass.len(),
+        profile.enclosed_mass_msun.len() - 1,
+        "M(<0) = 0 is left out"
+    );
+}
+
+/// Relative differences: a profile 10% above another is +0.1 in every bin; bins where the
+/// model has nothing are left out.
+#[cfg_attr(not(target_arch = "wasm32"), test)]
+#[cfg_attr(target_arch = "wasm32", wasm_bindgen_test::wasm_bindgen_test)]
+fn relative_differences_of_profiles() {
+    let model = wslap::radial::RadialProfile {
+        r_arcsec: vec![1.0, 3.0, 5.0],
+        kappa: vec![2.0, 0.0, 0.5],
+        r_edges_arcsec: vec![0.0, 2.0, 4.0, 6.0],
+        enclosed_mass_msun: vec![0.0, 1e12, 1e12, 2e12],
+    };
+    let ours = wslap::radial::RadialProfile {
+        kappa: model.kappa.iter().map(|k| 1.1 * k).collect(),
+        enclosed_mass_msun: model.enclosed_mass_msun.iter().map(|m| 1.1 * m).collect(),
+        ..model.clone()
+    };
+    let (kappa, mass) = profile_relative_differences(&ours, &model);
+    assert_eq!(kappa.iter().map(|p| p.0).collect::<Vec<_>>(), [1.0, 5.0]);
+    assert_eq!(
+        mass.iter().map(|p| p.0).collect::<Vec<_>>(),
+        [2.0, 4.0, 6.0]
+    );
+    for (_, d) in kappa.iter().chain(&mass) {
+        assert!((d - 0.1).abs() < 1e-12, "{d}");
+    }
 }
 
 /// The model's profile is taken about the reconstruction's sky origin: a model file whose frame

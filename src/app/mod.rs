@@ -22,6 +22,7 @@ pub use data::{
     ArcPixels, DataMarks, DataRole, LoadReport, LoadedData, NamedMap, NamedText, ParsedData,
     MAX_STORED_FITS_BYTES,
 };
+pub use plots::profile_relative_differences;
 pub use project::{Project, ProjectResult, StoredFits, PROJECT_FORMAT, PROJECT_VERSION};
 pub use run::{RunKind, SessionResult};
 pub use settings::{AppSettings, APP_MAP_PIXELS};

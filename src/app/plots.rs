@@ -10,7 +10,9 @@ use crate::grid::{Map, MapGeometry};
 use crate::model::ModelFile;
 use crate::profiles::MassComponent;
 use crate::radial::{radial_profile, RadialBins, RadialProfile};
-use crate::render::{compose_grid, Axis, LinePlot, LineStyle, RenderError, Series, PALETTE};
+use crate::render::{
+    compose_grid, Axis, LinePlot, LineStyle, Reference, RenderError, Series, PALETTE,
+};
 
 use super::run::{RunKind, SessionResult};
 use super::views::ViewPng;
@@ -68,7 +70,7 @@ pub type NamedProfile = (String, RadialProfile);
 pub(crate) struct ModelProfileCache(RefCell<Option<(u64, Option<NamedProfile>)>>);
 
 /// Points `(x, y)` of a plotted line.
-type Points = Vec<(f64, f64)>;
+pub type Points = Vec<(f64, f64)>;
 
 /// The profile's `(r, kappa)` and `(r, M(<r))` points.
 fn profile_points(p: &RadialProfile) -> (Points, Points) {
@@ -78,10 +80,36 @@ fn profile_points(p: &RadialProfile) -> (Points, Points) {
     (kappa.collect(), mass.collect())
 }
 
+/// `(r, ours / theirs - 1)` of a reconstruction's profile against a model's in the same bins:
+/// the mean kappa per annulus and the mass inside each radius. Radii where the model has no
+/// positive value are left out.
+pub fn profile_relative_differences(
+    ours: &RadialProfile,
+    model: &RadialProfile,
+) -> (Points, Points) {
+    let rel = |r: &[f64], a: &[f64], b: &[f64]| -> Points {
+        r.iter()
+            .zip(a.iter().zip(b))
+            .filter(|(_, (_, &b))| b > 0.0)
+            .map(|(&r, (&a, &b))| (r, a / b - 1.0))
+            .collect()
+    };
+    (
+        rel(&ours.r_arcsec, &ours.kappa, &model.kappa),
+        rel(
+            &ours.r_edges_arcsec,
+            &ours.enclosed_mass_msun,
+            &model.enclosed_mass_msun,
+        ),
+    )
+}
+
 impl Session {
     /// The radial profile about (0, 0): area-weighted mean kappa (`D_ls/D_s = 1`) per annulus and
     /// the projected mass inside each radius (Msun), both on log10 axes. Over a reconstruction,
-    /// the loaded model file's profile in the same bins, dashed (see [`Self::model_profile`]).
+    /// the loaded model file's profile in the same bins, dashed (see [`Self::model_profile`]),
+    /// and a third panel with their relative differences
+    /// ([`profile_relative_differences`]).
     pub fn radial_view(&self) -> Result<ViewPng, AppError> {
         let result = self.result()?;
         let (kappa, mass) = profile_points(&result.products.profile);
@@ -95,6 +123,7 @@ impl Session {
                 vec![Series::line("M(<r)", mass, PALETTE[1])],
             ),
         };
+        let mut difference = None;
         if let Some((name, model)) = self.model_profile(result)? {
             let (kappa, mass) = profile_points(&model);
             let dashed = |points| Series {
@@ -103,24 +132,41 @@ impl Session {
             };
             kappa_series.push(dashed(kappa));
             mass_series.push(dashed(mass));
+            // How far the reconstruction is from the model, radius by radius: the paper's
+            // profile error.
+            let (kappa, mass) = profile_relative_differences(&result.products.profile, &model);
+            let mut plot = panel(
+                &format!("reconstruction / loaded model - 1 ({name})"),
+                Axis::linear("r [arcsec]"),
+                Axis::linear("relative difference"),
+                vec![
+                    Series::line("mean kappa in annuli", kappa, PALETTE[0]),
+                    Series::line("M(<r)", mass, PALETTE[2]),
+                ],
+            );
+            plot.references.push(Reference {
+                value: 0.0,
+                label: "equal".to_string(),
+                color: [110, 110, 110],
+            });
+            difference = Some(plot);
         }
-        compose(
-            "radial-profile.png",
-            &[
-                panel(
-                    "mean kappa in annuli",
-                    Axis::linear("r [arcsec]"),
-                    Axis::log("kappa"),
-                    kappa_series,
-                ),
-                panel(
-                    "enclosed projected mass",
-                    Axis::linear("r [arcsec]"),
-                    Axis::log("M(<r) [Msun]"),
-                    mass_series,
-                ),
-            ],
-        )
+        let mut plots = vec![
+            panel(
+                "mean kappa in annuli",
+                Axis::linear("r [arcsec]"),
+                Axis::log("kappa"),
+                kappa_series,
+            ),
+            panel(
+                "enclosed projected mass",
+                Axis::linear("r [arcsec]"),
+                Axis::log("M(<r) [Msun]"),
+                mass_series,
+            ),
+        ];
+        plots.extend(difference);
+        compose("radial-profile.png", &plots)
     }
 
     /// The radial profile of the loaded model file (the true lens of the built-in examples) in
