@@ -327,6 +327,7 @@ impl Products {
     /// The kappa figure (PNG) with the critical curves on top.
     pub fn kappa_png(&self, scale: ColorScale) -> Result<Vec<u8>, ProductsError> {
         let overlay = Overlay {
+            lines: Vec::new(),
             curves: Some(&self.curves),
             points: Vec::new(),
         };

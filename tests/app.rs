@@ -9,7 +9,7 @@ use serde_json::json;
 use wslap::app::examples::{teaching_image_catalog, TEACHING_SOURCES};
 use wslap::app::{
     profile_relative_differences, system_rgb, DataRole, RunKind, Session, ViewOptions,
-    MAX_STORED_FITS_BYTES, OBSERVED_RGB, PREDICTED_RGB, SHOWN_MIN_MAGNIFICATION,
+    MAX_STORED_FITS_BYTES, MODEL_CURVE_RGB, OBSERVED_RGB, PREDICTED_RGB, SHOWN_MIN_MAGNIFICATION,
 };
 use wslap::demo::TEACHING_MODEL_JSON;
 use wslap::render::{LegendPlace, PIXEL_ALPHA};
@@ -787,9 +787,90 @@ fn relative_differences_of_profiles() {
     }
 }
 
-/// The model's profile is taken about the reconstruction's sky origin: a model file whose frame
-/// is 3 arcsec north of the catalogue's, with its components moved to the same sky positions,
-/// gives the same profile. A model at another lens redshift is not compared (`None`).
+/// Over a reconstruction, the kappa view draws the loaded model's critical curves (white,
+/// dashed) unless turned off. They are traced on the model's own maps; checked against the
+/// curves of an independent forward run of the same model (another session, its own map),
+/// point by point within a pixel of the model's map.
+#[cfg_attr(not(target_arch = "wasm32"), test)]
+#[cfg_attr(target_arch = "wasm32", wasm_bindgen_test::wasm_bindgen_test)]
+fn the_kappa_view_draws_the_loaded_model_curves() {
+    let mut s = teaching_session();
+    s.run(RunKind::Reconstruct, &mut |_| Control::Continue)
+        .unwrap();
+    assert!(
+        s.model_curves(s.result().unwrap()).unwrap().is_none(),
+        "no model loaded"
+    );
+    s.load_text(DataRole::Model, "model.json", TEACHING_MODEL_JSON)
+        .unwrap();
+    let r = s.result().unwrap();
+    let curves = s.model_curves(r).unwrap().expect("the model's curves");
+    assert_eq!(curves.name, "model.json");
+    assert!(!curves.tangential.is_empty());
+
+    let mut forward = Session::new();
+    forward
+        .load_text(DataRole::Model, "model.json", TEACHING_MODEL_JSON)
+        .unwrap();
+    forward
+        .set_field(
+            "reconstruct.products.z_source",
+            json!(r.products.curves.z_source),
+        )
+        .unwrap();
+    forward
+        .run(RunKind::Forward, &mut |_| Control::Continue)
+        .unwrap();
+    let truth = &forward.result().unwrap().products;
+    // The teaching model has no sky reference: its frame is the reconstruction's (no shift;
+    // the shift is checked with the profile below).
+    assert_eq!(truth.reference, None);
+    let model_pixel = r.products.maps.geometry().size_arcsec / 64.0;
+    let nearest = |p: DVec2, lines: &[Vec<DVec2>]| {
+        lines
+            .iter()
+            .flatten()
+            .map(|q| q.distance(p))
+            .fold(f64::INFINITY, f64::min)
+    };
+    let mut checked = 0;
+    for (ours, theirs) in [
+        (&curves.tangential, &truth.curves.tangential),
+        (&curves.radial, &truth.curves.radial),
+    ] {
+        for &p in ours.iter().flatten() {
+            let d = nearest(p, theirs);
+            assert!(
+                d < model_pixel,
+                "{p}: {d} arcsec from the forward run's curve"
+            );
+            checked += 1;
+        }
+    }
+    assert!(checked > 50, "{checked} points");
+
+    let pixels = |show_model_curves: bool| {
+        let opts = ViewOptions {
+            show_model_curves,
+            show_members: false,
+            ..ViewOptions::default()
+        };
+        let png = s.kappa_view(&opts).unwrap().png;
+        count_near(
+            &tiny_skia::Pixmap::decode_png(&png).unwrap(),
+            MODEL_CURVE_RGB,
+        )
+    };
+    let (with, without) = (pixels(true), pixels(false));
+    assert!(
+        with > without + 200,
+        "white pixels: {with} with the model's curves, {without} without"
+    );
+}
+
+/// The model's profile and curves are taken about the reconstruction's sky origin: a model
+/// file whose frame is 3 arcsec north of the catalogue's, with its components moved to the same
+/// sky positions, gives the same profile and the same curves. A model at another lens redshift is not compared (`None`).
 #[cfg_attr(not(target_arch = "wasm32"), test)]
 #[cfg_attr(target_arch = "wasm32", wasm_bindgen_test::wasm_bindgen_test)]
 fn the_model_profile_follows_the_sky_frame_and_the_lens_plane() {
@@ -808,9 +889,26 @@ fn the_model_profile_follows_the_sky_frame_and_the_lens_plane() {
         2.2 + 3.0 / 3600.0
     );
     let (_, a) = profile_of(&mut s, same_frame).unwrap();
+    let curves_a = s.model_curves(s.result().unwrap()).unwrap().unwrap();
     let (_, b) = profile_of(&mut s, &north).unwrap();
     for (x, y) in a.enclosed_mass_msun.iter().zip(&b.enclosed_mass_msun) {
         assert!((x - y).abs() <= 1e-6 * x.abs().max(1.0), "{x} vs {y}");
+    }
+    // So do its critical curves, drawn in the reconstruction's frame.
+    let curves_b = s.model_curves(s.result().unwrap()).unwrap().unwrap();
+    let points = |c: &wslap::app::ModelCurves| -> Vec<DVec2> {
+        c.tangential
+            .iter()
+            .chain(&c.radial)
+            .flatten()
+            .copied()
+            .collect()
+    };
+    let (pa, pb) = (points(&curves_a), points(&curves_b));
+    assert!(!pa.is_empty());
+    assert_eq!(pa.len(), pb.len());
+    for (p, q) in pa.iter().zip(&pb) {
+        assert!(p.distance(*q) < 1e-6, "{p} vs {q}");
     }
     // Unmoved, the components sit 3 arcsec off the centre: the inner profile drops.
     let unmoved = same_frame.replace("\"dec\": 2.2", &format!("\"dec\": {}", 2.2 + 3.0 / 3600.0));

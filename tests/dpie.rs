@@ -635,6 +635,7 @@ mod published {
             .flat_map(|s| s.images.iter().map(|i| i.position))
             .collect();
         let overlay = Overlay {
+            lines: Vec::new(),
             curves: Some(&ev.products.curves),
             points: vec![OverlayPoints {
                 label: "multiple images".into(),

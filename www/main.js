@@ -335,7 +335,7 @@ async function start() {
   $('lookup').addEventListener('click', () => run('lookup'));
   $('cancel').addEventListener('click', cancel);
   $('scale').addEventListener('change', render);
-  for (const id of ['show-members', 'show-observed', 'show-predicted']) $(id).addEventListener('change', render);
+  for (const id of ['show-members', 'show-observed', 'show-predicted', 'show-model-curves']) $(id).addEventListener('change', render);
   $('z-curves').addEventListener('change', async () => {
     try { await setZ(Number($('z-curves').value)); $('z-curves-error').textContent = ''; } catch (err) {
       $('z-curves-error').textContent = err.message;

@@ -22,12 +22,13 @@ pub use data::{
     ArcPixels, DataMarks, DataRole, LoadReport, LoadedData, NamedMap, NamedText, ParsedData,
     MAX_STORED_FITS_BYTES,
 };
-pub use plots::profile_relative_differences;
+pub use plots::{profile_relative_differences, ModelCurves};
 pub use project::{Project, ProjectResult, StoredFits, PROJECT_FORMAT, PROJECT_VERSION};
 pub use run::{RunKind, SessionResult};
 pub use settings::{AppSettings, APP_MAP_PIXELS};
 pub use views::{
-    system_rgb, HoverReadout, ViewOptions, ViewPng, OBSERVED_RGB, PREDICTED_RGB, SYSTEM_RGB,
+    system_rgb, HoverReadout, ViewOptions, ViewPng, MODEL_CURVE_RGB, OBSERVED_RGB, PREDICTED_RGB,
+    SYSTEM_RGB,
 };
 
 /// What the app reports to the user; every message names the file, line or setting.

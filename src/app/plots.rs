@@ -6,9 +6,10 @@ use std::hash::{DefaultHasher, Hash, Hasher};
 
 use glam::DVec2;
 
-use crate::grid::{Map, MapGeometry};
+use crate::curves::{critical_curves, CriticalCurves, Polyline};
+use crate::grid::MapGeometry;
+use crate::maps::LensMaps;
 use crate::model::ModelFile;
-use crate::profiles::MassComponent;
 use crate::radial::{radial_profile, RadialBins, RadialProfile};
 use crate::render::{
     compose_grid, Axis, LinePlot, LineStyle, Reference, RenderError, Series, PALETTE,
@@ -54,20 +55,43 @@ fn compose(name: &str, plots: &[LinePlot]) -> Result<ViewPng, AppError> {
     })
 }
 
-/// Pixels per side, at most, of the model's convergence map behind its profile. The view's
-/// bins are two product pixels wide, so at 256 product pixels a 128-pixel map has one pixel per
-/// bin; against a 512-pixel map of the built-in example's true lens its profile differs by at
-/// most 1.2% in kappa and 0.8% in enclosed mass (a line width on the plot), and it takes a
-/// quarter of the time (175 ms natively for 97 elliptical NFW halos, against 700 ms).
-const MODEL_PROFILE_MAX_PIXELS: usize = 128;
+/// Pixels per side, at most, of the model's maps behind its profile and critical curves. The
+/// profile view's bins are two product pixels wide, so at 256 product pixels a 128-pixel map
+/// has one pixel per bin; against a 512-pixel map of the built-in example's true lens its
+/// profile differs by at most 1.2% in kappa and 0.8% in enclosed mass (a line width on the
+/// plot). The maps take 0.3 - 0.5 s natively for the example's 97 elliptical NFW halos (a
+/// quarter of the 256-pixel time).
+const MODEL_MAPS_MAX_PIXELS: usize = 128;
 
 /// A model file's name and its profile.
 pub type NamedProfile = (String, RadialProfile);
 
-/// A model profile computed for one result and one model file (keyed by a hash of the file's
-/// name and text), so that switching views does not compute it again.
+/// A model file's critical curves, in a reconstruction's frame.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ModelCurves {
+    /// The model file's name.
+    pub name: String,
+    pub tangential: Vec<Polyline>,
+    pub radial: Vec<Polyline>,
+}
+
+/// The loaded model file's maps over a reconstruction's map.
+#[derive(Debug)]
+pub(crate) struct ModelMaps {
+    name: String,
+    maps: LensMaps,
+    /// The reconstruction's origin in the model's frame (the maps are centred on the
+    /// reconstruction's map centre, in the model's frame).
+    origin: DVec2,
+    /// The model's critical curves at the last distance ratio asked for, in the model's frame.
+    curves: RefCell<Option<(f64, CriticalCurves)>>,
+}
+
+/// The model maps computed for one result and one model file (keyed by a hash of the file's
+/// name and text; `None` inside when the model does not compare), so that switching views,
+/// hovering and redrawing do not compute them again.
 #[derive(Debug, Default)]
-pub(crate) struct ModelProfileCache(RefCell<Option<(u64, Option<NamedProfile>)>>);
+pub(crate) struct ModelCache(RefCell<Option<(u64, Option<ModelMaps>)>>);
 
 /// Points `(x, y)` of a plotted line.
 pub type Points = Vec<(f64, f64)>;
@@ -175,51 +199,66 @@ impl Session {
     /// (`z_lens`, cosmology) is not the reconstruction's: its kappa and masses would not
     /// compare. When both frames have a sky reference the model's map is centred on the
     /// reconstruction's origin (the small rotation between the two tangent planes is ignored).
-    /// The model's map has at most `MODEL_PROFILE_MAX_PIXELS` per side.
+    /// The model's map has at most `MODEL_MAPS_MAX_PIXELS` per side.
     pub fn model_profile(&self, result: &SessionResult) -> Result<Option<NamedProfile>, AppError> {
+        self.with_model_maps(result, |m| {
+            let bins = RadialBins::Edges(result.products.profile.r_edges_arcsec.clone());
+            let profile = radial_profile(&m.maps.kappa, m.origin, &bins, &result.products.plane)
+                .map_err(|e| AppError::Run(format!("{}: {e}", m.name)))?;
+            Ok((m.name.clone(), profile))
+        })
+    }
+
+    /// The loaded model file's tangential and radial critical curves at the result's source
+    /// redshift, in the reconstruction's frame, with the file's name; `None` as for
+    /// [`Self::model_profile`]. Traced on the model's maps (at most `MODEL_MAPS_MAX_PIXELS`
+    /// per side), once per source redshift.
+    pub fn model_curves(&self, result: &SessionResult) -> Result<Option<ModelCurves>, AppError> {
+        self.with_model_maps(result, |m| {
+            let f = result.products.distance_ratio;
+            let mut cached = m.curves.borrow_mut();
+            if !matches!(&*cached, Some((g, _)) if *g == f) {
+                let z_s = result.products.curves.z_source;
+                *cached = Some((f, critical_curves(&m.maps, f, z_s, None)));
+            }
+            let curves = &cached.as_ref().expect("just computed").1;
+            let shift = |lines: &[Polyline]| -> Vec<Polyline> {
+                let moved = lines
+                    .iter()
+                    .map(|l| l.iter().map(|&p| p - m.origin).collect());
+                moved.collect()
+            };
+            Ok(ModelCurves {
+                name: m.name.clone(),
+                tangential: shift(&curves.tangential),
+                radial: shift(&curves.radial),
+            })
+        })
+    }
+
+    /// Calls `f` with the loaded model's maps over `result` (computed on first use, then
+    /// cached); `None` when there are none to compare (see [`Self::model_profile`]).
+    fn with_model_maps<T>(
+        &self,
+        result: &SessionResult,
+        f: impl FnOnce(&ModelMaps) -> Result<T, AppError>,
+    ) -> Result<Option<T>, AppError> {
         let (RunKind::Reconstruct, Some(file)) = (result.kind, &self.data.model) else {
             return Ok(None);
         };
         let mut hasher = DefaultHasher::new();
         (&file.name, &file.text).hash(&mut hasher);
         let key = hasher.finish();
-        if let Some((k, cached)) = &*result.model_profile.0.borrow() {
-            if *k == key {
-                return Ok(cached.clone());
-            }
+        let fresh = matches!(&*result.model_maps.0.borrow(), Some((k, _)) if *k == key);
+        if !fresh {
+            let maps = compute_model_maps(result, &file.name, &file.text)?;
+            *result.model_maps.0.borrow_mut() = Some((key, maps));
         }
-        let profile = self.compute_model_profile(result, &file.name, &file.text)?;
-        *result.model_profile.0.borrow_mut() = Some((key, profile.clone()));
-        Ok(profile)
-    }
-
-    fn compute_model_profile(
-        &self,
-        result: &SessionResult,
-        name: &str,
-        text: &str,
-    ) -> Result<Option<NamedProfile>, AppError> {
-        let run = |e: &dyn std::fmt::Display| AppError::Run(format!("{name}: {e}"));
-        let model = ModelFile::from_json_str(text, name).map_err(|e| run(&e))?;
-        let plane = result.products.plane;
-        if model.z_lens != plane.z_lens || model.cosmology != plane.cosmology {
-            return Ok(None);
+        let cache = result.model_maps.0.borrow();
+        match cache.as_ref().and_then(|(_, m)| m.as_ref()) {
+            Some(m) => f(m).map(Some),
+            None => Ok(None),
         }
-        let lens = model.build_lens().map_err(|e| run(&e))?;
-        let center = match (result.products.reference, model.reference) {
-            (Some(ours), Some(theirs)) => theirs.to_offset_arcsec(ours.ra_deg, ours.dec_deg),
-            _ => DVec2::ZERO,
-        };
-        let bins = RadialBins::Edges(result.products.profile.r_edges_arcsec.clone());
-        let g = result.products.maps.geometry();
-        let geometry = MapGeometry {
-            center: center + g.center,
-            pixels: g.pixels.min(MODEL_PROFILE_MAX_PIXELS),
-            ..g
-        };
-        let kappa = Map::from_fn(geometry, |p| lens.kappa(p));
-        let profile = radial_profile(&kappa, center, &bins, &plane).map_err(|e| run(&e))?;
-        Ok(Some((name.to_string(), profile)))
     }
 
     /// The QADP history: objective, grid mass (Msun) and `C` of every layer against iteration
@@ -289,4 +328,36 @@ impl Session {
         }
         compose("convergence.png", &plots)
     }
+}
+
+/// The model file's maps over the reconstruction's map (see [`Session::model_profile`]);
+/// `None` when its lens plane is not the reconstruction's.
+fn compute_model_maps(
+    result: &SessionResult,
+    name: &str,
+    text: &str,
+) -> Result<Option<ModelMaps>, AppError> {
+    let run = |e: &dyn std::fmt::Display| AppError::Run(format!("{name}: {e}"));
+    let model = ModelFile::from_json_str(text, name).map_err(|e| run(&e))?;
+    let plane = result.products.plane;
+    if model.z_lens != plane.z_lens || model.cosmology != plane.cosmology {
+        return Ok(None);
+    }
+    let lens = model.build_lens().map_err(|e| run(&e))?;
+    let origin = match (result.products.reference, model.reference) {
+        (Some(ours), Some(theirs)) => theirs.to_offset_arcsec(ours.ra_deg, ours.dec_deg),
+        _ => DVec2::ZERO,
+    };
+    let g = result.products.maps.geometry();
+    let geometry = MapGeometry {
+        center: origin + g.center,
+        pixels: g.pixels.min(MODEL_MAPS_MAX_PIXELS),
+        ..g
+    };
+    Ok(Some(ModelMaps {
+        name: name.to_string(),
+        maps: LensMaps::from_lens(&lens, geometry),
+        origin,
+        curves: RefCell::new(None),
+    }))
 }

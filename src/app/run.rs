@@ -19,7 +19,7 @@ use crate::reconstruct::{
 use crate::solver::Control;
 
 use super::data::{DataMarks, ParsedData};
-use super::plots::ModelProfileCache;
+use super::plots::ModelCache;
 use super::{AppError, Session};
 
 /// Map width of a forward model without a `products.size_arcsec` setting (arcsec).
@@ -64,8 +64,9 @@ pub struct SessionResult {
     pub reconstruction: Option<ReconstructionResult>,
     /// Wall-clock time of the run in ms.
     pub elapsed_ms: f64,
-    /// The loaded model file's radial profile for the profile view, once computed.
-    pub(crate) model_profile: ModelProfileCache,
+    /// The loaded model file's maps for the profile view and the kappa view's model curves,
+    /// once computed.
+    pub(crate) model_maps: ModelCache,
 }
 
 impl SessionResult {
@@ -177,7 +178,7 @@ impl Session {
                 lens: r.lens,
             }),
             elapsed_ms: 0.0,
-            model_profile: ModelProfileCache::default(),
+            model_maps: ModelCache::default(),
         })
     }
 
@@ -245,7 +246,7 @@ impl Session {
                 lens,
             }),
             elapsed_ms: t.ms(),
-            model_profile: ModelProfileCache::default(),
+            model_maps: ModelCache::default(),
         });
         Ok(())
     }
@@ -274,7 +275,7 @@ impl Session {
             marks: parsed.marks(),
             reconstruction: None,
             elapsed_ms: 0.0,
-            model_profile: ModelProfileCache::default(),
+            model_maps: ModelCache::default(),
         })
     }
 
@@ -299,7 +300,7 @@ impl Session {
             marks: DataMarks::default(),
             reconstruction: None,
             elapsed_ms: 0.0,
-            model_profile: ModelProfileCache::default(),
+            model_maps: ModelCache::default(),
         })
     }
 

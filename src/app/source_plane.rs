@@ -125,6 +125,7 @@ impl Session {
         );
         let map = ray_shot(&p.maps, p.distance_ratio, region);
         let overlay = Overlay {
+            lines: Vec::new(),
             curves: Some(&caustics),
             points: back
                 .into_iter()
@@ -189,6 +190,7 @@ impl Session {
             ));
         }
         let overlay = Overlay {
+            lines: Vec::new(),
             curves: None,
             points,
         };

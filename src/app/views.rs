@@ -6,7 +6,7 @@ use serde::{Deserialize, Serialize};
 
 use crate::render::{
     kappa_figure_frame_for, render_kappa_png, ColorScale, FigureFrame, KappaPlotOptions,
-    LegendPlace, Marker, Overlay, OverlayPoints,
+    LegendPlace, Marker, Overlay, OverlayLines, OverlayPoints,
 };
 
 use super::data::ArcPixels;
@@ -18,6 +18,8 @@ pub const OBSERVED_RGB: [u8; 3] = [255, 60, 255];
 pub const PREDICTED_RGB: [u8; 3] = [255, 170, 0];
 /// Member galaxies: white circles.
 pub const MEMBER_RGB: [u8; 3] = [255, 255, 255];
+/// The loaded model file's critical curves over a reconstruction: white, dashed.
+pub const MODEL_CURVE_RGB: [u8; 3] = [255, 255, 255];
 /// One colour per multiple-image system (arc pixels, their images mapped back, the systems
 /// table), used in turn; none is the red or cyan of the curves, the white of the members or
 /// the orange of the predicted images.
@@ -60,6 +62,8 @@ pub struct ViewOptions {
     pub show_members: bool,
     pub show_observed: bool,
     pub show_predicted: bool,
+    /// After a reconstruction, the loaded model file's critical curves (white, dashed).
+    pub show_model_curves: bool,
     /// Map side on screen in pixels (default 512).
     pub map_pixels_on_screen: u32,
     /// Where the figures' legends go (default: under the map, so no data are hidden).
@@ -73,6 +77,7 @@ impl Default for ViewOptions {
             show_members: true,
             show_observed: true,
             show_predicted: true,
+            show_model_curves: true,
             map_pixels_on_screen: 512,
             legend: LegendPlace::Below,
         }
@@ -127,14 +132,26 @@ impl Session {
         })
     }
 
-    /// What the kappa view draws over the map: the curves, the arc pixels (one colour per
-    /// system), members, catalogue images and predicted images, as `opts` selects.
+    /// What the kappa view draws over the map: the curves, the loaded model's curves, the arc
+    /// pixels (one colour per system), members, catalogue images and predicted images, as
+    /// `opts` selects.
     fn kappa_overlay(&self, opts: &ViewOptions) -> Result<Overlay<'_>, AppError> {
         let r = self.result()?;
         let mut overlay = Overlay {
+            lines: Vec::new(),
             curves: Some(&r.products.curves),
             points: Vec::new(),
         };
+        if opts.show_model_curves {
+            if let Some(m) = self.model_curves(r)? {
+                overlay.lines.push(OverlayLines {
+                    label: format!("critical curves of {}", m.name),
+                    color: MODEL_CURVE_RGB,
+                    dashed: true,
+                    lines: m.tangential.into_iter().chain(m.radial).collect(),
+                });
+            }
+        }
         if opts.show_observed {
             overlay
                 .points

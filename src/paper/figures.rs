@@ -76,6 +76,7 @@ fn mass_maps(run: &PaperRun) -> Result<Vec<u8>, PaperError> {
     let mut pngs = Vec::new();
     for c in &run.cases {
         let overlay = Overlay {
+            lines: Vec::new(),
             curves: Some(&c.reconstruction.products.curves),
             points: Vec::new(),
         };
@@ -89,6 +90,7 @@ fn mass_maps(run: &PaperRun) -> Result<Vec<u8>, PaperError> {
         );
     }
     let overlay = Overlay {
+        lines: Vec::new(),
         curves: Some(&run.truth.curves),
         points: vec![arc_points(run)],
     };
@@ -370,6 +372,7 @@ fn deflection_error(run: &PaperRun) -> Result<Vec<u8>, PaperError> {
         ..KappaPlotOptions::default()
     };
     let overlay = Overlay {
+        lines: Vec::new(),
         curves: None,
         points: vec![arc_points(run)],
     };

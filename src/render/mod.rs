@@ -119,11 +119,24 @@ pub struct OverlayPoints {
     pub marker: Marker,
 }
 
+/// Labelled polylines (arcsec, frame of METHOD.md section 1) drawn over the map, e.g. the
+/// critical curves of another lens. A set with an empty `label` has no legend entry.
+#[derive(Debug, Clone, PartialEq)]
+pub struct OverlayLines {
+    pub label: String,
+    /// sRGB colour.
+    pub color: [u8; 3],
+    pub dashed: bool,
+    pub lines: Vec<Vec<DVec2>>,
+}
+
 /// What is drawn over the map: critical curves (tangential red, radial cyan; the caustics
-/// white and dashed if [`KappaPlotOptions::show_caustics`]) and point sets, clipped to the map.
+/// white and dashed if [`KappaPlotOptions::show_caustics`]), other lines and point sets,
+/// clipped to the map.
 #[derive(Debug, Clone, Default)]
 pub struct Overlay<'a> {
     pub curves: Option<&'a CriticalCurves>,
+    pub lines: Vec<OverlayLines>,
     pub points: Vec<OverlayPoints>,
 }
 

@@ -143,6 +143,12 @@ pub(super) fn legend_entries(overlay: &Overlay, show_caustics: bool) -> Vec<(Str
             }
         }
     }
+    for set in &overlay.lines {
+        if !set.label.is_empty() && set.lines.iter().any(|v| v.len() >= 2) {
+            let (rgb, dashed) = (set.color, set.dashed);
+            legend.push((set.label.clone(), Key::Line { rgb, dashed }));
+        }
+    }
     for set in &overlay.points {
         if !set.positions_arcsec.is_empty() && !set.label.is_empty() {
             let (rgb, marker) = (set.color, set.marker);
@@ -152,7 +158,7 @@ pub(super) fn legend_entries(overlay: &Overlay, show_caustics: bool) -> Vec<(Str
     legend
 }
 
-/// Draws pixel sets, curves and point markers, clipped to the map.
+/// Draws pixel sets, curves, other lines and point markers, clipped to the map.
 pub(super) fn draw_overlay(
     pm: &mut Pixmap,
     l: &Layout,
@@ -196,6 +202,16 @@ pub(super) fn draw_overlay(
             {
                 halo_stroke(pm, &path, rgb, width, dashed, mask);
             }
+        }
+    }
+    for set in &overlay.lines {
+        for path in set
+            .lines
+            .iter()
+            .filter(|v| v.len() >= 2)
+            .filter_map(|v| polyline_path(l, g, v))
+        {
+            halo_stroke(pm, &path, set.color, width, set.dashed, mask);
         }
     }
     let r = 3.0 * l.s as f32 + 1.0;

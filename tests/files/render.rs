@@ -90,6 +90,7 @@ fn assert_golden(name: &str, png: &[u8], golden: &[u8]) {
 fn golden_figures() {
     let (map, curves) = (figure_map(), figure_curves());
     let overlay = Overlay {
+        lines: Vec::new(),
         curves: Some(&curves),
         points: figure_points(),
     };
@@ -103,6 +104,7 @@ fn golden_figures() {
         GOLDEN_LINEAR,
     );
     let overlay = Overlay {
+        lines: Vec::new(),
         curves: Some(&curves),
         points: vec![],
     };
@@ -126,6 +128,7 @@ fn golden_figures() {
 fn figure_has_north_up_west_right_a_monotonic_colour_bar_and_the_curves() {
     let (map, curves) = (figure_map(), figure_curves());
     let overlay = Overlay {
+        lines: Vec::new(),
         curves: Some(&curves),
         points: vec![],
     };
@@ -294,6 +297,7 @@ fn render_errors() {
 fn sample_figure() {
     let (map, curves) = (figure_map(), figure_curves());
     let overlay = Overlay {
+        lines: Vec::new(),
         curves: Some(&curves),
         points: figure_points(),
     };

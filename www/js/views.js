@@ -41,6 +41,7 @@ export function viewOptions() {
     show_members: on('show-members'),
     show_observed: on('show-observed'),
     show_predicted: on('show-predicted'),
+    show_model_curves: on('show-model-curves'),
   };
 }
 
