@@ -219,6 +219,26 @@ fn reduced_paper_run_reproduces_the_orderings() {
     for f in &figures {
         assert_eq!(&f.png[1..4], b"PNG", "{}", f.file_name);
     }
+    // The truth's curves are drawn over each case's mass map, dashed in their own colour.
+    let maps = &figures[0];
+    assert_eq!(maps.file_name, "maps.png");
+    let pm = tiny_skia::Pixmap::decode_png(&maps.png).unwrap();
+    let c = wslap::paper::TRUE_CURVE_RGB;
+    let near = |p: &tiny_skia::PremultipliedColorU8| {
+        let d = |a: u8, b: u8| (a as i32 - b as i32).abs();
+        d(p.red(), c[0]) + d(p.green(), c[1]) + d(p.blue(), c[2]) < 40
+    };
+    let (w, h) = (pm.width() as usize, pm.height() as usize);
+    // Per panel of the 2 x 2 grid: the three cases have them, the truth's own panel not.
+    let mut counts = [0usize; 4];
+    for (k, p) in pm.pixels().iter().enumerate() {
+        if near(p) {
+            let (x, y) = (k % w, k / w);
+            counts[(y * 2 / h) * 2 + x * 2 / w] += 1;
+        }
+    }
+    assert!(counts[..3].iter().all(|&n| n > 300), "{counts:?}");
+    assert!(counts[3] < 10, "{counts:?}");
 }
 
 /// report.md has the studies' tables.

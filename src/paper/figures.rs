@@ -1,12 +1,12 @@
 //! The figures of `wslap paper` (PNG, tiny-skia), after the paper's figures 5 to 10: mass maps
-//! with critical curves per case next to the truth; radial profiles and their relative errors;
+//! with critical curves per case (the truth's dashed over them) next to the truth; radial profiles and their relative errors;
 //! the soft (dark) component recovered vs true; grid mass, galaxy mass and C vs iteration; the
 //! source-position error vs iteration; the deflection-error map.
 
 use crate::grid::Map;
 use crate::render::{
     compose_png_grid, render_kappa_png, Axis, AxisScale, ColorScale, KappaPlotOptions, LinePlot,
-    LineStyle, Marker, Overlay, OverlayPoints, Reference, Series, PALETTE,
+    LineStyle, Marker, Overlay, OverlayLines, OverlayPoints, Reference, Series, PALETTE,
 };
 
 use super::metrics::quantile;
@@ -28,6 +28,9 @@ const PLOT_H: u32 = 360;
 const GAP_PX: u32 = 12;
 /// Lowest kappa shown on the log maps (the outskirts of the field sit near 0.1).
 const KAPPA_LOG_MIN: f64 = 0.05;
+/// The truth's critical curves over each case's mass map: magenta, dashed (no other colour of
+/// the figure is near it).
+pub const TRUE_CURVE_RGB: [u8; 3] = [255, 0, 255];
 
 fn fig_err(figure: &'static str) -> impl Fn(crate::render::RenderError) -> PaperError {
     move |e| PaperError::Figure {
@@ -62,7 +65,8 @@ pub fn render_figures(run: &PaperRun) -> Result<Vec<Figure>, PaperError> {
     ])
 }
 
-/// Kappa (log) with the critical curves at z_s = 3, per case and the truth, on one colour scale.
+/// Kappa (log) with the critical curves at z_s = 3, per case (with the truth's curves dashed)
+/// and the truth, on one colour scale.
 fn mass_maps(run: &PaperRun) -> Result<Vec<u8>, PaperError> {
     let vmax = run.truth.maps.kappa.min_max().1;
     let opts = |title: String| KappaPlotOptions {
@@ -73,10 +77,24 @@ fn mass_maps(run: &PaperRun) -> Result<Vec<u8>, PaperError> {
         title: Some(title),
         ..KappaPlotOptions::default()
     };
+    // The truth's curves over each case, dashed, to compare in place.
+    let true_curves = OverlayLines {
+        label: "true curves".to_string(),
+        color: TRUE_CURVE_RGB,
+        dashed: true,
+        lines: run
+            .truth
+            .curves
+            .tangential
+            .iter()
+            .chain(&run.truth.curves.radial)
+            .cloned()
+            .collect(),
+    };
     let mut pngs = Vec::new();
     for c in &run.cases {
         let overlay = Overlay {
-            lines: Vec::new(),
+            lines: vec![true_curves.clone()],
             curves: Some(&c.reconstruction.products.curves),
             points: Vec::new(),
         };

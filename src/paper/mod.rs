@@ -39,7 +39,7 @@ use std::sync::Mutex;
 use glam::DVec2;
 use thiserror::Error;
 
-pub use figures::{render_figures, Figure};
+pub use figures::{render_figures, Figure, TRUE_CURVE_RGB};
 pub use markdown::markdown as report_markdown;
 pub use report::{CaseReport, Check, ConvergenceReport, PaperReport, RunSeries, TruthReport};
 pub use studies::{BestFit, StartRun, Studies, SweepRow};
