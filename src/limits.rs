@@ -129,6 +129,10 @@ pub fn json_error_parts(text: &str, e: &serde_json::Error) -> (usize, usize, Str
 fn non_json_number(text: &str, line: usize, column: usize) -> Option<&str> {
     let row = text.lines().nth(line.checked_sub(1)?)?;
     let at = column.checked_sub(1)?.min(row.len());
+    // serde_json counts columns in bytes; never cut a character whatever it counts.
+    if !row.is_char_boundary(at) {
+        return None;
+    }
     let part = |c: char| c.is_ascii_alphanumeric() || matches!(c, '-' | '+' | '.');
     let start = row[..at]
         .char_indices()
@@ -176,6 +180,7 @@ mod tests {
             ("[1, Infinity]", "Infinity"),
             ("[1,\n  nan]", "nan"),
             ("{\"a\": -inf}", "-inf"),
+            ("{\"μ\": [1, NaN]}", "NaN"),
         ] {
             let e = serde_json::from_str::<serde_json::Value>(text).unwrap_err();
             let m = json_error_message(text, &e);
@@ -184,7 +189,7 @@ mod tests {
                 "{text}: {m}"
             );
         }
-        for text in ["[1, none]", "[1, 2", "[1, x]"] {
+        for text in ["[1, none]", "[1, 2", "[1, x]", "[\"μμμ\", x]", "[\"μ\"x]"] {
             let e = serde_json::from_str::<serde_json::Value>(text).unwrap_err();
             assert!(
                 !json_error_message(text, &e).contains("not a number"),
