@@ -51,21 +51,41 @@ export async function openApp({ width = 1280, height = 900, query = '' } = {}) {
   };
 }
 
-/** Waits until the image `selector` has loaded and has a size. */
-export async function imageLoaded(page, selector) {
-  await page.waitForFunction((sel) => {
+/** `[width, height]` of the image `selector` once it has loaded (read in the task that sees
+ * it loaded, like `imageStats`). */
+export async function imageSize(page, selector) {
+  return page.$eval(selector, async (img) => {
+    for (let k = 0; k < 300 && !(img.complete && img.naturalWidth > 0); k++) {
+      await new Promise((r) => setTimeout(r, 100));
+    }
+    return [img.naturalWidth, img.naturalHeight];
+  });
+}
+
+/** The `src` of the image `selector` now, for `nextImage`. */
+export async function imageSrc(page, selector) {
+  return page.getAttribute(selector, 'src');
+}
+
+/** Waits for the image `selector` to show something other than `oldSrc`, loaded: a view drawn
+ * after an action, not the one on screen before it (which may be of the same view). */
+export async function nextImage(page, selector, oldSrc) {
+  await page.waitForFunction(([sel, old]) => {
     const img = document.querySelector(sel);
-    return img && img.complete && img.naturalWidth > 0;
-  }, selector);
+    return img && img.getAttribute('src') !== old && img.complete && img.naturalWidth > 0;
+  }, [selector, oldSrc]);
 }
 
 /** Statistics of the rendered image `selector` read back through a canvas in the page;
  * `near` counts the pixels within `tol` (per channel) of the colour `rgb`. The app sets an
- * image's `src` and `data-view` together, and the browser decodes it later, so this first
- * waits until the image has loaded (reading it before gives a 0 x 0 canvas). */
+ * image's `src` and `data-view` together and the browser decodes it later, and a view can be
+ * drawn again at any time (a new `src`), so the page waits until the image has loaded and
+ * reads it in the same task. */
 export async function imageStats(page, selector, { rgb = [0, 0, 0], tol = -1 } = {}) {
-  await imageLoaded(page, selector);
-  return page.$eval(selector, (img, [want, tol]) => {
+  return page.$eval(selector, async (img, [want, tol]) => {
+    for (let k = 0; k < 300 && !(img.complete && img.naturalWidth > 0); k++) {
+      await new Promise((r) => setTimeout(r, 100));
+    }
     const c = document.createElement('canvas');
     c.width = img.naturalWidth;
     c.height = img.naturalHeight;

@@ -6,7 +6,7 @@ import assert from 'node:assert/strict';
 import { join } from 'node:path';
 import { readFile, writeFile, mkdtemp } from 'node:fs/promises';
 import { tmpdir } from 'node:os';
-import { openApp, imageLoaded, imageStats, ARTIFACTS, ROOT, SETTLE_TIMEOUT_MS, setField, waitStatus } from './browser.mjs';
+import { openApp, imageSize, imageSrc, imageStats, nextImage, ARTIFACTS, ROOT, SETTLE_TIMEOUT_MS, setField, waitStatus } from './browser.mjs';
 
 const AS1063 = join(ROOT, '..', 'shared', 'data', 'AS1063', 'lenstool_cats');
 const TEACHING_MODEL = join(ROOT, 'www', 'examples', 'teaching', 'model.json');
@@ -158,8 +158,7 @@ test('forward mode draws a model file; the PNG download and the read-out follow'
       'the magnification did not change with z_s');
 
     // PNG download of the view: a PNG of the size shown.
-    await imageLoaded(page, '#view-image');
-    const [w, h] = await page.$eval('#view-image', (el) => [el.naturalWidth, el.naturalHeight]);
+    const [w, h] = await imageSize(page, '#view-image');
     await page.click('#downloads-panel summary');
     const [download] = await Promise.all([page.waitForEvent('download'), page.click('#dl-kappa-png')]);
     assert.equal(download.suggestedFilename(), 'kappa.png');
@@ -193,9 +192,12 @@ test('look-up mode reads deflection FITS, shows μ where clicked and survives a 
     await page.setInputFiles('#file-deflection_y', saved.y);
     await page.waitForFunction(() => /256 x 256 pixels/.test(document.getElementById('status-deflection_y').textContent));
     await page.waitForFunction(() => !document.getElementById('lookup').disabled);
+    // The forward run's mass map is on screen: wait for the look-up's own.
+    const forwardMap = await imageSrc(page, '#view-image');
     await page.click('#lookup');
     await waitStatus(page, /^Done in/);
-    await page.waitForFunction(() => document.getElementById('view-image').dataset.view === 'kappa');
+    await nextImage(page, '#view-image', forwardMap);
+    assert.equal(await page.$eval('#view-image', (el) => el.dataset.view), 'kappa');
     const stats = await imageStats(page, '#view-image');
     assert.ok(stats.reddish > 50, `only ${stats.reddish} red curve pixels`);
     const box = await (await page.$('#view-image')).boundingBox();
