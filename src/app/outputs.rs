@@ -50,8 +50,7 @@ impl SessionResult {
         let r = self.reconstruction.as_ref().ok_or_else(|| {
             AppError::Missing("images.reg needs a reconstruction: press Reconstruct".to_string())
         })?;
-        let p = &self.products;
-        Ok(image_regions(&r.sources, p.reference, &p.maps.geometry()))
+        Ok(image_regions(&r.sources, &self.products))
     }
 
     /// `convergence.json` (empty list without a reconstruction).

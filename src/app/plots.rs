@@ -6,7 +6,7 @@ use std::hash::{DefaultHasher, Hash, Hasher};
 
 use glam::DVec2;
 
-use crate::curves::{critical_curves, CriticalCurves, Polyline};
+use crate::curves::{critical_curves, Polyline};
 use crate::grid::MapGeometry;
 use crate::maps::LensMaps;
 use crate::model::ModelFile;
@@ -83,8 +83,9 @@ pub(crate) struct ModelMaps {
     /// The reconstruction's origin in the model's frame (the maps are centred on the
     /// reconstruction's map centre, in the model's frame).
     origin: DVec2,
-    /// The model's critical curves at the last distance ratio asked for, in the model's frame.
-    curves: RefCell<Option<(f64, CriticalCurves)>>,
+    /// The model's critical curves at the last distance ratio asked for, in the
+    /// reconstruction's frame.
+    curves: RefCell<Option<(f64, ModelCurves)>>,
 }
 
 /// The model maps computed for one result and one model file (keyed by a hash of the file's
@@ -219,20 +220,21 @@ impl Session {
             let mut cached = m.curves.borrow_mut();
             if !matches!(&*cached, Some((g, _)) if *g == f) {
                 let z_s = result.products.curves.z_source;
-                *cached = Some((f, critical_curves(&m.maps, f, z_s, None)));
+                let curves = critical_curves(&m.maps, f, z_s, None);
+                let shift = |lines: Vec<Polyline>| -> Vec<Polyline> {
+                    let moved = lines
+                        .into_iter()
+                        .map(|l| l.into_iter().map(|p| p - m.origin).collect());
+                    moved.collect()
+                };
+                let curves = ModelCurves {
+                    name: m.name.clone(),
+                    tangential: shift(curves.tangential),
+                    radial: shift(curves.radial),
+                };
+                *cached = Some((f, curves));
             }
-            let curves = &cached.as_ref().expect("just computed").1;
-            let shift = |lines: &[Polyline]| -> Vec<Polyline> {
-                let moved = lines
-                    .iter()
-                    .map(|l| l.iter().map(|&p| p - m.origin).collect());
-                moved.collect()
-            };
-            Ok(ModelCurves {
-                name: m.name.clone(),
-                tangential: shift(&curves.tangential),
-                radial: shift(&curves.radial),
-            })
+            Ok(cached.as_ref().expect("just computed").1.clone())
         })
     }
 

@@ -14,7 +14,7 @@ use crate::products::{own_map_side, ProductOptions, Products};
 use crate::profiles::Lens;
 use crate::reconstruct::{
     reconstruct, ConvergenceRecord, Inputs, LayerSource, ReconstructConfig, SourceReport,
-    StageTimings, SHOWN_MIN_MAGNIFICATION,
+    StageTimings,
 };
 use crate::solver::Control;
 
@@ -87,12 +87,13 @@ impl SessionResult {
     }
 
     /// Predicted image positions of every system (arcsec) with `|mu| >=`
-    /// [`SHOWN_MIN_MAGNIFICATION`], the ones the map draws.
+    /// [`crate::reconstruct::SHOWN_MIN_MAGNIFICATION`], the ones the map draws
+    /// ([`crate::reconstruct::PredictedImage::is_shown`]).
     pub fn predicted(&self) -> Vec<DVec2> {
         let sources = self.reconstruction.iter().flat_map(|r| r.sources.iter());
         sources
             .flat_map(|s| s.predicted.iter())
-            .filter(|p| p.magnification.abs() >= SHOWN_MIN_MAGNIFICATION)
+            .filter(|p| p.is_shown())
             .map(|p| p.position_arcsec)
             .collect()
     }

@@ -216,11 +216,7 @@ pub(super) fn write_reconstruction(r: &Reconstruction, dir: &Path) -> Result<(),
         fs::write(&path, text).map_err(|e| format!("{}: {e}", path.display()))
     };
     write("sources.json", json(&r.sources)?)?;
-    let geometry = r.products.maps.geometry();
-    write(
-        "images.reg",
-        image_regions(&r.sources, r.products.reference, &geometry),
-    )?;
+    write("images.reg", image_regions(&r.sources, &r.products))?;
     write("convergence.json", json(&r.convergence)?)?;
     write("summary.json", json(&r.summary())?)?;
     Ok(())

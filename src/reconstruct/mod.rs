@@ -14,7 +14,8 @@ use thiserror::Error;
 
 pub use config::{ProductConfig, ReconstructConfig, SolverConfig, SolverMethod};
 pub use sources::{
-    image_regions, ImageReport, SourceReport, IMAGE_REGION_RADIUS_ARCSEC, SHOWN_MIN_MAGNIFICATION,
+    image_regions, ImageReport, PredictedImage, SourceReport, IMAGE_REGION_RADIUS_ARCSEC,
+    SHOWN_MIN_MAGNIFICATION,
 };
 pub use summary::{ReconstructSummary, Solved};
 

@@ -6,13 +6,11 @@ use glam::DVec2;
 use serde::{Deserialize, Serialize};
 
 use crate::ds9::{write_marks, Mark};
-use crate::grid::MapGeometry;
 use crate::images::{find_images, magnification_at, source_position, ImageSearch, SearchGrid};
 use crate::inversion::LinearSystem;
 use crate::maps::LensMaps;
 use crate::products::Products;
 use crate::profiles::{Lens, MassComponent};
-use crate::sky::SkyReference;
 
 use super::{Inputs, ReconstructError};
 
@@ -74,6 +72,13 @@ pub struct PredictedImage {
     pub magnification: f64,
 }
 
+impl PredictedImage {
+    /// Whether the map and `images.reg` show it: `|mu| >=` [`SHOWN_MIN_MAGNIFICATION`].
+    pub fn is_shown(&self) -> bool {
+        self.magnification.abs() >= SHOWN_MIN_MAGNIFICATION
+    }
+}
+
 /// One source system (`sources.json`).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct SourceReport {
@@ -110,13 +115,9 @@ pub const IMAGE_REGION_RADIUS_ARCSEC: f64 = 0.5;
 /// labelled with the system id and the signed magnification at the system's redshift), to lay over the cluster image and look for the
 /// counter-images the model predicts. A predicted image that is no observed image's nearest
 /// says "not observed": a candidate, or a prediction to check. Held-out systems are marked.
-/// Frames as in [`crate::ds9::write_regions`] (`fk5` with a sky reference, else pixels of
-/// `geometry`).
-pub fn image_regions(
-    sources: &[SourceReport],
-    reference: Option<SkyReference>,
-    geometry: &MapGeometry,
-) -> String {
+/// Frames as in [`crate::ds9::write_regions`] (`fk5` with the products' sky reference, else
+/// pixels of their maps).
+pub fn image_regions(sources: &[SourceReport], products: &Products) -> String {
     let mut marks = Vec::new();
     for s in sources {
         let held = if s.held_out { " (held out)" } else { "" };
@@ -129,11 +130,7 @@ pub fn image_regions(
                 dashed: false,
             });
         }
-        let shown = s
-            .predicted
-            .iter()
-            .filter(|p| p.magnification.abs() >= SHOWN_MIN_MAGNIFICATION);
-        for p in shown {
+        for p in s.predicted.iter().filter(|p| p.is_shown()) {
             // An observed image's nearest predicted image is a copy of one of these.
             let matched = s
                 .observed
@@ -163,8 +160,8 @@ pub fn image_regions(
         ),
         &marks,
         IMAGE_REGION_RADIUS_ARCSEC,
-        reference,
-        geometry,
+        products.reference,
+        &products.maps.geometry(),
     )
 }
 
