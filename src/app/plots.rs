@@ -59,8 +59,8 @@ fn compose(name: &str, plots: &[LinePlot]) -> Result<ViewPng, AppError> {
 /// profile view's bins are two product pixels wide, so at 256 product pixels a 128-pixel map
 /// has one pixel per bin; against a 512-pixel map of the built-in example's true lens its
 /// profile differs by at most 1.2% in kappa and 0.8% in enclosed mass (a line width on the
-/// plot). The maps take 0.3 - 0.5 s natively for the example's 97 elliptical NFW halos (a
-/// quarter of the 256-pixel time).
+/// plot). The maps take 0.27 s natively for the example's 97 elliptical NFW halos on an idle
+/// machine (a quarter of the 256-pixel time).
 const MODEL_MAPS_MAX_PIXELS: usize = 128;
 
 /// A model file's name and its profile.
