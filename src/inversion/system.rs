@@ -18,6 +18,13 @@
 //!   positive for the non-negative solver; the source position is `beta = X_beta - S`.
 //!   Default `S = max_i max(|theta_x,i|, |theta_y,i|) + field width`, rounded up to an arcsec:
 //!   `|beta| <= |theta| + |alpha|` and no deflection in the field exceeds its width.
+//! - `S` does not change the minimiser, but it changes the path of QADP, whose multiplicative
+//!   update is not invariant under a shift of the unknowns, and so the early-stopped answer.
+//!   Measured on `wslap paper` (8000 iterations; median deflection error in the arc region of
+//!   case (ii)): S = 120" gives 2.09", the default (~240") 0.98", S = 500" 1.97". Eliminating
+//!   the betas (each at its best value for the current masses, METHOD.md section 5's other
+//!   option) lets QADP reach the over-fitted "point-source solution" within the 8000
+//!   iterations (8.8", grid mass +33% in case (iii)), so the betas stay unknowns here.
 //!
 //! `Gamma` is never held whole: rows are made in blocks of at most `block_mbytes` and fed to
 //! the normal-equation accumulator; cell columns are filled by all threads natively.
@@ -72,8 +79,8 @@ pub enum SystemError {
 pub struct SystemConfig {
     /// Mass unit of the cell unknowns in Msun (default 1e12). Allowed [1e3, 1e18].
     pub mass_unit_msun: f64,
-    /// Frame shift `S` in arcsec (default: automatic, see the module documentation).
-    /// Allowed [0, 1e6].
+    /// Frame shift `S` in arcsec (default: automatic, see the module documentation, which
+    /// also says how `S` changes QADP's early-stopped answer). Allowed [0, 1e6].
     pub theta_shift_arcsec: Option<f64>,
     /// Largest block of `Gamma` rows held at once, in MB (default 64). Allowed [0.001, 1e5].
     pub block_mbytes: f64,
