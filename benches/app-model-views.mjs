@@ -8,26 +8,18 @@
 //   npm run build && node benches/app-model-views.mjs
 //
 // Needs www/pkg (npm run build) and /usr/bin/chromium (or CHROMIUM).
-import { openApp, setField, waitStatus } from '../tests/e2e/browser.mjs';
+import { openApp, renderCount, setField, waitStatus, waitView } from '../tests/e2e/browser.mjs';
 
 const app = await openApp();
 try {
   const { page } = app;
   await waitStatus(page, /^Ready/);
   await setField(page, '#set-reconstruct-solver-iterations', 600);
-  // Every new image (a new src) counts; `shown` waits for the next image of `view` after the
-  // count `after` and returns the milliseconds since `start`.
-  await page.evaluate(() => {
-    const el = document.getElementById('view-image');
-    window.imagesShown = 0;
-    new MutationObserver(() => { window.imagesShown += 1; }).observe(el, { attributes: true, attributeFilter: ['src'] });
-  });
-  const count = () => page.evaluate(() => window.imagesShown);
+  // `shown` waits for the next drawing of `view` after the render count `after` and returns the
+  // milliseconds since `start`.
+  const count = () => renderCount(page);
   const shown = async (view, after, start) => {
-    await page.waitForFunction(([v, n]) => {
-      const el = document.getElementById('view-image');
-      return window.imagesShown > n && el.dataset.view === v && el.complete && el.naturalWidth > 0;
-    }, [view, after]);
+    await waitView(page, view, after, 120_000);
     return performance.now() - start;
   };
   const click = async (selector, view) => {

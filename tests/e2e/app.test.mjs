@@ -4,7 +4,7 @@ import { test } from 'node:test';
 import assert from 'node:assert/strict';
 import { join } from 'node:path';
 import { readFile } from 'node:fs/promises';
-import { openApp, imageStats, ARTIFACTS, setField, waitStatus, fitsAxes, watchLongTasks } from './browser.mjs';
+import { openApp, imageStats, renderCount, waitView, ARTIFACTS, setField, waitStatus, fitsAxes, watchLongTasks } from './browser.mjs';
 
 /** Iterations of the quick test runs (the examples' own settings are 8000 and 3000). */
 const QUICK_ITERATIONS = 600;
@@ -28,10 +28,10 @@ test('the built-in example reconstructs and shows a map with critical curves', a
     // From Reconstruct to the map on screen, the main thread is never blocked for more than
     // 50 ms: the run is in the worker, and so is the rendering.
     const longTasks = await watchLongTasks(page);
+    const drawn = await renderCount(page);
     await page.click('#reconstruct');
     await waitStatus(page, /^Done in/);
-    await page.waitForFunction(() => document.getElementById('view-image').dataset.view === 'kappa');
-    await page.waitForFunction(() => document.getElementById('view-image').complete);
+    await waitView(page, 'kappa', drawn);
     assert.deepEqual(await longTasks(), [], 'main-thread tasks over 50 ms [start, duration]');
     const stats = await imageStats(page, '#view-image');
     assert.ok(stats.width >= 400 && stats.height >= 400, `figure is ${stats.width}x${stats.height}`);
@@ -48,12 +48,9 @@ test('the built-in example reconstructs and shows a map with critical curves', a
     const withPredicted = (await imageStats(page, '#view-image', orange)).near;
     assert.ok(withPredicted > 50, `only ${withPredicted} orange pixels of predicted images`);
     const redrawn = async (toggle) => {
-      const src = await page.getAttribute('#view-image', 'src');
+      const shown = await renderCount(page);
       await toggle();
-      await page.waitForFunction((old) => {
-        const img = document.getElementById('view-image');
-        return img.src !== old && img.complete && img.naturalWidth > 0;
-      }, src);
+      await waitView(page, 'kappa', shown);
     };
     await redrawn(() => page.uncheck('#show-predicted'));
     const without = (await imageStats(page, '#view-image', orange)).near;
@@ -85,7 +82,7 @@ test('the built-in example reconstructs and shows a map with critical curves', a
     // Every view renders.
     for (const tab of ['source', 'radial', 'convergence']) {
       await page.click(`#tab-${tab}`);
-      await page.waitForFunction((t) => document.getElementById('view-image').dataset.view === t, tab);
+      await waitView(page, tab);
       const s = await imageStats(page, '#view-image');
       assert.ok(s.distinctColours > 20, `${tab}: ${s.distinctColours} colours`);
       if (tab === 'radial') {
@@ -130,7 +127,7 @@ test('the built-in example reconstructs and shows a map with critical curves', a
     // Reload: the project comes back from IndexedDB without solving again.
     await page.reload();
     await waitStatus(page, /^Restored/);
-    await page.waitForFunction(() => document.getElementById('view-image').dataset.view === 'kappa');
+    await waitView(page, 'kappa');
     const again = await imageStats(page, '#view-image');
     assert.ok(again.reddish > 50, `after reload only ${again.reddish} red curve pixels`);
     assert.match(await page.textContent('#summary'), /Restored/);
@@ -152,10 +149,10 @@ test('the teaching example loads from the menu and reconstructs', async () => {
     // From Reconstruct to the map on screen, the main thread is never blocked for more than
     // 50 ms: the run is in the worker, and so is the rendering.
     const longTasks = await watchLongTasks(page);
+    const drawn = await renderCount(page);
     await page.click('#reconstruct');
     await waitStatus(page, /^Done in/);
-    await page.waitForFunction(() => document.getElementById('view-image').dataset.view === 'kappa');
-    await page.waitForFunction(() => document.getElementById('view-image').complete);
+    await waitView(page, 'kappa', drawn);
     assert.deepEqual(await longTasks(), [], 'main-thread tasks over 50 ms [start, duration]');
     const stats = await imageStats(page, '#view-image');
     assert.ok(stats.reddish > 50, `only ${stats.reddish} red curve pixels`);
@@ -196,9 +193,10 @@ test('the page fits a phone-width screen', async () => {
     const { page } = app;
     await waitStatus(page, /^Ready/);
     await setField(page, '#set-reconstruct-solver-iterations', 200);
+    const drawn = await renderCount(page);
     await page.click('#reconstruct');
     await waitStatus(page, /^Done in/);
-    await page.waitForFunction(() => document.getElementById('view-image').dataset.view === 'kappa');
+    await waitView(page, 'kappa', drawn);
     const overflow = await page.evaluate(() => document.documentElement.scrollWidth - window.innerWidth);
     assert.ok(overflow <= 0, `page is ${overflow}px wider than the screen`);
     await page.screenshot({ path: join(ARTIFACTS, 'app-phone.png'), fullPage: true });

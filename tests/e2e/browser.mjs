@@ -62,18 +62,20 @@ export async function imageSize(page, selector) {
   });
 }
 
-/** The `src` of the image `selector` now, for `nextImage`. */
-export async function imageSrc(page, selector) {
-  return page.getAttribute(selector, 'src');
+/** How many views the app has shown so far (`data-render` of `#view-image`), for `waitView`. */
+export async function renderCount(page) {
+  return page.$eval('#view-image', (img) => Number(img.dataset.render ?? 0));
 }
 
-/** Waits for the image `selector` to show something other than `oldSrc`, loaded: a view drawn
- * after an action, not the one on screen before it (which may be of the same view). */
-export async function nextImage(page, selector, oldSrc) {
-  await page.waitForFunction(([sel, old]) => {
-    const img = document.querySelector(sel);
-    return img && img.getAttribute('src') !== old && img.complete && img.naturalWidth > 0;
-  }, [selector, oldSrc]);
+/** Waits until `#view-image` shows the view `name` drawn after render number `after` (from
+ * `renderCount` before the action), loaded. The app keeps the previous drawing on screen, with
+ * its view name, until the new one arrives, so the name alone can match an old map. */
+export async function waitView(page, name, after = 0, timeout = 60_000) {
+  await page.waitForFunction(([n, k]) => {
+    const img = document.getElementById('view-image');
+    return img.dataset.view === n && Number(img.dataset.render ?? 0) > k &&
+      img.complete && img.naturalWidth > 0;
+  }, [name, after], { timeout });
 }
 
 /** Statistics of the rendered image `selector` read back through a canvas in the page;

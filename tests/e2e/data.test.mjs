@@ -5,7 +5,7 @@ import assert from 'node:assert/strict';
 import { join } from 'node:path';
 import { writeFile, mkdtemp } from 'node:fs/promises';
 import { tmpdir } from 'node:os';
-import { openApp, imageStats, ARTIFACTS, ROOT, setField, waitStatus } from './browser.mjs';
+import { openApp, imageStats, renderCount, waitView, ARTIFACTS, ROOT, setField, waitStatus } from './browser.mjs';
 
 const AS1063 = join(ROOT, '..', 'shared', 'data', 'AS1063', 'lenstool_cats');
 
@@ -32,9 +32,10 @@ test('uploading the AS1063 catalogues reconstructs them', async () => {
     // (tests/reconstruct.rs measures the same run natively). Default iterations (8000).
     await setField(page, '#set-reconstruct-members-c_prior_sigma', 0.1);
     await setField(page, '#set-reconstruct-products-size_arcsec', '');
+    const drawn = await renderCount(page);
     await page.click('#reconstruct');
     await waitStatus(page, /^Done in/, 120_000);
-    await page.waitForFunction(() => document.getElementById('view-image').dataset.view === 'kappa');
+    await waitView(page, 'kappa', drawn);
     // The published CATS model's Einstein radius at z_s = 2 is 29.8 arcsec (tests/reconstruct.rs
     // evaluates it); the issue asks for 25%.
     const caption = await page.textContent('#summary');
@@ -144,9 +145,10 @@ test('Cancel stops a run at once and the page keeps working', async () => {
     assert.ok(Date.now() - t0 < 5000, 'cancel took too long');
     assert.equal(await page.isHidden('#progress-box'), true);
     await setField(page, '#set-reconstruct-solver-iterations', 100);
+    const drawn = await renderCount(page);
     await page.click('#reconstruct');
     await waitStatus(page, /^Done in/);
-    await page.waitForFunction(() => document.getElementById('view-image').dataset.view === 'kappa');
+    await waitView(page, 'kappa', drawn);
     const stats = await imageStats(page, '#view-image');
     assert.ok(stats.reddish > 20, `only ${stats.reddish} red curve pixels after cancel`);
     assert.deepEqual(app.consoleErrors, []);

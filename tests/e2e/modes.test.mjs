@@ -6,7 +6,7 @@ import assert from 'node:assert/strict';
 import { join } from 'node:path';
 import { readFile, writeFile, mkdtemp } from 'node:fs/promises';
 import { tmpdir } from 'node:os';
-import { openApp, imageSize, imageSrc, imageStats, nextImage, ARTIFACTS, ROOT, SETTLE_TIMEOUT_MS, setField, waitStatus } from './browser.mjs';
+import { openApp, imageSize, imageStats, renderCount, waitView, ARTIFACTS, ROOT, SETTLE_TIMEOUT_MS, setField, waitStatus } from './browser.mjs';
 
 const AS1063 = join(ROOT, '..', 'shared', 'data', 'AS1063', 'lenstool_cats');
 const TEACHING_MODEL = join(ROOT, 'www', 'examples', 'teaching', 'model.json');
@@ -139,9 +139,10 @@ test('forward mode draws a model file; the PNG download and the read-out follow'
     // The model replaces the open example: its arcs and members are not drawn over the model.
     await page.waitForFunction(() => document.getElementById('project-name').textContent === 'Your data');
     assert.equal(await page.textContent('#status-arcs'), '');
+    const drawn = await renderCount(page);
     await page.click('#forward');
     await waitStatus(page, /^Done in/);
-    await page.waitForFunction(() => document.getElementById('view-image').dataset.view === 'kappa');
+    await waitView(page, 'kappa', drawn);
     const after = await imageStats(page, '#view-image');
     assert.ok(after.distinctColours > 100, `a flat map: ${after.distinctColours} colours`);
     assert.ok(after.reddish > 50, `only ${after.reddish} red curve pixels`);
@@ -193,11 +194,10 @@ test('look-up mode reads deflection FITS, shows μ where clicked and survives a 
     await page.waitForFunction(() => /256 x 256 pixels/.test(document.getElementById('status-deflection_y').textContent));
     await page.waitForFunction(() => !document.getElementById('lookup').disabled);
     // The forward run's mass map is on screen: wait for the look-up's own.
-    const forwardMap = await imageSrc(page, '#view-image');
+    const forwardMap = await renderCount(page);
     await page.click('#lookup');
     await waitStatus(page, /^Done in/);
-    await nextImage(page, '#view-image', forwardMap);
-    assert.equal(await page.$eval('#view-image', (el) => el.dataset.view), 'kappa');
+    await waitView(page, 'kappa', forwardMap);
     const stats = await imageStats(page, '#view-image');
     assert.ok(stats.reddish > 50, `only ${stats.reddish} red curve pixels`);
     const box = await (await page.$('#view-image')).boundingBox();
@@ -210,7 +210,7 @@ test('look-up mode reads deflection FITS, shows μ where clicked and survives a 
     await page.reload();
     await waitStatus(page, /^Restored/);
     await page.waitForFunction(() => /x-arcsec-deflect\.fits: loaded/.test(document.getElementById('status-deflection_x').textContent));
-    await page.waitForFunction(() => document.getElementById('view-image').dataset.view === 'kappa');
+    await waitView(page, 'kappa');
     assert.equal(await page.isDisabled('#lookup'), false);
     assert.equal(await page.textContent('#summary'), caption);
     const again = await imageStats(page, '#view-image');

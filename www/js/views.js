@@ -4,6 +4,7 @@
 const img = () => document.getElementById('view-image');
 let current = 'kappa';
 let url = null;
+let renders = 0; // views shown so far: `data-render` on the image tells a new drawing from an old one
 const pngs = {}; // view name -> Blob, for downloads
 let app = null; // renders views and answers hovers (set by wireViews)
 let point = null; // { x, y, pin }: PNG pixels of the kappa view last hovered or clicked
@@ -74,6 +75,7 @@ export function showPng(name, bytes) {
   el.alt = { kappa: 'Convergence map with critical curves', data: 'The loaded data',
     source: 'Source plane with caustics', radial: 'Radial profile', convergence: 'Convergence plot' }[name] ?? name;
   el.dataset.view = name;
+  el.dataset.render = String(++renders);
   el.hidden = false;
   document.getElementById('systems').hidden = true;
   document.getElementById('figure').hidden = false;
