@@ -91,7 +91,7 @@ fn studies_markdown(s: &mut String, studies: &Studies, t: &TruthReport) {
         let _ = writeln!(s, "\n## Case (iii) from several starts\n");
         let _ = writeln!(
             s,
-            "Same data, same layer (galaxy-true), same iterations; only the start differs. chi2 is the weighted squared residual of the lens equation (what QADP lowers). If the data pinned C down, every start would end near the same C; a lower chi2 with a worse mass is the drift towards the over-massive \"point-source solution\" that the iteration count stops.\n"
+            "Same data, same layer (galaxy-true), same iterations; only the start differs. chi2 is the weighted squared residual of the lens equation (what QADP lowers). If the data pinned C down, every start would end near the same C; a lower chi2 with a worse mass is the drift towards the over-massive \"point-source solution\" that the iteration count stops. The cell rows start the grid higher with the same C0: how the mass splits between grid and galaxies then follows the start (the early-stopped iterate keeps part of it, the paper's \"memory effect\").\n"
         );
         let _ = writeln!(s, "| start | cell mass (Msun) | C0 | final C | chi2 | source-plane rms (\") | image-plane rms (\") | grid mass in arc region (vs soft {:.3e}) | defl. err. median (\") |", t.soft_mass_region_msun);
         let _ = writeln!(s, "|---|---|---|---|---|---|---|---|---|");

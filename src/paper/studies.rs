@@ -1,6 +1,7 @@
 //! The runs behind the caveats and choices of `report.md`, each at the case iteration count:
 //!
-//! - **Starts**: case (iii) from several starts (C0 = 0.001, the reasonable start, C0 = 1, and
+//! - **Starts**: case (iii) from several starts (C0 = 0.001, the reasonable start, C0 = 1, the
+//!   reasonable C0 with 10x the cell mass and with the true soft mass spread over the cells, and
 //!   the bad start), each with its final C, lens-equation chi2 and grid mass in the arc region:
 //!   how much the answer depends on the start, and whether a lower chi2 means a truer mass.
 //! - **Best fit**: the minimiser of the same objective, approached with the accelerated
@@ -130,6 +131,18 @@ pub(super) fn run_studies(
         ("C0 = 0.001", reasonable_mass, 0.001),
         ("reasonable", reasonable_mass, config.reasonable_start_c),
         ("C0 = 1", reasonable_mass, 1.0),
+        // Higher cell starts with the reasonable C0: 10x the reasonable cells, and the true soft
+        // mass spread evenly over the cells.
+        (
+            "cells x10",
+            10.0 * reasonable_mass,
+            config.reasonable_start_c,
+        ),
+        (
+            "cells = soft mass",
+            soft_per_cell,
+            config.reasonable_start_c,
+        ),
         (
             "bad",
             config.bad_start_cell_factor * soft_per_cell,
