@@ -145,6 +145,27 @@ fn a_bad_setting_is_refused_and_the_old_value_kept() {
     );
     assert_eq!(s.settings.z_lens, z_lens);
     assert_eq!(s.settings.reconstruct.products.z_source, z_s);
+    // So must the redshift given to images with z = 0, and it keeps the lens where it is.
+    let err = s
+        .set_field("reconstruct.constraints.default_z", json!(z_lens))
+        .unwrap_err()
+        .to_string();
+    assert!(
+        err.starts_with(
+            "reconstruct.constraints.default_z: the redshift for images with z = 0: z_s = "
+        ) && err.contains("is not behind the lens"),
+        "{err}"
+    );
+    assert_eq!(s.settings.reconstruct.constraints.default_z, None);
+    s.set_field("reconstruct.constraints.default_z", json!(1.0))
+        .unwrap();
+    assert_eq!(s.settings.reconstruct.constraints.default_z, Some(1.0));
+    assert!(z_s > 1.5);
+    let err = s.set_field("z_lens", json!(1.5)).unwrap_err().to_string();
+    assert!(err.contains("images with z = 0"), "{err}");
+    assert_eq!(s.settings.z_lens, z_lens);
+    s.set_field("reconstruct.constraints.default_z", json!(null))
+        .unwrap();
     assert_eq!(
         s.settings.reconstruct.products.pixels,
         wslap::app::APP_MAP_PIXELS

@@ -564,7 +564,13 @@ fn systems_are_excluded_for_redshift_single_image_and_hold_out() {
             ("4", Exclusion::SingleImage)
         ]
     );
-    assert_eq!(set.warnings.len(), 2);
+    assert_eq!(
+        set.warnings,
+        [
+            "test.cat: system 2 has no redshift and no default_z is set: not used",
+            "test.cat: system 4 has a single image: not used"
+        ]
+    );
     let with_default = ConstraintConfig {
         default_z: Some(2.5),
         ..config.clone()
@@ -572,6 +578,10 @@ fn systems_are_excluded_for_redshift_single_image_and_hold_out() {
     let set = build_constraints(ConstraintSource::Catalog(&cat), &with_default, &[]).unwrap();
     assert_eq!(set.systems[1].z, 2.5);
     assert!(set.systems[1].z_assumed && !set.systems[0].z_assumed);
+    assert_eq!(
+        set.warnings[0],
+        "test.cat: system 2 has no redshift: default_z = 2.5 assumed"
+    );
     let err = build_constraints(ConstraintSource::Catalog(&cat), &config, &["9".to_string()])
         .unwrap_err();
     assert!(

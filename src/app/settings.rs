@@ -86,23 +86,30 @@ impl AppSettings {
             serde_json::from_value(tree).map_err(|e| AppError::Setting(format!("{path}: {e}")))?;
         next.validate()
             .map_err(|e| AppError::Setting(format!("{path}: {e}")))?;
-        next.check_curves_behind_lens()
+        next.check_sources_behind_lens()
             .map_err(|e| AppError::Setting(format!("{path}: {e}")))?;
         Ok(next)
     }
 
-    /// The curves' source redshift must be behind the lens. Checked when a field changes, not
-    /// in [`Self::validate`]: a project saved with both equal still opens (its run reports it).
-    fn check_curves_behind_lens(&self) -> Result<(), AppError> {
-        let z_s = self.reconstruct.products.z_source;
-        if z_s > self.z_lens {
-            return Ok(());
+    /// The curves' source redshift, and the redshift given to images with z = 0, must be
+    /// behind the lens. Checked when a field changes, not in [`Self::validate`]: a project saved
+    /// with such values still opens (its run reports them).
+    fn check_sources_behind_lens(&self) -> Result<(), AppError> {
+        let behind = |what: &str, z_s: f64| {
+            if z_s > self.z_lens {
+                return Ok(());
+            }
+            Err(AppError::Setting(format!(
+                "{what} z_s = {z_s} is not behind the lens (z_lens = {}): a source must have \
+                 z_s > z_lens",
+                self.z_lens
+            )))
+        };
+        behind("the curves'", self.reconstruct.products.z_source)?;
+        match self.reconstruct.constraints.default_z {
+            Some(z) => behind("the redshift for images with z = 0:", z),
+            None => Ok(()),
         }
-        Err(AppError::Setting(format!(
-            "the curves' z_s = {z_s} is not behind the lens (z_lens = {}): a source must have \
-             z_s > z_lens",
-            self.z_lens
-        )))
     }
 
     /// Parses settings JSON (missing fields take their defaults); errors name the line.

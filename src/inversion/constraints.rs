@@ -464,7 +464,15 @@ pub fn build_constraints(
             Err(Exclusion::UnknownRedshift)
         };
         match exclusion {
-            Ok(z) => add_system(&mut set, c, z, config),
+            Ok(z) => {
+                if c.z.is_none() {
+                    set.warnings.push(format!(
+                        "{source_name}: system {} has no redshift: default_z = {z} assumed",
+                        c.id
+                    ));
+                }
+                add_system(&mut set, c, z, config);
+            }
             Err(reason) => set.excluded.push(ExcludedSystem { id: c.id, reason }),
         }
     }
@@ -522,12 +530,6 @@ fn add_system(set: &mut ConstraintSet, c: Candidate, z: f64, config: &Constraint
             }));
     }
     let z_assumed = c.z.is_none();
-    if z_assumed {
-        set.warnings.push(format!(
-            "system {} has no redshift: default_z = {z} assumed",
-            c.id
-        ));
-    }
     set.systems.push(ConstraintSystem {
         id: c.id,
         z,

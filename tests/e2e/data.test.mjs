@@ -8,6 +8,7 @@ import { tmpdir } from 'node:os';
 import { openApp, imageStats, renderCount, waitView, ARTIFACTS, ROOT, setField, waitStatus } from './browser.mjs';
 
 const AS1063 = join(ROOT, '..', 'shared', 'data', 'AS1063', 'lenstool_cats');
+const MACS1931 = join(ROOT, '..', 'shared', 'data', 'MACS1931', 'lenstool_cats');
 
 test('uploading the AS1063 catalogues reconstructs them', async () => {
   const app = await openApp();
@@ -92,6 +93,50 @@ test('a file chosen while an example opens replaces that example once it is open
     for (const role of ['images', 'model', 'arcs']) {
       assert.equal(await page.textContent(`#status-${role}`), '', `${role} of an example is left`);
     }
+    assert.deepEqual(app.consoleErrors, []);
+  } finally {
+    await app.close();
+  }
+});
+
+test('systems without a redshift join the fit once the settings give them one', async () => {
+  const app = await openApp();
+  try {
+    const { page } = app;
+    await waitStatus(page, /^Ready/);
+    // MACS1931's catalogue writes z = 0 for the systems whose redshift is unknown.
+    await page.setInputFiles('#file-images', join(MACS1931, 'immul_ongoing.cat'));
+    await page.waitForFunction(() => /systems/.test(document.getElementById('status-images').textContent));
+    await setField(page, '#set-z_lens', 0.352);
+    await setField(page, '#set-reconstruct-constraints-mode', 'point');
+    await setField(page, '#set-reconstruct-solver-iterations', 300);
+    const run = async () => {
+      const drawn = await renderCount(page);
+      await page.click('#reconstruct');
+      await waitStatus(page, /^Done in/);
+      await waitView(page, 'kappa', drawn);
+      const warnings = await page.locator('#run-warnings li').allTextContents();
+      await page.click('#tab-systems');
+      await page.waitForSelector('#systems table');
+      const systems = await page.locator('#systems tbody tr').count();
+      await page.click('#tab-kappa');
+      return { warnings, systems };
+    };
+    const without = await run();
+    const noZ = without.warnings.filter((t) => /immul_ongoing\.cat: system \S+ has no redshift and no default_z is set: not used/.test(t));
+    assert.ok(noZ.length >= 1, without.warnings.join(' | '));
+    // A redshift at or in front of the lens is refused and the field keeps its value.
+    await page.fill('#set-reconstruct-constraints-default_z', '0.3');
+    await page.dispatchEvent('#set-reconstruct-constraints-default_z', 'change');
+    await page.waitForFunction(() => /images with z = 0: z_s = 0.3 is not behind the lens/
+      .test(document.getElementById('set-reconstruct-constraints-default_z-error').textContent));
+    assert.equal(await page.inputValue('#set-reconstruct-constraints-default_z'), '');
+    await setField(page, '#set-reconstruct-constraints-default_z', 2);
+    const withZ = await run();
+    assert.deepEqual(withZ.warnings.filter((t) => /not used/.test(t)), []);
+    const assumed = withZ.warnings.filter((t) => /immul_ongoing\.cat: system \S+ has no redshift: default_z = 2 assumed/.test(t));
+    assert.equal(assumed.length, noZ.length, withZ.warnings.join(' | '));
+    assert.equal(withZ.systems, without.systems + noZ.length, `${without.systems} systems, ${noZ.length} without z`);
     assert.deepEqual(app.consoleErrors, []);
   } finally {
     await app.close();
