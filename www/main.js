@@ -9,6 +9,12 @@ import { wireViews, showPng, showSystems, viewOptions, currentView, refreshReado
 import { showDownloads } from './js/downloads.js';
 
 const $ = (id) => document.getElementById(id);
+// Page parameters: `?example=ID` opens that built-in example (in the full app only when no
+// project is saved in this browser, which it would replace); `?embed` is the compact demo for
+// other pages' iframes: the example, Reconstruct and the views, nothing kept in the browser.
+const params = new URLSearchParams(location.search);
+const EMBED = params.has('embed');
+if (EMBED) document.body.classList.add('embed');
 let examples = [];
 let resultKind = null; // kind of the shown result, null before any
 let lastProject = null; // the worker's project.json after the last change (restored on cancel)
@@ -34,6 +40,7 @@ function clearError() { $('error').hidden = true; $('error').textContent = ''; }
 
 async function persist() {
   lastProject = await ask('textFile', { name: 'project.json' });
+  if (EMBED) return; // a demo in someone's page keeps nothing
   const problem = await saveProject(lastProject);
   if (problem) setStatus(problem);
 }
@@ -219,6 +226,7 @@ async function loadExample(ex) {
     await ask('loadText', { role: f.role, name: f.path.split('/').pop(), text });
   }
   describe(ex.name, ex.description);
+  $('full-app').href = `./?example=${encodeURIComponent(ex.id)}`;
   await afterOpen(null);
   await persist();
   setStatus('Ready: press Reconstruct.');
@@ -357,15 +365,26 @@ async function start() {
   setStatus(`Worker ready (wslap ${version}).`);
   $('core-info').textContent = `Core: wslap ${version}, WebAssembly with ${
     simd === 'relaxed' ? 'relaxed SIMD (fused multiply-add)' : 'SIMD'}.`;
-  const saved = await loadProject();
+  const wanted = params.get('example');
+  const linked = examples.find((e) => e.id === wanted);
+  // Said after the fallback has opened (opening an example clears the error line).
+  const unknown = () => {
+    if (wanted !== null && !linked) showError(`no built-in example "${wanted}" (there are: ${examples.map((e) => e.id).join(', ')})`);
+  };
+  const saved = EMBED ? null : await loadProject();
   if (saved) {
     try {
       await openProject(saved, 'saved project');
-      setStatus('Restored your project from this browser.');
+      setStatus(linked
+        ? `Restored your project from this browser (the link's example, "${linked.name}", is in the Example menu).`
+        : 'Restored your project from this browser.');
+      unknown();
       return;
     } catch { /* fall back to the example */ }
   }
-  if (examples.length) await loadExample(examples[0]);
+  const first = linked ?? examples[0];
+  if (first) await loadExample(first);
+  unknown();
 }
 
 start().catch((err) => showError(err.message));

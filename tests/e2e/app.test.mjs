@@ -187,6 +187,46 @@ test('the teaching example loads from the menu and reconstructs', async () => {
   }
 });
 
+test('?embed is a compact demo that keeps nothing; ?example= opens an example without replacing a saved project', async () => {
+  const app = await openApp({ width: 900, height: 700, query: '?embed&example=teaching' });
+  try {
+    const { page, url } = app;
+    await waitStatus(page, /^Ready/);
+    assert.match(await page.textContent('#project-name'), /^Teaching example/);
+    // Only the example, Reconstruct and the views; a link to the full app on the same example.
+    for (const hidden of ['header', 'footer', '#files-panel', '#settings-panel', '#downloads-panel', '#lookup']) {
+      assert.ok(await page.isHidden(hidden), hidden);
+    }
+    assert.ok(await page.isVisible('#full-app'));
+    assert.equal(await page.getAttribute('#full-app', 'href'), './?example=teaching');
+    const drawn = await renderCount(page);
+    await page.click('#reconstruct');
+    await waitStatus(page, /^Done in/);
+    await waitView(page, 'kappa', drawn);
+    const stats = await imageStats(page, '#view-image');
+    assert.ok(stats.reddish > 50, `only ${stats.reddish} red curve pixels`);
+    await page.screenshot({ path: join(ARTIFACTS, 'app-embed.png'), fullPage: true });
+
+    // Nothing was saved: the full app opens on its first example, and that one is saved.
+    await page.goto(url);
+    await waitStatus(page, /^Ready/);
+    assert.match(await page.textContent('#project-name'), /^Simulated A1689/);
+    assert.ok(await page.isVisible('#files-panel') && await page.isHidden('#full-app'));
+    // A link to an example restores the saved project instead, and says where the example is.
+    await page.goto(`${url}?example=teaching`);
+    await waitStatus(page, /^Restored your project from this browser \(the link's example, "Teaching example: one halo, four sources", is in the Example menu\)\.$/);
+    assert.match(await page.textContent('#project-name'), /^Simulated A1689/);
+    // An unknown example is named, with the ones there are.
+    await page.goto(`${url}?embed&example=nope`);
+    await page.waitForFunction(() => /no built-in example "nope" \(there are: a1689-sim, teaching\)/.test(document.getElementById('error').textContent));
+    await waitStatus(page, /^Ready/);
+    assert.match(await page.textContent('#project-name'), /^Simulated A1689/);
+    assert.deepEqual(app.consoleErrors, []);
+  } finally {
+    await app.close();
+  }
+});
+
 test('the page fits a phone-width screen', async () => {
   const app = await openApp({ width: 390, height: 844 });
   try {
