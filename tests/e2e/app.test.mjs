@@ -227,6 +227,25 @@ test('?embed is a compact demo that keeps nothing; ?example= opens an example wi
   }
 });
 
+test('every field of the settings form is a setting of the core', async () => {
+  const app = await openApp();
+  try {
+    const { page } = app;
+    await waitStatus(page, /^Ready/);
+    // Each field, sent back with the value it shows, is taken (an unknown path or a value of
+    // the wrong type would come back as the field's error).
+    const ids = await page.$$eval('#settings-form input, #settings-form select', (els) => els.map((el) => el.id));
+    assert.ok(ids.length >= 20, `${ids.length} fields`);
+    for (const id of ids) {
+      await setField(page, `#${id}`, await page.inputValue(`#${id}`));
+    }
+    assert.deepEqual(await page.$$eval('#settings-form .field-error', (els) => els.map((e) => e.textContent).filter(Boolean)), []);
+    assert.deepEqual(app.consoleErrors, []);
+  } finally {
+    await app.close();
+  }
+});
+
 test('the page fits a phone-width screen', async () => {
   const app = await openApp({ width: 390, height: 844 });
   try {
