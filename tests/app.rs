@@ -889,6 +889,34 @@ fn the_kappa_view_draws_the_loaded_model_curves() {
     );
 }
 
+/// The model's maps are computed once for a field: a second reconstruction of the same data
+/// reuses them (the same curves, no new computation), another map width computes them again.
+#[cfg_attr(not(target_arch = "wasm32"), test)]
+#[cfg_attr(target_arch = "wasm32", wasm_bindgen_test::wasm_bindgen_test)]
+fn the_model_maps_are_kept_for_the_next_run_of_the_same_field() {
+    let mut s = solved();
+    s.load_text(DataRole::Model, "model.json", TEACHING_MODEL_JSON)
+        .unwrap();
+    assert_eq!(s.model_maps_computed(), 0);
+    let first = s.model_curves(s.result().unwrap()).unwrap().unwrap();
+    s.model_profile(s.result().unwrap()).unwrap().unwrap();
+    assert_eq!(s.model_maps_computed(), 1);
+    let run = |s: &mut Session| {
+        s.run(RunKind::Reconstruct, &mut |_| Control::Continue)
+            .unwrap();
+        s.model_curves(s.result().unwrap()).unwrap().unwrap()
+    };
+    s.set_field("reconstruct.solver.iterations", json!(300))
+        .unwrap();
+    assert_eq!(run(&mut s), first);
+    assert_eq!(s.model_maps_computed(), 1);
+    let width = s.result().unwrap().products.maps.geometry().size_arcsec;
+    s.set_field("reconstruct.products.size_arcsec", json!(width + 10.0))
+        .unwrap();
+    assert_ne!(run(&mut s), first);
+    assert_eq!(s.model_maps_computed(), 2);
+}
+
 /// The model's profile and curves are taken about the reconstruction's sky origin: a model
 /// file whose frame is 3 arcsec north of the catalogue's, with its components moved to the same
 /// sky positions, gives the same profile and the same curves. A model at another lens redshift is not compared (`None`).

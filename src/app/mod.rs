@@ -56,6 +56,10 @@ pub struct Session {
     pub result: Option<SessionResult>,
     /// The example or project name shown by the app.
     pub name: String,
+    /// The loaded model file's maps over the last reconstruction's map (the profile view's
+    /// model profile and the kappa view's model curves), kept for the next result of the same
+    /// field.
+    pub(crate) model_maps: plots::ModelCache,
 }
 
 impl Session {

@@ -19,7 +19,6 @@ use crate::reconstruct::{
 use crate::solver::Control;
 
 use super::data::{DataMarks, ParsedData};
-use super::plots::ModelCache;
 use super::{AppError, Session};
 
 /// Map width of a forward model without a `products.size_arcsec` setting (arcsec).
@@ -64,9 +63,6 @@ pub struct SessionResult {
     pub reconstruction: Option<ReconstructionResult>,
     /// Wall-clock time of the run in ms.
     pub elapsed_ms: f64,
-    /// The loaded model file's maps for the profile view and the kappa view's model curves,
-    /// once computed.
-    pub(crate) model_maps: ModelCache,
 }
 
 impl SessionResult {
@@ -179,7 +175,6 @@ impl Session {
                 lens: r.lens,
             }),
             elapsed_ms: 0.0,
-            model_maps: ModelCache::default(),
         })
     }
 
@@ -247,7 +242,6 @@ impl Session {
                 lens,
             }),
             elapsed_ms: t.ms(),
-            model_maps: ModelCache::default(),
         });
         Ok(())
     }
@@ -276,7 +270,6 @@ impl Session {
             marks: parsed.marks(),
             reconstruction: None,
             elapsed_ms: 0.0,
-            model_maps: ModelCache::default(),
         })
     }
 
@@ -301,7 +294,6 @@ impl Session {
             marks: DataMarks::default(),
             reconstruction: None,
             elapsed_ms: 0.0,
-            model_maps: ModelCache::default(),
         })
     }
 
