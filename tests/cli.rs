@@ -785,3 +785,80 @@ fn reconstruct_from_a_ds9_region_file() {
         "{err}"
     );
 }
+
+/// `wslap maps --lenstool` evaluates a published Lenstool model (AS1063's CATS gold bestopt.par
+/// with its potfile): the same Einstein radius as the library's model of the same files on the
+/// same map, maps in the .par's sky frame, and a clear error when a potfile is not found.
+#[test]
+fn maps_of_a_lenstool_model_match_the_library_and_name_a_missing_potfile() {
+    use wslap::lenstool_par::load_lenstool_model;
+    use wslap::products::{ProductOptions, Products};
+    let par = shared("AS1063/lenstool_cats/cats_gold_bestopt.par");
+    let potfile = shared("AS1063/lenstool_cats/cats_gold_ref_potential_w_clumpNE.cat");
+    let dir = temp_dir("lenstool");
+    let out = wslap(&[
+        "maps",
+        "--lenstool",
+        &par,
+        "--potfile",
+        &potfile,
+        "--z-source",
+        "2",
+        "--size",
+        "160",
+        "--pixels",
+        "200",
+        "--out",
+        &dir.display().to_string(),
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let model = load_lenstool_model(Path::new(&par), &[Path::new(&potfile)]).unwrap();
+    let opts = ProductOptions {
+        z_source: 2.0,
+        size_arcsec: 160.0,
+        pixels: 200,
+        ..ProductOptions::default()
+    };
+    let library = Products::from_lens(&model.lens, model.plane, model.reference, &opts).unwrap();
+    let theta_e = summary(&dir)["einstein_radius_arcsec"].as_f64().unwrap();
+    assert!(
+        (theta_e - library.curves.einstein_radius_arcsec).abs() <= 1e-9 * theta_e,
+        "{theta_e} vs {}",
+        library.curves.einstein_radius_arcsec
+    );
+    // The published model's radius at z_s = 2 (tests/reconstruct.rs checks it against the
+    // reconstruction): about 30 arcsec.
+    assert!((25.0..35.0).contains(&theta_e), "{theta_e}");
+    let fits = read_image(&fs::read(dir.join("kappa.fits")).unwrap(), "kappa.fits").unwrap();
+    let (geometry, reference) = fits.geometry().unwrap();
+    assert_eq!(geometry.pixels, 200);
+    let reference = reference.expect("the .par's reference");
+    let wanted = model.reference.unwrap();
+    assert!((reference.ra_deg - wanted.ra_deg).abs() < 1e-6);
+    assert!((reference.dec_deg - wanted.dec_deg).abs() < 1e-6);
+
+    // Without --potfile the .par's own `filein` is looked for next to it; here it has another
+    // name, and the error says which file and what to do.
+    let out = wslap(&[
+        "maps",
+        "--lenstool",
+        &par,
+        "--out",
+        &dir.join("o").display().to_string(),
+    ]);
+    assert!(!out.status.success());
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        err.contains("ref_potential_w_clumpNE.cat")
+            && err.contains("give its member catalogue with --potfile"),
+        "{err}"
+    );
+    // --potfile belongs to --lenstool.
+    let out = wslap(&["maps", "--model", &par, "--potfile", &potfile, "--out", "x"]);
+    assert!(!out.status.success());
+    assert!(String::from_utf8_lossy(&out.stderr).contains("cannot be used with"));
+}

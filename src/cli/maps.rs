@@ -1,4 +1,5 @@
-//! `wslap maps`: the map products of a model file, or of published HFF deflection maps.
+//! `wslap maps`: the map products of a model file, of a published Lenstool model (`.par` and
+//! its member catalogues), or of published HFF deflection maps.
 
 use std::fs;
 use std::path::{Path, PathBuf};
@@ -6,7 +7,9 @@ use std::path::{Path, PathBuf};
 use super::input::{read_bytes, read_text};
 
 use clap::Args;
+use wslap::catalog::parse_member_catalog;
 use wslap::fits::read_image;
+use wslap::lenstool_par::parse_par;
 use wslap::limits::InputKind;
 use wslap::model::ModelFile;
 use wslap::products::{ProductOptions, Products};
@@ -19,11 +22,19 @@ use wslap::{Cosmology, LensPlane};
 /// y-arcsec-deflect.fits (all for D_ls/D_s = 1), magnif.fits (at --z-source, header ZSOURCE),
 /// critical-curves.json, critical-curves.reg (DS9), kappa.png and summary.json.
 #[derive(Debug, Args)]
-#[command(group(clap::ArgGroup::new("lens").required(true).args(["model", "deflection"])))]
+#[command(group(clap::ArgGroup::new("lens").required(true).args(["model", "lenstool", "deflection"])))]
 pub struct MapsArgs {
     /// Model file (JSON) of a parametric lens.
     #[arg(long, value_name = "MODEL.json")]
     model: Option<PathBuf>,
+    /// A Lenstool parametric model (e.g. a published bestopt.par): its dPIE and shear
+    /// potentials, and its potfile members (see --potfile), evaluated as written.
+    #[arg(long, value_name = "MODEL.par")]
+    lenstool: Option<PathBuf>,
+    /// Member catalogue of the --lenstool model's potfile blocks, one per block in order
+    /// (repeat the option); without it, each block's `filein`, next to the .par file.
+    #[arg(long, value_name = "MEMBERS.cat", conflicts_with_all = ["model", "deflection"])]
+    potfile: Vec<PathBuf>,
     /// Published deflection maps (HFF x- and y-arcsec-deflect FITS, D_ls/D_s = 1).
     #[arg(long, num_args = 2, value_names = ["X.fits", "Y.fits"], requires = "z_lens")]
     deflection: Option<Vec<PathBuf>>,
@@ -42,10 +53,10 @@ pub struct MapsArgs {
     /// Source redshift of the magnification map and the critical curves.
     #[arg(long, default_value_t = 2.0)]
     z_source: f64,
-    /// Map width in arcsec, centred on (0, 0) (model files only).
+    /// Map width in arcsec, centred on (0, 0) (model files and Lenstool models).
     #[arg(long, default_value_t = 200.0)]
     size: f64,
-    /// Pixels on a side (model files only).
+    /// Pixels on a side (model files and Lenstool models).
     #[arg(long, default_value_t = 512)]
     pixels: usize,
     /// Colour scale of kappa.png.
@@ -69,17 +80,19 @@ impl From<Scale> for ColorScale {
 }
 
 pub fn run(args: &MapsArgs) -> Result<(), String> {
+    let opts = ProductOptions {
+        z_source: args.z_source,
+        size_arcsec: args.size,
+        pixels: args.pixels,
+        scale: args.scale.into(),
+    };
     let products = if let Some(path) = &args.model {
         let text = read_text(path, InputKind::Model)?;
         let model = ModelFile::from_json_str(&text, &path.display().to_string())
             .map_err(|e| e.to_string())?;
-        let opts = ProductOptions {
-            z_source: args.z_source,
-            size_arcsec: args.size,
-            pixels: args.pixels,
-            scale: args.scale.into(),
-        };
         Products::from_model(&model, &opts).map_err(|e| e.to_string())?
+    } else if let Some(path) = &args.lenstool {
+        lenstool_products(path, &args.potfile, &opts)?
     } else {
         let paths = args.deflection.as_deref().unwrap_or_default();
         let (ax, ay) = (read_map(&paths[0])?, read_map(&paths[1])?);
@@ -100,6 +113,40 @@ pub fn run(args: &MapsArgs) -> Result<(), String> {
         s.radial_curves
     );
     Ok(())
+}
+
+/// The products of the Lenstool model `par_path` with the member catalogues `potfiles` (one per
+/// potfile block; when empty, each block's `filein` next to the .par file), on the map of `opts`
+/// centred on the model's reference point.
+fn lenstool_products(
+    par_path: &Path,
+    potfiles: &[PathBuf],
+    opts: &ProductOptions,
+) -> Result<Products, String> {
+    let name = par_path.display().to_string();
+    let par =
+        parse_par(&read_text(par_path, InputKind::Model)?, &name).map_err(|e| e.to_string())?;
+    let paths: Vec<PathBuf> = if potfiles.is_empty() {
+        let dir = par_path.parent().unwrap_or(Path::new("."));
+        par.potfiles.iter().map(|p| dir.join(&p.filein)).collect()
+    } else {
+        potfiles.to_vec()
+    };
+    let mut catalogs = Vec::with_capacity(paths.len());
+    for path in &paths {
+        let text = read_text(path, InputKind::Catalog).map_err(|e| {
+            format!("{e} (a potfile of {name}; give its member catalogue with --potfile)")
+        })?;
+        let (catalog, warnings) =
+            parse_member_catalog(&text, &path.display().to_string(), par.reference)
+                .map_err(|e| e.to_string())?;
+        for w in warnings {
+            eprintln!("warning: {w}");
+        }
+        catalogs.push(catalog);
+    }
+    let model = par.build(&catalogs).map_err(|e| e.to_string())?;
+    Products::from_lens(&model.lens, model.plane, model.reference, opts).map_err(|e| e.to_string())
 }
 
 fn read_map(path: &Path) -> Result<(wslap::Map, Option<wslap::sky::SkyReference>), String> {
