@@ -1186,3 +1186,89 @@ fn a_refined_grid_runs_and_its_project_asks_for_a_new_solve() {
         .unwrap();
     assert_eq!(report.result, "solve_needed", "{}", report.message);
 }
+
+/// A published Lenstool model (AS1063's CATS gold `bestopt.par`) as the model file: forward
+/// maps equal to the library's model of the same files, its potfile members taken from the
+/// loaded member catalogue (an error says so when there is none), and its curves drawn over a
+/// reconstruction at the model's z_lens (not at another).
+#[cfg(not(target_arch = "wasm32"))]
+#[test]
+fn a_lenstool_par_is_a_model_file_with_the_member_catalogue_as_its_potfile() {
+    use wslap::lenstool_par::load_lenstool_model;
+    use wslap::products::{ProductOptions, Products};
+    let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../shared/data/AS1063/lenstool_cats");
+    let read = |name: &str| std::fs::read_to_string(dir.join(name)).unwrap();
+    let (par, members) = (
+        "cats_gold_bestopt.par",
+        "cats_gold_ref_potential_w_clumpNE.cat",
+    );
+
+    // Without the member catalogue the model loads but cannot be evaluated.
+    let mut s = Session::new();
+    let report = s.load_text(DataRole::Model, par, &read(par)).unwrap();
+    assert!(
+        report.summary.starts_with("Lenstool model: ")
+            && report
+                .summary
+                .contains("potfile's members from the member catalogue")
+            && report.summary.ends_with("at z_lens = 0.3475"),
+        "{}",
+        report.summary
+    );
+    let err = s
+        .run(RunKind::Forward, &mut |_| Control::Continue)
+        .unwrap_err()
+        .to_string();
+    assert!(err.contains("needs the member catalogue"), "{err}");
+
+    // With it: the forward maps are the library's.
+    s.load_text(DataRole::Members, members, &read(members))
+        .unwrap();
+    for (path, value) in [
+        ("reconstruct.products.z_source", json!(2.0)),
+        ("reconstruct.products.size_arcsec", json!(160.0)),
+        ("reconstruct.products.pixels", json!(100)),
+    ] {
+        s.set_field(path, value).unwrap();
+    }
+    s.run(RunKind::Forward, &mut |_| Control::Continue).unwrap();
+    let ours = s.result().unwrap().products.curves.einstein_radius_arcsec;
+    let model = load_lenstool_model(&dir.join(par), &[&dir.join(members)]).unwrap();
+    let opts = ProductOptions {
+        z_source: 2.0,
+        size_arcsec: 160.0,
+        pixels: 100,
+        ..ProductOptions::default()
+    };
+    let library = Products::from_lens(&model.lens, model.plane, model.reference, &opts).unwrap();
+    assert_eq!(ours, library.curves.einstein_radius_arcsec);
+    assert!((25.0..35.0).contains(&ours), "{ours}");
+
+    // Over a reconstruction of the gold images at the model's z_lens, its curves are drawn.
+    let images = "cats_gold_mul_gold.cat";
+    s.load_text(DataRole::Images, images, &read(images))
+        .unwrap();
+    for (path, value) in [
+        ("z_lens", json!(0.3475)),
+        ("reconstruct.grid.cells", json!(12)),
+        ("reconstruct.solver.iterations", json!(200)),
+        ("reconstruct.constraints.mode", json!("point")),
+    ] {
+        s.set_field(path, value).unwrap();
+    }
+    s.run(RunKind::Reconstruct, &mut |_| Control::Continue)
+        .unwrap();
+    let curves = s
+        .model_curves(s.result().unwrap())
+        .unwrap()
+        .expect("the model's curves");
+    assert_eq!(curves.name, par);
+    assert!(!curves.tangential.is_empty());
+    assert!(s.model_profile(s.result().unwrap()).unwrap().is_some());
+    // At another z_lens its kappa would not compare: no curves.
+    s.set_field("z_lens", json!(0.348)).unwrap();
+    s.run(RunKind::Reconstruct, &mut |_| Control::Continue)
+        .unwrap();
+    assert!(s.model_curves(s.result().unwrap()).unwrap().is_none());
+}

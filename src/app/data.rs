@@ -5,10 +5,13 @@ use glam::DVec2;
 use serde::{Deserialize, Serialize};
 
 use crate::catalog::{parse_image_catalog, parse_member_catalog, ImageCatalog, MemberCatalog};
+use crate::cosmology::LensPlane;
 use crate::fits::read_image;
 use crate::grid::Map;
 use crate::inversion::{arcs_from_regions, is_region_file, parse_arcs, ArcCatalog};
+use crate::lenstool_par::parse_par;
 use crate::model::ModelFile;
+use crate::profiles::Lens;
 use crate::sky::SkyReference;
 
 use super::AppError;
@@ -82,6 +85,19 @@ pub struct LoadedData {
     pub model: Option<NamedText>,
     /// Deflection maps along x and y (look-up mode).
     pub deflection: [Option<NamedMap>; 2],
+}
+
+/// A loaded model ready to evaluate (see [`LoadedData::model_lens`]).
+#[derive(Debug)]
+pub struct ModelLens {
+    pub lens: Lens,
+    pub plane: LensPlane,
+    pub reference: Option<SkyReference>,
+}
+
+/// Whether a model file's text is a Lenstool parameter file rather than a JSON model file.
+fn is_lenstool_par(text: &str) -> bool {
+    !text.trim_start().starts_with('{')
 }
 
 /// Arc pixel side assumed when it cannot be measured (milliarcsec).
@@ -257,6 +273,45 @@ fn region_arcs(
 }
 
 impl LoadedData {
+    /// The loaded model file as a lens with its plane and sky reference: a JSON model file, or
+    /// a Lenstool parametric model (`.par`, e.g. a published `bestopt.par`) whose potfile
+    /// members are the loaded member catalogue's. `None` without a model file; an error names
+    /// what is missing (a `.par` with a potfile and no member catalogue).
+    pub fn model_lens(&self) -> Result<Option<ModelLens>, AppError> {
+        let Some(file) = &self.model else {
+            return Ok(None);
+        };
+        let err = |e: &dyn std::fmt::Display| AppError::File(e.to_string());
+        if !is_lenstool_par(&file.text) {
+            let model = ModelFile::from_json_str(&file.text, &file.name).map_err(|e| err(&e))?;
+            return Ok(Some(ModelLens {
+                lens: model.build_lens().map_err(|e| err(&e))?,
+                plane: model.lens_plane().map_err(|e| err(&e))?,
+                reference: model.reference,
+            }));
+        }
+        let par = parse_par(&file.text, &file.name).map_err(|e| err(&e))?;
+        let mut catalogs = Vec::new();
+        if let Some(potfile) = par.potfiles.first() {
+            let members = self.members.as_ref().ok_or_else(|| {
+                AppError::Missing(format!(
+                    "{}: its potfile ({}) needs the member catalogue: load it as the member \
+                     catalogue",
+                    file.name, potfile.filein
+                ))
+            })?;
+            let (catalog, _) = parse_member_catalog(&members.text, &members.name, par.reference)
+                .map_err(|e| err(&e))?;
+            catalogs.push(catalog);
+        }
+        let model = par.build(&catalogs).map_err(|e| err(&e))?;
+        Ok(Some(ModelLens {
+            lens: model.lens,
+            plane: model.plane,
+            reference: model.reference,
+        }))
+    }
+
     /// Checks `text` as a file of `role` and keeps it; an error leaves everything as it was.
     /// `arc_pixel_arcsec` is the pixel of arcs drawn as DS9 regions.
     pub fn load_text(
@@ -299,6 +354,26 @@ impl LoadedData {
                 };
                 (
                     format!("{n} systems, {pixels} arc pixels{from}"),
+                    Vec::new(),
+                )
+            }
+            DataRole::Model if is_lenstool_par(text) => {
+                let par = parse_par(text, name).map_err(|e| file(&e))?;
+                let members = match par.potfiles.len() {
+                    0 => String::new(),
+                    1 => ", and its potfile's members from the member catalogue".to_string(),
+                    n => {
+                        return Err(AppError::File(format!(
+                            "{name}: {n} potfile blocks; the app takes one member catalogue"
+                        )))
+                    }
+                };
+                (
+                    format!(
+                        "Lenstool model: {} potentials{members}, at z_lens = {}",
+                        par.potentials.len(),
+                        par.z_lens
+                    ),
                     Vec::new(),
                 )
             }

@@ -19,8 +19,8 @@ use thiserror::Error;
 pub use crate::reconstruct::ReconstructSummary;
 pub use crate::reconstruct::SHOWN_MIN_MAGNIFICATION;
 pub use data::{
-    ArcPixels, DataMarks, DataRole, LoadReport, LoadedData, NamedMap, NamedText, ParsedData,
-    MAX_STORED_FITS_BYTES,
+    ArcPixels, DataMarks, DataRole, LoadReport, LoadedData, ModelLens, NamedMap, NamedText,
+    ParsedData, MAX_STORED_FITS_BYTES,
 };
 pub use plots::{profile_relative_differences, ModelCurves};
 pub use project::{Project, ProjectResult, StoredFits, PROJECT_FORMAT, PROJECT_VERSION};

@@ -9,12 +9,12 @@ use glam::DVec2;
 use crate::curves::{critical_curves, Polyline};
 use crate::grid::MapGeometry;
 use crate::maps::LensMaps;
-use crate::model::ModelFile;
 use crate::radial::{radial_profile, RadialBins, RadialProfile};
 use crate::render::{
     compose_grid, Axis, LinePlot, LineStyle, Reference, RenderError, Series, PALETTE,
 };
 
+use super::data::ModelLens;
 use super::run::{RunKind, SessionResult};
 use super::views::ViewPng;
 use super::{AppError, Session};
@@ -258,11 +258,22 @@ impl Session {
         let (RunKind::Reconstruct, Some(file)) = (result.kind, &self.data.model) else {
             return Ok(None);
         };
-        let Some((lens, origin, geometry)) = model_frame(result, &file.name, &file.text)? else {
+        // A model that cannot be built (a Lenstool model without its member catalogue) is not
+        // drawn; forward mode says why.
+        let Ok(Some(model)) = self.data.model_lens() else {
+            return Ok(None);
+        };
+        let Some((origin, geometry)) = model_frame(result, &model) else {
             return Ok(None);
         };
         let mut hasher = DefaultHasher::new();
         (&file.name, &file.text, geometry.pixels).hash(&mut hasher);
+        // A Lenstool model's members come from the member catalogue.
+        self.data
+            .members
+            .as_ref()
+            .map(|m| &m.text)
+            .hash(&mut hasher);
         for v in [geometry.center.x, geometry.center.y, geometry.size_arcsec] {
             v.to_bits().hash(&mut hasher);
         }
@@ -271,7 +282,7 @@ impl Session {
         if !fresh {
             let maps = ModelMaps {
                 name: file.name.clone(),
-                maps: LensMaps::from_lens(&lens, geometry),
+                maps: LensMaps::from_lens(&model.lens, geometry),
                 origin,
                 curves: RefCell::new(None),
             };
@@ -354,21 +365,14 @@ impl Session {
     }
 }
 
-/// The model file's lens, the reconstruction's origin in the model's frame, and the geometry of
-/// the model's maps over the reconstruction's map (see [`Session::model_profile`]); `None` when
-/// its lens plane is not the reconstruction's.
-fn model_frame(
-    result: &SessionResult,
-    name: &str,
-    text: &str,
-) -> Result<Option<(crate::profiles::Lens, DVec2, MapGeometry)>, AppError> {
-    let run = |e: &dyn std::fmt::Display| AppError::Run(format!("{name}: {e}"));
-    let model = ModelFile::from_json_str(text, name).map_err(|e| run(&e))?;
+/// The reconstruction's origin in the model's frame and the geometry of the model's maps over
+/// the reconstruction's map (see [`Session::model_profile`]); `None` when the model's lens plane
+/// is not the reconstruction's.
+fn model_frame(result: &SessionResult, model: &ModelLens) -> Option<(DVec2, MapGeometry)> {
     let plane = result.products.plane;
-    if model.z_lens != plane.z_lens || model.cosmology != plane.cosmology {
-        return Ok(None);
+    if model.plane.z_lens != plane.z_lens || model.plane.cosmology != plane.cosmology {
+        return None;
     }
-    let lens = model.build_lens().map_err(|e| run(&e))?;
     let origin = match (result.products.reference, model.reference) {
         (Some(ours), Some(theirs)) => theirs.to_offset_arcsec(ours.ra_deg, ours.dec_deg),
         _ => DVec2::ZERO,
@@ -379,5 +383,5 @@ fn model_frame(
         pixels: g.pixels.min(MODEL_MAPS_MAX_PIXELS),
         ..g
     };
-    Ok(Some((lens, origin, geometry)))
+    Some((origin, geometry))
 }

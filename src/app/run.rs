@@ -9,7 +9,6 @@ use crate::inversion::{
     build_constraints, build_member_layers, CellGrid, ConstraintMode, ConstraintSource, Layer,
     LinearSystem,
 };
-use crate::model::ModelFile;
 use crate::products::{own_map_side, ProductOptions, Products};
 use crate::profiles::Lens;
 use crate::reconstruct::{
@@ -247,13 +246,10 @@ impl Session {
     }
 
     fn run_forward(&self) -> Result<SessionResult, AppError> {
-        let file = self
+        let model = self
             .data
-            .model
-            .as_ref()
+            .model_lens()?
             .ok_or_else(|| AppError::Missing("load a model file first".to_string()))?;
-        let model = ModelFile::from_json_str(&file.text, &file.name)
-            .map_err(|e| AppError::File(e.to_string()))?;
         let p = &self.settings.reconstruct.products;
         let opts = ProductOptions {
             z_source: p.z_source,
@@ -261,8 +257,8 @@ impl Session {
             pixels: p.pixels,
             ..ProductOptions::default()
         };
-        let products =
-            Products::from_model(&model, &opts).map_err(|e| AppError::Run(e.to_string()))?;
+        let products = Products::from_lens(&model.lens, model.plane, model.reference, &opts)
+            .map_err(|e| AppError::Run(e.to_string()))?;
         let parsed = self.parsed().unwrap_or_default();
         Ok(SessionResult {
             kind: RunKind::Forward,

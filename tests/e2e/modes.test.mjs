@@ -170,6 +170,34 @@ test('forward mode draws a model file; the PNG download and the read-out follow'
   }
 });
 
+test('a published Lenstool model (.par) with its member catalogue draws in forward mode', async () => {
+  const app = await openApp();
+  try {
+    const { page } = app;
+    await waitStatus(page, /^Ready/);
+    await page.setInputFiles('#file-members', join(AS1063, 'cats_gold_ref_potential_w_clumpNE.cat'));
+    await page.waitForFunction(() => /members/.test(document.getElementById('status-members').textContent));
+    await page.setInputFiles('#file-model', join(AS1063, 'cats_gold_bestopt.par'));
+    await page.waitForFunction(() => /^cats_gold_bestopt\.par: Lenstool model: \d+ potentials, and its potfile's members from the member catalogue, at z_lens = 0\.3475/
+      .test(document.getElementById('status-model').textContent));
+    await setField(page, '#set-reconstruct-products-z_source', 2);
+    await setField(page, '#set-reconstruct-products-size_arcsec', 160);
+    const drawn = await renderCount(page);
+    await page.click('#forward');
+    await waitStatus(page, /^Done in/);
+    await waitView(page, 'kappa', drawn);
+    const stats = await imageStats(page, '#view-image');
+    assert.ok(stats.reddish > 50, `only ${stats.reddish} red curve pixels`);
+    // The CATS model's Einstein radius at z_s = 2 (tests/app.rs: the library's, 29.8″ on its map).
+    const r = Number((await page.textContent('#summary')).match(/Einstein radius (\d+\.\d)″ at z_s = 2/)[1]);
+    assert.ok(r > 25 && r < 35, `Einstein radius ${r}`);
+    await page.screenshot({ path: join(ARTIFACTS, 'app-lenstool-par.png'), fullPage: true });
+    assert.deepEqual(app.consoleErrors, []);
+  } finally {
+    await app.close();
+  }
+});
+
 test('look-up mode reads deflection FITS, shows μ where clicked and survives a reload', async () => {
   const app = await openApp();
   try {

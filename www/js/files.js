@@ -5,7 +5,7 @@ export const ROLES = [
   { role: 'images', label: 'Image catalogue (Lenstool)', accept: '.cat,.txt,.dat' },
   { role: 'members', label: 'Member catalogue (Lenstool)', accept: '.cat,.txt,.dat' },
   { role: 'arcs', label: 'Arcs (JSON, or DS9 regions in fk5)', accept: '.json,.reg' },
-  { role: 'model', label: 'Model file (forward mode, JSON)', accept: '.json' },
+  { role: 'model', label: 'Model file (JSON, or a Lenstool .par; forward mode)', accept: '.json,.par' },
   { role: 'deflection_x', label: 'Deflection x (FITS)', accept: '.fits,.fit' },
   { role: 'deflection_y', label: 'Deflection y (FITS)', accept: '.fits,.fit' },
   { role: 'project', label: 'Project file (JSON)', accept: '.json' },
@@ -17,6 +17,7 @@ export async function guessRole(file) {
   if (/\.fits?$/.test(name)) return /(^|[-_.])y([-_.]|$)|y-arcsec|deflect_y|_y\./.test(name) ? 'deflection_y' : 'deflection_x';
   const head = (await file.slice(0, 4000).text());
   if (name.endsWith('.reg') || /^\s*# Region file format/.test(head)) return 'arcs';
+  if (name.endsWith('.par')) return 'model';
   if (name.endsWith('.json')) {
     if (head.includes('wslap-project')) return 'project';
     if (head.includes('"components"')) return 'model';
