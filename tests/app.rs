@@ -1266,9 +1266,21 @@ fn a_lenstool_par_is_a_model_file_with_the_member_catalogue_as_its_potfile() {
     assert_eq!(curves.name, par);
     assert!(!curves.tangential.is_empty());
     assert!(s.model_profile(s.result().unwrap()).unwrap().is_some());
-    // At another z_lens its kappa would not compare: no curves.
+    assert_eq!(s.model_not_compared(s.result().unwrap()), None);
+    // At another z_lens its kappa would not compare: no curves, and the result says why.
     s.set_field("z_lens", json!(0.348)).unwrap();
     s.run(RunKind::Reconstruct, &mut |_| Control::Continue)
         .unwrap();
     assert!(s.model_curves(s.result().unwrap()).unwrap().is_none());
+    assert_eq!(
+        s.model_not_compared(s.result().unwrap()).as_deref(),
+        Some(
+            "cats_gold_bestopt.par is not compared: its z_lens = 0.3475 is not the \
+             reconstruction's 0.348 (set z_lens to compare)"
+        )
+    );
+    // Without its member catalogue it cannot be built: that is the reason given.
+    s.data.clear(DataRole::Members);
+    let why = s.model_not_compared(s.result().unwrap()).unwrap();
+    assert!(why.contains("needs the member catalogue"), "{why}");
 }

@@ -105,8 +105,10 @@ function caption(info) {
   const offsets = offsetText('image offsets', sum.image_offset_median_arcsec, sum.image_plane_rms_arcsec);
   const held = offsetText('held-out images:', sum.holdout_image_offset_median_arcsec,
     sum.holdout_image_plane_rms_arcsec);
+  // A loaded model file that is not drawn next to a reconstruction says why.
+  const note = info.model_note ? ` ${info.model_note}.` : '';
   $('summary').textContent = `${status}Einstein radius ${bound}${s.einstein_radius_arcsec.toFixed(1)}″ at ` +
-    `z_s = ${s.z_source}; ${factors}${offsets}${held}${s.tangential_curves} tangential and ${s.radial_curves} radial critical curves.`;
+    `z_s = ${s.z_source}; ${factors}${offsets}${held}${s.tangential_curves} tangential and ${s.radial_curves} radial critical curves.${note}`;
 }
 
 /** Under the views: the systems a run left out of the fit and its warnings (collapsed: a

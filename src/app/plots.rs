@@ -242,6 +242,34 @@ impl Session {
         })
     }
 
+    /// Why the loaded model file is not compared with `result` (a reconstruction): it cannot be
+    /// built (a Lenstool model without its member catalogue) or its lens plane is not the
+    /// reconstruction's; `None` when it is compared, or when there is nothing to compare.
+    pub fn model_not_compared(&self, result: &SessionResult) -> Option<String> {
+        let (RunKind::Reconstruct, Some(file)) = (result.kind, &self.data.model) else {
+            return None;
+        };
+        let why = match self.data.model_lens() {
+            Err(e) => e.to_string(),
+            Ok(None) => return None,
+            Ok(Some(model)) => {
+                let (theirs, ours) = (model.plane, result.products.plane);
+                if model_frame(result, &model).is_some() {
+                    return None;
+                }
+                if theirs.z_lens != ours.z_lens {
+                    format!(
+                        "its z_lens = {} is not the reconstruction's {} (set z_lens to compare)",
+                        theirs.z_lens, ours.z_lens
+                    )
+                } else {
+                    "its cosmology is not the reconstruction's".to_string()
+                }
+            }
+        };
+        Some(format!("{} is not compared: {why}", file.name))
+    }
+
     /// How many times this session computed the loaded model's maps (they are kept for the next
     /// result over the same field: a second reconstruction does not compute them again).
     pub fn model_maps_computed(&self) -> usize {

@@ -118,7 +118,8 @@ impl AppSession {
         self.result_info()
     }
 
-    /// `{kind, elapsed_ms, status, iterations, summary}` of the last result.
+    /// `{kind, elapsed_ms, status, iterations, summary, model_note}` of the last result
+    /// (`model_note`: why the loaded model file is not compared with a reconstruction, or null).
     pub fn result_info(&self) -> Result<JsValue, JsError> {
         let r = self.inner.result().map_err(err)?;
         let summary: serde_json::Value =
@@ -130,6 +131,7 @@ impl AppSession {
             "status": rec.map(|x| x.status.clone()),
             "iterations": rec.map(|x| x.iterations),
             "summary": summary,
+            "model_note": self.inner.model_not_compared(r),
         }))
     }
 

@@ -192,6 +192,23 @@ test('a published Lenstool model (.par) with its member catalogue draws in forwa
     const r = Number((await page.textContent('#summary')).match(/Einstein radius (\d+\.\d)″ at z_s = 2/)[1]);
     assert.ok(r > 25 && r < 35, `Einstein radius ${r}`);
     await page.screenshot({ path: join(ARTIFACTS, 'app-lenstool-par.png'), fullPage: true });
+    // Over a reconstruction at another z_lens it is not compared, and the caption says why;
+    // at its own z_lens it is.
+    await page.setInputFiles('#file-images', join(AS1063, 'cats_gold_mul_gold.cat'));
+    await page.waitForFunction(() => /19 systems/.test(document.getElementById('status-images').textContent));
+    await setField(page, '#set-reconstruct-constraints-mode', 'point');
+    await setField(page, '#set-reconstruct-solver-iterations', 200);
+    const reconstruct = async () => {
+      const before = await renderCount(page);
+      await page.click('#reconstruct');
+      await waitStatus(page, /^Done in/);
+      await waitView(page, 'kappa', before);
+      return page.textContent('#summary');
+    };
+    await setField(page, '#set-z_lens', 0.348);
+    assert.match(await reconstruct(), /cats_gold_bestopt\.par is not compared: its z_lens = 0\.3475 is not the reconstruction's 0\.348 \(set z_lens to compare\)\.$/);
+    await setField(page, '#set-z_lens', 0.3475);
+    assert.doesNotMatch(await reconstruct(), /not compared/);
     assert.deepEqual(app.consoleErrors, []);
   } finally {
     await app.close();
