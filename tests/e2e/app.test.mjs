@@ -4,7 +4,7 @@ import { test } from 'node:test';
 import assert from 'node:assert/strict';
 import { join } from 'node:path';
 import { readFile } from 'node:fs/promises';
-import { openApp, imageStats, renderCount, waitView, ARTIFACTS, setField, waitStatus, fitsAxes, watchLongTasks } from './browser.mjs';
+import { openApp, imageStats, renderCount, runToMap, waitView, ARTIFACTS, setField, waitStatus, fitsAxes, watchLongTasks } from './browser.mjs';
 
 /** Iterations of the quick test runs (the examples' own settings are 8000 and 3000). */
 const QUICK_ITERATIONS = 600;
@@ -28,10 +28,7 @@ test('the built-in example reconstructs and shows a map with critical curves', a
     // From Reconstruct to the map on screen, the main thread is never blocked for more than
     // 50 ms: the run is in the worker, and so is the rendering.
     const longTasks = await watchLongTasks(page);
-    const drawn = await renderCount(page);
-    await page.click('#reconstruct');
-    await waitStatus(page, /^Done in/);
-    await waitView(page, 'kappa', drawn);
+    await runToMap(page, '#reconstruct');
     assert.deepEqual(await longTasks(), [], 'main-thread tasks over 50 ms [start, duration]');
     const stats = await imageStats(page, '#view-image');
     assert.ok(stats.width >= 400 && stats.height >= 400, `figure is ${stats.width}x${stats.height}`);
@@ -149,10 +146,7 @@ test('the teaching example loads from the menu and reconstructs', async () => {
     // From Reconstruct to the map on screen, the main thread is never blocked for more than
     // 50 ms: the run is in the worker, and so is the rendering.
     const longTasks = await watchLongTasks(page);
-    const drawn = await renderCount(page);
-    await page.click('#reconstruct');
-    await waitStatus(page, /^Done in/);
-    await waitView(page, 'kappa', drawn);
+    await runToMap(page, '#reconstruct');
     assert.deepEqual(await longTasks(), [], 'main-thread tasks over 50 ms [start, duration]');
     const stats = await imageStats(page, '#view-image');
     assert.ok(stats.reddish > 50, `only ${stats.reddish} red curve pixels`);
@@ -199,10 +193,7 @@ test('?embed is a compact demo that keeps nothing; ?example= opens an example wi
     }
     assert.ok(await page.isVisible('#full-app'));
     assert.equal(await page.getAttribute('#full-app', 'href'), './?example=teaching');
-    const drawn = await renderCount(page);
-    await page.click('#reconstruct');
-    await waitStatus(page, /^Done in/);
-    await waitView(page, 'kappa', drawn);
+    await runToMap(page, '#reconstruct');
     const stats = await imageStats(page, '#view-image');
     assert.ok(stats.reddish > 50, `only ${stats.reddish} red curve pixels`);
     await page.screenshot({ path: join(ARTIFACTS, 'app-embed.png'), fullPage: true });
@@ -252,10 +243,7 @@ test('the page fits a phone-width screen', async () => {
     const { page } = app;
     await waitStatus(page, /^Ready/);
     await setField(page, '#set-reconstruct-solver-iterations', 200);
-    const drawn = await renderCount(page);
-    await page.click('#reconstruct');
-    await waitStatus(page, /^Done in/);
-    await waitView(page, 'kappa', drawn);
+    await runToMap(page, '#reconstruct');
     const overflow = await page.evaluate(() => document.documentElement.scrollWidth - window.innerWidth);
     assert.ok(overflow <= 0, `page is ${overflow}px wider than the screen`);
     await page.screenshot({ path: join(ARTIFACTS, 'app-phone.png'), fullPage: true });

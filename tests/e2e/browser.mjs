@@ -78,6 +78,15 @@ export async function waitView(page, name, after = 0, timeout = 60_000) {
   }, [name, after], { timeout });
 }
 
+/** Presses the run button `button` (Reconstruct, Forward model, Deflection look-up), waits for
+ * "Done in" and then for the mass map of that run (drawn after the one on screen before). */
+export async function runToMap(page, button, timeout = 60_000) {
+  const before = await renderCount(page);
+  await page.click(button);
+  await waitStatus(page, /^Done in/, timeout);
+  await waitView(page, 'kappa', before);
+}
+
 /** Statistics of the rendered image `selector` read back through a canvas in the page;
  * `near` counts the pixels within `tol` (per channel) of the colour `rgb`. The app sets an
  * image's `src` and `data-view` together and the browser decodes it later, and a view can be

@@ -5,7 +5,7 @@ import assert from 'node:assert/strict';
 import { join } from 'node:path';
 import { writeFile, mkdtemp } from 'node:fs/promises';
 import { tmpdir } from 'node:os';
-import { openApp, imageStats, renderCount, waitView, ARTIFACTS, ROOT, setField, waitStatus } from './browser.mjs';
+import { openApp, imageStats, runToMap, ARTIFACTS, ROOT, setField, waitStatus } from './browser.mjs';
 
 const AS1063 = join(ROOT, '..', 'shared', 'data', 'AS1063', 'lenstool_cats');
 const MACS1931 = join(ROOT, '..', 'shared', 'data', 'MACS1931', 'lenstool_cats');
@@ -33,10 +33,7 @@ test('uploading the AS1063 catalogues reconstructs them', async () => {
     // (tests/reconstruct.rs measures the same run natively). Default iterations (8000).
     await setField(page, '#set-reconstruct-members-c_prior_sigma', 0.1);
     await setField(page, '#set-reconstruct-products-size_arcsec', '');
-    const drawn = await renderCount(page);
-    await page.click('#reconstruct');
-    await waitStatus(page, /^Done in/, 120_000);
-    await waitView(page, 'kappa', drawn);
+    await runToMap(page, '#reconstruct', 120_000);
     // The published CATS model's Einstein radius at z_s = 2 is 29.8 arcsec (tests/reconstruct.rs
     // evaluates it); the issue asks for 25%.
     const caption = await page.textContent('#summary');
@@ -111,10 +108,7 @@ test('systems without a redshift join the fit once the settings give them one', 
     await setField(page, '#set-reconstruct-constraints-mode', 'point');
     await setField(page, '#set-reconstruct-solver-iterations', 300);
     const run = async () => {
-      const drawn = await renderCount(page);
-      await page.click('#reconstruct');
-      await waitStatus(page, /^Done in/);
-      await waitView(page, 'kappa', drawn);
+      await runToMap(page, '#reconstruct');
       const warnings = await page.locator('#run-warnings li').allTextContents();
       await page.click('#tab-systems');
       await page.waitForSelector('#systems table');
@@ -190,10 +184,7 @@ test('Cancel stops a run at once and the page keeps working', async () => {
     assert.ok(Date.now() - t0 < 5000, 'cancel took too long');
     assert.equal(await page.isHidden('#progress-box'), true);
     await setField(page, '#set-reconstruct-solver-iterations', 100);
-    const drawn = await renderCount(page);
-    await page.click('#reconstruct');
-    await waitStatus(page, /^Done in/);
-    await waitView(page, 'kappa', drawn);
+    await runToMap(page, '#reconstruct');
     const stats = await imageStats(page, '#view-image');
     assert.ok(stats.reddish > 20, `only ${stats.reddish} red curve pixels after cancel`);
     assert.deepEqual(app.consoleErrors, []);

@@ -6,7 +6,7 @@ import assert from 'node:assert/strict';
 import { join } from 'node:path';
 import { readFile, writeFile, mkdtemp } from 'node:fs/promises';
 import { tmpdir } from 'node:os';
-import { openApp, imageSize, imageStats, renderCount, waitView, ARTIFACTS, ROOT, SETTLE_TIMEOUT_MS, setField, waitStatus } from './browser.mjs';
+import { openApp, imageSize, imageStats, runToMap, waitView, ARTIFACTS, ROOT, SETTLE_TIMEOUT_MS, setField, waitStatus } from './browser.mjs';
 
 const AS1063 = join(ROOT, '..', 'shared', 'data', 'AS1063', 'lenstool_cats');
 const TEACHING_MODEL = join(ROOT, 'www', 'examples', 'teaching', 'model.json');
@@ -139,10 +139,7 @@ test('forward mode draws a model file; the PNG download and the read-out follow'
     // The model replaces the open example: its arcs and members are not drawn over the model.
     await page.waitForFunction(() => document.getElementById('project-name').textContent === 'Your data');
     assert.equal(await page.textContent('#status-arcs'), '');
-    const drawn = await renderCount(page);
-    await page.click('#forward');
-    await waitStatus(page, /^Done in/);
-    await waitView(page, 'kappa', drawn);
+    await runToMap(page, '#forward');
     const after = await imageStats(page, '#view-image');
     assert.ok(after.distinctColours > 100, `a flat map: ${after.distinctColours} colours`);
     assert.ok(after.reddish > 50, `only ${after.reddish} red curve pixels`);
@@ -182,10 +179,7 @@ test('a published Lenstool model (.par) with its member catalogue draws in forwa
       .test(document.getElementById('status-model').textContent));
     await setField(page, '#set-reconstruct-products-z_source', 2);
     await setField(page, '#set-reconstruct-products-size_arcsec', 160);
-    const drawn = await renderCount(page);
-    await page.click('#forward');
-    await waitStatus(page, /^Done in/);
-    await waitView(page, 'kappa', drawn);
+    await runToMap(page, '#forward');
     const stats = await imageStats(page, '#view-image');
     assert.ok(stats.reddish > 50, `only ${stats.reddish} red curve pixels`);
     // The CATS model's Einstein radius at z_s = 2 (tests/app.rs: the library's, 29.8″ on its map).
@@ -199,10 +193,7 @@ test('a published Lenstool model (.par) with its member catalogue draws in forwa
     await setField(page, '#set-reconstruct-constraints-mode', 'point');
     await setField(page, '#set-reconstruct-solver-iterations', 200);
     const reconstruct = async () => {
-      const before = await renderCount(page);
-      await page.click('#reconstruct');
-      await waitStatus(page, /^Done in/);
-      await waitView(page, 'kappa', before);
+      await runToMap(page, '#reconstruct');
       return page.textContent('#summary');
     };
     await setField(page, '#set-z_lens', 0.348);
@@ -239,10 +230,7 @@ test('look-up mode reads deflection FITS, shows μ where clicked and survives a 
     await page.waitForFunction(() => /256 x 256 pixels/.test(document.getElementById('status-deflection_y').textContent));
     await page.waitForFunction(() => !document.getElementById('lookup').disabled);
     // The forward run's mass map is on screen: wait for the look-up's own.
-    const forwardMap = await renderCount(page);
-    await page.click('#lookup');
-    await waitStatus(page, /^Done in/);
-    await waitView(page, 'kappa', forwardMap);
+    await runToMap(page, '#lookup');
     const stats = await imageStats(page, '#view-image');
     assert.ok(stats.reddish > 50, `only ${stats.reddish} red curve pixels`);
     const box = await (await page.$('#view-image')).boundingBox();

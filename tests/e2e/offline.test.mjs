@@ -4,7 +4,7 @@ import { test } from 'node:test';
 import assert from 'node:assert/strict';
 import { readdir, readFile } from 'node:fs/promises';
 import { join, relative } from 'node:path';
-import { openApp, renderCount, waitView, ROOT, ARTIFACTS, setField, waitStatus } from './browser.mjs';
+import { openApp, runToMap, ROOT, ARTIFACTS, setField, waitStatus } from './browser.mjs';
 
 /** Every file of www/ outside examples/ (those are cached from examples/index.json). */
 async function appFiles(dir = join(ROOT, 'www')) {
@@ -56,10 +56,7 @@ test('after one visit the app reloads and reconstructs with the server gone', as
     assert.equal(await page.$eval('#example-select', (s) => s.selectedOptions[0]?.textContent),
       'Teaching example: one halo, four sources');
     assert.match(await page.textContent('#core-info'), /^Core: wslap/);
-    const drawn = await renderCount(page);
-    await page.click('#reconstruct');
-    await waitStatus(page, /^Done in/);
-    await waitView(page, 'kappa', drawn);
+    await runToMap(page, '#reconstruct');
     await page.screenshot({ path: join(ARTIFACTS, 'app-offline.png'), fullPage: true });
     assert.deepEqual(app.consoleErrors, []);
   } finally {
