@@ -229,6 +229,14 @@ impl LenstoolPar {
         })
     }
 
+    /// Where the member catalogues of the `potfile` blocks are when the `.par` file is
+    /// `par_path`: each block's `filein`, relative to the `.par`'s folder (as Lenstool reads it
+    /// when run there).
+    pub fn potfile_paths(&self, par_path: &std::path::Path) -> Vec<std::path::PathBuf> {
+        let dir = par_path.parent().unwrap_or(std::path::Path::new("."));
+        self.potfiles.iter().map(|p| dir.join(&p.filein)).collect()
+    }
+
     /// Builds the lens: one component per `potentiel` block, then one dPIE per member of
     /// `member_catalogs[k]` for the `k`-th `potfile` block (read them with
     /// [`crate::catalog::parse_member_catalog`] in the frame of [`Self::reference`]).
@@ -307,9 +315,8 @@ pub fn load_lenstool_model(
         })
     };
     let par = parse_par(&read(par_path)?, &par_path.display().to_string())?;
-    let dir = par_path.parent().unwrap_or(std::path::Path::new("."));
     let paths: Vec<std::path::PathBuf> = if member_paths.is_empty() {
-        par.potfiles.iter().map(|p| dir.join(&p.filein)).collect()
+        par.potfile_paths(par_path)
     } else {
         member_paths.iter().map(|p| p.to_path_buf()).collect()
     };

@@ -252,20 +252,7 @@ impl Session {
         let why = match self.data.model_lens() {
             Err(e) => e.to_string(),
             Ok(None) => return None,
-            Ok(Some(model)) => {
-                let (theirs, ours) = (model.plane, result.products.plane);
-                if model_frame(result, &model).is_some() {
-                    return None;
-                }
-                if theirs.z_lens != ours.z_lens {
-                    format!(
-                        "its z_lens = {} is not the reconstruction's {} (set z_lens to compare)",
-                        theirs.z_lens, ours.z_lens
-                    )
-                } else {
-                    "its cosmology is not the reconstruction's".to_string()
-                }
-            }
+            Ok(Some(model)) => model_frame(result, &model).err()?,
         };
         Some(format!("{} is not compared: {why}", file.name))
     }
@@ -291,7 +278,7 @@ impl Session {
         let Ok(Some(model)) = self.data.model_lens() else {
             return Ok(None);
         };
-        let Some((origin, geometry)) = model_frame(result, &model) else {
+        let Ok((origin, geometry)) = model_frame(result, &model) else {
             return Ok(None);
         };
         let mut hasher = DefaultHasher::new();
@@ -394,12 +381,18 @@ impl Session {
 }
 
 /// The reconstruction's origin in the model's frame and the geometry of the model's maps over
-/// the reconstruction's map (see [`Session::model_profile`]); `None` when the model's lens plane
-/// is not the reconstruction's.
-fn model_frame(result: &SessionResult, model: &ModelLens) -> Option<(DVec2, MapGeometry)> {
-    let plane = result.products.plane;
-    if model.plane.z_lens != plane.z_lens || model.plane.cosmology != plane.cosmology {
-        return None;
+/// the reconstruction's map (see [`Session::model_profile`]); when the model's lens plane is not
+/// the reconstruction's (its kappa would not compare), why, in words.
+fn model_frame(result: &SessionResult, model: &ModelLens) -> Result<(DVec2, MapGeometry), String> {
+    let (theirs, ours) = (model.plane, result.products.plane);
+    if theirs.z_lens != ours.z_lens {
+        return Err(format!(
+            "its z_lens = {} is not the reconstruction's {} (set z_lens to compare)",
+            theirs.z_lens, ours.z_lens
+        ));
+    }
+    if theirs.cosmology != ours.cosmology {
+        return Err("its cosmology is not the reconstruction's".to_string());
     }
     let origin = match (result.products.reference, model.reference) {
         (Some(ours), Some(theirs)) => theirs.to_offset_arcsec(ours.ra_deg, ours.dec_deg),
@@ -411,5 +404,5 @@ fn model_frame(result: &SessionResult, model: &ModelLens) -> Option<(DVec2, MapG
         pixels: g.pixels.min(MODEL_MAPS_MAX_PIXELS),
         ..g
     };
-    Some((origin, geometry))
+    Ok((origin, geometry))
 }

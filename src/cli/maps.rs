@@ -127,8 +127,7 @@ fn lenstool_products(
     let par =
         parse_par(&read_text(par_path, InputKind::Model)?, &name).map_err(|e| e.to_string())?;
     let paths: Vec<PathBuf> = if potfiles.is_empty() {
-        let dir = par_path.parent().unwrap_or(Path::new("."));
-        par.potfiles.iter().map(|p| dir.join(&p.filein)).collect()
+        par.potfile_paths(par_path)
     } else {
         potfiles.to_vec()
     };
