@@ -129,6 +129,23 @@ fn regular_32_grid_on_512_and_256_maps() {
     }
 }
 
+/// 24 cells on 256 pixels: 10 2/3 pixels per cell. The cells fall into 3 x 3 sub-pixel phases,
+/// each a lattice 32 pixels apart, and all nine groups are convolved (the teaching example's
+/// grid on the app's map).
+#[cfg_attr(not(target_arch = "wasm32"), test)]
+#[cfg_attr(target_arch = "wasm32", wasm_bindgen_test::wasm_bindgen_test)]
+fn fractional_pixels_per_cell_split_into_phase_lattices() {
+    let (grid, b2) = random_grid(DVec2::new(1.7, -0.6), 60.0, 24, 9);
+    let mass = GridMass::new(&grid, b2).expect("grid mass");
+    let geometry = product_geometry(&grid, 256);
+    let plan = mass.map_plan(&geometry);
+    assert_eq!(
+        (plan.fft_groups, plan.fft_cells, plan.direct_cells),
+        (9, 576, 0)
+    );
+    compare_sampled("24x24 grid, 256^2 map", &mass, geometry);
+}
+
 #[cfg_attr(not(target_arch = "wasm32"), test)]
 #[cfg_attr(target_arch = "wasm32", wasm_bindgen_test::wasm_bindgen_test)]
 fn whole_map_equals_direct_sum() {
