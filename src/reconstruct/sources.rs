@@ -7,7 +7,7 @@ use serde::{Deserialize, Serialize};
 
 use crate::ds9::{write_marks, Mark};
 use crate::images::{find_images, magnification_at, source_position, ImageSearch, SearchGrid};
-use crate::inversion::LinearSystem;
+use crate::inversion::{ConstraintSource, LinearSystem};
 use crate::maps::LensMaps;
 use crate::products::Products;
 use crate::profiles::{Lens, MassComponent};
@@ -245,42 +245,72 @@ pub(super) fn report(
             f,
         ));
     }
-    if let Some(catalog) = inputs.catalog {
-        for id in inputs.holdout {
-            let Some(sys) = catalog.systems.iter().find(|s| &s.id == id) else {
-                continue;
-            };
-            let z = sys.z.or(default_z).unwrap_or(f64::NAN);
-            let Ok(f) = inputs.plane.distance_ratio(z) else {
-                continue;
-            };
-            let observed: Vec<(String, DVec2)> = sys
-                .images
-                .iter()
-                .map(|i| (i.id.clone(), i.position))
-                .collect();
-            let back: Vec<DVec2> = observed
-                .iter()
-                .map(|(_, p)| source_position(lens, f, *p))
-                .collect();
-            let beta = back.iter().copied().sum::<DVec2>() / back.len().max(1) as f64;
-            let d2: Vec<f64> = back.iter().map(|b| b.distance_squared(beta)).collect();
-            let predicted = predict(f, beta)?;
-            reports.push(finish(
-                id.clone(),
-                z,
-                sys.z.is_none(),
-                true,
-                beta,
-                rms(&d2),
-                observed,
-                predicted,
-                lens,
-                f,
-            ));
-        }
+    for id in inputs.holdout {
+        let Some((z, observed)) = held_out_images(inputs, id) else {
+            continue;
+        };
+        let z_assumed = z.is_none();
+        let z = z.or(default_z).unwrap_or(f64::NAN);
+        let Ok(f) = inputs.plane.distance_ratio(z) else {
+            continue;
+        };
+        let back: Vec<DVec2> = observed
+            .iter()
+            .map(|(_, p)| source_position(lens, f, *p))
+            .collect();
+        let beta = back.iter().copied().sum::<DVec2>() / back.len().max(1) as f64;
+        let d2: Vec<f64> = back.iter().map(|b| b.distance_squared(beta)).collect();
+        let predicted = predict(f, beta)?;
+        reports.push(finish(
+            id.clone(),
+            z,
+            z_assumed,
+            true,
+            beta,
+            rms(&d2),
+            observed,
+            predicted,
+            lens,
+            f,
+        ));
     }
     Ok(reports)
+}
+
+/// Observed images by id and position (arcsec).
+type Observed = Vec<(String, DVec2)>;
+
+/// The redshift (if known) and the observed images of the held-out system `id`: the image
+/// catalogue's positions when it has the system, else the mean of each image's arc pixels;
+/// `None` for an id that is in neither.
+fn held_out_images(inputs: &Inputs<'_>, id: &str) -> Option<(Option<f64>, Observed)> {
+    if let Some(sys) = inputs
+        .catalog
+        .and_then(|c| c.systems.iter().find(|s| s.id == id))
+    {
+        let images = sys.images.iter().map(|i| (i.id.clone(), i.position));
+        return Some((sys.z, images.collect()));
+    }
+    let ConstraintSource::Arcs(arcs) = inputs.images else {
+        return None;
+    };
+    let sys = arcs.systems.iter().find(|s| s.id == id)?;
+    // Named as in the constraints: the file's labels when every image has one.
+    let named = sys.image_ids.len() == sys.images.len();
+    let images = sys
+        .images
+        .iter()
+        .enumerate()
+        .filter(|(_, pixels)| !pixels.is_empty())
+        .map(|(k, pixels)| {
+            let id = match named {
+                true => sys.image_ids[k].clone(),
+                false => format!("{}.{}", sys.id, k + 1),
+            };
+            let mean = pixels.iter().copied().sum::<DVec2>() / pixels.len() as f64;
+            (id, mean)
+        });
+    Some((sys.z, images.collect()))
 }
 
 /// The catalogue position of an image when there is a catalogue, else the mean of its pixels.
