@@ -40,6 +40,17 @@ fn temp_dir(name: &str) -> PathBuf {
     dir
 }
 
+/// A quick CONFIG.json in `dir`: 16 x 16 cells, 64-pixel maps 60 arcsec wide.
+fn quick_config(dir: &Path) -> PathBuf {
+    let config = dir.join("config.json");
+    fs::write(
+        &config,
+        r#"{"grid": {"cells": 16}, "products": {"pixels": 64, "size_arcsec": 60}}"#,
+    )
+    .unwrap();
+    config
+}
+
 fn summary(dir: &Path) -> serde_json::Value {
     serde_json::from_str(&fs::read_to_string(dir.join("summary.json")).expect("summary"))
         .expect("summary is JSON")
@@ -494,6 +505,64 @@ fn reconstruct_from_arc_pixels() {
     assert!(!out.status.success());
 }
 
+/// `--folds K` also writes crossval.json: K hold-out runs, every fitted system predicted once
+/// (library: tests/crossval.rs). A number of folds that cannot work is refused before the first
+/// run, naming the count of systems.
+#[test]
+fn reconstruct_folds_writes_crossval_json() {
+    let dir = temp_dir("folds");
+    let images = dir.join("images.cat");
+    fs::write(
+        &images,
+        wslap::app::examples::teaching_image_catalog().unwrap(),
+    )
+    .unwrap();
+    let config = quick_config(&dir);
+    let out_dir = dir.join("out");
+    let args = [
+        "--images",
+        images.to_str().unwrap(),
+        "--z-lens",
+        "0.3",
+        "--config",
+        config.to_str().unwrap(),
+        "--iterations",
+        "200",
+    ];
+    let mut all = vec!["reconstruct"];
+    all.extend(args);
+    all.extend(["--folds", "2", "--out", out_dir.to_str().unwrap()]);
+    let out = wslap(&all);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    assert!(String::from_utf8_lossy(&out.stdout).contains("2 folds: held-out images median"));
+    assert!(out_dir.join("summary.json").exists());
+    let cv: serde_json::Value =
+        serde_json::from_str(&fs::read_to_string(out_dir.join("crossval.json")).unwrap()).unwrap();
+    assert_eq!(cv["folds"], 2);
+    assert_eq!(cv["status"], "Completed");
+    assert_eq!(cv["runs"].as_array().unwrap().len(), 2);
+    let mut predicted: Vec<&str> = cv["systems"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|s| s["id"].as_str().unwrap())
+        .collect();
+    predicted.sort();
+    assert_eq!(predicted, ["1", "2", "3", "4"]);
+    assert!(cv["holdout_image_offset_median_arcsec"].as_f64().unwrap() > 0.0);
+    let mut all = args.to_vec();
+    all.extend(["--folds", "5"]);
+    let err = refused(&dir, "reconstruct", &all);
+    assert!(
+        err.contains("folds = 5") && err.contains("4 fitted"),
+        "{err}"
+    );
+}
+
 /// Runs `wslap <command>` with `args` (plus `--out`), expects failure and no output folder,
 /// returns stderr.
 fn refused(dir: &Path, command: &str, args: &[&str]) -> String {
@@ -720,12 +789,7 @@ fn reconstruct_from_a_ds9_region_file() {
     }
     let regions = dir.join("arcs.reg");
     fs::write(&regions, reg).unwrap();
-    let config = dir.join("config.json");
-    fs::write(
-        &config,
-        r#"{"grid": {"cells": 16}, "products": {"pixels": 64, "size_arcsec": 60}}"#,
-    )
-    .unwrap();
+    let config = quick_config(&dir);
     let out_dir = dir.join("out");
     let out = wslap(&[
         "reconstruct",

@@ -1,11 +1,15 @@
-//! Hold-out predictions (`wslap reconstruct --holdout`) on the teaching example (four
-//! two-image systems behind one halo): quick, and every system has a redshift.
+//! Hold-out predictions and K-fold cross-validation (`wslap reconstruct --holdout`, `--folds`),
+//! on the teaching example (four two-image systems behind one halo): quick, and every system
+//! has a redshift.
 
 use glam::DVec2;
 use wslap::app::examples::teaching_image_catalog;
 use wslap::catalog::{parse_image_catalog, ImageCatalog};
 use wslap::inversion::{ArcCatalog, ArcSystem, ConstraintMode, ConstraintSource};
-use wslap::reconstruct::{reconstruct, ConvergenceRecord, Inputs, LayerSource, ReconstructConfig};
+use wslap::reconstruct::{
+    cross_validate, fold_groups, reconstruct, ConvergenceRecord, Inputs, LayerSource,
+    ReconstructConfig, ReconstructError,
+};
 use wslap::solver::Control;
 use wslap::{Cosmology, LensPlane};
 
@@ -30,6 +34,17 @@ fn config() -> ReconstructConfig {
 
 fn plane() -> LensPlane {
     LensPlane::new(Cosmology::default(), 0.3).unwrap()
+}
+
+fn inputs<'a>(cat: &'a ImageCatalog, holdout: &'a [String]) -> Inputs<'a> {
+    Inputs {
+        images: ConstraintSource::Catalog(cat),
+        layers: LayerSource::None,
+        plane: plane(),
+        reference: cat.reference,
+        holdout,
+        catalog: Some(cat),
+    }
 }
 
 fn ids(list: &[&str]) -> Vec<String> {
@@ -97,4 +112,107 @@ fn held_out_arc_systems_are_predicted_from_their_pixels() {
         assert_eq!(o.offset_arcsec, Some(nearest));
     }
     assert!(r.image_offset_median_arcsec(true).is_some());
+}
+
+/// The folds deal the fitted systems out in catalogue order, leave the user's hold-out list
+/// out of every group, and refuse fewer than 2 folds or more folds than systems (naming the
+/// count).
+#[test]
+fn fold_groups_deal_the_fitted_systems_out_in_turn() {
+    let cat = catalog();
+    let none: Vec<String> = Vec::new();
+    let groups = fold_groups(&inputs(&cat, &none), &config(), 2).unwrap();
+    assert_eq!(groups, [ids(&["1", "3"]), ids(&["2", "4"])]);
+    let groups = fold_groups(&inputs(&cat, &none), &config(), 4).unwrap();
+    assert_eq!(groups, [ids(&["1"]), ids(&["2"]), ids(&["3"]), ids(&["4"])]);
+    let user = ids(&["3"]);
+    let groups = fold_groups(&inputs(&cat, &user), &config(), 3).unwrap();
+    assert_eq!(groups, [ids(&["1"]), ids(&["2"]), ids(&["4"])]);
+    for folds in [0, 1, 5] {
+        let err = fold_groups(&inputs(&cat, &none), &config(), folds).unwrap_err();
+        assert!(
+            matches!(err, ReconstructError::Folds { systems: 4, .. }),
+            "{err}"
+        );
+        let text = err.to_string();
+        assert!(
+            text.contains(&format!("folds = {folds}")) && text.contains("4 fitted"),
+            "{text}"
+        );
+    }
+}
+
+/// Each fold is exactly `reconstruct` with that group held out: the same predicted images and
+/// offsets. Every fitted system is predicted once, and the totals are the median and rms of
+/// all the predicted systems' offsets.
+#[test]
+fn each_fold_is_a_hold_out_run_and_every_system_is_predicted_once() {
+    let cat = catalog();
+    let none: Vec<String> = Vec::new();
+    let cv = cross_validate(&inputs(&cat, &none), &config(), 2, &mut |_, _| {
+        Control::Continue
+    })
+    .unwrap();
+    assert_eq!(cv.status, "Completed");
+    assert_eq!(cv.runs.len(), 2);
+    let mut predicted: Vec<&str> = cv.systems.iter().map(|s| s.report.id.as_str()).collect();
+    predicted.sort();
+    assert_eq!(predicted, ["1", "2", "3", "4"]);
+    for run in &cv.runs {
+        let alone = reconstruct(&inputs(&cat, &run.held_out), &config(), &mut quiet).unwrap();
+        let expected: Vec<_> = alone.sources.iter().filter(|s| s.held_out).collect();
+        let got: Vec<_> = cv
+            .systems
+            .iter()
+            .filter(|s| s.fold == run.fold)
+            .map(|s| &s.report)
+            .collect();
+        assert_eq!(got, expected, "fold {}", run.fold);
+        assert_eq!(run.c, alone.layer_factors());
+        assert_eq!(
+            run.fit_image_offset_median_arcsec,
+            alone.image_offset_median_arcsec(false)
+        );
+        assert_eq!(
+            run.holdout_image_offset_median_arcsec,
+            alone.image_offset_median_arcsec(true)
+        );
+    }
+    let mut offsets: Vec<f64> = cv
+        .systems
+        .iter()
+        .flat_map(|s| s.report.observed.iter().filter_map(|o| o.offset_arcsec))
+        .collect();
+    assert_eq!(cv.holdout_images, 8);
+    assert_eq!(cv.holdout_images_unmatched, 8 - offsets.len());
+    offsets.sort_by(f64::total_cmp);
+    let n = offsets.len();
+    let median = 0.5 * (offsets[(n - 1) / 2] + offsets[n / 2]);
+    let rms = (offsets.iter().map(|o| o * o).sum::<f64>() / n as f64).sqrt();
+    assert_eq!(cv.holdout_image_offset_median_arcsec, Some(median));
+    assert!((cv.holdout_image_plane_rms_arcsec.unwrap() - rms).abs() < 1e-12);
+    // A lens fitted to two systems reproduces them more closely than it predicts the others.
+    assert!(cv.fit_image_offset_median_arcsec.unwrap() < median);
+}
+
+/// Cancelling in the second fold keeps the first fold's result and says "Cancelled".
+#[test]
+fn cancel_keeps_the_folds_before_it() {
+    let cat = catalog();
+    let none: Vec<String> = Vec::new();
+    let mut seen = Vec::new();
+    let cv = cross_validate(&inputs(&cat, &none), &config(), 2, &mut |fold, _| {
+        seen.push(fold);
+        if fold == 2 {
+            Control::Cancel
+        } else {
+            Control::Continue
+        }
+    })
+    .unwrap();
+    assert_eq!(cv.status, "Cancelled");
+    assert_eq!(cv.runs.len(), 1);
+    assert!(cv.systems.iter().all(|s| s.fold == 1));
+    assert_eq!(cv.systems.len(), 2);
+    assert!(seen.contains(&1) && seen.contains(&2));
 }

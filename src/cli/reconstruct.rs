@@ -11,8 +11,8 @@ use wslap::inversion::{
 };
 use wslap::limits::InputKind;
 use wslap::reconstruct::{
-    image_regions, reconstruct, ConvergenceRecord, Inputs, LayerSource, ReconstructConfig,
-    Reconstruction,
+    cross_validate, fold_groups, image_regions, reconstruct, ConvergenceRecord, CrossValidation,
+    Inputs, LayerSource, ReconstructConfig, Reconstruction,
 };
 use wslap::render::ColorScale;
 use wslap::solver::Control;
@@ -28,7 +28,7 @@ use super::maps::write_products;
 /// images, offsets; held-out systems marked), images.reg (DS9 circles: observed images green,
 /// predicted ones magenta), convergence.json (objective, grid mass and C per report) and
 /// summary.json (settings, C per layer, grid mass, enclosed masses, Einstein
-/// radius, image-plane rms, timings).
+/// radius, image-plane rms, timings); with --folds also crossval.json.
 #[derive(Debug, Args)]
 #[command(group(clap::ArgGroup::new("constraints").required(true).args(["images", "arcs"])))]
 pub struct ReconstructArgs {
@@ -66,6 +66,13 @@ pub struct ReconstructArgs {
     /// Omega_m of flat LCDM.
     #[arg(long, default_value_t = 0.3)]
     omega_m: f64,
+    /// Also cross-validate (default 5 folds): reconstruct K more times, each time holding out
+    /// one group of the fitted systems (every K-th in catalogue order) and predicting its
+    /// images; writes crossval.json (per fold and per predicted system; the held-out images'
+    /// median and rms offsets against the fitted ones'). How well the settings predict images
+    /// the model was not given.
+    #[arg(long, value_name = "K", num_args = 0..=1, default_missing_value = "5")]
+    folds: Option<usize>,
     /// Also write the linear system (gamma.npy, theta.npy, weights.npy, columns.json) here.
     #[arg(long, value_name = "DIR")]
     export_system: Option<PathBuf>,
@@ -181,6 +188,10 @@ pub fn run(args: &ReconstructArgs) -> Result<(), String> {
         holdout: &args.holdout,
         catalog: catalog.as_ref(),
     };
+    if let Some(folds) = args.folds {
+        // A number of folds that cannot work is refused before the first run.
+        fold_groups(&inputs, &config, folds).map_err(|e| e.to_string())?;
+    }
     let total = config.solver.iterations;
     let mut progress = |r: &ConvergenceRecord| {
         if r.iteration % 1000 == 0 || r.iteration == total {
@@ -200,7 +211,34 @@ pub fn run(args: &ReconstructArgs) -> Result<(), String> {
     }
     write_reconstruction(&result, &args.out)?;
     println!("{}", one_line(&result, &args.out));
+    if let Some(folds) = args.folds {
+        let mut progress = |fold: usize, r: &ConvergenceRecord| {
+            if r.iteration == total {
+                eprintln!("fold {fold}/{folds}: {total} iterations");
+            }
+            Control::Continue
+        };
+        let cv =
+            cross_validate(&inputs, &config, folds, &mut progress).map_err(|e| e.to_string())?;
+        let path = args.out.join("crossval.json");
+        fs::write(&path, json(&cv)?).map_err(|e| format!("{}: {e}", path.display()))?;
+        println!("{}", crossval_line(&cv, &path));
+    }
     Ok(())
+}
+
+fn crossval_line(cv: &CrossValidation, path: &Path) -> String {
+    let arcsec = |v: Option<f64>| v.map_or("n/a".to_string(), |v| format!("{v:.2} arcsec"));
+    format!(
+        "wrote {} ({} folds: held-out images median {}, rms {}, {} of {} without a predicted image; fitted images median {})",
+        path.display(),
+        cv.folds,
+        arcsec(cv.holdout_image_offset_median_arcsec),
+        arcsec(cv.holdout_image_plane_rms_arcsec),
+        cv.holdout_images_unmatched,
+        cv.holdout_images,
+        arcsec(cv.fit_image_offset_median_arcsec),
+    )
 }
 
 fn name(path: &Path) -> String {

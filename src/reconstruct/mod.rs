@@ -5,6 +5,7 @@
 //! The pipeline of the paper (Sendra et al., section 2) and METHOD.md sections 3 to 6.
 
 mod config;
+mod crossval;
 mod sources;
 mod summary;
 
@@ -13,6 +14,10 @@ use serde::{Deserialize, Serialize};
 use thiserror::Error;
 
 pub use config::{ProductConfig, ReconstructConfig, SolverConfig, SolverMethod};
+pub use crossval::{
+    cross_validate, fitted_system_ids, fold_groups, CrossValidation, FoldRun, PredictedSystem,
+    DEFAULT_FOLDS,
+};
 pub use sources::{
     image_regions, ImageReport, PredictedImage, SourceReport, IMAGE_REGION_RADIUS_ARCSEC,
     SHOWN_MIN_MAGNIFICATION,
@@ -63,6 +68,8 @@ pub enum ReconstructError {
     TooLarge(#[from] crate::limits::TooLarge),
     #[error("no system is left to constrain the lens ({0})")]
     NoConstraints(String),
+    #[error("folds = {folds}: cross-validation holds out each of at least 2 groups of the fitted systems, at most one group per system ({systems} fitted here)")]
+    Folds { folds: usize, systems: usize },
 }
 
 /// Where the member-galaxy layers come from.

@@ -39,19 +39,13 @@ impl<'a> Solved<'a> {
     /// The offsets (arcsec) between observed images and their nearest predicted images over the
     /// fitted (or, with `held_out`, the held-out) systems.
     fn image_offsets_arcsec(&self, held_out: bool) -> Vec<f64> {
-        self.sources
-            .iter()
-            .filter(|s| s.held_out == held_out)
-            .flat_map(|s| s.observed.iter().filter_map(|i| i.offset_arcsec))
-            .collect()
+        image_offsets_arcsec(self.sources.iter().filter(|s| s.held_out == held_out))
     }
 
     /// Root mean square of the offsets between observed and predicted images, arcsec, over the
     /// fitted (or, with `held_out`, the held-out) systems; `None` when no image was matched.
     pub fn image_plane_rms_arcsec(&self, held_out: bool) -> Option<f64> {
-        let offsets = self.image_offsets_arcsec(held_out);
-        (!offsets.is_empty())
-            .then(|| (offsets.iter().map(|o| o * o).sum::<f64>() / offsets.len() as f64).sqrt())
+        rms_arcsec(&self.image_offsets_arcsec(held_out))
     }
 
     /// Median of the same offsets, arcsec (the mean of the middle two for an even count). The
@@ -59,10 +53,7 @@ impl<'a> Solved<'a> {
     /// has no predicted image near it, and its offset of many arcsec dominates the rms (AS1063:
     /// rms 4.1, median 0.2 arcsec). The median says how well the typical image is reproduced.
     pub fn image_offset_median_arcsec(&self, held_out: bool) -> Option<f64> {
-        let mut offsets = self.image_offsets_arcsec(held_out);
-        offsets.sort_by(f64::total_cmp);
-        let n = offsets.len();
-        (n > 0).then(|| 0.5 * (offsets[(n - 1) / 2] + offsets[n / 2]))
+        median_arcsec(self.image_offsets_arcsec(held_out))
     }
 
     /// `summary.json`, with `status` as written ("Completed", "Cancelled", ...) and the map
@@ -133,4 +124,28 @@ pub struct ReconstructSummary<'a> {
     pub warnings: &'a [String],
     pub maps: Summary,
     pub timings_ms: StageTimings,
+}
+
+/// The offsets (arcsec) of the observed images of `sources` from their nearest predicted
+/// images (images without a predicted one have none).
+pub(super) fn image_offsets_arcsec<'s>(
+    sources: impl Iterator<Item = &'s SourceReport>,
+) -> Vec<f64> {
+    sources
+        .flat_map(|s| s.observed.iter().filter_map(|i| i.offset_arcsec))
+        .collect()
+}
+
+/// Root mean square of `offsets`; `None` when there are none.
+pub(super) fn rms_arcsec(offsets: &[f64]) -> Option<f64> {
+    (!offsets.is_empty())
+        .then(|| (offsets.iter().map(|o| o * o).sum::<f64>() / offsets.len() as f64).sqrt())
+}
+
+/// Median of `offsets` (the mean of the middle two for an even count); `None` when there are
+/// none.
+pub(super) fn median_arcsec(mut offsets: Vec<f64>) -> Option<f64> {
+    offsets.sort_by(f64::total_cmp);
+    let n = offsets.len();
+    (n > 0).then(|| 0.5 * (offsets[(n - 1) / 2] + offsets[n / 2]))
 }
