@@ -1092,6 +1092,60 @@ fn held_out_systems_are_predicted_and_survive_a_project() {
     assert!(s.result.is_some());
 }
 
+/// Cross-validation in the app: one fold per system when there are fewer than five fitted
+/// systems (the hold-out setting's systems are not among them), each fold the same as a run
+/// with that group held out, and the session's result untouched.
+#[cfg_attr(not(target_arch = "wasm32"), test)]
+#[cfg_attr(target_arch = "wasm32", wasm_bindgen_test::wasm_bindgen_test)]
+fn cross_validation_predicts_each_system_and_keeps_the_result() {
+    let mut s = teaching_session();
+    assert_eq!(s.default_folds().unwrap(), 4);
+    s.run(RunKind::Reconstruct, &mut |_| Control::Continue)
+        .unwrap();
+    let before = s.result().unwrap().summary_json().unwrap();
+    let mut folds_seen = Vec::new();
+    let cv = s
+        .cross_validate(2, &mut |fold, _| {
+            if folds_seen.last() != Some(&fold) {
+                folds_seen.push(fold);
+            }
+            Control::Continue
+        })
+        .unwrap();
+    assert_eq!(folds_seen, [1, 2]);
+    assert_eq!(s.result().unwrap().summary_json().unwrap(), before);
+    assert_eq!(cv.systems.len(), 4);
+    for run in &cv.runs {
+        let mut t = teaching_session();
+        t.set_field("holdout", json!(run.held_out)).unwrap();
+        t.run(RunKind::Reconstruct, &mut |_| Control::Continue)
+            .unwrap();
+        let r = t.result().unwrap();
+        let alone: Vec<_> = r
+            .reconstruction
+            .as_ref()
+            .unwrap()
+            .sources
+            .iter()
+            .filter(|x| x.held_out)
+            .collect();
+        let folded: Vec<_> = cv
+            .systems
+            .iter()
+            .filter(|x| x.fold == run.fold)
+            .map(|x| &x.report)
+            .collect();
+        assert_eq!(folded, alone, "fold {}", run.fold);
+    }
+    s.set_field("holdout", json!(["4"])).unwrap();
+    assert_eq!(s.default_folds().unwrap(), 3);
+    let err = Session::new().default_folds().unwrap_err().to_string();
+    assert!(
+        err.contains("load an image catalogue or an arcs file"),
+        "{err}"
+    );
+}
+
 /// The constraint pixel samples loaded DS9 region arcs: a finer one gives more pixels (the
 /// reloaded report says how many), and one that would exceed the arcs' pixel limit is refused,
 /// keeping the old value.

@@ -5,8 +5,8 @@ import { LensClient } from './lens-client.js';
 import { loadProject, saveProject } from './js/store.js';
 import { buildFileRows, setFileStatus, ROLES } from './js/files.js';
 import { buildSettings, showSettings, valueAt } from './js/settings.js';
-import { wireViews, showPng, showSystems, viewOptions, currentView, refreshReadout } from './js/views.js';
-import { showDownloads } from './js/downloads.js';
+import { wireViews, showPng, showSystems, showCrossval, viewOptions, currentView, refreshReadout } from './js/views.js';
+import { showDownloads, save } from './js/downloads.js';
 
 const $ = (id) => document.getElementById(id);
 // Page parameters: `?example=ID` opens that built-in example (in the full app only when no
@@ -50,6 +50,7 @@ async function refreshLoaded() {
   $('reconstruct').disabled = !(loaded.images || loaded.arcs);
   $('forward').disabled = !loaded.model;
   $('lookup').disabled = !(loaded.deflection_x && loaded.deflection_y);
+  $('crossval').disabled = $('reconstruct').disabled;
   return loaded;
 }
 
@@ -151,28 +152,27 @@ async function showResult(info) {
 function showProgress(on) {
   $('progress-box').hidden = !on;
   $('cancel').hidden = !on;
-  for (const id of ['reconstruct', 'forward', 'lookup']) $(id).disabled = on || $(id).disabled;
+  for (const id of ['reconstruct', 'forward', 'lookup', 'crossval']) $(id).disabled = on || $(id).disabled;
 }
 
-async function run(kind) {
+/** Runs `job(onProgress)` in the worker with the progress bar and Cancel shown: `status` while
+ * it runs, `done(answer)` after it; a failure shows its message (a cancel says nothing here).
+ * `position(p)` gives a progress report's `[done, total]` iterations and its words. */
+async function inWorker(status, job, position, done) {
   clearError();
-  const total = settings?.reconstruct?.solver?.iterations ?? 1;
   showProgress(true);
   $('progress').value = 0;
   $('progress-text').textContent = 'Building the linear system…';
-  setStatus(kind === 'reconstruct' ? 'Reconstructing…' : 'Computing…');
+  setStatus(status);
   try {
-    const info = await ask('run', { kind }, (p) => {
-      const frac = Math.min(1, p.iteration / total);
+    const answer = await job((p) => {
+      const [k, total, words] = position(p);
+      const frac = Math.min(1, k / total);
       const left = frac > 0 ? (p.elapsed_ms / frac - p.elapsed_ms) / 1000 : NaN;
       $('progress').value = frac;
-      $('progress-text').textContent = `iteration ${p.iteration} / ${total}, objective ` +
-        `${p.objective.toExponential(4)}, about ${Number.isFinite(left) ? left.toFixed(0) : '?'} s left`;
+      $('progress-text').textContent = `${words}, about ${Number.isFinite(left) ? left.toFixed(0) : '?'} s left`;
     });
-    setStatus(`Done in ${(info.elapsed_ms / 1000).toFixed(2)} s.`);
-    await showResult(info);
-    await persist();
-    await render();
+    await done(answer);
   } catch (err) {
     if (err.cancelled) return;
     setStatus('Failed.');
@@ -181,6 +181,36 @@ async function run(kind) {
     showProgress(false);
     await refreshLoaded().catch(() => {});
   }
+}
+
+function run(kind) {
+  const total = settings?.reconstruct?.solver?.iterations ?? 1;
+  return inWorker(kind === 'reconstruct' ? 'Reconstructing…' : 'Computing…',
+    (onProgress) => ask('run', { kind }, onProgress),
+    (p) => [p.iteration, total, `iteration ${p.iteration} / ${total}, objective ${p.objective.toExponential(4)}`],
+    async (info) => {
+      setStatus(`Done in ${(info.elapsed_ms / 1000).toFixed(2)} s.`);
+      await showResult(info);
+      await persist();
+      await render();
+    });
+}
+
+// The last cross-validation, shown until the data or a setting changes (it was made with them).
+function clearCrossval() { showCrossval(null); }
+
+function crossValidate() {
+  const n = settings?.reconstruct?.solver?.iterations ?? 1;
+  return inWorker('Cross-validating…',
+    (onProgress) => ask('crossValidate', {}, onProgress),
+    (p) => [(p.fold - 1) * n + p.iteration, p.folds * n, `fold ${p.fold} / ${p.folds}, iteration ${p.iteration} / ${n}`],
+    (cv) => {
+      const seconds = cv.runs.reduce((t, r) => t + r.elapsed_ms, 0) / 1000;
+      setStatus(`Cross-validated in ${seconds.toFixed(2)} s (${cv.runs.length} folds).`);
+      showCrossval(cv, () => save('crossval.json',
+        new Blob([JSON.stringify(cv, null, 2)], { type: 'application/json' })));
+      $('crossval-box').scrollIntoView({ block: 'nearest' });
+    });
 }
 
 async function cancel() {
@@ -200,6 +230,7 @@ async function showSessionSettings() {
 }
 
 async function afterOpen(report) {
+  clearCrossval();
   await showSessionSettings();
   const loaded = await refreshLoaded();
   for (const { role } of ROLES) setFileStatus(role, loaded[role] ? `${loaded[role]}: loaded` : '');
@@ -283,6 +314,7 @@ async function onFile(role, file) {
       report = await ask('loadText', { role, name: file.name, text: await file.text() });
     }
     setFileStatus(role, reportText(report));
+    clearCrossval();
     if (example) await leaveExample(example, role);
     await refreshLoaded();
     await persist();
@@ -306,6 +338,7 @@ function queueFile(role, file) { return enqueue(() => onFile(role, file)); }
 async function applySetting(path, value) {
   if (path === 'reconstruct.products.z_source') return setZ(value);
   settings = await askSettings('setField', { path, value });
+  clearCrossval();
   // A DS9 region file's arc pixels follow the constraint pixel: say how many there are now.
   if (path === 'reconstruct.constraints.pixel_arcsec') {
     const report = await ask('reload', { role: 'arcs' });
@@ -343,6 +376,7 @@ async function start() {
   $('reconstruct').addEventListener('click', () => run('reconstruct'));
   $('forward').addEventListener('click', () => run('forward'));
   $('lookup').addEventListener('click', () => run('lookup'));
+  $('crossval').addEventListener('click', crossValidate);
   $('cancel').addEventListener('click', cancel);
   $('scale').addEventListener('change', render);
   for (const id of ['show-members', 'show-observed', 'show-predicted', 'show-model-curves']) $(id).addEventListener('change', render);

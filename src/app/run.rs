@@ -12,8 +12,8 @@ use crate::inversion::{
 use crate::products::{own_map_side, ProductOptions, Products};
 use crate::profiles::Lens;
 use crate::reconstruct::{
-    reconstruct, ConvergenceRecord, Inputs, LayerSource, ReconstructConfig, SourceReport,
-    StageTimings,
+    cross_validate, fitted_system_ids, reconstruct, ConvergenceRecord, CrossValidation, Inputs,
+    LayerSource, ReconstructConfig, ReconstructError, SourceReport, StageTimings, DEFAULT_FOLDS,
 };
 use crate::solver::Control;
 
@@ -94,6 +94,10 @@ impl SessionResult {
     }
 }
 
+fn run_error(e: ReconstructError) -> AppError {
+    AppError::Run(e.to_string())
+}
+
 /// The constraint source of the data with the configuration's mode (arcs force mode "arcs"
 /// when they are the only constraints, as in the CLI).
 fn constraint_source<'a>(
@@ -134,10 +138,11 @@ impl Session {
         Ok(())
     }
 
-    fn run_reconstruction(
+    /// Runs `f` on the reconstruction's inputs (the loaded data in one frame) and settings.
+    fn with_inputs<T>(
         &self,
-        progress: &mut dyn FnMut(&ConvergenceRecord) -> Control,
-    ) -> Result<SessionResult, AppError> {
+        f: impl FnOnce(&Inputs<'_>, &ReconstructConfig, &ParsedData) -> Result<T, AppError>,
+    ) -> Result<T, AppError> {
         let parsed = self.parsed()?;
         let plane = self.settings.lens_plane()?;
         let mut config = self.settings.reconstruct.clone();
@@ -153,27 +158,59 @@ impl Session {
             holdout: &self.settings.holdout,
             catalog: parsed.images.as_ref(),
         };
-        let r =
-            reconstruct(&inputs, &config, progress).map_err(|e| AppError::Run(e.to_string()))?;
-        let mut warnings = parsed.warnings.clone();
-        warnings.extend(r.warnings);
-        Ok(SessionResult {
-            kind: RunKind::Reconstruct,
-            products: r.products,
-            marks: parsed.marks(),
-            reconstruction: Some(ReconstructionResult {
-                config: r.config,
-                system: r.system,
-                x: r.x,
-                status: format!("{:?}", r.status),
-                iterations: r.iterations,
-                convergence: r.convergence,
-                sources: r.sources,
-                warnings,
-                timings: r.timings,
-                lens: r.lens,
-            }),
-            elapsed_ms: 0.0,
+        f(&inputs, &config, &parsed)
+    }
+
+    fn run_reconstruction(
+        &self,
+        progress: &mut dyn FnMut(&ConvergenceRecord) -> Control,
+    ) -> Result<SessionResult, AppError> {
+        self.with_inputs(|inputs, config, parsed| {
+            let r =
+                reconstruct(inputs, config, progress).map_err(|e| AppError::Run(e.to_string()))?;
+            let mut warnings = parsed.warnings.clone();
+            warnings.extend(r.warnings);
+            Ok(SessionResult {
+                kind: RunKind::Reconstruct,
+                products: r.products,
+                marks: parsed.marks(),
+                reconstruction: Some(ReconstructionResult {
+                    config: r.config,
+                    system: r.system,
+                    x: r.x,
+                    status: format!("{:?}", r.status),
+                    iterations: r.iterations,
+                    convergence: r.convergence,
+                    sources: r.sources,
+                    warnings,
+                    timings: r.timings,
+                    lens: r.lens,
+                }),
+                elapsed_ms: 0.0,
+            })
+        })
+    }
+
+    /// The app's number of cross-validation folds: [`DEFAULT_FOLDS`], or one per fitted system
+    /// when there are fewer.
+    pub fn default_folds(&self) -> Result<usize, AppError> {
+        self.with_inputs(|inputs, config, _| {
+            let ids = fitted_system_ids(inputs, config).map_err(run_error)?;
+            Ok(DEFAULT_FOLDS.min(ids.len()))
+        })
+    }
+
+    /// K-fold cross-validation of the settings on the loaded data
+    /// ([`crate::reconstruct::cross_validate`], `wslap reconstruct --folds`). The session's
+    /// result is not touched. `progress` sees the fold (1-based) and every QADP report, and
+    /// may cancel.
+    pub fn cross_validate(
+        &self,
+        folds: usize,
+        progress: &mut dyn FnMut(usize, &ConvergenceRecord) -> Control,
+    ) -> Result<CrossValidation, AppError> {
+        self.with_inputs(|inputs, config, _| {
+            cross_validate(inputs, config, folds, progress).map_err(run_error)
         })
     }
 

@@ -12,6 +12,41 @@ use super::{set, to_js};
 /// Least time between two progress messages, in ms.
 const PROGRESS_INTERVAL_MS: f64 = 100.0;
 
+/// Passes QADP reports on to a JavaScript callback at most every [`PROGRESS_INTERVAL_MS`], with
+/// `elapsed_ms` and any extra fields.
+struct Throttle<'a> {
+    progress: &'a js_sys::Function,
+    clock: crate::products::Clock,
+    last: f64,
+}
+
+impl<'a> Throttle<'a> {
+    fn new(progress: &'a js_sys::Function) -> Self {
+        Self {
+            progress,
+            clock: crate::products::Clock::start(),
+            last: f64::NEG_INFINITY,
+        }
+    }
+
+    fn report(&mut self, r: &ConvergenceRecord, extra: &[(&str, f64)]) {
+        let now = self.clock.ms();
+        if now - self.last < PROGRESS_INTERVAL_MS {
+            return;
+        }
+        self.last = now;
+        if let Ok(v) = to_js(r) {
+            if let Some(obj) = v.dyn_ref::<js_sys::Object>() {
+                let _ = set(obj, "elapsed_ms", &JsValue::from_f64(now));
+                for (key, value) in extra {
+                    let _ = set(obj, key, &JsValue::from_f64(*value));
+                }
+            }
+            let _ = self.progress.call1(&JsValue::NULL, &v);
+        }
+    }
+}
+
 fn err(e: impl std::fmt::Display) -> JsError {
     JsError::new(&e.to_string())
 }
@@ -99,23 +134,28 @@ impl AppSession {
     pub fn run(&mut self, kind: &str, progress: &js_sys::Function) -> Result<JsValue, JsError> {
         let kind: RunKind = serde_json::from_value(serde_json::Value::String(kind.into()))
             .map_err(|_| JsError::new(&format!("unknown run kind '{kind}'")))?;
-        let clock = crate::products::Clock::start();
-        let mut last = f64::NEG_INFINITY;
+        let mut throttle = Throttle::new(progress);
         let mut report = |r: &ConvergenceRecord| {
-            let now = clock.ms();
-            if now - last >= PROGRESS_INTERVAL_MS {
-                last = now;
-                if let Ok(v) = to_js(r) {
-                    if let Some(obj) = v.dyn_ref::<js_sys::Object>() {
-                        let _ = set(obj, "elapsed_ms", &JsValue::from_f64(now));
-                    }
-                    let _ = progress.call1(&JsValue::NULL, &v);
-                }
-            }
+            throttle.report(r, &[]);
             Control::Continue
         };
         self.inner.run(kind, &mut report).map_err(err)?;
         self.result_info()
+    }
+
+    /// K-fold cross-validation of the settings on the loaded data
+    /// ([`Session::cross_validate`], default folds): `crossval.json` as an object. The
+    /// session's result is not touched. `progress` gets each QADP report throttled like
+    /// [`AppSession::run`]'s, with `fold` (1-based), `folds` and `elapsed_ms`.
+    pub fn cross_validate(&self, progress: &js_sys::Function) -> Result<JsValue, JsError> {
+        let folds = self.inner.default_folds().map_err(err)?;
+        let mut throttle = Throttle::new(progress);
+        let mut report = |fold: usize, r: &ConvergenceRecord| {
+            throttle.report(r, &[("fold", fold as f64), ("folds", folds as f64)]);
+            Control::Continue
+        };
+        let cv = self.inner.cross_validate(folds, &mut report).map_err(err)?;
+        to_js(&cv)
     }
 
     /// `{kind, elapsed_ms, status, iterations, summary, model_note}` of the last result

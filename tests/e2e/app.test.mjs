@@ -135,14 +135,19 @@ test('the built-in example reconstructs and shows a map with critical curves', a
   }
 });
 
+/** Opens the teaching example from the menu, with QUICK_ITERATIONS. */
+async function openTeaching(page) {
+  await waitStatus(page, /^Ready/);
+  await page.selectOption('#example-select', { label: 'Teaching example: one halo, four sources' });
+  await page.waitForFunction(() => /Teaching/.test(document.getElementById('project-name').textContent));
+  await setField(page, '#set-reconstruct-solver-iterations', QUICK_ITERATIONS);
+}
+
 test('the teaching example loads from the menu and reconstructs', async () => {
   const app = await openApp();
   try {
     const { page } = app;
-    await waitStatus(page, /^Ready/);
-    await page.selectOption('#example-select', { label: 'Teaching example: one halo, four sources' });
-    await page.waitForFunction(() => /Teaching/.test(document.getElementById('project-name').textContent));
-    await setField(page, '#set-reconstruct-solver-iterations', QUICK_ITERATIONS);
+    await openTeaching(page);
     // From Reconstruct to the map on screen, the main thread is never blocked for more than
     // 50 ms: the run is in the worker, and so is the rendering.
     const longTasks = await watchLongTasks(page);
@@ -175,6 +180,43 @@ test('the teaching example loads from the menu and reconstructs', async () => {
     const heads = await page.$$eval('#systems tbody th', (ths) => ths.map((th) => th.textContent));
     assert.deepEqual(heads.filter((t) => /held out/.test(t)), ['2 (held out)']);
     await page.screenshot({ path: join(ARTIFACTS, 'app-teaching-holdout.png'), fullPage: true });
+    assert.deepEqual(app.consoleErrors, []);
+  } finally {
+    await app.close();
+  }
+});
+
+test('Cross-validate predicts each system once and keeps the result on screen', async () => {
+  const app = await openApp();
+  try {
+    const { page } = app;
+    await openTeaching(page);
+    await runToMap(page, '#reconstruct');
+    const caption = await page.textContent('#summary');
+    // Four systems: one fold each (fewer than five). The worker runs the folds; the page stays free.
+    const longTasks = await watchLongTasks(page);
+    await page.click('#crossval');
+    await waitStatus(page, /^Cross-validated in [\d.]+ s \(4 folds\)\.$/);
+    assert.deepEqual(await longTasks(), [], 'main-thread tasks over 50 ms [start, duration]');
+    const text = (await page.textContent('#crossval-summary')).replace(/\s+/g, ' ');
+    const m = text.match(/Held-out images lie (\d+\.\d\d)″ from their predictions \(median; rms (\d+\.\d\d)″\), the fitted ones (\d+\.\d\d)″/);
+    assert.ok(m, text);
+    const [median, rms, fitted] = m.slice(1).map(Number);
+    assert.ok(median > 0 && rms >= median && fitted >= 0, text);
+    await page.click('#crossval-systems summary');
+    const folds = await page.$$eval('#crossval-box tbody tr td:nth-child(2)', (tds) => tds.map((td) => td.textContent));
+    assert.deepEqual(folds.sort(), ['1', '2', '3', '4']);
+    // The reconstruction on screen is the one from before.
+    assert.equal(await page.textContent('#summary'), caption);
+    await page.screenshot({ path: join(ARTIFACTS, 'app-crossval.png'), fullPage: true });
+    const [download] = await Promise.all([page.waitForEvent('download'), page.click('#dl-crossval-json')]);
+    const cv = JSON.parse(await readFile(await download.path(), 'utf8'));
+    assert.equal(cv.folds, 4);
+    assert.equal(cv.systems.length, 4);
+    assert.equal(cv.holdout_image_offset_median_arcsec.toFixed(2), median.toFixed(2));
+    // Made with the settings of its time: a change takes it away.
+    await setField(page, '#set-reconstruct-solver-iterations', QUICK_ITERATIONS + 100);
+    await page.waitForSelector('#crossval-box', { state: 'hidden', timeout: 5000 });
     assert.deepEqual(app.consoleErrors, []);
   } finally {
     await app.close();

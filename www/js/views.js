@@ -81,16 +81,19 @@ export function showPng(name, bytes) {
   document.getElementById('figure').hidden = false;
 }
 
+/** `text` (a system or image id from a user's file) safe inside HTML. */
+const esc = (text) => String(text).replace(/[&<>"']/g, (c) => `&#${c.charCodeAt(0)};`);
+
 /** The per-system table (sources.json rows). */
 export function showSystems(sources) {
   const box = document.getElementById('systems');
   const f = (v, d = 2) => (v == null ? '–' : Number(v).toFixed(d));
   // The colour of the system's arc pixels in the views (none for catalogue systems).
   const swatch = (s) => (s.rgb ? `<span class="swatch" style="background:${s.rgb}" aria-hidden="true"></span>` : '');
-  const rows = sources.map((s) => `<tr><th scope="row">${swatch(s)}${s.id}${s.held_out ? ' (held out)' : ''}</th>
+  const rows = sources.map((s) => `<tr><th scope="row">${swatch(s)}${esc(s.id)}${s.held_out ? ' (held out)' : ''}</th>
     <td>${f(s.z, 3)}${s.z_assumed ? '*' : ''}</td><td>${f(s.beta_arcsec[0])}, ${f(s.beta_arcsec[1])}</td>
     <td>${f(s.scatter_arcsec)}</td><td>${s.observed.length} / ${s.predicted.length}</td>
-    <td>${s.observed.map((o) => `${o.id}: ${f(o.offset_arcsec)}${o.magnification == null ? '' : ` (μ ${f(o.magnification, 1)})`}`).join('<br>')}</td>
+    <td>${s.observed.map((o) => `${esc(o.id)}: ${f(o.offset_arcsec)}${o.magnification == null ? '' : ` (μ ${f(o.magnification, 1)})`}`).join('<br>')}</td>
     <td>${f(s.image_plane_rms_arcsec)}</td></tr>`).join('');
   box.innerHTML = sources.length === 0 ? '<p class="hint">No systems: not a reconstruction.</p>'
     : `<div class="table-scroll"><table><caption>Per system: redshift, solved source position β, source-plane scatter, images observed / predicted (all of them; the map leaves out the demagnified ones, |μ| &lt; 0.1), offsets of the observed images from the nearest predicted one (arcsec) and the model's magnification μ at each observed image: a large offset where |μ| is high usually means the image lies near a critical curve with its source just outside the model's caustic, so its pair has merged</caption>
@@ -98,6 +101,43 @@ export function showSystems(sources) {
     <th scope="col">images</th><th scope="col">offsets [″] (μ)</th><th scope="col">rms [″]</th></tr></thead><tbody>${rows}</tbody></table></div>`;
   box.hidden = false;
   document.getElementById('figure').hidden = true;
+}
+
+/** The cross-validation (crossval.json) under the views: the held-out images' offsets against
+ * the fitted ones', and per predicted system its fold and image offsets; `null` hides it. */
+export function showCrossval(cv, onDownload) {
+  const box = document.getElementById('crossval-box');
+  if (!cv) {
+    box.replaceChildren();
+    box.hidden = true;
+    return;
+  }
+  const f = (v, d = 2) => (v == null ? '–' : Number(v).toFixed(d));
+  const cancelled = cv.status === 'Cancelled' ? ` Cancelled after ${cv.runs.length} of ${cv.folds} folds.` : '';
+  const unmatched = cv.holdout_images_unmatched
+    ? ` ${cv.holdout_images_unmatched} of ${cv.holdout_images} held-out images had no predicted image.` : '';
+  const rows = cv.systems.map((s) => `<tr><th scope="row">${esc(s.id)}</th><td>${s.fold}</td><td>${f(s.z, 3)}</td>
+    <td>${s.observed.map((o) => `${esc(o.id)}: ${f(o.offset_arcsec)}${o.magnification == null ? '' : ` (μ ${f(o.magnification, 1)})`}`).join('<br>')}</td>
+    <td>${f(s.image_plane_rms_arcsec)}</td></tr>`).join('');
+  box.innerHTML = `<h3>Cross-validation, ${cv.folds} folds</h3>
+    <p id="crossval-summary">Each fold reconstructs the lens without one group of the systems and predicts
+    that group's images, so every system is predicted once by a lens that never saw it. Held-out images lie ${f(cv.holdout_image_offset_median_arcsec)}″ from
+    their predictions (median; rms ${f(cv.holdout_image_plane_rms_arcsec)}″), the fitted ones
+    ${f(cv.fit_image_offset_median_arcsec)}″: the first says how well these settings find images the model
+    was not given.${unmatched}${cancelled}</p>
+    <details id="crossval-systems"><summary>Per system (${cv.systems.length})</summary>
+    <div class="table-scroll"><table><caption>Per held-out system: the fold that left it out, its redshift, each
+    observed image's offset from the nearest predicted image (arcsec) with the fold's magnification there, and their rms</caption>
+    <thead><tr><th scope="col">system</th><th scope="col">fold</th><th scope="col">z</th>
+    <th scope="col">offsets [″] (μ)</th><th scope="col">rms [″]</th></tr></thead><tbody>${rows}</tbody></table></div></details>`;
+  const b = document.createElement('button');
+  b.type = 'button';
+  b.className = 'secondary';
+  b.id = 'dl-crossval-json';
+  b.textContent = 'crossval.json';
+  b.addEventListener('click', onDownload);
+  box.append(b);
+  box.hidden = false;
 }
 
 /** Wires the tabs (click and arrow keys) and the read-out. `app` renders views and hovers. */
