@@ -27,8 +27,8 @@ pub use project::{Project, ProjectResult, StoredFits, PROJECT_FORMAT, PROJECT_VE
 pub use run::{RunKind, SessionResult};
 pub use settings::{AppSettings, APP_MAP_PIXELS};
 pub use views::{
-    system_rgb, HoverReadout, ViewOptions, ViewPng, MODEL_CURVE_RGB, OBSERVED_RGB, PREDICTED_RGB,
-    SYSTEM_RGB,
+    system_rgb, CounterImages, HoverReadout, ViewOptions, ViewPng, COUNTER_IMAGE_RGB,
+    MODEL_CURVE_RGB, OBSERVED_RGB, PREDICTED_RGB, SYSTEM_RGB,
 };
 
 /// What the app reports to the user; every message names the file, line or setting.

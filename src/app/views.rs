@@ -11,6 +11,10 @@ use crate::render::{
 
 use super::data::ArcPixels;
 use super::{AppError, Session, SHOWN_MIN_MAGNIFICATION};
+use crate::reconstruct::{images_on_maps, source_on_maps, PredictedImage};
+
+/// The images of a clicked point's source: yellow squares.
+pub const COUNTER_IMAGE_RGB: [u8; 3] = [255, 235, 0];
 
 /// Observed images: magenta plus signs.
 pub const OBSERVED_RGB: [u8; 3] = [255, 60, 255];
@@ -68,6 +72,9 @@ pub struct ViewOptions {
     pub map_pixels_on_screen: u32,
     /// Where the figures' legends go (default: under the map, so no data are hidden).
     pub legend: LegendPlace,
+    /// A point of the map (arcsec): the images of the source behind it are drawn
+    /// ([`Session::counter_images`]).
+    pub pin_arcsec: Option<[f64; 2]>,
 }
 
 impl Default for ViewOptions {
@@ -80,6 +87,7 @@ impl Default for ViewOptions {
             show_model_curves: true,
             map_pixels_on_screen: 512,
             legend: LegendPlace::Below,
+            pin_arcsec: None,
         }
     }
 }
@@ -102,6 +110,20 @@ pub struct HoverReadout {
     /// Magnification at the curves' source redshift (bilinear).
     pub magnification: f64,
     pub z_source: f64,
+}
+
+/// The source behind a point of the map and all its images, at the curves' source redshift.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct CounterImages {
+    /// The point (arcsec).
+    pub x_arcsec: f64,
+    pub y_arcsec: f64,
+    pub z_source: f64,
+    /// Its source position `theta - f alpha(theta)` (arcsec).
+    pub beta_arcsec: [f64; 2],
+    /// Every image of that source (the point itself among them), with its signed
+    /// magnification, brightest first.
+    pub images: Vec<PredictedImage>,
 }
 
 pub(super) fn points(label: &str, rgb: [u8; 3], marker: Marker, p: Vec<DVec2>) -> OverlayPoints {
@@ -178,6 +200,23 @@ impl Session {
                 .points
                 .push(points("observed", OBSERVED_RGB, Marker::Plus, o));
         }
+        // A pin off these maps (left from another result) draws nothing; the app's list of
+        // the images says why.
+        if let Some(Ok(c)) = opts
+            .pin_arcsec
+            .map(|[x, y]| self.counter_images(DVec2::new(x, y)))
+        {
+            let label = format!(
+                "images of the clicked point's source (z_s = {})",
+                c.z_source
+            );
+            // As the predicted images: the faint central ones are listed, not drawn.
+            let shown = c.images.iter().filter(|i| i.is_shown());
+            let p = shown.map(|i| i.position_arcsec).collect();
+            overlay
+                .points
+                .push(points(&label, COUNTER_IMAGE_RGB, Marker::Square, p));
+        }
         Ok(overlay)
     }
 
@@ -202,6 +241,50 @@ impl Session {
         kappa_figure_frame_for(kappa, &overlay, &self.kappa_options(opts)?).map_err(render)
     }
 
+    /// The point of the kappa view drawn with `opts` under `(px, py)` (PNG pixels, origin
+    /// top-left), in arcsec; `None` outside the map.
+    pub fn kappa_point(
+        &self,
+        opts: &ViewOptions,
+        px: f32,
+        py: f32,
+    ) -> Result<Option<DVec2>, AppError> {
+        let frame = self.kappa_frame(opts)?;
+        let inside = |v: f32, lo: f32| v >= lo && v <= lo + frame.map_side;
+        let on_map = inside(px, frame.map_left) && inside(py, frame.map_top);
+        Ok(on_map.then(|| frame.screen_to_arcsec(px, py)))
+    }
+
+    /// The source behind the point `p` (arcsec) of the result's maps at the curves' source
+    /// redshift, and every image of it: the lens equation solved forward on the maps, as for
+    /// the predicted images of a reconstruction. Any result will do (a reconstruction, a
+    /// forward model, deflection maps): where else a candidate arc should appear.
+    pub fn counter_images(&self, p: DVec2) -> Result<CounterImages, AppError> {
+        let r = self.result()?;
+        let products = &r.products;
+        let g = products.maps.geometry();
+        let half = 0.5 * g.size_arcsec;
+        let on_maps = (p - g.center).abs().max_element() <= half;
+        if !(p.is_finite() && on_maps) {
+            return Err(AppError::Setting(format!(
+                "({:.2}, {:.2}) arcsec is not on the maps",
+                p.x, p.y
+            )));
+        }
+        let f = products.distance_ratio;
+        let beta = source_on_maps(&products.maps, f, p);
+        let mut images =
+            images_on_maps(&products.maps, f, beta).map_err(|e| AppError::Run(e.to_string()))?;
+        images.sort_by(|a, b| b.magnification.abs().total_cmp(&a.magnification.abs()));
+        Ok(CounterImages {
+            x_arcsec: p.x,
+            y_arcsec: p.y,
+            z_source: products.curves.z_source,
+            beta_arcsec: beta.to_array(),
+            images,
+        })
+    }
+
     /// x, y (arcsec), kappa and magnification under the point `(px, py)` of the kappa view
     /// drawn with `opts` (PNG pixels, origin top-left); `None` outside the map.
     pub fn hover(
@@ -212,12 +295,9 @@ impl Session {
     ) -> Result<Option<HoverReadout>, AppError> {
         let r = self.result()?;
         let kappa = &r.products.maps.kappa;
-        let frame = self.kappa_frame(opts)?;
-        let inside = |v: f32, lo: f32| v >= lo && v <= lo + frame.map_side;
-        if !(inside(px, frame.map_left) && inside(py, frame.map_top)) {
+        let Some(p) = self.kappa_point(opts, px, py)? else {
             return Ok(None);
-        }
-        let p = frame.screen_to_arcsec(px, py);
+        };
         Ok(Some(HoverReadout {
             x_arcsec: p.x,
             y_arcsec: p.y,

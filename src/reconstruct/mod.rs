@@ -19,8 +19,8 @@ pub use crossval::{
     DEFAULT_FOLDS,
 };
 pub use sources::{
-    image_regions, ImageReport, PredictedImage, SourceReport, IMAGE_REGION_RADIUS_ARCSEC,
-    SHOWN_MIN_MAGNIFICATION,
+    image_regions, images_on_maps, source_on_maps, ImageReport, PredictedImage, SourceReport,
+    IMAGE_REGION_RADIUS_ARCSEC, SHOWN_MIN_MAGNIFICATION,
 };
 pub use summary::{ReconstructSummary, Solved};
 

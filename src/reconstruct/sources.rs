@@ -6,7 +6,9 @@ use glam::DVec2;
 use serde::{Deserialize, Serialize};
 
 use crate::ds9::{write_marks, Mark};
-use crate::images::{find_images, magnification_at, source_position, ImageSearch, SearchGrid};
+use crate::images::{
+    find_images, magnification_at, source_position, ImageError, ImageSearch, SearchGrid,
+};
 use crate::inversion::{ConstraintSource, LinearSystem};
 use crate::maps::LensMaps;
 use crate::products::Products;
@@ -38,6 +40,40 @@ impl MassComponent for InterpolatedLens<'_> {
         );
         [k + g1, g2, k - g1]
     }
+}
+
+/// The images of a source at `beta` (arcsec) for `f = D_ls/D_s`, found on `maps` interpolated:
+/// the exact lens of a reconstruction sums every cell and galaxy at each Newton step, which for
+/// a 64 x 64 grid costs minutes per system.
+pub fn images_on_maps(
+    maps: &LensMaps,
+    f: f64,
+    beta: DVec2,
+) -> Result<Vec<PredictedImage>, ImageError> {
+    let search = ImageSearch {
+        tolerance_arcsec: MAP_IMAGE_TOLERANCE_ARCSEC,
+        ..ImageSearch::default()
+    };
+    let found = find_images(
+        &InterpolatedLens(maps),
+        SearchGrid::Maps(maps),
+        f,
+        beta,
+        &search,
+    )?;
+    Ok(found
+        .into_iter()
+        .map(|i| PredictedImage {
+            position_arcsec: i.position,
+            magnification: i.magnification,
+        })
+        .collect())
+}
+
+/// The source position `theta - f alpha(theta)` (arcsec) of the point `theta` on `maps`
+/// (deflection interpolated).
+pub fn source_on_maps(maps: &LensMaps, f: f64, theta: DVec2) -> DVec2 {
+    source_position(&InterpolatedLens(maps), f, theta)
 }
 
 /// Most constraint pixels of one system back-projected for its scatter.
@@ -175,27 +211,8 @@ pub(super) fn report(
     default_z: Option<f64>,
 ) -> Result<Vec<SourceReport>, ReconstructError> {
     let betas = system.betas_arcsec(x)?;
-    // Images are found on the product maps, interpolated: the exact lens sums every cell and
-    // galaxy at each Newton step, which for a 64 x 64 grid costs minutes per system.
-    let search = ImageSearch {
-        tolerance_arcsec: MAP_IMAGE_TOLERANCE_ARCSEC,
-        ..ImageSearch::default()
-    };
-    let map_lens = InterpolatedLens(&products.maps);
     let predict = |f: f64, beta: DVec2| -> Result<Vec<PredictedImage>, ReconstructError> {
-        Ok(find_images(
-            &map_lens,
-            SearchGrid::Maps(&products.maps),
-            f,
-            beta,
-            &search,
-        )?
-        .into_iter()
-        .map(|i| PredictedImage {
-            position_arcsec: i.position,
-            magnification: i.magnification,
-        })
-        .collect())
+        Ok(images_on_maps(&products.maps, f, beta)?)
     };
     let mut reports = Vec::new();
     for (s, sys) in system.constraints.systems.iter().enumerate() {

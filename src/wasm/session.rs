@@ -207,6 +207,18 @@ impl AppSession {
         }
     }
 
+    /// The source behind the point `(x, y)` (arcsec; a hover read-out's `x_arcsec, y_arcsec`)
+    /// and all its images at the curves' z_s: `{x_arcsec, y_arcsec, z_source, beta_arcsec,
+    /// images: [{position_arcsec, magnification}]}`. The view option `pin_arcsec: [x, y]` draws
+    /// them.
+    pub fn counter_images(&self, x: f64, y: f64) -> Result<JsValue, JsError> {
+        let c = self
+            .inner
+            .counter_images(glam::DVec2::new(x, y))
+            .map_err(err)?;
+        to_js(&c)
+    }
+
     /// Per-system reports (`sources.json` as objects), each with `rgb`: the CSS colour of its
     /// arc pixels in the views (`null` for catalogue systems, drawn as markers).
     pub fn sources(&self) -> Result<JsValue, JsError> {

@@ -159,6 +159,32 @@ test('the teaching example loads from the menu and reconstructs', async () => {
     await page.waitForSelector('#systems table');
     assert.equal(await page.locator('#systems tbody tr').count(), 4);
     await page.screenshot({ path: join(ARTIFACTS, 'app-teaching.png'), fullPage: true });
+    // A click on the map: the source behind the point and all its images, listed and drawn as
+    // yellow squares; the clicked point is one of them. z_s moves them; Clear removes them.
+    const shown = await renderCount(page);
+    await page.click('#tab-kappa');
+    await waitView(page, 'kappa', shown);
+    const yellow = async () => (await imageStats(page, '#view-image', { rgb: [255, 235, 0], tol: 40 })).near;
+    const plain = await yellow();
+    const box = await page.$eval('#view-image', (el) => { const r = el.getBoundingClientRect(); return [r.left, r.top, r.width, r.height]; });
+    let before = await renderCount(page);
+    await page.mouse.click(box[0] + 0.42 * box[2], box[1] + 0.38 * box[3]);
+    await waitView(page, 'kappa', before);
+    await page.waitForSelector('#counter-images:not([hidden])');
+    const listed = await page.textContent('#counter-images-text');
+    const m = listed.match(/behind \((-?[\d.]+)″, (-?[\d.]+)″\) lies at β = .*; at z_s = 2 it has (\d+) images?/);
+    assert.ok(m, listed);
+    const images = [...listed.matchAll(/\((-?[\d.]+), (-?[\d.]+)\) μ/g)].map((g) => [Number(g[1]), Number(g[2])]);
+    assert.equal(images.length, Number(m[3]), listed);
+    assert.ok(images.some(([x, y]) => Math.hypot(x - Number(m[1]), y - Number(m[2])) < 0.02), listed);
+    assert.ok(await yellow() > plain + 20, 'the images are drawn');
+    await setField(page, '#z-curves', 3);
+    await page.waitForFunction(() => /at z_s = 3 it has/.test(document.getElementById('counter-images-text').textContent));
+    before = await renderCount(page);
+    await page.click('#clear-pin');
+    await waitView(page, 'kappa', before);
+    assert.equal(await page.isHidden('#counter-images'), true);
+    assert.ok(await yellow() <= plain, 'no images drawn after Clear');
     assert.doesNotMatch(await page.textContent('#summary'), /accelerated gradient/);
     // The solver setting: the best fit's run says so in the caption.
     await setField(page, '#set-reconstruct-solver-method', 'accelerated_gradient');

@@ -8,6 +8,7 @@ let renders = 0; // views shown so far: `data-render` on the image tells a new d
 const pngs = {}; // view name -> Blob, for downloads
 let app = null; // renders views and answers hovers (set by wireViews)
 let point = null; // { x, y, pin }: PNG pixels of the kappa view last hovered or clicked
+let pin = null; // [x, y] arcsec last clicked on the kappa map: its source's images are drawn and listed
 let busy = false; // a hover question is on its way
 let queued = false; // ask again when it is answered (the cursor moved or the map changed)
 
@@ -30,9 +31,44 @@ async function readOut() {
   if (queued) { queued = false; await readOut(); }
 }
 
-/** Reads out again at the last point, e.g. after z_s changed: μ depends on it. */
+/** Lists the images of the pinned point's source (or hides the list). */
+async function listCounterImages() {
+  const box = document.getElementById('counter-images');
+  if (!pin) {
+    box.replaceChildren();
+    box.hidden = true;
+    return;
+  }
+  const f = (v, d = 2) => Number(v).toFixed(d);
+  let text;
+  try {
+    const c = await app.counterImages(pin);
+    const images = c.images.map((i) => `(${f(i.position_arcsec[0])}, ${f(i.position_arcsec[1])}) μ ${f(i.magnification, 1)}`);
+    text = `The source behind (${f(c.x_arcsec)}″, ${f(c.y_arcsec)}″) lies at β = (${f(c.beta_arcsec[0])}″, ` +
+      `${f(c.beta_arcsec[1])}″); at z_s = ${c.z_source} it has ${images.length} image${images.length === 1 ? '' : 's'} ` +
+      `(yellow squares where |μ| ≥ 0.1): ${images.join('; ')}.`;
+  } catch (err) {
+    text = `The clicked point: ${err.message}.`;
+  }
+  const p = document.createElement('span');
+  p.id = 'counter-images-text';
+  p.textContent = `${text} `;
+  const clear = document.createElement('button');
+  clear.type = 'button';
+  clear.className = 'link';
+  clear.id = 'clear-pin';
+  clear.textContent = 'Clear';
+  clear.addEventListener('click', () => { pin = null; listCounterImages(); app.render(); });
+  box.replaceChildren(p, clear);
+  box.hidden = false;
+}
+
+/** Reads out again at the last point, e.g. after z_s changed: μ depends on it; so do the
+ * clicked point's images, which are listed again. */
 export async function refreshReadout() {
-  if (point && img().dataset.view === 'kappa') await readOut();
+  if (img().dataset.view !== 'kappa') return;
+  if (point) await readOut();
+  await listCounterImages();
 }
 
 export function viewOptions() {
@@ -43,6 +79,7 @@ export function viewOptions() {
     show_observed: on('show-observed'),
     show_predicted: on('show-predicted'),
     show_model_curves: on('show-model-curves'),
+    pin_arcsec: pin,
   };
 }
 
@@ -62,6 +99,7 @@ function selectTab(name) {
   document.getElementById('scale').disabled = !map;
   document.getElementById('show-options').disabled = !map;
   if (!map) document.getElementById('readout').textContent = '';
+  document.getElementById('counter-images').hidden = !map || !pin;
 }
 
 /** Shows PNG `bytes` as the view `name`. */
@@ -167,5 +205,12 @@ export function wireViews(appApi) {
     readOut();
   };
   img().addEventListener('mousemove', (e) => ask(e, false));
-  img().addEventListener('click', (e) => ask(e, true));
+  img().addEventListener('click', async (e) => {
+    ask(e, true);
+    // The point under the click, in arcsec: its source's images are drawn and listed.
+    const h = await app.hover(point.x, point.y).catch(() => null);
+    if (!h) return;
+    pin = [h.x_arcsec, h.y_arcsec];
+    await app.render();
+  });
 }
