@@ -737,6 +737,23 @@ fn a_clicked_point_shows_the_images_of_its_source() {
         with > without + 20,
         "{with} yellow pixels with the pin, {without} without"
     );
+    // And the source plane marks its source (a forward model has no other source marks).
+    let yellow = |pin: Option<[f64; 2]>| {
+        let opts = ViewOptions {
+            pin_arcsec: pin,
+            ..ViewOptions::default()
+        };
+        let png = s.source_view(&opts).unwrap().png;
+        count_near(
+            &tiny_skia::Pixmap::decode_png(&png).unwrap(),
+            COUNTER_IMAGE_RGB,
+        )
+    };
+    let (with, without) = (yellow(Some(rows[0].1.to_array())), yellow(None));
+    assert!(
+        with > without + 10,
+        "source plane: {with} yellow pixels with the pin, {without} without"
+    );
 }
 
 /// Pixels of `pm` within a small distance of `color` (antialiased line cores).

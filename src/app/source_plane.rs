@@ -9,7 +9,9 @@ use crate::render::OverlayPoints;
 use crate::render::{render_kappa_png, ColorScale, Colormap, KappaPlotOptions, Marker, Overlay};
 use crate::CriticalCurves;
 
-use super::views::{arc_overlays, ViewOptions, ViewPng, MEMBER_RGB, OBSERVED_RGB};
+use super::views::{
+    arc_overlays, ViewOptions, ViewPng, COUNTER_IMAGE_RGB, MEMBER_RGB, OBSERVED_RGB,
+};
 use super::{AppError, Session};
 
 /// Source-plane pixels a side.
@@ -98,7 +100,8 @@ fn set(label: &str, color: [u8; 3], marker: Marker, p: Vec<DVec2>) -> OverlayPoi
 impl Session {
     /// The source plane at the curves' redshift: tangential (red) and radial (cyan) caustics,
     /// each system's beta and its back-projected observed images, over the ray-shot total
-    /// magnification (log10).
+    /// magnification (log10); with `opts.pin_arcsec`, the source of that point (a yellow
+    /// circle).
     pub fn source_view(&self, opts: &ViewOptions) -> Result<ViewPng, AppError> {
         let r = self.result()?;
         let p = &r.products;
@@ -116,10 +119,19 @@ impl Session {
             let p = s.observed.iter().map(|i| i.beta_arcsec).collect();
             back.push(set(label, rgb, Marker::Plus, p));
         }
+        // The source of the point clicked on the mass map (pin_arcsec), if it is on the maps.
+        let pinned: Vec<DVec2> = opts
+            .pin_arcsec
+            .and_then(|[x, y]| self.counter_images(DVec2::new(x, y)).ok())
+            .map(|c| DVec2::from_array(c.beta_arcsec))
+            .into_iter()
+            .collect();
         let caustics = caustics_as_curves(&p.curves);
         let all = caustics.tangential.iter().chain(&caustics.radial).flatten();
         let region = square_around(
-            all.copied().chain(betas.iter().copied()),
+            all.copied()
+                .chain(betas.iter().copied())
+                .chain(pinned.iter().copied()),
             MIN_SOURCE_FIELD_ARCSEC,
             SOURCE_PIXELS,
         );
@@ -130,6 +142,10 @@ impl Session {
             points: back
                 .into_iter()
                 .chain([set("beta", BETA_RGB, Marker::Square, betas)])
+                .chain((!pinned.is_empty()).then(|| {
+                    let label = "source of the clicked point";
+                    set(label, COUNTER_IMAGE_RGB, Marker::Circle, pinned)
+                }))
                 .collect(),
         };
         let plot = KappaPlotOptions {
