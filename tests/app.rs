@@ -717,6 +717,34 @@ fn a_clicked_point_shows_the_images_of_its_source() {
     }
     let bright = c.images.iter().filter(|i| i.magnification.abs() > 0.1);
     assert_eq!(bright.count(), 2, "{:?}", c.images);
+    // As DS9 regions: the clicked point and the two images, yellow, where they are.
+    let text = s.counter_image_regions(rows[0].1).unwrap();
+    let regions = wslap::ds9::read_regions(&text, "counter-images.reg").unwrap();
+    let r = s.result().unwrap();
+    let geometry = r.products.maps.geometry();
+    let centres: Vec<DVec2> = regions
+        .iter()
+        .map(|g| {
+            assert_eq!(g.color.as_deref(), Some("yellow"));
+            match g
+                .to_frame_arcsec(r.products.reference, Some(&geometry))
+                .unwrap()
+            {
+                wslap::ds9::Shape::Circle { center, .. } => center,
+                other => panic!("{other:?}"),
+            }
+        })
+        .collect();
+    assert_eq!(regions[0].text.as_deref(), Some("clicked point"));
+    assert_eq!(centres.len(), 3, "{text}");
+    assert!(centres[0].distance(rows[0].1) < 1e-3);
+    for (id, p) in &rows {
+        let nearest = centres[1..]
+            .iter()
+            .map(|c| c.distance(*p))
+            .fold(f64::INFINITY, f64::min);
+        assert!(nearest < 0.05, "region of image {id}: {nearest} arcsec off");
+    }
     // Off the maps: an error that says so.
     let err = s.counter_images(DVec2::new(100.0, 0.0)).unwrap_err();
     assert!(err.to_string().contains("not on the maps"), "{err}");

@@ -364,6 +364,7 @@ const app = {
   render,
   hover: (x, y) => ask('hover', { options: viewOptions(), x, y }),
   counterImages: ([x, y]) => ask('counterImages', { x, y }),
+  counterImageRegions: ([x, y]) => ask('counterImageRegions', { x, y }),
   textFile: (name) => ask('textFile', { name }),
   fitsFile: async (name) => (await ask('fitsFiles')).find((f) => f.name === name).bytes,
   viewPng: async (name) => (await ask('view', { name, options: viewOptions() })).png,

@@ -46,6 +46,7 @@ const handlers = {
   view: (m) => ({ png: session.view(m.name, m.options ?? null) }),
   hover: (m) => session.hover(m.options ?? null, m.x, m.y),
   counterImages: (m) => session.counter_images(m.x, m.y),
+  counterImageRegions: (m) => session.counter_image_regions(m.x, m.y),
   sources: () => session.sources(),
   textFile: (m) => session.text_file(m.name),
   fitsFiles: () => session.fits_files(),

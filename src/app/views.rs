@@ -11,7 +11,10 @@ use crate::render::{
 
 use super::data::ArcPixels;
 use super::{AppError, Session, SHOWN_MIN_MAGNIFICATION};
-use crate::reconstruct::{images_on_maps, source_on_maps, PredictedImage};
+use crate::ds9::{write_marks, Mark};
+use crate::reconstruct::{
+    images_on_maps, source_on_maps, PredictedImage, IMAGE_REGION_RADIUS_ARCSEC,
+};
 
 /// The images of a clicked point's source: yellow squares.
 pub const COUNTER_IMAGE_RGB: [u8; 3] = [255, 235, 0];
@@ -283,6 +286,42 @@ impl Session {
             beta_arcsec: beta.to_array(),
             images,
         })
+    }
+
+    /// [`Session::counter_images`] of `p` as a DS9 region file to lay over the cluster image:
+    /// the clicked point (yellow) and every image of its source with `|mu| >=`
+    /// [`SHOWN_MIN_MAGNIFICATION`] (yellow, dashed, labelled with the signed magnification);
+    /// fk5 with the result's sky reference, else pixels of its maps.
+    pub fn counter_image_regions(&self, p: DVec2) -> Result<String, AppError> {
+        let c = self.counter_images(p)?;
+        let products = &self.result()?.products;
+        let clicked = Mark {
+            position_arcsec: p,
+            label: "clicked point".to_string(),
+            color: "yellow",
+            tag: "clicked",
+            dashed: false,
+        };
+        let images = c.images.iter().filter(|i| i.is_shown()).map(|i| Mark {
+            position_arcsec: i.position_arcsec,
+            label: format!("image, mu={:.2}", i.magnification),
+            color: "yellow",
+            tag: "image",
+            dashed: true,
+        });
+        let marks: Vec<Mark> = std::iter::once(clicked).chain(images).collect();
+        let comment = format!(
+            "WSLAP+: the images (dashed) of the source behind the clicked point at z_s = {},\n\
+             source at beta = ({:.3}, {:.3}) arcsec; mu: signed magnification (|mu| >= {})",
+            c.z_source, c.beta_arcsec[0], c.beta_arcsec[1], SHOWN_MIN_MAGNIFICATION
+        );
+        Ok(write_marks(
+            &comment,
+            &marks,
+            IMAGE_REGION_RADIUS_ARCSEC,
+            products.reference,
+            &products.maps.geometry(),
+        ))
     }
 
     /// x, y (arcsec), kappa and magnification under the point `(px, py)` of the kappa view

@@ -219,6 +219,12 @@ impl AppSession {
         to_js(&c)
     }
 
+    /// The same as a DS9 region file (`Session::counter_image_regions`).
+    pub fn counter_image_regions(&self, x: f64, y: f64) -> Result<String, JsError> {
+        let p = glam::DVec2::new(x, y);
+        self.inner.counter_image_regions(p).map_err(err)
+    }
+
     /// Per-system reports (`sources.json` as objects), each with `rgb`: the CSS colour of its
     /// arc pixels in the views (`null` for catalogue systems, drawn as markers).
     pub fn sources(&self) -> Result<JsValue, JsError> {

@@ -178,6 +178,12 @@ test('the teaching example loads from the menu and reconstructs', async () => {
     assert.equal(images.length, Number(m[3]), listed);
     assert.ok(images.some(([x, y]) => Math.hypot(x - Number(m[1]), y - Number(m[2])) < 0.02), listed);
     assert.ok(await yellow() > plain + 20, 'the images are drawn');
+    // The same as DS9 regions: the clicked point and each image with |μ| >= 0.1.
+    const bright = [...listed.matchAll(/μ (-?[\d.]+)/g)].filter((g) => Math.abs(Number(g[1])) >= 0.1).length;
+    const [reg] = await Promise.all([page.waitForEvent('download'), page.click('#dl-counter-images-reg')]);
+    const circles = (await readFile(await reg.path(), 'utf8')).split('\n').filter((l) => l.startsWith('circle('));
+    assert.equal(circles.length, 1 + bright, circles.join('\n'));
+    assert.ok(circles.every((l) => l.includes('color=yellow')), circles.join('\n'));
     await setField(page, '#z-curves', 3);
     await page.waitForFunction(() => /at z_s = 3 it has/.test(document.getElementById('counter-images-text').textContent));
     before = await renderCount(page);

@@ -1,6 +1,8 @@
 // The result views: tabs, PNGs from the worker shown through blob URLs (decoded off the main
 // thread), the hover/click read-out on the mass map, and the per-system table.
 
+import { save } from './downloads.js';
+
 const img = () => document.getElementById('view-image');
 let current = 'kappa';
 let url = null;
@@ -59,7 +61,15 @@ async function listCounterImages() {
   clear.id = 'clear-pin';
   clear.textContent = 'Clear';
   clear.addEventListener('click', () => { pin = null; listCounterImages(); app.render(); });
-  box.replaceChildren(p, clear);
+  const reg = document.createElement('button');
+  reg.type = 'button';
+  reg.className = 'link';
+  reg.id = 'dl-counter-images-reg';
+  reg.textContent = 'counter-images.reg';
+  reg.title = 'The clicked point and its source\'s images as DS9 regions, to lay over the cluster image';
+  reg.addEventListener('click', () => app.counterImageRegions(pin)
+    .then((t) => save('counter-images.reg', new Blob([t], { type: 'text/plain' })), (err) => app.showError(err.message)));
+  box.replaceChildren(p, reg, document.createTextNode(' · '), clear);
   box.hidden = false;
 }
 
