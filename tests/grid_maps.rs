@@ -242,3 +242,41 @@ fn lens_of_grid_and_nfw_matches_direct_maps() {
         LensMaps::from_lens_pixelwise(&only_nfw, geometry)
     );
 }
+
+/// The product map of a reconstruction (`reconstruct::product_options`): as asked when the
+/// cells fall on lattices of the pixels (whole or fractional pixels per cell with a few
+/// phases), and otherwise a little narrower or wider, so that a cell spans a whole number of
+/// pixels and the FFT makes the maps: the built-in example's grid (158 arcsec, 32 cells) on a
+/// map 100 arcsec wide, 256 pixels, becomes 13 pixels per cell, 97.2 arcsec.
+#[cfg_attr(not(target_arch = "wasm32"), test)]
+#[cfg_attr(target_arch = "wasm32", wasm_bindgen_test::wasm_bindgen_test)]
+fn product_maps_are_widened_or_narrowed_onto_the_cell_lattice() {
+    use wslap::reconstruct::{product_options, ReconstructConfig};
+    let plan = |grid: &CellGrid, size_arcsec: f64, pixels: usize| {
+        let mass = GridMass::new(grid, vec![1.0; grid.len()]).expect("grid mass");
+        let geometry = MapGeometry {
+            pixels,
+            size_arcsec,
+            center: DVec2::ZERO,
+        };
+        mass.map_plan(&geometry)
+    };
+    let mut config = ReconstructConfig::default();
+    let grid = CellGrid::regular(DVec2::new(2.3, -1.1), 158.0, 32, 1.25).expect("grid");
+    // The default: the grid's width on 256 pixels, 8 pixels per cell.
+    config.products.pixels = 256;
+    assert_eq!(product_options(&config, &grid).size_arcsec, 158.0);
+    config.products.size_arcsec = Some(100.0);
+    assert!(plan(&grid, 100.0, 256).direct_cells > 0);
+    let snapped = product_options(&config, &grid).size_arcsec;
+    assert!(
+        (snapped - 256.0 * 158.0 / 32.0 / 13.0).abs() < 1e-9,
+        "{snapped}"
+    );
+    assert_eq!(plan(&grid, snapped, 256).direct_cells, 0);
+    // 24 cells on 256 pixels: 3 phases a side, all convolved: kept as asked.
+    let grid = CellGrid::regular(DVec2::ZERO, 60.0, 24, 0.75).expect("grid");
+    config.products.size_arcsec = None;
+    assert_eq!(plan(&grid, 60.0, 256).direct_cells, 0);
+    assert_eq!(product_options(&config, &grid).size_arcsec, 60.0);
+}

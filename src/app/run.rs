@@ -12,8 +12,9 @@ use crate::inversion::{
 use crate::products::{own_map_side, ProductOptions, Products};
 use crate::profiles::Lens;
 use crate::reconstruct::{
-    cross_validate, fitted_system_ids, reconstruct, ConvergenceRecord, CrossValidation, Inputs,
-    LayerSource, ReconstructConfig, ReconstructError, SourceReport, StageTimings, DEFAULT_FOLDS,
+    cross_validate, fitted_system_ids, product_options, reconstruct, ConvergenceRecord,
+    CrossValidation, Inputs, LayerSource, ReconstructConfig, ReconstructError, SourceReport,
+    StageTimings, DEFAULT_FOLDS,
 };
 use crate::solver::Control;
 
@@ -253,12 +254,7 @@ impl Session {
         let system = LinearSystem::build(&grid, &layers, &constraints, &plane, &config.system)
             .map_err(|e| run(&e))?;
         let lens = system.reconstructed_lens(&x).map_err(|e| run(&e))?;
-        let opts = ProductOptions {
-            z_source: config.products.z_source,
-            size_arcsec: config.products.size_arcsec.unwrap_or(grid.width_arcsec),
-            pixels: config.products.pixels,
-            ..ProductOptions::default()
-        };
+        let opts = product_options(&config, &grid);
         let products =
             Products::from_lens(&lens, plane, parsed.reference(), &opts).map_err(|e| run(&e))?;
         self.result = Some(SessionResult {
