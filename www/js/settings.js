@@ -38,7 +38,8 @@ export const FIELDS = [
     hint: 'left out of the fit, then predicted by the model: their image offsets show how well it finds images it was not given' },
   { path: 'reconstruct.products.z_source', label: 'z_s of the curves', type: 'number', step: 0.1 },
   { path: 'reconstruct.products.pixels', label: 'Map pixels per side', type: 'int' },
-  { path: 'reconstruct.products.size_arcsec', label: 'Map width [arcsec] (empty: the field)', type: 'optional' },
+  { path: 'reconstruct.products.size_arcsec', label: 'Map width [arcsec] (empty: the field)', type: 'optional',
+    hint: 'rounded, for a reconstruction, so that a grid cell spans whole map pixels (fast maps)' },
 ];
 
 // A change is sent when an input fires 'change'; the worker answers with all the settings.
