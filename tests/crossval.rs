@@ -170,6 +170,11 @@ fn each_fold_is_a_hold_out_run_and_every_system_is_predicted_once() {
         assert_eq!(got, expected, "fold {}", run.fold);
         assert_eq!(run.c, alone.layer_factors());
         assert_eq!(
+            run.einstein_radius_arcsec,
+            alone.products.summary().einstein_radius_arcsec
+        );
+        assert_eq!(run.einstein_radius_z_source, config().products.z_source);
+        assert_eq!(
             run.fit_image_offset_median_arcsec,
             alone.image_offset_median_arcsec(false)
         );

@@ -39,8 +39,11 @@ pub struct FoldRun {
     pub c: Vec<f64>,
     /// Its grid mass in Msun.
     pub grid_mass_msun: f64,
-    /// Its Einstein radius at the products' z_s (arcsec).
+    /// Its Einstein radius at the products' z_s (arcsec): the spread over the folds is a quick
+    /// measure of how much the answer depends on which systems are fitted.
     pub einstein_radius_arcsec: f64,
+    /// That z_s.
+    pub einstein_radius_z_source: f64,
     /// Median offset of the fitted systems' images from their predictions (arcsec).
     pub fit_image_offset_median_arcsec: Option<f64>,
     /// Median offset of the held-out systems' images from their predictions (arcsec).
@@ -158,6 +161,7 @@ pub fn cross_validate(
             c: r.layer_factors(),
             grid_mass_msun: r.grid_mass_msun(),
             einstein_radius_arcsec: r.products.summary().einstein_radius_arcsec,
+            einstein_radius_z_source: r.products.curves.z_source,
             fit_image_offset_median_arcsec: r.image_offset_median_arcsec(false),
             holdout_image_offset_median_arcsec: median_arcsec(image_offsets_arcsec(
                 predicted.iter(),

@@ -246,6 +246,12 @@ test('Cross-validate predicts each system once and keeps the result on screen', 
     assert.equal(cv.folds, 4);
     assert.equal(cv.systems.length, 4);
     assert.equal(cv.holdout_image_offset_median_arcsec.toFixed(2), median.toFixed(2));
+    // The spread of the folds' Einstein radii, as the panel gives it.
+    const thetas = cv.runs.map((r) => r.einstein_radius_arcsec);
+    const spread = text.match(/Across the folds the Einstein radius at z_s = 2 is ([\d.]+)(?: – ([\d.]+))?″/);
+    assert.ok(spread, text);
+    assert.equal(spread[1], Math.min(...thetas).toFixed(1));
+    assert.equal(spread[2] ?? spread[1], Math.max(...thetas).toFixed(1));
     // Made with the settings of its time: a change takes it away.
     await setField(page, '#set-reconstruct-solver-iterations', QUICK_ITERATIONS + 100);
     await page.waitForSelector('#crossval-box', { state: 'hidden', timeout: 5000 });

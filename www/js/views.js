@@ -164,6 +164,18 @@ export function showCrossval(cv, onDownload) {
   const cancelled = cv.status === 'Cancelled' ? ` Cancelled after ${cv.runs.length} of ${cv.folds} folds.` : '';
   const unmatched = cv.holdout_images_unmatched
     ? ` ${cv.holdout_images_unmatched} of ${cv.holdout_images} held-out images had no predicted image.` : '';
+  const span = (values, d) => {
+    const lo = Math.min(...values);
+    const hi = Math.max(...values);
+    return lo === hi ? f(lo, d) : `${f(lo, d)} – ${f(hi, d)}`;
+  };
+  const runs = cv.runs;
+  const thetas = runs.map((r) => r.einstein_radius_arcsec);
+  const layers = runs.length ? runs[0].c.length : 0;
+  const factors = [...Array(layers).keys()].map((l) => span(runs.map((r) => r.c[l]), 2));
+  const spread = runs.length < 2 ? '' : ` Across the folds the Einstein radius at z_s = ${runs[0].einstein_radius_z_source} is
+    ${span(thetas, 1)}″${factors.length ? ` and the member factor C is ${factors.join(', ')}` : ''}: how much the answer
+    depends on which systems are fitted.`;
   const rows = cv.systems.map((s) => `<tr><th scope="row">${esc(s.id)}</th><td>${s.fold}</td><td>${f(s.z, 3)}</td>
     <td>${s.observed.map((o) => `${esc(o.id)}: ${f(o.offset_arcsec)}${o.magnification == null ? '' : ` (μ ${f(o.magnification, 1)})`}`).join('<br>')}</td>
     <td>${f(s.image_plane_rms_arcsec)}</td></tr>`).join('');
@@ -172,7 +184,7 @@ export function showCrossval(cv, onDownload) {
     that group's images, so every system is predicted once by a lens that never saw it. Held-out images lie ${f(cv.holdout_image_offset_median_arcsec)}″ from
     their predictions (median; rms ${f(cv.holdout_image_plane_rms_arcsec)}″), the fitted ones
     ${f(cv.fit_image_offset_median_arcsec)}″: the first says how well these settings find images the model
-    was not given.${unmatched}${cancelled}</p>
+    was not given.${spread}${unmatched}${cancelled}</p>
     <details id="crossval-systems"><summary>Per system (${cv.systems.length})</summary>
     <div class="table-scroll"><table><caption>Per held-out system: the fold that left it out, its redshift, each
     observed image's offset from the nearest predicted image (arcsec) with the fold's magnification there, and their rms</caption>
