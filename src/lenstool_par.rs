@@ -26,7 +26,7 @@
 use glam::DVec2;
 use thiserror::Error;
 
-use crate::catalog::{CatalogError, Member, MemberCatalog};
+use crate::catalog::{CatalogError, CatalogWarning, Member, MemberCatalog};
 use crate::cosmology::{Cosmology, CosmologyError, LensPlane};
 use crate::profiles::{Dpie, ExternalShear, Lens, MassComponent, ProfileError};
 use crate::sky::SkyReference;
@@ -237,6 +237,24 @@ impl LenstoolPar {
         self.potfiles.iter().map(|p| dir.join(&p.filein)).collect()
     }
 
+    /// [`Self::build`] from the texts of the member catalogues, `(name, text)` one per
+    /// `potfile` block in order, each read in the frame of [`Self::reference`] as Lenstool
+    /// does; also returns the catalogues' warnings.
+    pub fn build_from_texts(
+        &self,
+        member_texts: &[(&str, &str)],
+    ) -> Result<(LenstoolModel, Vec<CatalogWarning>), ParError> {
+        let mut catalogs = Vec::with_capacity(member_texts.len());
+        let mut warnings = Vec::new();
+        for (name, text) in member_texts {
+            let (catalog, w) = crate::catalog::parse_member_catalog(text, name, self.reference)
+                .map_err(|e| ParError::Catalog(Box::new(e)))?;
+            warnings.extend(w);
+            catalogs.push(catalog);
+        }
+        Ok((self.build(&catalogs)?, warnings))
+    }
+
     /// Builds the lens: one component per `potentiel` block, then one dPIE per member of
     /// `member_catalogs[k]` for the `k`-th `potfile` block (read them with
     /// [`crate::catalog::parse_member_catalog`] in the frame of [`Self::reference`]).
@@ -320,13 +338,13 @@ pub fn load_lenstool_model(
     } else {
         member_paths.iter().map(|p| p.to_path_buf()).collect()
     };
-    let mut catalogs = Vec::with_capacity(paths.len());
-    for path in &paths {
-        let name = path.display().to_string();
-        let (cat, _warnings) =
-            crate::catalog::parse_member_catalog(&read(path)?, &name, par.reference)
-                .map_err(|e| ParError::Catalog(Box::new(e)))?;
-        catalogs.push(cat);
-    }
-    par.build(&catalogs)
+    let texts = paths
+        .iter()
+        .map(|path| Ok((path.display().to_string(), read(path)?)))
+        .collect::<Result<Vec<_>, ParError>>()?;
+    let texts: Vec<(&str, &str)> = texts
+        .iter()
+        .map(|(n, t)| (n.as_str(), t.as_str()))
+        .collect();
+    Ok(par.build_from_texts(&texts)?.0)
 }

@@ -291,7 +291,7 @@ impl LoadedData {
             }));
         }
         let par = parse_par(&file.text, &file.name).map_err(|e| err(&e))?;
-        let mut catalogs = Vec::new();
+        let mut texts = Vec::new();
         if let Some(potfile) = par.potfiles.first() {
             let members = self.members.as_ref().ok_or_else(|| {
                 AppError::Missing(format!(
@@ -300,11 +300,9 @@ impl LoadedData {
                     file.name, potfile.filein
                 ))
             })?;
-            let (catalog, _) = parse_member_catalog(&members.text, &members.name, par.reference)
-                .map_err(|e| err(&e))?;
-            catalogs.push(catalog);
+            texts.push((members.name.as_str(), members.text.as_str()));
         }
-        let model = par.build(&catalogs).map_err(|e| err(&e))?;
+        let (model, _) = par.build_from_texts(&texts).map_err(|e| err(&e))?;
         Ok(Some(ModelLens {
             lens: model.lens,
             plane: model.plane,

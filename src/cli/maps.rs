@@ -7,7 +7,6 @@ use std::path::{Path, PathBuf};
 use super::input::{read_bytes, read_text};
 
 use clap::Args;
-use wslap::catalog::parse_member_catalog;
 use wslap::fits::read_image;
 use wslap::lenstool_par::parse_par;
 use wslap::limits::InputKind;
@@ -131,20 +130,21 @@ fn lenstool_products(
     } else {
         potfiles.to_vec()
     };
-    let mut catalogs = Vec::with_capacity(paths.len());
+    let mut texts = Vec::with_capacity(paths.len());
     for path in &paths {
         let text = read_text(path, InputKind::Catalog).map_err(|e| {
             format!("{e} (a potfile of {name}; give its member catalogue with --potfile)")
         })?;
-        let (catalog, warnings) =
-            parse_member_catalog(&text, &path.display().to_string(), par.reference)
-                .map_err(|e| e.to_string())?;
-        for w in warnings {
-            eprintln!("warning: {w}");
-        }
-        catalogs.push(catalog);
+        texts.push((path.display().to_string(), text));
     }
-    let model = par.build(&catalogs).map_err(|e| e.to_string())?;
+    let texts: Vec<(&str, &str)> = texts
+        .iter()
+        .map(|(n, t)| (n.as_str(), t.as_str()))
+        .collect();
+    let (model, warnings) = par.build_from_texts(&texts).map_err(|e| e.to_string())?;
+    for w in warnings {
+        eprintln!("warning: {w}");
+    }
     Products::from_lens(&model.lens, model.plane, model.reference, opts).map_err(|e| e.to_string())
 }
 
