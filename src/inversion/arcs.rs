@@ -33,6 +33,20 @@ pub struct ArcSystem {
     pub line: usize,
 }
 
+impl ArcSystem {
+    /// The images' ids: the file's labels when every image has one, else `system.1`,
+    /// `system.2`, ... in order.
+    pub fn image_ids(&self) -> Vec<String> {
+        if self.image_ids.len() == self.images.len() {
+            self.image_ids.clone()
+        } else {
+            (1..=self.images.len())
+                .map(|k| format!("{}.{k}", self.id))
+                .collect()
+        }
+    }
+}
+
 /// Largest source redshift accepted (exclusive).
 pub(crate) const MAX_Z: f64 = 20.0;
 

@@ -404,13 +404,7 @@ pub fn build_constraints(
                 .map(|s| Candidate {
                     id: s.id.clone(),
                     z: s.z,
-                    image_ids: if s.image_ids.len() == s.images.len() {
-                        s.image_ids.clone()
-                    } else {
-                        (1..=s.images.len())
-                            .map(|k| format!("{}.{k}", s.id))
-                            .collect()
-                    },
+                    image_ids: s.image_ids(),
                     images: s.images.clone(),
                     single_is_one_image: false,
                 })

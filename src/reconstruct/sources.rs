@@ -211,9 +211,6 @@ pub(super) fn report(
     default_z: Option<f64>,
 ) -> Result<Vec<SourceReport>, ReconstructError> {
     let betas = system.betas_arcsec(x)?;
-    let predict = |f: f64, beta: DVec2| -> Result<Vec<PredictedImage>, ReconstructError> {
-        Ok(images_on_maps(&products.maps, f, beta)?)
-    };
     let mut reports = Vec::new();
     for (s, sys) in system.constraints.systems.iter().enumerate() {
         let f = system.distance_ratios[s];
@@ -248,7 +245,7 @@ pub(super) fn report(
                 )
             })
             .collect();
-        let predicted = predict(f, beta)?;
+        let predicted = images_on_maps(&products.maps, f, beta)?;
         reports.push(finish(
             sys.id.clone(),
             sys.z,
@@ -277,7 +274,7 @@ pub(super) fn report(
             .collect();
         let beta = back.iter().copied().sum::<DVec2>() / back.len().max(1) as f64;
         let d2: Vec<f64> = back.iter().map(|b| b.distance_squared(beta)).collect();
-        let predicted = predict(f, beta)?;
+        let predicted = images_on_maps(&products.maps, f, beta)?;
         reports.push(finish(
             id.clone(),
             z,
@@ -312,18 +309,12 @@ fn held_out_images(inputs: &Inputs<'_>, id: &str) -> Option<(Option<f64>, Observ
         return None;
     };
     let sys = arcs.systems.iter().find(|s| s.id == id)?;
-    // Named as in the constraints: the file's labels when every image has one.
-    let named = sys.image_ids.len() == sys.images.len();
     let images = sys
-        .images
-        .iter()
-        .enumerate()
+        .image_ids()
+        .into_iter()
+        .zip(&sys.images)
         .filter(|(_, pixels)| !pixels.is_empty())
-        .map(|(k, pixels)| {
-            let id = match named {
-                true => sys.image_ids[k].clone(),
-                false => format!("{}.{}", sys.id, k + 1),
-            };
+        .map(|(id, pixels)| {
             let mean = pixels.iter().copied().sum::<DVec2>() / pixels.len() as f64;
             (id, mean)
         });
