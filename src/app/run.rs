@@ -167,8 +167,7 @@ impl Session {
         progress: &mut dyn FnMut(&ConvergenceRecord) -> Control,
     ) -> Result<SessionResult, AppError> {
         self.with_inputs(|inputs, config, parsed| {
-            let r =
-                reconstruct(inputs, config, progress).map_err(|e| AppError::Run(e.to_string()))?;
+            let r = reconstruct(inputs, config, progress).map_err(run_error)?;
             let mut warnings = parsed.warnings.clone();
             warnings.extend(r.warnings);
             Ok(SessionResult {

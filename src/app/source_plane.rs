@@ -122,8 +122,7 @@ impl Session {
         // The source of the point clicked on the mass map (pin_arcsec), if it is on the maps.
         let pinned: Vec<DVec2> = opts
             .pin_arcsec
-            .and_then(|[x, y]| self.counter_images(DVec2::new(x, y)).ok())
-            .map(|c| DVec2::from_array(c.beta_arcsec))
+            .and_then(|[x, y]| self.source_behind(DVec2::new(x, y)).ok())
             .into_iter()
             .collect();
         let caustics = caustics_as_curves(&p.curves);

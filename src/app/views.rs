@@ -263,19 +263,9 @@ impl Session {
     /// the predicted images of a reconstruction. Any result will do (a reconstruction, a
     /// forward model, deflection maps): where else a candidate arc should appear.
     pub fn counter_images(&self, p: DVec2) -> Result<CounterImages, AppError> {
-        let r = self.result()?;
-        let products = &r.products;
-        let g = products.maps.geometry();
-        let half = 0.5 * g.size_arcsec;
-        let on_maps = (p - g.center).abs().max_element() <= half;
-        if !(p.is_finite() && on_maps) {
-            return Err(AppError::Setting(format!(
-                "({:.2}, {:.2}) arcsec is not on the maps",
-                p.x, p.y
-            )));
-        }
+        let products = &self.result()?.products;
         let f = products.distance_ratio;
-        let beta = source_on_maps(&products.maps, f, p);
+        let beta = self.source_behind(p)?;
         let mut images =
             images_on_maps(&products.maps, f, beta).map_err(|e| AppError::Run(e.to_string()))?;
         images.sort_by(|a, b| b.magnification.abs().total_cmp(&a.magnification.abs()));
@@ -286,6 +276,21 @@ impl Session {
             beta_arcsec: beta.to_array(),
             images,
         })
+    }
+
+    /// The source position (arcsec) behind the point `p` of the result's maps at the curves'
+    /// source redshift; an error when `p` is not on the maps.
+    pub(super) fn source_behind(&self, p: DVec2) -> Result<DVec2, AppError> {
+        let products = &self.result()?.products;
+        let g = products.maps.geometry();
+        let on_maps = (p - g.center).abs().max_element() <= 0.5 * g.size_arcsec;
+        if !(p.is_finite() && on_maps) {
+            return Err(AppError::Setting(format!(
+                "({:.2}, {:.2}) arcsec is not on the maps",
+                p.x, p.y
+            )));
+        }
+        Ok(source_on_maps(&products.maps, products.distance_ratio, p))
     }
 
     /// [`Session::counter_images`] of `p` as a DS9 region file to lay over the cluster image:

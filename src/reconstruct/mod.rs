@@ -297,13 +297,15 @@ pub fn reconstruct(
 pub fn product_options(config: &ReconstructConfig, grid: &CellGrid) -> ProductOptions {
     let pixels = config.products.pixels;
     let requested = config.products.size_arcsec.unwrap_or(grid.width_arcsec);
+    let unit = GridMass::new(grid, vec![1.0; grid.len()]).ok();
     let direct = |size_arcsec: f64| {
         let geometry = MapGeometry {
             pixels,
             size_arcsec,
             center: DVec2::ZERO,
         };
-        GridMass::new(grid, vec![1.0; grid.len()]).map_or(0, |m| m.map_plan(&geometry).direct_cells)
+        unit.as_ref()
+            .map_or(0, |m| m.map_plan(&geometry).direct_cells)
     };
     let cell = grid.width_arcsec / grid.cells_per_side.max(1) as f64;
     let per_cell = cell * pixels as f64 / requested;
