@@ -25,10 +25,11 @@ export function save(name, blob) {
   setTimeout(() => URL.revokeObjectURL(a.href), 10_000);
 }
 
-function button(label, id, onClick) {
+/** A button labelled `label` with id `id` that calls `onClick`; `className` its look. */
+export function button(label, id, onClick, className = 'secondary') {
   const b = document.createElement('button');
   b.type = 'button';
-  b.className = 'secondary';
+  b.className = className;
   b.textContent = label;
   b.id = id;
   b.addEventListener('click', onClick);

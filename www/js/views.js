@@ -1,7 +1,7 @@
 // The result views: tabs, PNGs from the worker shown through blob URLs (decoded off the main
 // thread), the hover/click read-out on the mass map, and the per-system table.
 
-import { save } from './downloads.js';
+import { button, save } from './downloads.js';
 
 const img = () => document.getElementById('view-image');
 let current = 'kappa';
@@ -41,13 +41,12 @@ async function listCounterImages() {
     box.hidden = true;
     return;
   }
-  const f = (v, d = 2) => Number(v).toFixed(d);
   let text;
   try {
     const c = await app.counterImages(pin);
-    const images = c.images.map((i) => `(${f(i.position_arcsec[0])}, ${f(i.position_arcsec[1])}) μ ${f(i.magnification, 1)}`);
-    text = `The source behind (${f(c.x_arcsec)}″, ${f(c.y_arcsec)}″) lies at β = (${f(c.beta_arcsec[0])}″, ` +
-      `${f(c.beta_arcsec[1])}″); at z_s = ${c.z_source} it has ${images.length} image${images.length === 1 ? '' : 's'} ` +
+    const images = c.images.map((i) => `(${fmt(i.position_arcsec[0])}, ${fmt(i.position_arcsec[1])}) μ ${fmt(i.magnification, 1)}`);
+    text = `The source behind (${fmt(c.x_arcsec)}″, ${fmt(c.y_arcsec)}″) lies at β = (${fmt(c.beta_arcsec[0])}″, ` +
+      `${fmt(c.beta_arcsec[1])}″); at z_s = ${c.z_source} it has ${images.length} image${images.length === 1 ? '' : 's'} ` +
       `(yellow squares where |μ| ≥ 0.1): ${images.join('; ')}.`;
   } catch (err) {
     text = `The clicked point: ${err.message}.`;
@@ -55,20 +54,10 @@ async function listCounterImages() {
   const p = document.createElement('span');
   p.id = 'counter-images-text';
   p.textContent = `${text} `;
-  const clear = document.createElement('button');
-  clear.type = 'button';
-  clear.className = 'link';
-  clear.id = 'clear-pin';
-  clear.textContent = 'Clear';
-  clear.addEventListener('click', () => { pin = null; listCounterImages(); app.render(); });
-  const reg = document.createElement('button');
-  reg.type = 'button';
-  reg.className = 'link';
-  reg.id = 'dl-counter-images-reg';
-  reg.textContent = 'counter-images.reg';
+  const clear = button('Clear', 'clear-pin', () => { pin = null; listCounterImages(); app.render(); }, 'link');
+  const reg = button('counter-images.reg', 'dl-counter-images-reg', () => app.counterImageRegions(pin)
+    .then((t) => save('counter-images.reg', new Blob([t], { type: 'text/plain' })), (err) => app.showError(err.message)), 'link');
   reg.title = 'The clicked point and its source\'s images as DS9 regions, to lay over the cluster image';
-  reg.addEventListener('click', () => app.counterImageRegions(pin)
-    .then((t) => save('counter-images.reg', new Blob([t], { type: 'text/plain' })), (err) => app.showError(err.message)));
   box.replaceChildren(p, reg, document.createTextNode(' · '), clear);
   box.hidden = false;
 }
@@ -132,17 +121,24 @@ export function showPng(name, bytes) {
 /** `text` (a system or image id from a user's file) safe inside HTML. */
 const esc = (text) => String(text).replace(/[&<>"']/g, (c) => `&#${c.charCodeAt(0)};`);
 
+/** A number with `d` decimals, or a dash when there is none. */
+const fmt = (v, d = 2) => (v == null ? '–' : Number(v).toFixed(d));
+
+/** A table cell of observed images: each one's offset from the nearest predicted image and
+ * the model's magnification there. */
+const offsetsCell = (observed) => `<td>${observed.map((o) => `${esc(o.id)}: ${fmt(o.offset_arcsec)}${
+  o.magnification == null ? '' : ` (μ ${fmt(o.magnification, 1)})`}`).join('<br>')}</td>`;
+
 /** The per-system table (sources.json rows). */
 export function showSystems(sources) {
   const box = document.getElementById('systems');
-  const f = (v, d = 2) => (v == null ? '–' : Number(v).toFixed(d));
   // The colour of the system's arc pixels in the views (none for catalogue systems).
   const swatch = (s) => (s.rgb ? `<span class="swatch" style="background:${s.rgb}" aria-hidden="true"></span>` : '');
   const rows = sources.map((s) => `<tr><th scope="row">${swatch(s)}${esc(s.id)}${s.held_out ? ' (held out)' : ''}</th>
-    <td>${f(s.z, 3)}${s.z_assumed ? '*' : ''}</td><td>${f(s.beta_arcsec[0])}, ${f(s.beta_arcsec[1])}</td>
-    <td>${f(s.scatter_arcsec)}</td><td>${s.observed.length} / ${s.predicted.length}</td>
-    <td>${s.observed.map((o) => `${esc(o.id)}: ${f(o.offset_arcsec)}${o.magnification == null ? '' : ` (μ ${f(o.magnification, 1)})`}`).join('<br>')}</td>
-    <td>${f(s.image_plane_rms_arcsec)}</td></tr>`).join('');
+    <td>${fmt(s.z, 3)}${s.z_assumed ? '*' : ''}</td><td>${fmt(s.beta_arcsec[0])}, ${fmt(s.beta_arcsec[1])}</td>
+    <td>${fmt(s.scatter_arcsec)}</td><td>${s.observed.length} / ${s.predicted.length}</td>
+    ${offsetsCell(s.observed)}
+    <td>${fmt(s.image_plane_rms_arcsec)}</td></tr>`).join('');
   box.innerHTML = sources.length === 0 ? '<p class="hint">No systems: not a reconstruction.</p>'
     : `<div class="table-scroll"><table><caption>Per system: redshift, solved source position β, source-plane scatter, images observed / predicted (all of them; the map leaves out the demagnified ones, |μ| &lt; 0.1), offsets of the observed images from the nearest predicted one (arcsec) and the model's magnification μ at each observed image: a large offset where |μ| is high usually means the image lies near a critical curve with its source just outside the model's caustic, so its pair has merged</caption>
     <thead><tr><th scope="col">system</th><th scope="col">z</th><th scope="col">β [″]</th><th scope="col">scatter [″]</th>
@@ -160,14 +156,13 @@ export function showCrossval(cv, onDownload) {
     box.hidden = true;
     return;
   }
-  const f = (v, d = 2) => (v == null ? '–' : Number(v).toFixed(d));
   const cancelled = cv.status === 'Cancelled' ? ` Cancelled after ${cv.runs.length} of ${cv.folds} folds.` : '';
   const unmatched = cv.holdout_images_unmatched
     ? ` ${cv.holdout_images_unmatched} of ${cv.holdout_images} held-out images had no predicted image.` : '';
   const span = (values, d) => {
     const lo = Math.min(...values);
     const hi = Math.max(...values);
-    return lo === hi ? f(lo, d) : `${f(lo, d)} – ${f(hi, d)}`;
+    return lo === hi ? fmt(lo, d) : `${fmt(lo, d)} – ${fmt(hi, d)}`;
   };
   const runs = cv.runs;
   const thetas = runs.map((r) => r.einstein_radius_arcsec);
@@ -176,27 +171,21 @@ export function showCrossval(cv, onDownload) {
   const spread = runs.length < 2 ? '' : ` Across the folds the Einstein radius at z_s = ${runs[0].einstein_radius_z_source} is
     ${span(thetas, 1)}″${factors.length ? ` and the member factor C is ${factors.join(', ')}` : ''}: how much the answer
     depends on which systems are fitted.`;
-  const rows = cv.systems.map((s) => `<tr><th scope="row">${esc(s.id)}</th><td>${s.fold}</td><td>${f(s.z, 3)}</td>
-    <td>${s.observed.map((o) => `${esc(o.id)}: ${f(o.offset_arcsec)}${o.magnification == null ? '' : ` (μ ${f(o.magnification, 1)})`}`).join('<br>')}</td>
-    <td>${f(s.image_plane_rms_arcsec)}</td></tr>`).join('');
+  const rows = cv.systems.map((s) => `<tr><th scope="row">${esc(s.id)}</th><td>${s.fold}</td><td>${fmt(s.z, 3)}</td>
+    ${offsetsCell(s.observed)}
+    <td>${fmt(s.image_plane_rms_arcsec)}</td></tr>`).join('');
   box.innerHTML = `<h3>Cross-validation, ${cv.folds} folds</h3>
     <p id="crossval-summary">Each fold reconstructs the lens without one group of the systems and predicts
-    that group's images, so every system is predicted once by a lens that never saw it. Held-out images lie ${f(cv.holdout_image_offset_median_arcsec)}″ from
-    their predictions (median; rms ${f(cv.holdout_image_plane_rms_arcsec)}″), the fitted ones
-    ${f(cv.fit_image_offset_median_arcsec)}″: the first says how well these settings find images the model
+    that group's images, so every system is predicted once by a lens that never saw it. Held-out images lie ${fmt(cv.holdout_image_offset_median_arcsec)}″ from
+    their predictions (median; rms ${fmt(cv.holdout_image_plane_rms_arcsec)}″), the fitted ones
+    ${fmt(cv.fit_image_offset_median_arcsec)}″: the first says how well these settings find images the model
     was not given.${spread}${unmatched}${cancelled}</p>
     <details id="crossval-systems"><summary>Per system (${cv.systems.length})</summary>
     <div class="table-scroll"><table><caption>Per held-out system: the fold that left it out, its redshift, each
     observed image's offset from the nearest predicted image (arcsec) with the fold's magnification there, and their rms</caption>
     <thead><tr><th scope="col">system</th><th scope="col">fold</th><th scope="col">z</th>
     <th scope="col">offsets [″] (μ)</th><th scope="col">rms [″]</th></tr></thead><tbody>${rows}</tbody></table></div></details>`;
-  const b = document.createElement('button');
-  b.type = 'button';
-  b.className = 'secondary';
-  b.id = 'dl-crossval-json';
-  b.textContent = 'crossval.json';
-  b.addEventListener('click', onDownload);
-  box.append(b);
+  box.append(button('crossval.json', 'dl-crossval-json', onDownload));
   box.hidden = false;
 }
 
