@@ -312,7 +312,7 @@ fn lens_offsets(lens: &dyn MassComponent, g: &MapGeometry, f: f64, beta: DVec2) 
     };
     #[cfg(not(target_arch = "wasm32"))]
     {
-        let threads = std::thread::available_parallelism().map_or(1, |t| t.get());
+        let threads = crate::threads::available();
         let rows_per_band = n.div_ceil(threads * 4).max(1);
         let mut bands: Vec<(usize, &mut [DVec2])> = out
             .chunks_mut(rows_per_band * n)

@@ -28,6 +28,7 @@ pub mod render;
 pub mod simulate;
 pub mod sky;
 pub mod solver;
+pub mod threads;
 pub mod units;
 
 #[cfg(target_arch = "wasm32")]

@@ -311,7 +311,7 @@ fn fill_parallel(parts: &[&dyn MassComponent], geometry: &MapGeometry, out: RowS
     if n == 0 {
         return;
     }
-    let threads = std::thread::available_parallelism().map_or(1, |t| t.get());
+    let threads = crate::threads::available();
     // A few bands per thread balance rows of uneven cost (e.g. a dense cluster core).
     let bands = (threads * 4).min(n);
     let rows_per_band = n.div_ceil(bands);

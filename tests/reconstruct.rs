@@ -288,6 +288,48 @@ fn synthetic_lens_with_the_true_galaxy_layer() {
     assert!(compared >= 5, "{compared} images compared");
 }
 
+/// `system.threads` holds for the whole run: every parallel section (rows, normal equations,
+/// QADP passes, maps, image search) takes its thread count from `wslap::threads::available()`
+/// on the run's thread, which is also where the progress callback runs.
+#[cfg(not(target_arch = "wasm32"))]
+#[test]
+fn system_threads_limits_every_parallel_section_of_the_run() {
+    let truth = Truth::new();
+    let catalog = truth.catalog();
+    let all = wslap::threads::available();
+    for threads in [1, 3] {
+        let mut config = ReconstructConfig::default();
+        config.grid.cells = 8;
+        config.solver.iterations = 20;
+        config.solver.report_every = 5;
+        config.products.pixels = 32;
+        config.system.threads = threads;
+        let inputs = Inputs {
+            images: ConstraintSource::Catalog(&catalog),
+            layers: LayerSource::None,
+            plane: truth.plane,
+            reference: None,
+            holdout: &[],
+            catalog: Some(&catalog),
+        };
+        let mut seen = Vec::new();
+        reconstruct(&inputs, &config, &mut |_| {
+            seen.push(wslap::threads::available());
+            Control::Continue
+        })
+        .unwrap();
+        assert!(
+            !seen.is_empty() && seen.iter().all(|&t| t == threads),
+            "system.threads = {threads}: the run's sections saw {seen:?}"
+        );
+    }
+    assert_eq!(
+        wslap::threads::available(),
+        all,
+        "the limit ends with the run"
+    );
+}
+
 /// When the layer is the whole true lens (halo and galaxies), nothing is left for the grid to
 /// trade against, and C must come back at 1: this checks the layer column's normalisation
 /// (`a_l` at C = 1 is the catalogue mass) end to end. Measured: C = 0.984, median deflection

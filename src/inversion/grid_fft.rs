@@ -404,7 +404,7 @@ impl Fft2 {
 /// Transforms every row of `data` (rows of `fft.len()` points).
 fn rows(data: &mut [Complex64], fft: &Arc<dyn Fft<f64>>) {
     let len = fft.len();
-    let bands = threads();
+    let bands = crate::threads::available();
     let rows_per_band = (data.len() / len).div_ceil(bands).max(1);
     let chunks: Vec<&mut [Complex64]> = data.chunks_mut(rows_per_band * len).collect();
     for_each_band(chunks, |chunk| fft.process(chunk));
@@ -429,22 +429,10 @@ fn transpose(src: &[Complex64], rows: usize, cols: usize, dst: &mut [Complex64])
     });
 }
 
-/// Worker threads to use (1 on wasm32).
-fn threads() -> usize {
-    #[cfg(not(target_arch = "wasm32"))]
-    {
-        std::thread::available_parallelism().map_or(1, |t| t.get())
-    }
-    #[cfg(target_arch = "wasm32")]
-    {
-        1
-    }
-}
-
-/// Runs `f` on every item, natively spread over [`threads`] scoped threads (items dealt in
+/// Runs `f` on every item, natively spread over [`crate::threads::available`] scoped threads (items dealt in
 /// turn), serially on wasm32.
 fn for_each_band<T: Send>(items: Vec<T>, f: impl Fn(T) + Sync) {
-    let t = threads();
+    let t = crate::threads::available();
     if t <= 1 || items.len() <= 1 {
         items.into_iter().for_each(f);
         return;

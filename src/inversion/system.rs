@@ -84,8 +84,8 @@ pub struct SystemConfig {
     pub theta_shift_arcsec: Option<f64>,
     /// Largest block of `Gamma` rows held at once, in MB (default 64). Allowed [0.001, 1e5].
     pub block_mbytes: f64,
-    /// Threads for filling rows and for the QADP passes of a reconstruction; 0 (default) = all
-    /// available (always 1 on wasm32).
+    /// Threads for the whole reconstruction (rows, normal equations, QADP passes, maps, image
+    /// search); 0 (default) = all available (always 1 on wasm32).
     pub threads: usize,
 }
 
@@ -183,7 +183,7 @@ pub struct LinearSystem {
     rows_per_block: usize,
 }
 
-/// Threads to use: `requested`, or all available when 0; always 1 on wasm32.
+/// Threads to use: `requested`, or [`crate::threads::available`] when 0; always 1 on wasm32.
 fn thread_count(requested: usize) -> usize {
     if cfg!(target_arch = "wasm32") {
         return 1;
@@ -191,7 +191,7 @@ fn thread_count(requested: usize) -> usize {
     if requested > 0 {
         requested
     } else {
-        std::thread::available_parallelism().map_or(1, |n| n.get())
+        crate::threads::available()
     }
 }
 

@@ -521,9 +521,7 @@ fn run_all<T: Send>(
     mut jobs: Vec<Job<'_>>,
     finish: impl Fn(usize, Reconstruction) -> Result<T, PaperError> + Sync,
 ) -> Result<Vec<T>, PaperError> {
-    let workers = std::thread::available_parallelism()
-        .map_or(1, |n| n.get())
-        .min(jobs.len());
+    let workers = crate::threads::available().min(jobs.len());
     if workers <= 1 {
         return jobs
             .iter()

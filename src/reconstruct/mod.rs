@@ -181,8 +181,20 @@ impl Reconstruction {
 }
 
 /// Runs the reconstruction. `progress` sees every QADP report and may cancel; a cancelled run
-/// still returns the products of the last iterate (its status says `Cancelled`).
+/// still returns the products of the last iterate (its status says `Cancelled`). Every
+/// parallel section of the run (rows, normal equations, QADP passes, maps, image search) uses
+/// at most `system.threads` threads (0: all cores).
 pub fn reconstruct(
+    inputs: &Inputs<'_>,
+    config: &ReconstructConfig,
+    progress: &mut dyn FnMut(&ConvergenceRecord) -> Control,
+) -> Result<Reconstruction, ReconstructError> {
+    crate::threads::with_limit(config.system.threads, || {
+        reconstruct_limited(inputs, config, progress)
+    })
+}
+
+fn reconstruct_limited(
     inputs: &Inputs<'_>,
     config: &ReconstructConfig,
     progress: &mut dyn FnMut(&ConvergenceRecord) -> Control,

@@ -142,7 +142,7 @@ fn thread_count(requested: usize, n: usize) -> usize {
     let available = if requested > 0 {
         requested
     } else {
-        std::thread::available_parallelism().map_or(1, |t| t.get())
+        crate::threads::available()
     };
     available.min(n / MIN_ROWS_PER_THREAD).max(1)
 }

@@ -151,9 +151,7 @@ fn add_block(a: &mut [f64], n: usize, block: &[f64], packed_b: &[f64], k: usize)
     let threads = if cfg!(target_arch = "wasm32") || n < 256 {
         1
     } else {
-        std::thread::available_parallelism()
-            .map_or(1, |t| t.get())
-            .min(8)
+        crate::threads::available().min(8)
     };
     let total: usize = (0..row_panels).map(work).sum();
     // Cut the row panels into `threads` contiguous bands of about equal work.

@@ -108,7 +108,7 @@ fn thread_count(requested: usize, n: usize) -> usize {
     if requested > 0 {
         return requested.min(n.div_ceil(2));
     }
-    let available = std::thread::available_parallelism().map_or(1, |t| t.get());
+    let available = crate::threads::available();
     available
         .min(MAX_THREADS)
         .min(n / MIN_ROWS_PER_THREAD)

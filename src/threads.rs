@@ -1,0 +1,64 @@
+//! How many threads a parallel section of the native code may start.
+//!
+//! A reconstruction's thread count (`system.threads`) has to reach every parallel section it
+//! runs: the rows of the system, the normal equations, the QADP passes, the maps and the image
+//! search. Rather than pass it through every map and profile function, the run sets a limit on
+//! its own thread with [`with_limit`], and each section asks [`available`]. The limit belongs to
+//! the thread that set it (a thread-local), so two runs in one process (tests, the paper's
+//! cases side by side) each keep their own. Sections start their helpers from the limited
+//! thread; the helpers themselves start none. On wasm32 there is always one thread.
+
+use std::cell::Cell;
+
+thread_local! {
+    /// 0 = no limit.
+    static LIMIT: Cell<usize> = const { Cell::new(0) };
+}
+
+/// Threads a parallel section started on this thread may use: the limit of the innermost
+/// [`with_limit`] around it, else every available core (always 1 on wasm32).
+pub fn available() -> usize {
+    if cfg!(target_arch = "wasm32") {
+        return 1;
+    }
+    match LIMIT.with(Cell::get) {
+        0 => std::thread::available_parallelism().map_or(1, |n| n.get()),
+        n => n,
+    }
+}
+
+/// Runs `f` with the parallel sections it starts on this thread limited to `threads` threads
+/// (0 = no limit, every available core). The previous limit is restored afterwards, also when
+/// `f` panics.
+pub fn with_limit<R>(threads: usize, f: impl FnOnce() -> R) -> R {
+    struct Restore(usize);
+    impl Drop for Restore {
+        fn drop(&mut self) {
+            LIMIT.with(|l| l.set(self.0));
+        }
+    }
+    let _restore = Restore(LIMIT.with(|l| l.replace(threads)));
+    f()
+}
+
+#[cfg(all(test, not(target_arch = "wasm32")))]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_limit_holds_inside_and_is_restored_after() {
+        let all = available();
+        assert!(all >= 1);
+        with_limit(1, || {
+            assert_eq!(available(), 1);
+            with_limit(3, || assert_eq!(available(), 3));
+            assert_eq!(available(), 1);
+            // Another thread does not see this thread's limit.
+            let other = std::thread::spawn(available).join().unwrap();
+            assert_eq!(other, all);
+        });
+        assert_eq!(available(), all);
+        let _ = std::panic::catch_unwind(|| with_limit(1, || panic!("inside")));
+        assert_eq!(available(), all);
+    }
+}
