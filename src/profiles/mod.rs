@@ -17,6 +17,7 @@ mod point;
 mod shear;
 mod sis;
 mod tnfw;
+mod tnfw_near;
 
 pub use dpie::{dpie_b0_arcsec, kk_epsilon, Dpie, CIRCULAR_EPSILON as DPIE_CIRCULAR_EPSILON};
 pub use error::ProfileError;
