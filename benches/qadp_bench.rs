@@ -59,7 +59,11 @@ fn main() {
         .collect();
     let arg = |k: usize, default: usize| args.get(k).copied().unwrap_or(default);
     let (n_grid, n_pix, iterations, threads) = (arg(0, 32), arg(1, 4000), arg(2, 8000), arg(3, 0));
+    // THREADS holds for every stage, the normal matrix included.
+    wslap::threads::with_limit(threads, || run(n_grid, n_pix, iterations, threads));
+}
 
+fn run(n_grid: usize, n_pix: usize, iterations: usize, threads: usize) {
     let t0 = Instant::now();
     let (gamma, theta, w) = synthetic(n_grid, n_pix, 30);
     let t1 = Instant::now();
