@@ -554,6 +554,28 @@ fn reconstruct_folds_writes_crossval_json() {
     predicted.sort();
     assert_eq!(predicted, ["1", "2", "3", "4"]);
     assert!(cv["holdout_image_offset_median_arcsec"].as_f64().unwrap() > 0.0);
+    // The folds' convergence, on the pixels of kappa.fits.
+    let read = |file: &str| {
+        let path = out_dir.join(file);
+        read_image(&fs::read(&path).unwrap(), file).unwrap()
+    };
+    let kappa = read("kappa.fits");
+    for file in ["crossval-kappa-mean.fits", "crossval-kappa-spread.fits"] {
+        let map = read(file);
+        assert_eq!(
+            (map.width, map.height),
+            (kappa.width, kappa.height),
+            "{file}"
+        );
+        assert_eq!(map.geometry().unwrap(), kappa.geometry().unwrap(), "{file}");
+        assert_eq!(map.card("NFOLDS").unwrap().as_f64(), Some(2.0), "{file}");
+        assert_eq!(map.non_finite_count(), 0, "{file}");
+    }
+    let spread = read("crossval-kappa-spread.fits");
+    assert!(spread.data.iter().all(|&v| v >= 0.0));
+    assert!(spread.data.iter().any(|&v| v > 0.0), "the two folds differ");
+    let png = fs::read(out_dir.join("crossval-kappa-spread.png")).unwrap();
+    assert!(png.starts_with(b"\x89PNG"));
     let mut all = args.to_vec();
     all.extend(["--folds", "5"]);
     let err = refused(&dir, "reconstruct", &all);

@@ -210,7 +210,7 @@ impl Session {
         progress: &mut dyn FnMut(usize, &ConvergenceRecord) -> Control,
     ) -> Result<CrossValidation, AppError> {
         self.with_inputs(|inputs, config, _| {
-            cross_validate(inputs, config, folds, progress).map_err(run_error)
+            cross_validate(inputs, config, folds, None, progress).map_err(run_error)
         })
     }
 

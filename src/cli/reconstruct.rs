@@ -28,7 +28,8 @@ use super::maps::write_products;
 /// images, offsets; held-out systems marked), images.reg (DS9 circles: observed images green,
 /// predicted ones magenta), convergence.json (objective, grid mass and C per report) and
 /// summary.json (settings, C per layer, grid mass, enclosed masses, Einstein
-/// radius, image-plane rms, timings); with --folds also crossval.json.
+/// radius, image-plane rms, timings); with --folds also crossval.json and the folds' convergence
+/// (crossval-kappa-mean.fits, crossval-kappa-spread.fits, crossval-kappa-spread.png).
 #[derive(Debug, Args)]
 #[command(group(clap::ArgGroup::new("constraints").required(true).args(["images", "arcs"])))]
 pub struct ReconstructArgs {
@@ -70,7 +71,9 @@ pub struct ReconstructArgs {
     /// one group of the fitted systems (every K-th in catalogue order) and predicting its
     /// images; writes crossval.json (per fold and per predicted system; the held-out images'
     /// median and rms offsets against the fitted ones'). How well the settings predict images
-    /// the model was not given.
+    /// the model was not given. Also the mean and standard deviation of the folds' convergence
+    /// on the maps of kappa.fits (crossval-kappa-mean.fits, crossval-kappa-spread.fits and a
+    /// PNG): where the mass map depends on which systems are fitted.
     #[arg(long, value_name = "K", num_args = 0..=1, default_missing_value = "5")]
     folds: Option<usize>,
     /// Also write the linear system (gamma.npy, theta.npy, weights.npy, columns.json) here.
@@ -218,11 +221,28 @@ pub fn run(args: &ReconstructArgs) -> Result<(), String> {
             }
             Control::Continue
         };
-        let cv =
-            cross_validate(&inputs, &config, folds, &mut progress).map_err(|e| e.to_string())?;
-        let path = args.out.join("crossval.json");
-        fs::write(&path, json(&cv)?).map_err(|e| format!("{}: {e}", path.display()))?;
-        println!("{}", crossval_line(&cv, &path));
+        let geometry = result.products.maps.geometry();
+        let cv = cross_validate(&inputs, &config, folds, Some(geometry), &mut progress)
+            .map_err(|e| e.to_string())?;
+        let write = |file: &str, bytes: &[u8]| -> Result<(), String> {
+            let path = args.out.join(file);
+            fs::write(&path, bytes).map_err(|e| format!("{}: {e}", path.display()))
+        };
+        write("crossval.json", json(&cv)?.as_bytes())?;
+        if let Some(kappa) = &cv.kappa {
+            let products = &result.products;
+            for (file, bytes) in kappa
+                .fits_files(products.reference, products.plane.z_lens, cv.runs.len())
+                .map_err(|e| e.to_string())?
+            {
+                write(file, &bytes)?;
+            }
+            let png = kappa
+                .spread_png(Some(&products.curves), cv.runs.len())
+                .map_err(|e| e.to_string())?;
+            write("crossval-kappa-spread.png", &png)?;
+        }
+        println!("{}", crossval_line(&cv, &args.out.join("crossval.json")));
     }
     Ok(())
 }

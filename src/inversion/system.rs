@@ -453,13 +453,18 @@ impl LinearSystem {
             .collect())
     }
 
-    /// The mass model of solution `x` at `D_ls/D_s = 1`: the cells as Gaussians of mass
-    /// `X_j mu` and each layer scaled by `C_l` (layers with `C_l = 0` left out).
-    pub fn reconstructed_lens(&self, x: &[f64]) -> Result<Lens, SystemError> {
+    /// The grid part of the reconstructed lens for unknowns `x` (the cells' masses alone).
+    pub fn grid_mass(&self, x: &[f64]) -> Result<GridMass, SystemError> {
         self.check_x(x)?;
         let k = point_mass_deflection_arcsec2() * self.mass_unit_msun / self.d_l_mpc;
         let b2 = x[self.cell_columns()].iter().map(|m| k * m).collect();
-        let grid = GridMass::new(&self.grid, b2)?;
+        Ok(GridMass::new(&self.grid, b2)?)
+    }
+
+    /// The mass model of solution `x` at `D_ls/D_s = 1`: the cells as Gaussians of mass
+    /// `X_j mu` and each layer scaled by `C_l` (layers with `C_l = 0` left out).
+    pub fn reconstructed_lens(&self, x: &[f64]) -> Result<Lens, SystemError> {
+        let grid = self.grid_mass(x)?;
         let mut components: Vec<Box<dyn MassComponent>> = vec![Box::new(grid)];
         for (layer, &c) in self.layers.iter().zip(&x[self.layer_columns()]) {
             if c != 0.0 {

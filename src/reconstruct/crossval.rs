@@ -18,9 +18,17 @@ use serde::{Deserialize, Serialize};
 
 use super::summary::{image_offsets_arcsec, median_arcsec, rms_arcsec};
 use super::{
-    reconstruct, ConvergenceRecord, Inputs, ReconstructConfig, ReconstructError, SourceReport,
+    reconstruct, ConvergenceRecord, Inputs, ReconstructConfig, ReconstructError, Reconstruction,
+    SourceReport,
 };
+use crate::curves::CriticalCurves;
+use crate::fits::{write_image, Card, FitsError, FitsWriteOptions};
+use crate::grid::{Map, MapGeometry};
 use crate::inversion::build_constraints;
+use crate::maps::LensMaps;
+use crate::profiles::MassComponent;
+use crate::render::{render_kappa_png, ColorScale, KappaPlotOptions, Overlay, RenderError};
+use crate::sky::SkyReference;
 use crate::solver::{Control, SolveStatus};
 
 /// Default number of folds of `wslap reconstruct --folds` and the app.
@@ -81,6 +89,160 @@ pub struct CrossValidation {
     /// The same for the fitted systems' images, pooled over the folds' fits (arcsec): the
     /// in-sample figure to compare with.
     pub fit_image_offset_median_arcsec: Option<f64>,
+    /// The folds' convergence maps, when asked for (not part of `crossval.json`: the CLI writes
+    /// them as FITS).
+    #[serde(skip)]
+    pub kappa: Option<KappaSpread>,
+}
+
+/// The folds' convergence (`D_ls/D_s = 1`) on one map: where the mass map depends on which
+/// systems are fitted. Pixels are those of the geometry given to [`cross_validate`].
+#[derive(Debug, Clone, PartialEq)]
+pub struct KappaSpread {
+    /// Mean of the folds' kappa.
+    pub mean: Map,
+    /// Standard deviation of the folds' kappa about that mean (over the `K` folds, divided by
+    /// `K`). A delete-a-group jackknife would take `sqrt(K - 1)` times this as the standard
+    /// error of the map made from all the systems.
+    pub spread: Map,
+}
+
+impl KappaSpread {
+    /// `crossval-kappa-mean.fits` and `crossval-kappa-spread.fits`, HFF-style like
+    /// `kappa.fits` (sky `reference` of the frame, lens redshift `ZLENS`), with the number of
+    /// folds in `NFOLDS`.
+    pub fn fits_files(
+        &self,
+        reference: Option<SkyReference>,
+        z_lens: f64,
+        folds: usize,
+    ) -> Result<Vec<(&'static str, Vec<u8>)>, FitsError> {
+        let opts = |what: &str| FitsWriteOptions {
+            bunit: String::new(),
+            comments: vec![
+                format!(
+                    "{what} of the convergence over the {folds} folds of a cross-validation, \
+                     written by wslap {}",
+                    env!("CARGO_PKG_VERSION")
+                ),
+                "Normalised to D_ls/D_s = 1 (HFF convention).".to_string(),
+            ],
+            reference,
+            extra_cards: vec![
+                Card::real("ZLENS", z_lens, "lens redshift"),
+                Card::integer("NFOLDS", folds as i64, "folds of the cross-validation"),
+            ],
+        };
+        Ok(vec![
+            (
+                "crossval-kappa-mean.fits",
+                write_image(&self.mean, &opts("Mean"))?,
+            ),
+            (
+                "crossval-kappa-spread.fits",
+                write_image(&self.spread, &opts("Standard deviation (1/K)"))?,
+            ),
+        ])
+    }
+
+    /// `crossval-kappa-spread.png`: the spread as a figure (linear scale from 0), with
+    /// critical `curves` on top when given (those of the reconstruction from all the systems).
+    pub fn spread_png(
+        &self,
+        curves: Option<&CriticalCurves>,
+        folds: usize,
+    ) -> Result<Vec<u8>, RenderError> {
+        let overlay = Overlay {
+            curves,
+            ..Overlay::default()
+        };
+        let title = match curves {
+            Some(c) => format!(
+                "Spread of kappa over {folds} folds; critical curves at z_s = {}",
+                c.z_source
+            ),
+            None => format!("Spread of kappa over {folds} folds"),
+        };
+        let opts = KappaPlotOptions {
+            scale: ColorScale::Linear,
+            vmin: Some(0.0),
+            title: Some(title),
+            colorbar_label: Some("kappa spread".to_string()),
+            ..KappaPlotOptions::default()
+        };
+        render_kappa_png(&self.spread, &overlay, &opts)
+    }
+}
+
+/// Running mean and sum of squared deviations per pixel (Welford).
+struct SpreadSum {
+    geometry: MapGeometry,
+    folds: f64,
+    mean: Vec<f64>,
+    m2: Vec<f64>,
+}
+
+impl SpreadSum {
+    fn new(geometry: MapGeometry) -> Self {
+        let n = geometry.pixels * geometry.pixels;
+        Self {
+            geometry,
+            folds: 0.0,
+            mean: vec![0.0; n],
+            m2: vec![0.0; n],
+        }
+    }
+
+    fn add(&mut self, kappa: &[f64]) {
+        self.folds += 1.0;
+        for ((mean, m2), &k) in self.mean.iter_mut().zip(&mut self.m2).zip(kappa) {
+            let d = k - *mean;
+            *mean += d / self.folds;
+            *m2 += d * (k - *mean);
+        }
+    }
+
+    fn finish(self) -> Option<KappaSpread> {
+        (self.folds > 0.0).then(|| KappaSpread {
+            spread: Map {
+                geometry: self.geometry,
+                data: self.m2.iter().map(|m2| (m2 / self.folds).sqrt()).collect(),
+            },
+            mean: Map {
+                geometry: self.geometry,
+                data: self.mean,
+            },
+        })
+    }
+}
+
+/// A fold's convergence at the pixels of `geometry`. Its grid's map is made on the fold's own
+/// product map (where its cells fall on the pixel lattice, so by FFT) and interpolated
+/// ([`Map::sample_cubic`]) where that map covers a pixel with a pixel to spare; elsewhere the
+/// cells are summed at the pixel. The galaxy layers, whose halos are sharper than a pixel, are
+/// evaluated at every pixel, times the fold's `C_l`.
+fn fold_kappa(r: &Reconstruction, geometry: MapGeometry) -> Result<Vec<f64>, ReconstructError> {
+    let grid = r.system.grid_mass(&r.x)?;
+    let own = r.products.maps.geometry();
+    let grid_map = LensMaps::from_lens(&grid, own).kappa;
+    let half = 0.5 * own.size_arcsec - 1.5 * own.pixel_arcsec();
+    let layers: Vec<_> = r
+        .system
+        .layers
+        .iter()
+        .zip(r.layer_factors())
+        .filter(|(_, c)| *c != 0.0)
+        .collect();
+    Ok(Map::from_fn(geometry, |p| {
+        let d = p - own.center;
+        let cells = if d.x.abs() <= half && d.y.abs() <= half {
+            grid_map.sample_cubic(p)
+        } else {
+            grid.kappa(p)
+        };
+        cells + layers.iter().map(|(l, c)| c * l.lens.kappa(p)).sum::<f64>()
+    })
+    .data)
 }
 
 /// The ids of the systems a reconstruction of `inputs` fits, in catalogue order (not the
@@ -118,15 +280,19 @@ pub fn fold_groups(
 
 /// Reconstructs the lens `folds` times, each time without one group of [`fold_groups`], and
 /// predicts the images of the group left out. Systems in `inputs.holdout` stay out of every
-/// fit and of the result. `progress` sees the fold number (1-based) and every QADP report,
-/// and may cancel: the result then holds the folds completed before, with status "Cancelled".
+/// fit and of the result. With `kappa_on`, also the mean and spread of the folds' convergence
+/// on that map ([`KappaSpread`]; the map of the reconstruction from all the systems, say).
+/// `progress` sees the fold number (1-based) and every QADP report, and may cancel: the result
+/// then holds the folds completed before, with status "Cancelled".
 pub fn cross_validate(
     inputs: &Inputs<'_>,
     config: &ReconstructConfig,
     folds: usize,
+    kappa_on: Option<MapGeometry>,
     progress: &mut dyn FnMut(usize, &ConvergenceRecord) -> Control,
 ) -> Result<CrossValidation, ReconstructError> {
     let groups = fold_groups(inputs, config, folds)?;
+    let mut spread = kappa_on.map(SpreadSum::new);
     let mut runs = Vec::new();
     let mut systems = Vec::new();
     let mut fitted = Vec::new();
@@ -153,6 +319,9 @@ pub fn cross_validate(
         fitted.extend(image_offsets_arcsec(
             r.sources.iter().filter(|s| !s.held_out),
         ));
+        if let Some(sum) = &mut spread {
+            sum.add(&fold_kappa(&r, sum.geometry)?);
+        }
         runs.push(FoldRun {
             fold,
             held_out: group.clone(),
@@ -186,5 +355,6 @@ pub fn cross_validate(
         holdout_image_offset_median_arcsec: median_arcsec(offsets),
         fit_image_offset_median_arcsec: median_arcsec(fitted),
         systems,
+        kappa: spread.and_then(SpreadSum::finish),
     })
 }

@@ -15,8 +15,8 @@ use thiserror::Error;
 
 pub use config::{ProductConfig, ReconstructConfig, SolverConfig, SolverMethod};
 pub use crossval::{
-    cross_validate, fitted_system_ids, fold_groups, CrossValidation, FoldRun, PredictedSystem,
-    DEFAULT_FOLDS,
+    cross_validate, fitted_system_ids, fold_groups, CrossValidation, FoldRun, KappaSpread,
+    PredictedSystem, DEFAULT_FOLDS,
 };
 pub use sources::{
     image_regions, images_on_maps, source_on_maps, ImageReport, PredictedImage, SourceReport,
@@ -298,6 +298,20 @@ fn reconstruct_limited(
         warnings,
         timings,
     })
+}
+
+/// The map geometry of the products a reconstruction of `inputs` with `config` makes (with
+/// no grid refinement; a refined grid keeps its field): the maps of `kappa.fits`.
+pub fn map_geometry(
+    inputs: &Inputs<'_>,
+    config: &ReconstructConfig,
+) -> Result<MapGeometry, ReconstructError> {
+    config.validate()?;
+    let constraints = build_constraints(inputs.images, &config.constraints, inputs.holdout)?;
+    let positions: Vec<DVec2> = constraints.pixels.iter().map(|p| p.position).collect();
+    let grid = CellGrid::from_config(&config.grid, &positions)?;
+    let opts = product_options(config, &grid);
+    Ok(MapGeometry::centered(opts.size_arcsec, opts.pixels))
 }
 
 /// The product maps of a reconstruction on `grid`: `products.size_arcsec` (default: the grid's
