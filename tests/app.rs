@@ -1228,6 +1228,28 @@ fn cross_validation_predicts_each_system_and_keeps_the_result() {
     assert_eq!(folds_seen, [1, 2]);
     assert_eq!(s.result().unwrap().summary_json().unwrap(), before);
     assert_eq!(cv.systems.len(), 4);
+    // The folds' convergence is on the result's maps (the same settings make the same maps),
+    // and its files are the CLI's, the figure with the result's curves.
+    let products = &s.result().unwrap().products;
+    let kappa = cv.kappa.as_ref().expect("the folds' kappa maps");
+    assert_eq!(kappa.spread.geometry, products.maps.geometry());
+    let files = s.crossval_files(&cv).unwrap();
+    let names: Vec<&str> = files.iter().map(|(n, _)| *n).collect();
+    assert_eq!(
+        names,
+        [
+            "crossval-kappa-mean.fits",
+            "crossval-kappa-spread.fits",
+            "crossval-kappa-spread.png"
+        ]
+    );
+    let (fits, png) = (&files[1].1, &files[2].1);
+    let spread = wslap::fits::read_image(fits, "spread")
+        .unwrap()
+        .to_map()
+        .unwrap();
+    assert_eq!(spread.data.len(), kappa.spread.data.len());
+    assert!(png.starts_with(b"\x89PNG"));
     for run in &cv.runs {
         let mut t = teaching_session();
         t.set_field("holdout", json!(run.held_out)).unwrap();

@@ -204,11 +204,12 @@ function crossValidate() {
   return inWorker('Cross-validating…',
     (onProgress) => ask('crossValidate', {}, onProgress),
     (p) => [(p.fold - 1) * n + p.iteration, p.folds * n, `fold ${p.fold} / ${p.folds}, iteration ${p.iteration} / ${n}`],
-    (cv) => {
+    async (cv) => {
       const seconds = cv.runs.reduce((t, r) => t + r.elapsed_ms, 0) / 1000;
       setStatus(`Cross-validated in ${seconds.toFixed(2)} s (${cv.runs.length} folds).`);
+      const files = await ask('crossvalFiles');
       showCrossval(cv, () => save('crossval.json',
-        new Blob([JSON.stringify(cv, null, 2)], { type: 'application/json' })));
+        new Blob([JSON.stringify(cv, null, 2)], { type: 'application/json' })), files);
       $('crossval-box').scrollIntoView({ block: 'nearest' });
     });
 }

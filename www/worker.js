@@ -41,6 +41,7 @@ const handlers = {
   // Throttled progress (at most every 100 ms) is posted from inside the Rust loop.
   run: (m, progress) => session.run(m.kind, progress),
   crossValidate: (m, progress) => session.cross_validate(progress),
+  crossvalFiles: () => session.crossval_files(),
   resultInfo: () => session.result_info(),
   setZSource: (m) => session.set_z_source(m.z),
   view: (m) => ({ png: session.view(m.name, m.options ?? null) }),

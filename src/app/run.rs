@@ -12,9 +12,9 @@ use crate::inversion::{
 use crate::products::{own_map_side, ProductOptions, Products};
 use crate::profiles::Lens;
 use crate::reconstruct::{
-    cross_validate, fitted_system_ids, product_options, reconstruct, ConvergenceRecord,
-    CrossValidation, Inputs, LayerSource, ReconstructConfig, ReconstructError, SourceReport,
-    StageTimings, DEFAULT_FOLDS,
+    cross_validate, fitted_system_ids, map_geometry, product_options, reconstruct,
+    ConvergenceRecord, CrossValidation, Inputs, LayerSource, ReconstructConfig, ReconstructError,
+    SourceReport, StageTimings, DEFAULT_FOLDS,
 };
 use crate::solver::Control;
 
@@ -201,7 +201,8 @@ impl Session {
     }
 
     /// K-fold cross-validation of the settings on the loaded data
-    /// ([`crate::reconstruct::cross_validate`], `wslap reconstruct --folds`). The session's
+    /// ([`crate::reconstruct::cross_validate`], `wslap reconstruct --folds`), with the folds'
+    /// convergence on the maps a reconstruction with these settings makes. The session's
     /// result is not touched. `progress` sees the fold (1-based) and every QADP report, and
     /// may cancel.
     pub fn cross_validate(
@@ -210,8 +211,39 @@ impl Session {
         progress: &mut dyn FnMut(usize, &ConvergenceRecord) -> Control,
     ) -> Result<CrossValidation, AppError> {
         self.with_inputs(|inputs, config, _| {
-            cross_validate(inputs, config, folds, None, progress).map_err(run_error)
+            let geometry = map_geometry(inputs, config).map_err(run_error)?;
+            cross_validate(inputs, config, folds, Some(geometry), progress).map_err(run_error)
         })
+    }
+
+    /// The files of `cv`'s convergence maps (`wslap reconstruct --folds` writes the same):
+    /// `crossval-kappa-mean.fits`, `crossval-kappa-spread.fits` (in the loaded data's sky
+    /// frame) and `crossval-kappa-spread.png`, with the result's critical curves when the
+    /// result is on the same maps. None without maps.
+    pub fn crossval_files(
+        &self,
+        cv: &CrossValidation,
+    ) -> Result<Vec<(&'static str, Vec<u8>)>, AppError> {
+        let Some(kappa) = &cv.kappa else {
+            return Ok(Vec::new());
+        };
+        let folds = cv.runs.len();
+        let curves = self
+            .result()
+            .ok()
+            .map(|r| &r.products)
+            .filter(|p| p.maps.geometry() == kappa.spread.geometry)
+            .map(|p| &p.curves);
+        let (reference, z_lens) =
+            self.with_inputs(|inputs, _, _| Ok((inputs.reference, inputs.plane.z_lens)))?;
+        let mut files = kappa
+            .fits_files(reference, z_lens, folds)
+            .map_err(|e| AppError::Run(e.to_string()))?;
+        let png = kappa
+            .spread_png(curves, folds)
+            .map_err(|e| AppError::Run(e.to_string()))?;
+        files.push(("crossval-kappa-spread.png", png));
+        Ok(files)
     }
 
     /// Rebuilds a reconstruction from a stored solution `x` without iterating: the same

@@ -62,10 +62,25 @@ fn bytes(png: &[u8]) -> JsValue {
     js_sys::Uint8Array::from(png).into()
 }
 
+/// Files as an array of `{name, bytes}`.
+fn files_js<'a>(files: impl Iterator<Item = (&'a str, &'a [u8])>) -> Result<JsValue, JsError> {
+    let out = js_sys::Array::new();
+    for (name, data) in files {
+        let obj = js_sys::Object::new();
+        set(&obj, "name", &JsValue::from_str(name))?;
+        set(&obj, "bytes", &bytes(data))?;
+        out.push(&obj);
+    }
+    Ok(out.into())
+}
+
 /// One session: loaded data, settings and the last result.
 #[wasm_bindgen]
 pub struct AppSession {
     inner: Session,
+    /// The files of the last cross-validation's convergence maps (see
+    /// [`Session::crossval_files`]).
+    crossval_files: Vec<(&'static str, Vec<u8>)>,
 }
 
 impl Default for AppSession {
@@ -81,6 +96,7 @@ impl AppSession {
     pub fn new() -> AppSession {
         AppSession {
             inner: Session::new(),
+            crossval_files: Vec::new(),
         }
     }
 
@@ -147,7 +163,7 @@ impl AppSession {
     /// ([`Session::cross_validate`], default folds): `crossval.json` as an object. The
     /// session's result is not touched. `progress` gets each QADP report throttled like
     /// [`AppSession::run`]'s, with `fold` (1-based), `folds` and `elapsed_ms`.
-    pub fn cross_validate(&self, progress: &js_sys::Function) -> Result<JsValue, JsError> {
+    pub fn cross_validate(&mut self, progress: &js_sys::Function) -> Result<JsValue, JsError> {
         let folds = self.inner.default_folds().map_err(err)?;
         let mut throttle = Throttle::new(progress);
         let mut report = |fold: usize, r: &ConvergenceRecord| {
@@ -155,7 +171,15 @@ impl AppSession {
             Control::Continue
         };
         let cv = self.inner.cross_validate(folds, &mut report).map_err(err)?;
+        self.crossval_files = self.inner.crossval_files(&cv).map_err(err)?;
         to_js(&cv)
+    }
+
+    /// The last cross-validation's convergence maps as files: an array of `{name, bytes}`
+    /// (`crossval-kappa-mean.fits`, `crossval-kappa-spread.fits`,
+    /// `crossval-kappa-spread.png`).
+    pub fn crossval_files(&self) -> Result<JsValue, JsError> {
+        files_js(self.crossval_files.iter().map(|(n, b)| (*n, b.as_slice())))
     }
 
     /// `{kind, elapsed_ms, status, iterations, summary, model_note}` of the last result
@@ -268,14 +292,7 @@ impl AppSession {
     pub fn fits_files(&self) -> Result<JsValue, JsError> {
         let r = self.inner.result().map_err(err)?;
         let files = r.products.fits_files().map_err(err)?;
-        let out = js_sys::Array::new();
-        for (name, data) in files {
-            let obj = js_sys::Object::new();
-            set(&obj, "name", &JsValue::from_str(name))?;
-            set(&obj, "bytes", &bytes(&data))?;
-            out.push(&obj);
-        }
-        Ok(out.into())
+        files_js(files.iter().map(|(n, b)| (*n, b.as_slice())))
     }
 
     /// Replaces the session by a project file; returns `{name, result, message}`.

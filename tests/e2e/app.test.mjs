@@ -252,6 +252,18 @@ test('Cross-validate predicts each system once and keeps the result on screen', 
     assert.ok(spread, text);
     assert.equal(spread[1], Math.min(...thetas).toFixed(1));
     assert.equal(spread[2] ?? spread[1], Math.max(...thetas).toFixed(1));
+    // The folds' convergence: the spread drawn as a figure (with the red tangential curve),
+    // and the mean and spread as FITS maps on the result's pixels.
+    const stats = await imageStats(page, '#crossval-spread');
+    assert.ok(stats.width > 200 && stats.distinctColours > 50 && stats.reddish > 20, JSON.stringify(stats));
+    await page.$eval('details:has(#downloads)', (d) => { d.open = true; });
+    const axes = async (id) => {
+      const [d] = await Promise.all([page.waitForEvent('download'), page.click(id)]);
+      return fitsAxes(await readFile(await d.path()));
+    };
+    const result = await axes('#dl-kappa-fits');
+    assert.deepEqual(await axes('#dl-crossval-kappa-mean-fits'), result);
+    assert.deepEqual(await axes('#dl-crossval-kappa-spread-fits'), result);
     // Made with the settings of its time: a change takes it away.
     await setField(page, '#set-reconstruct-solver-iterations', QUICK_ITERATIONS + 100);
     await page.waitForSelector('#crossval-box', { state: 'hidden', timeout: 5000 });

@@ -147,10 +147,17 @@ export function showSystems(sources) {
   document.getElementById('figure').hidden = true;
 }
 
+// The object URL of the cross-validation's spread figure on screen (revoked when it goes).
+let spreadUrl = null;
+
 /** The cross-validation (crossval.json) under the views: the held-out images' offsets against
- * the fitted ones', and per predicted system its fold and image offsets; `null` hides it. */
-export function showCrossval(cv, onDownload) {
+ * the fitted ones', per predicted system its fold and image offsets, and the folds' convergence
+ * maps from `files` (`{name, bytes}`: the spread as a figure, the maps as FITS); `null` hides
+ * it. */
+export function showCrossval(cv, onDownload, files = []) {
   const box = document.getElementById('crossval-box');
+  if (spreadUrl) URL.revokeObjectURL(spreadUrl);
+  spreadUrl = null;
   if (!cv) {
     box.replaceChildren();
     box.hidden = true;
@@ -185,7 +192,24 @@ export function showCrossval(cv, onDownload) {
     observed image's offset from the nearest predicted image (arcsec) with the fold's magnification there, and their rms</caption>
     <thead><tr><th scope="col">system</th><th scope="col">fold</th><th scope="col">z</th>
     <th scope="col">offsets [″] (μ)</th><th scope="col">rms [″]</th></tr></thead><tbody>${rows}</tbody></table></div></details>`;
+  const type = (name) => (name.endsWith('.png') ? 'image/png' : 'application/fits');
+  const png = files.find((f) => f.name.endsWith('.png'));
+  if (png) {
+    spreadUrl = URL.createObjectURL(new Blob([png.bytes], { type: 'image/png' }));
+    const figure = document.createElement('figure');
+    figure.id = 'crossval-spread-figure';
+    figure.innerHTML = `<img id="crossval-spread" src="${spreadUrl}"
+      alt="Map of the standard deviation of the folds' convergence, with the result's critical curves">
+      <figcaption>Standard deviation of the ${runs.length} folds' convergence κ on the result's map: where the
+      mass map depends on which systems are fitted. (A delete-a-group jackknife would take √(K − 1) times it
+      as the standard error of the map from all the systems.)</figcaption>`;
+    box.append(figure);
+  }
   box.append(button('crossval.json', 'dl-crossval-json', onDownload));
+  for (const f of files) {
+    box.append(button(f.name, `dl-${f.name.replace(/\./g, '-')}`,
+      () => save(f.name, new Blob([f.bytes], { type: type(f.name) }))));
+  }
   box.hidden = false;
 }
 
