@@ -538,7 +538,15 @@ fn reconstruct_folds_writes_crossval_json() {
         "{}",
         String::from_utf8_lossy(&out.stderr)
     );
-    assert!(String::from_utf8_lossy(&out.stdout).contains("2 folds: held-out images median"));
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        stdout.contains("2 folds: held-out images median"),
+        "{stdout}"
+    );
+    assert!(
+        stdout.contains("the folds' kappa spread: median"),
+        "{stdout}"
+    );
     assert!(out_dir.join("summary.json").exists());
     let cv: serde_json::Value =
         serde_json::from_str(&fs::read_to_string(out_dir.join("crossval.json")).unwrap()).unwrap();

@@ -249,8 +249,17 @@ pub fn run(args: &ReconstructArgs) -> Result<(), String> {
 
 fn crossval_line(cv: &CrossValidation, path: &Path) -> String {
     let arcsec = |v: Option<f64>| v.map_or("n/a".to_string(), |v| format!("{v:.2} arcsec"));
+    let spread = cv.kappa.as_ref().map_or(String::new(), |k| {
+        let mut values = k.spread.data.clone();
+        values.sort_by(f64::total_cmp);
+        format!(
+            "; the folds' kappa spread: median {:.3}, largest {:.3} (crossval-kappa-spread.fits)",
+            values[values.len() / 2],
+            values.last().copied().unwrap_or(f64::NAN)
+        )
+    });
     format!(
-        "wrote {} ({} folds: held-out images median {}, rms {}, {} of {} without a predicted image; fitted images median {})",
+        "wrote {} ({} folds: held-out images median {}, rms {}, {} of {} without a predicted image; fitted images median {}{spread})",
         path.display(),
         cv.folds,
         arcsec(cv.holdout_image_offset_median_arcsec),
