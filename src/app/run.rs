@@ -219,7 +219,7 @@ impl Session {
     /// The files of `cv`'s convergence maps (`wslap reconstruct --folds` writes the same):
     /// `crossval-kappa-mean.fits`, `crossval-kappa-spread.fits` (in the loaded data's sky
     /// frame) and `crossval-kappa-spread.png`, with the result's critical curves when the
-    /// result is on the same maps. None without maps.
+    /// result is on the same maps. Empty when `cv` has no maps.
     pub fn crossval_files(
         &self,
         cv: &CrossValidation,

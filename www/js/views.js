@@ -199,10 +199,11 @@ export function showCrossval(cv, onDownload, files = []) {
     const figure = document.createElement('figure');
     figure.id = 'crossval-spread-figure';
     figure.innerHTML = `<img id="crossval-spread" src="${spreadUrl}"
-      alt="Map of the standard deviation of the folds' convergence, with the result's critical curves">
-      <figcaption>Standard deviation of the ${runs.length} folds' convergence κ on the result's map: where the
-      mass map depends on which systems are fitted. (A delete-a-group jackknife would take √(K − 1) times it
-      as the standard error of the map from all the systems.)</figcaption>`;
+      alt="Map of the standard deviation of the folds' convergence">
+      <figcaption>Standard deviation of the ${runs.length} folds' convergence κ, on the map a reconstruction
+      with these settings makes (with the critical curves of the result on screen when it is that map): where
+      the mass map depends on which systems are fitted. (A delete-a-group jackknife would take √(K − 1) times
+      it as the standard error of the map from all the systems.)</figcaption>`;
     box.append(figure);
   }
   box.append(button('crossval.json', 'dl-crossval-json', onDownload));
