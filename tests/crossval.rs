@@ -177,6 +177,11 @@ fn each_fold_is_a_hold_out_run_and_every_system_is_predicted_once() {
         );
         assert_eq!(run.einstein_radius_z_source, config().products.z_source);
         assert_eq!(
+            run.mass_within_arcsec,
+            alone.products.summary().mass_within_arcsec
+        );
+        assert_eq!(run.mass_within_arcsec.len(), 3);
+        assert_eq!(
             run.fit_image_offset_median_arcsec,
             alone.image_offset_median_arcsec(false)
         );

@@ -52,6 +52,10 @@ pub struct FoldRun {
     pub einstein_radius_arcsec: f64,
     /// That z_s.
     pub einstein_radius_z_source: f64,
+    /// Its projected mass (Msun) inside 10, 20 and 50 arcsec of (0, 0), as in `summary.json`
+    /// (`null` where the circle leaves its map).
+    #[serde(default)]
+    pub mass_within_arcsec: Vec<(f64, Option<f64>)>,
     /// Median offset of the fitted systems' images from their predictions (arcsec).
     pub fit_image_offset_median_arcsec: Option<f64>,
     /// Median offset of the held-out systems' images from their predictions (arcsec).
@@ -322,6 +326,7 @@ pub fn cross_validate(
         if let Some(sum) = &mut spread {
             sum.add(&fold_kappa(&r, sum.geometry)?);
         }
+        let summary = r.products.summary();
         runs.push(FoldRun {
             fold,
             held_out: group.clone(),
@@ -329,8 +334,9 @@ pub fn cross_validate(
             iterations: r.iterations,
             c: r.layer_factors(),
             grid_mass_msun: r.grid_mass_msun(),
-            einstein_radius_arcsec: r.products.summary().einstein_radius_arcsec,
+            einstein_radius_arcsec: summary.einstein_radius_arcsec,
             einstein_radius_z_source: r.products.curves.z_source,
+            mass_within_arcsec: summary.mass_within_arcsec,
             fit_image_offset_median_arcsec: r.image_offset_median_arcsec(false),
             holdout_image_offset_median_arcsec: median_arcsec(image_offsets_arcsec(
                 predicted.iter(),

@@ -252,6 +252,13 @@ test('Cross-validate predicts each system once and keeps the result on screen', 
     assert.ok(spread, text);
     assert.equal(spread[1], Math.min(...thetas).toFixed(1));
     assert.equal(spread[2] ?? spread[1], Math.max(...thetas).toFixed(1));
+    // And their projected mass within 10″ and 20″ (50″ leaves the teaching example's 60″ map).
+    for (const [k, r] of [[0, 10], [1, 20]]) {
+      const ms = cv.runs.map((run) => run.mass_within_arcsec[k][1]);
+      const want = [Math.min(...ms), Math.max(...ms)].map((v) => v.toExponential(2).replace('e+', 'e'));
+      assert.ok(text.includes(`within ${r}″ ${want[0] === want[1] ? want[0] : want.join(' – ')} M☉`), text);
+    }
+    assert.ok(!text.includes('within 50″'), text);
     // The folds' convergence: the spread drawn as a figure (with the red tangential curve),
     // and the mean and spread as FITS maps on the result's pixels.
     const stats = await imageStats(page, '#crossval-spread');

@@ -175,9 +175,18 @@ export function showCrossval(cv, onDownload, files = []) {
   const thetas = runs.map((r) => r.einstein_radius_arcsec);
   const layers = runs.length ? runs[0].c.length : 0;
   const factors = [...Array(layers).keys()].map((l) => span(runs.map((r) => r.c[l]), 2));
+  // The folds' projected mass inside each summary radius that every fold's map holds.
+  const massSpan = (values) => {
+    const [lo, hi] = [Math.min(...values), Math.max(...values)].map((v) => v.toExponential(2).replace('e+', 'e'));
+    return lo === hi ? lo : `${lo} – ${hi}`;
+  };
+  const masses = runs.length < 2 ? [] : (runs[0].mass_within_arcsec ?? [])
+    .map(([r], k) => [r, runs.map((run) => run.mass_within_arcsec?.[k]?.[1])])
+    .filter(([, values]) => values.every((m) => Number.isFinite(m)))
+    .map(([r, values]) => `within ${fmt(r, 0)}″ ${massSpan(values)} M☉`);
   const spread = runs.length < 2 ? '' : ` Across the folds the Einstein radius at z_s = ${runs[0].einstein_radius_z_source} is
     ${span(thetas, 1)}″${factors.length ? ` and the member factor C is ${factors.join(', ')}` : ''}: how much the answer
-    depends on which systems are fitted.`;
+    depends on which systems are fitted.${masses.length ? ` Their projected mass: ${masses.join('; ')}.` : ''}`;
   const rows = cv.systems.map((s) => `<tr><th scope="row">${esc(s.id)}</th><td>${s.fold}</td><td>${fmt(s.z, 3)}</td>
     ${offsetsCell(s.observed)}
     <td>${fmt(s.image_plane_rms_arcsec)}</td></tr>`).join('');
