@@ -227,7 +227,6 @@ impl Session {
         let Some(kappa) = &cv.kappa else {
             return Ok(Vec::new());
         };
-        let folds = cv.runs.len();
         let curves = self
             .result()
             .ok()
@@ -236,14 +235,9 @@ impl Session {
             .map(|p| &p.curves);
         let (reference, z_lens) =
             self.with_inputs(|inputs, _, _| Ok((inputs.reference, inputs.plane.z_lens)))?;
-        let mut files = kappa
-            .fits_files(reference, z_lens, folds)
-            .map_err(|e| AppError::Run(e.to_string()))?;
-        let png = kappa
-            .spread_png(curves, folds)
-            .map_err(|e| AppError::Run(e.to_string()))?;
-        files.push(("crossval-kappa-spread.png", png));
-        Ok(files)
+        kappa
+            .files(reference, z_lens, curves, cv.runs.len())
+            .map_err(|e| AppError::Run(e.to_string()))
     }
 
     /// Rebuilds a reconstruction from a stored solution `x` without iterating: the same

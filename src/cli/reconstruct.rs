@@ -230,17 +230,13 @@ pub fn run(args: &ReconstructArgs) -> Result<(), String> {
         };
         write("crossval.json", json(&cv)?.as_bytes())?;
         if let Some(kappa) = &cv.kappa {
-            let products = &result.products;
-            for (file, bytes) in kappa
-                .fits_files(products.reference, products.plane.z_lens, cv.runs.len())
-                .map_err(|e| e.to_string())?
-            {
+            let p = &result.products;
+            let files = kappa
+                .files(p.reference, p.plane.z_lens, Some(&p.curves), cv.runs.len())
+                .map_err(|e| e.to_string())?;
+            for (file, bytes) in files {
                 write(file, &bytes)?;
             }
-            let png = kappa
-                .spread_png(Some(&products.curves), cv.runs.len())
-                .map_err(|e| e.to_string())?;
-            write("crossval-kappa-spread.png", &png)?;
         }
         println!("{}", crossval_line(&cv, &args.out.join("crossval.json")));
     }

@@ -22,12 +22,13 @@ use super::{
     SourceReport,
 };
 use crate::curves::CriticalCurves;
-use crate::fits::{write_image, Card, FitsError, FitsWriteOptions};
+use crate::fits::{write_image, Card, FitsWriteOptions};
 use crate::grid::{Map, MapGeometry};
 use crate::inversion::build_constraints;
 use crate::maps::LensMaps;
+use crate::products::ProductsError;
 use crate::profiles::MassComponent;
-use crate::render::{render_kappa_png, ColorScale, KappaPlotOptions, Overlay, RenderError};
+use crate::render::{render_kappa_png, ColorScale, KappaPlotOptions, Overlay};
 use crate::sky::SkyReference;
 use crate::solver::{Control, SolveStatus};
 
@@ -112,15 +113,19 @@ pub struct KappaSpread {
 }
 
 impl KappaSpread {
+    /// The files of `wslap reconstruct --folds` and the app's downloads:
     /// `crossval-kappa-mean.fits` and `crossval-kappa-spread.fits`, HFF-style like
-    /// `kappa.fits` (sky `reference` of the frame, lens redshift `ZLENS`), with the number of
-    /// folds in `NFOLDS`.
-    pub fn fits_files(
+    /// `kappa.fits` (sky `reference` of the frame, lens redshift `ZLENS`, the number of folds
+    /// in `NFOLDS`), and `crossval-kappa-spread.png`, the spread as a figure (linear scale from
+    /// 0) with critical `curves` on top when given (those of the reconstruction from all the
+    /// systems).
+    pub fn files(
         &self,
         reference: Option<SkyReference>,
         z_lens: f64,
+        curves: Option<&CriticalCurves>,
         folds: usize,
-    ) -> Result<Vec<(&'static str, Vec<u8>)>, FitsError> {
+    ) -> Result<Vec<(&'static str, Vec<u8>)>, ProductsError> {
         let opts = |what: &str| FitsWriteOptions {
             bunit: String::new(),
             comments: vec![
@@ -137,25 +142,6 @@ impl KappaSpread {
                 Card::integer("NFOLDS", folds as i64, "folds of the cross-validation"),
             ],
         };
-        Ok(vec![
-            (
-                "crossval-kappa-mean.fits",
-                write_image(&self.mean, &opts("Mean"))?,
-            ),
-            (
-                "crossval-kappa-spread.fits",
-                write_image(&self.spread, &opts("Standard deviation (1/K)"))?,
-            ),
-        ])
-    }
-
-    /// `crossval-kappa-spread.png`: the spread as a figure (linear scale from 0), with
-    /// critical `curves` on top when given (those of the reconstruction from all the systems).
-    pub fn spread_png(
-        &self,
-        curves: Option<&CriticalCurves>,
-        folds: usize,
-    ) -> Result<Vec<u8>, RenderError> {
         let overlay = Overlay {
             curves,
             ..Overlay::default()
@@ -167,14 +153,27 @@ impl KappaSpread {
             ),
             None => format!("Spread of kappa over {folds} folds"),
         };
-        let opts = KappaPlotOptions {
+        let plot = KappaPlotOptions {
             scale: ColorScale::Linear,
             vmin: Some(0.0),
             title: Some(title),
             colorbar_label: Some("kappa spread".to_string()),
             ..KappaPlotOptions::default()
         };
-        render_kappa_png(&self.spread, &overlay, &opts)
+        Ok(vec![
+            (
+                "crossval-kappa-mean.fits",
+                write_image(&self.mean, &opts("Mean"))?,
+            ),
+            (
+                "crossval-kappa-spread.fits",
+                write_image(&self.spread, &opts("Standard deviation (1/K)"))?,
+            ),
+            (
+                "crossval-kappa-spread.png",
+                render_kappa_png(&self.spread, &overlay, &plot)?,
+            ),
+        ])
     }
 }
 
