@@ -242,13 +242,14 @@ impl LenstoolPar {
     /// does; also returns the catalogues' warnings.
     pub fn build_from_texts(
         &self,
-        member_texts: &[(&str, &str)],
+        member_texts: &[(impl AsRef<str>, impl AsRef<str>)],
     ) -> Result<(LenstoolModel, Vec<CatalogWarning>), ParError> {
         let mut catalogs = Vec::with_capacity(member_texts.len());
         let mut warnings = Vec::new();
         for (name, text) in member_texts {
-            let (catalog, w) = crate::catalog::parse_member_catalog(text, name, self.reference)
-                .map_err(|e| ParError::Catalog(Box::new(e)))?;
+            let (catalog, w) =
+                crate::catalog::parse_member_catalog(text.as_ref(), name.as_ref(), self.reference)
+                    .map_err(|e| ParError::Catalog(Box::new(e)))?;
             warnings.extend(w);
             catalogs.push(catalog);
         }
@@ -342,9 +343,5 @@ pub fn load_lenstool_model(
         .iter()
         .map(|path| Ok((path.display().to_string(), read(path)?)))
         .collect::<Result<Vec<_>, ParError>>()?;
-    let texts: Vec<(&str, &str)> = texts
-        .iter()
-        .map(|(n, t)| (n.as_str(), t.as_str()))
-        .collect();
     Ok(par.build_from_texts(&texts)?.0)
 }

@@ -137,10 +137,6 @@ fn lenstool_products(
         })?;
         texts.push((path.display().to_string(), text));
     }
-    let texts: Vec<(&str, &str)> = texts
-        .iter()
-        .map(|(n, t)| (n.as_str(), t.as_str()))
-        .collect();
     let (model, warnings) = par.build_from_texts(&texts).map_err(|e| e.to_string())?;
     for w in warnings {
         eprintln!("warning: {w}");

@@ -429,8 +429,8 @@ fn transpose(src: &[Complex64], rows: usize, cols: usize, dst: &mut [Complex64])
     });
 }
 
-/// Runs `f` on every item, natively spread over [`crate::threads::available`] scoped threads (items dealt in
-/// turn), serially on wasm32.
+/// Runs `f` on every item, natively spread over [`crate::threads::available`] scoped threads
+/// (items dealt in turn), serially on wasm32.
 fn for_each_band<T: Send>(items: Vec<T>, f: impl Fn(T) + Sync) {
     let t = crate::threads::available();
     if t <= 1 || items.len() <= 1 {
