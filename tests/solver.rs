@@ -330,6 +330,65 @@ fn threads_agree_to_rounding() {
     }
 }
 
+/// The threads of a run live as long as the run: every report sees the state all bands agree
+/// on, and a cancel (as any other end) lets them go.
+#[cfg_attr(not(target_arch = "wasm32"), test)]
+#[cfg_attr(target_arch = "wasm32", wasm_bindgen_test::wasm_bindgen_test)]
+fn threaded_runs_report_every_chunk_and_end_on_cancel() {
+    let n = 61;
+    let (a, b) = random_problem(&mut Rng(13), n);
+    let problem = QadpProblem::new(&a, &b, n).expect("valid problem");
+    let record = |threads| {
+        let mut reports = Vec::new();
+        let settings = QadpSettings {
+            iterations: 400,
+            report_every: 30,
+            threads,
+        };
+        let outcome = problem
+            .run(&[0.1; 61], &settings, &mut |p| {
+                reports.push((p.iteration, p.objective, objective(&a, &b, p.x)));
+                if p.iteration >= 150 {
+                    Control::Cancel
+                } else {
+                    Control::Continue
+                }
+            })
+            .expect("valid run");
+        (outcome, reports)
+    };
+    let (serial, serial_reports) = record(1);
+    for threads in [2, 3] {
+        let (outcome, reports) = record(threads);
+        assert_eq!(outcome.status, SolveStatus::Cancelled);
+        assert_eq!(outcome.iterations, 150);
+        assert_eq!(reports.len(), serial_reports.len());
+        for (&(k, reported, exact), &(k_ref, reported_ref, _)) in
+            reports.iter().zip(&serial_reports)
+        {
+            assert_eq!(k, k_ref);
+            assert_rel(
+                "reported objective",
+                reported,
+                exact,
+                REPORTED_OBJECTIVE_RTOL,
+            );
+            assert_rel(
+                "objective against one thread",
+                reported,
+                reported_ref,
+                THREADS_RTOL,
+            );
+        }
+        assert_rel(
+            "final objective",
+            outcome.objective,
+            serial.objective,
+            THREADS_RTOL,
+        );
+    }
+}
+
 #[cfg_attr(not(target_arch = "wasm32"), test)]
 #[cfg_attr(target_arch = "wasm32", wasm_bindgen_test::wasm_bindgen_test)]
 fn normal_equations_match_naive_product() {

@@ -5,8 +5,9 @@
 //! column sums that belong to later bands, and waits (barrier 1); it then completes `a`, `c` of
 //! its rows with the earlier bands' column sums and the diagonal, writes its rows of the next
 //! `Z`, and waits (barrier 2). `Z` lives in two buffers (version `k` in buffer `k % 2`), so a
-//! buffer is written only after everyone has read it. The callback runs on the calling thread
-//! between chunks of `report_every` updates, when no other thread is running.
+//! buffer is written only after everyone has read it. The threads are started once per run;
+//! the callback runs on the calling thread between chunks of `report_every` updates, while the
+//! others wait for the next chunk.
 
 use std::ops::Range;
 use std::sync::atomic::{AtomicU64, AtomicUsize, Ordering};
@@ -80,11 +81,16 @@ impl ScaledProblem {
     }
 }
 
-/// What the threads share: the two versions of `Z` and each band's published column sums.
+/// What the threads share: the two versions of `Z`, each band's published column sums and
+/// share of the objective, and the means to keep in step.
 struct Shared {
     z: [Vec<AtomicU64>; 2],
     col_a: Vec<Vec<AtomicU64>>,
     col_c: Vec<Vec<AtomicU64>>,
+    objective: Vec<AtomicU64>,
+    /// Between the halves of an update, and at the end of a chunk.
+    barrier: SpinBarrier,
+    orders: Orders,
 }
 
 /// One band of rows and its private buffers.
@@ -95,8 +101,6 @@ struct Band {
     /// Complete `a_i`, `c_i` of the band's rows for the current `Z`.
     a: Vec<f64>,
     c: Vec<f64>,
-    /// This band's share of `phi_M(Z)`.
-    partial_objective: f64,
     z: Vec<f64>,
     z_f32: Vec<f32>,
 }
@@ -132,6 +136,9 @@ fn band_rows(n: usize, padded: usize, threads: usize) -> Vec<Range<usize>> {
 }
 
 /// The whole run: chunks of updates with a report after each (see [`super::QadpProblem::run`]).
+/// Natively with more than one band, each further band gets a thread for the whole run; the
+/// calling thread takes the first band and runs the callback between chunks, while the others
+/// wait (blocked, not spinning) for the next chunk.
 pub(crate) fn run_chunks(
     p: &ScaledProblem,
     x0: &[f64],
@@ -152,6 +159,9 @@ pub(crate) fn run_chunks(
         ],
         col_a: ranges.iter().map(|_| atomics(n)).collect(),
         col_c: ranges.iter().map(|_| atomics(n)).collect(),
+        objective: atomics(ranges.len()),
+        barrier: SpinBarrier::new(ranges.len()),
+        orders: Orders::new(ranges.len()),
     };
     let mut bands: Vec<Band> = ranges
         .into_iter()
@@ -162,96 +172,114 @@ pub(crate) fn run_chunks(
             a: vec![0.0; rows.len()],
             c: vec![0.0; rows.len()],
             rows,
-            partial_objective: 0.0,
             z: vec![0.0; n],
             z_f32: vec![0.0; padded],
         })
         .collect();
-    run_chunk(p, &shared, &mut bands, true, 0, 0);
-    let objective_of =
-        |bands: &[Band]| p.objective_scale * bands.iter().map(|b| b.partial_objective).sum::<f64>();
-    let objective0 = objective_of(&bands);
+    let (first, rest) = bands
+        .split_first_mut()
+        .expect("band_rows makes at least one band");
+    #[cfg(not(target_arch = "wasm32"))]
+    if !rest.is_empty() {
+        return std::thread::scope(|s| {
+            for band in rest {
+                let shared = &shared;
+                s.spawn(move || follow(p, shared, band));
+            }
+            // Releases the other threads however the run ends.
+            let _release = Release(&shared.orders);
+            lead(p, x0, &shared, first, settings, callback)
+        });
+    }
+    debug_assert!(rest.is_empty(), "wasm32 runs one band");
+    lead(p, x0, &shared, first, settings, callback)
+}
+
+/// The calling thread's part: the first band, the chunks and the callback.
+fn lead(
+    p: &ScaledProblem,
+    x0: &[f64],
+    shared: &Shared,
+    band: &mut Band,
+    settings: &QadpSettings,
+    callback: &mut dyn FnMut(&Progress) -> Control,
+) -> Result<SolveOutcome, SolverError> {
+    let objective = |shared: &Shared| {
+        p.objective_scale
+            * shared
+                .objective
+                .iter()
+                .map(|o| f64::from_bits(o.load(Ordering::Relaxed)))
+                .sum::<f64>()
+    };
+    let mut chunk = |initial: bool, steps: usize, parity: usize| {
+        shared.orders.give(Chunk {
+            initial,
+            steps,
+            parity,
+        });
+        sweep_band(p, shared, band, initial, steps, parity);
+        shared.barrier.wait();
+    };
+    chunk(true, 0, 0);
+    let objective0 = objective(shared);
     drive(
         x0.to_vec(),
         objective0,
         settings,
         callback,
         &mut |done, steps| {
-            run_chunk(p, &shared, &mut bands, false, steps, done % 2);
+            chunk(false, steps, done % 2);
             let x = shared.z[(done + steps) % 2]
                 .iter()
                 .zip(&p.to_scaled)
                 .map(|(z, s)| f64::from_bits(z.load(Ordering::Relaxed)) / s)
                 .collect();
-            Some((x, objective_of(&bands)))
+            Some((x, objective(shared)))
         },
     )
 }
 
-/// `steps` updates starting from version `parity` of `Z` (preceded by a pass if `initial`),
-/// every band on its own thread natively.
-fn run_chunk(
-    p: &ScaledProblem,
-    shared: &Shared,
-    bands: &mut [Band],
-    initial: bool,
-    steps: usize,
-    parity: usize,
-) {
-    let barrier = SpinBarrier::new(bands.len());
-    #[cfg(not(target_arch = "wasm32"))]
-    if let Some((first, rest)) = bands.split_first_mut() {
-        if !rest.is_empty() {
-            std::thread::scope(|s| {
-                for band in rest {
-                    let barrier = &barrier;
-                    s.spawn(move || sweep_band(p, shared, band, barrier, initial, steps, parity));
-                }
-                sweep_band(p, shared, first, &barrier, initial, steps, parity);
-            });
-            return;
-        }
-    }
-    for band in bands {
-        sweep_band(p, shared, band, &barrier, initial, steps, parity);
+/// Another thread's part: its band in every chunk, until the run ends.
+#[cfg(not(target_arch = "wasm32"))]
+fn follow(p: &ScaledProblem, shared: &Shared, band: &mut Band) {
+    while let Some(chunk) = shared.orders.take() {
+        sweep_band(p, shared, band, chunk.initial, chunk.steps, chunk.parity);
+        shared.barrier.wait();
     }
 }
 
+/// `steps` updates starting from version `parity` of `Z` (preceded by a pass if `initial`);
+/// the band's share of the objective at the end goes to `shared.objective`.
 fn sweep_band(
     p: &ScaledProblem,
     shared: &Shared,
     band: &mut Band,
-    barrier: &SpinBarrier,
     initial: bool,
     steps: usize,
     mut parity: usize,
 ) {
     if initial {
-        compute_sums(p, shared, parity, band, barrier);
+        compute_sums(p, shared, parity, band);
     }
     for _ in 0..steps {
         update_rows(p, &shared.z[1 - parity], band);
-        barrier.wait();
+        shared.barrier.wait();
         parity = 1 - parity;
-        compute_sums(p, shared, parity, band, barrier);
+        compute_sums(p, shared, parity, band);
     }
-    band.partial_objective = band
+    let objective: f64 = band
         .rows
         .clone()
         .zip(band.a.iter().zip(&band.c))
         .map(|(i, (a, c))| band.z[i] * (0.5 * (a - c) + p.b_hat[i]))
         .sum();
+    shared.objective[band.index].store(objective.to_bits(), Ordering::Relaxed);
 }
 
 /// Loads version `parity` of `Z`, makes the band's pass, exchanges column sums with the other
 /// bands (one barrier) and completes `a`, `c` of the band's rows.
-fn compute_sums(
-    p: &ScaledProblem,
-    shared: &Shared,
-    parity: usize,
-    band: &mut Band,
-    barrier: &SpinBarrier,
-) {
+fn compute_sums(p: &ScaledProblem, shared: &Shared, parity: usize, band: &mut Band) {
     let mut z_max = 0.0f64;
     for (dst, src) in band.z.iter_mut().zip(&shared.z[parity]) {
         *dst = f64::from_bits(src.load(Ordering::Relaxed));
@@ -272,7 +300,7 @@ fn compute_sums(
             d.store(s.to_bits(), Ordering::Relaxed);
         }
     }
-    barrier.wait();
+    shared.barrier.wait();
     for (k, i) in band.rows.clone().enumerate() {
         let (mut a, mut c) = (
             band.sums.row_a[k] + band.sums.col_a[i],
@@ -311,18 +339,93 @@ fn qadp_ratio(a: f64, c: f64, b: f64) -> f64 {
     }
 }
 
-/// A barrier for a fixed number of threads that spins briefly and then yields, so that a
-/// short wait (the usual case: the bands take about the same time) costs well under a
-/// microsecond, and a long one (the machine is busy) does not burn the time slice the other
-/// thread needs. Generation counting makes it reusable.
+/// One chunk of updates, as the first band's thread orders it.
+#[derive(Debug, Clone, Copy)]
+struct Chunk {
+    initial: bool,
+    steps: usize,
+    parity: usize,
+}
+
+/// Hands each chunk from the calling thread to the other bands' threads, which wait for it at
+/// a blocking barrier: between chunks the callback may take its time without their spinning.
+struct Orders {
+    start: std::sync::Barrier,
+    /// Steps of the next chunk, or [`Orders::STOP`] when the run is over.
+    steps: AtomicUsize,
+    /// Bit 0: parity; bit 1: initial pass.
+    flags: AtomicUsize,
+}
+
+impl Orders {
+    #[cfg(not(target_arch = "wasm32"))]
+    const STOP: usize = usize::MAX;
+
+    fn new(threads: usize) -> Self {
+        Self {
+            start: std::sync::Barrier::new(threads),
+            steps: AtomicUsize::new(0),
+            flags: AtomicUsize::new(0),
+        }
+    }
+
+    /// The calling thread: publishes `chunk` and releases the others. (The barrier orders
+    /// these stores before the others' loads; the others cannot be reading the previous chunk
+    /// any more: they have passed the end-of-chunk barrier.)
+    fn give(&self, chunk: Chunk) {
+        self.steps.store(chunk.steps, Ordering::Relaxed);
+        self.flags.store(
+            chunk.parity | usize::from(chunk.initial) << 1,
+            Ordering::Relaxed,
+        );
+        self.start.wait();
+    }
+
+    /// Another thread: waits for the next chunk; `None` when the run is over.
+    #[cfg(not(target_arch = "wasm32"))]
+    fn take(&self) -> Option<Chunk> {
+        self.start.wait();
+        let steps = self.steps.load(Ordering::Relaxed);
+        let flags = self.flags.load(Ordering::Relaxed);
+        (steps != Self::STOP).then_some(Chunk {
+            initial: flags & 2 != 0,
+            steps,
+            parity: flags & 1,
+        })
+    }
+}
+
+/// Tells the other threads that the run is over when dropped: after the last chunk, on an
+/// error, on a cancel.
+#[cfg(not(target_arch = "wasm32"))]
+struct Release<'a>(&'a Orders);
+
+#[cfg(not(target_arch = "wasm32"))]
+impl Drop for Release<'_> {
+    fn drop(&mut self) {
+        self.0.steps.store(Orders::STOP, Ordering::Relaxed);
+        self.0.start.wait();
+    }
+}
+
+/// A barrier for a fixed number of threads that spins for up to [`SPIN_TIME`] and then
+/// yields. Every thread of a run has a core of its own in the usual case, and the bands take
+/// about the same time, so a wait is a few microseconds and spinning answers it at once. A
+/// thread that gave up its core at every wait (as an earlier version did after 200 spins) let
+/// the scheduler put both bands on one core, where they took turns: no faster than one
+/// thread. A wait longer than [`SPIN_TIME`] means the machine is busy, and yielding then
+/// leaves the time slice to the thread that needs it. Generation counting makes it reusable.
 struct SpinBarrier {
     threads: usize,
     arrived: AtomicUsize,
     generation: AtomicUsize,
 }
 
-/// Spins before yielding to the scheduler while waiting at a [`SpinBarrier`].
-const SPINS_BEFORE_YIELD: u32 = 200;
+/// How long a thread spins at a [`SpinBarrier`] before yielding: about one update of the
+/// largest systems, ten of the usual ones.
+const SPIN_TIME: std::time::Duration = std::time::Duration::from_micros(200);
+/// Spins between looks at the clock.
+const SPINS_PER_CLOCK: u32 = 64;
 
 impl SpinBarrier {
     fn new(threads: usize) -> Self {
@@ -335,17 +438,22 @@ impl SpinBarrier {
 
     /// Blocks until all `threads` threads have called `wait`.
     fn wait(&self) {
+        if self.threads == 1 {
+            // Also keeps the clock (absent on wasm32) out of single-threaded runs.
+            return;
+        }
         let generation = self.generation.load(Ordering::Acquire);
         if self.arrived.fetch_add(1, Ordering::AcqRel) + 1 == self.threads {
             self.arrived.store(0, Ordering::Relaxed);
             self.generation.fetch_add(1, Ordering::Release);
             return;
         }
-        let mut spins = 0;
+        let began = std::time::Instant::now();
         while self.generation.load(Ordering::Acquire) == generation {
-            if spins < SPINS_BEFORE_YIELD {
-                spins += 1;
-                std::hint::spin_loop();
+            if began.elapsed() < SPIN_TIME {
+                for _ in 0..SPINS_PER_CLOCK {
+                    std::hint::spin_loop();
+                }
             } else {
                 std::thread::yield_now();
             }
