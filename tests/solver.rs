@@ -24,6 +24,10 @@ const MONOTONE_RTOL: f64 = 1e-13;
 /// Bands of rows change how the f32 column sums are grouped: runs with different thread counts
 /// agree to the f32 rounding of the sums (measured: ~1e-9 of max x after 700 iterations).
 const THREADS_RTOL: f64 = 1e-6;
+/// Another storage order groups the f32 sums differently too; on the ill-conditioned lens
+/// problem the iterates drift further apart than on the random ones (measured: 1.1e-6 of
+/// max x after 1500 iterations).
+const ORDER_RTOL: f64 = 1e-5;
 /// The accelerated projected gradient against the exact optimum, after enough iterations
 /// (measured: <= 3e-16 after 3000: rounding).
 const ACCELERATED_OBJECTIVE_RTOL: f64 = 1e-10;
@@ -327,6 +331,100 @@ fn threads_agree_to_rounding() {
             serial.objective,
             THREADS_RTOL,
         );
+    }
+}
+
+/// A lens-shaped problem: the deflections of a 12 x 12 grid of Gaussian cells at 300 pixels,
+/// plus a ridge. Its matrix has long stretches of one sign, which the solver's pass handles
+/// apart from stretches of both signs.
+fn lens_problem(rng: &mut Rng) -> (Vec<f64>, Vec<f64>, Vec<[f64; 2]>) {
+    let (side, pixels) = (12, 300);
+    let n = side * side;
+    let centres: Vec<[f64; 2]> = (0..n)
+        .map(|k| {
+            [
+                (k % side) as f64 * 10.0 - 55.0,
+                (k / side) as f64 * 10.0 - 55.0,
+            ]
+        })
+        .collect();
+    let rows = 2 * pixels + n;
+    let mut g = vec![0.0; rows * n];
+    let mut y = vec![0.0; rows];
+    for p in 0..pixels {
+        let (px, py) = (rng.uniform() * 80.0 - 40.0, rng.uniform() * 80.0 - 40.0);
+        for (k, c) in centres.iter().enumerate() {
+            let (dx, dy) = (px - c[0], py - c[1]);
+            let r2 = dx * dx + dy * dy + 1e-9;
+            let f = (1.0 - (-r2 / 50.0).exp()) / r2;
+            g[p * n + k] = f * dx;
+            g[(pixels + p) * n + k] = f * dy;
+        }
+        // An NFW-like pull towards the centre.
+        y[p] = 0.3 * px / (1.0 + (px * px + py * py).sqrt() / 20.0);
+        y[pixels + p] = 0.3 * py / (1.0 + (px * px + py * py).sqrt() / 20.0);
+    }
+    for k in 0..n {
+        g[(2 * pixels + k) * n + k] = 0.05;
+    }
+    let (a, b) = gram_weighted(&g, rows, n, &vec![1.0; rows], &y).expect("valid lens system");
+    (a, b, centres)
+}
+
+#[cfg_attr(not(target_arch = "wasm32"), test)]
+#[cfg_attr(target_arch = "wasm32", wasm_bindgen_test::wasm_bindgen_test)]
+fn the_storage_order_changes_only_the_rounding() {
+    let (a, b, centres) = lens_problem(&mut Rng(14));
+    let n = centres.len();
+    let settings = QadpSettings {
+        iterations: 1500,
+        report_every: 500,
+        threads: 1,
+    };
+    let x0 = vec![0.01; n];
+    let plain = QadpProblem::new(&a, &b, n).expect("valid problem");
+    let (reference, reports) = run_recorded((&a, &b), &plain, &x0, &settings);
+    let reversed: Vec<usize> = (0..n).rev().collect();
+    for (name, order) in [
+        (
+            "along the Hilbert curve",
+            wslap::solver::locality_order(&centres),
+        ),
+        ("reversed", reversed),
+    ] {
+        let problem = QadpProblem::with_order(&a, &b, n, order).expect("valid order");
+        for threads in [1, 2] {
+            let settings = QadpSettings {
+                threads,
+                ..settings
+            };
+            let (outcome, ordered_reports) = run_recorded((&a, &b), &problem, &x0, &settings);
+            let x_max = reference.x.iter().fold(0.0f64, |m, &v| m.max(v));
+            for (x, x_ref) in outcome.x.iter().zip(&reference.x) {
+                common::assert_abs(name, *x, *x_ref, ORDER_RTOL * x_max);
+            }
+            for (&(_, reported, exact, _), &(_, reported_ref, _, _)) in
+                ordered_reports.iter().zip(&reports)
+            {
+                assert_rel(name, reported, exact, REPORTED_OBJECTIVE_RTOL);
+                assert_rel(name, reported, reported_ref, THREADS_RTOL);
+            }
+        }
+    }
+}
+
+#[cfg_attr(not(target_arch = "wasm32"), test)]
+#[cfg_attr(target_arch = "wasm32", wasm_bindgen_test::wasm_bindgen_test)]
+fn a_bad_storage_order_is_named() {
+    let (a, b) = random_problem(&mut Rng(15), 4);
+    for (order, says) in [
+        (vec![0, 1, 2], "it has 3 entries"),
+        (vec![0, 1, 2, 4], "entry 3 is 4"),
+        (vec![0, 2, 1, 2], "2 appears twice (again at entry 3)"),
+    ] {
+        let err = QadpProblem::with_order(&a, &b, 4, order).expect_err("bad order");
+        assert!(matches!(err, SolverError::BadOrder { n: 4, .. }), "{err:?}");
+        assert!(err.to_string().contains(says), "{err}");
     }
 }
 

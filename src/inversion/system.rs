@@ -285,6 +285,21 @@ impl LinearSystem {
         0..self.grid.len()
     }
 
+    /// The order in which the solver stores the columns: the cells along a Hilbert curve
+    /// through their centres, then the other columns (see
+    /// [`crate::solver::QadpProblem::with_order`]; only the speed depends on it).
+    pub fn solver_order(&self) -> Vec<usize> {
+        let centres: Vec<[f64; 2]> = self
+            .grid
+            .cells
+            .iter()
+            .map(|c| [c.center.x, c.center.y])
+            .collect();
+        let mut order = crate::solver::locality_order(&centres);
+        order.extend(self.grid.len()..self.n_columns());
+        order
+    }
+
     /// Columns of the layer scales `C_l`.
     pub fn layer_columns(&self) -> Range<usize> {
         let start = self.grid.len();

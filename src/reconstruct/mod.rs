@@ -255,7 +255,11 @@ fn reconstruct_limited(
         let n = system.n_columns();
         let outcome = match config.solver.method {
             SolverMethod::Qadp => {
-                QadpProblem::new(&system.a, &system.b, n)?.run(&x0, &settings, &mut callback)?
+                QadpProblem::with_order(&system.a, &system.b, n, system.solver_order())?.run(
+                    &x0,
+                    &settings,
+                    &mut callback,
+                )?
             }
             SolverMethod::AcceleratedGradient => {
                 accelerated_gradient(&system.a, &system.b, n, &x0, &settings, &mut callback)?

@@ -72,6 +72,8 @@ pub enum SolverError {
         index: usize,
         value: f64,
     },
+    #[error("solver: the order of the unknowns is not a permutation of 0..{n}: {reason}")]
+    BadOrder { n: usize, reason: String },
     #[error("solver: setting {name} = {value} is not allowed ({reason})")]
     BadSetting {
         name: &'static str,
@@ -156,6 +158,80 @@ pub(crate) fn check_len(what: &'static str, v: &[f64], expected: usize) -> Resul
     Ok(())
 }
 
+pub(crate) fn check_permutation(order: &[usize], n: usize) -> Result<(), SolverError> {
+    let bad = |reason: String| Err(SolverError::BadOrder { n, reason });
+    if order.len() != n {
+        return bad(format!("it has {} entries", order.len()));
+    }
+    let mut seen = vec![false; n];
+    for (r, &u) in order.iter().enumerate() {
+        if u >= n {
+            return bad(format!("entry {r} is {u}"));
+        }
+        if std::mem::replace(&mut seen[u], true) {
+            return bad(format!("{u} appears twice (again at entry {r})"));
+        }
+    }
+    Ok(())
+}
+
+/// An order of points (e.g. grid-cell centres) along a Hilbert curve over their bounding box,
+/// so that points next to each other in the order are next to each other on the sky, for
+/// [`QadpProblem::with_order`]. `result[r]` is the index of the `r`-th point; points that are
+/// not finite go last, in their own order.
+pub fn locality_order(points: &[[f64; 2]]) -> Vec<usize> {
+    /// Cells of the curve per side: 2^16, far finer than any grid.
+    const BITS: u32 = 16;
+    let finite = |p: &[f64; 2]| p[0].is_finite() && p[1].is_finite();
+    let (mut lo, mut hi) = ([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]);
+    for p in points.iter().filter(|p| finite(p)) {
+        for k in 0..2 {
+            lo[k] = lo[k].min(p[k]);
+            hi[k] = hi[k].max(p[k]);
+        }
+    }
+    let side = (hi[0] - lo[0]).max(hi[1] - lo[1]);
+    let cells = f64::from(1u32 << BITS);
+    let key = |p: &[f64; 2]| -> u64 {
+        if !finite(p) {
+            return u64::MAX;
+        }
+        let cell = |k: usize| {
+            let t = if side > 0.0 {
+                (p[k] - lo[k]) / side
+            } else {
+                0.0
+            };
+            ((t * cells) as u32).min((1 << BITS) - 1)
+        };
+        hilbert_index(BITS, cell(0), cell(1))
+    };
+    let mut order: Vec<usize> = (0..points.len()).collect();
+    order.sort_by_key(|&i| (key(&points[i]), i));
+    order
+}
+
+/// Position of cell `(x, y)` along the Hilbert curve over `2^bits x 2^bits` cells.
+fn hilbert_index(bits: u32, mut x: u32, mut y: u32) -> u64 {
+    let mask = (1u32 << bits) - 1;
+    let mut d = 0u64;
+    let mut s = 1u32 << (bits - 1);
+    while s > 0 {
+        let rx = u32::from(x & s != 0);
+        let ry = u32::from(y & s != 0);
+        d += u64::from(s) * u64::from(s) * u64::from((3 * rx) ^ ry);
+        // Turn the quadrant so that the curve inside it runs the standard way.
+        if ry == 0 {
+            if rx == 1 {
+                (x, y) = (mask ^ x, mask ^ y);
+            }
+            (x, y) = (y, x);
+        }
+        s /= 2;
+    }
+    d
+}
+
 pub(crate) fn check_finite(what: &'static str, v: &[f64]) -> Result<(), SolverError> {
     match v.iter().position(|x| !x.is_finite()) {
         Some(index) => Err(SolverError::NonFinite {
@@ -177,4 +253,44 @@ pub fn objective(a: &[f64], b: &[f64], x: &[f64]) -> f64 {
         phi += x[i] * (0.5 * ax_i + b[i]);
     }
     phi
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn hilbert_curve_visits_every_cell_once_in_unit_steps() {
+        let bits = 4;
+        let side = 1u32 << bits;
+        let mut cell_at = vec![None; (side * side) as usize];
+        for x in 0..side {
+            for y in 0..side {
+                let d = hilbert_index(bits, x, y) as usize;
+                assert!(cell_at[d].replace((x, y)).is_none(), "index {d} twice");
+            }
+        }
+        let cells: Vec<(u32, u32)> = cell_at.into_iter().map(|c| c.expect("all")).collect();
+        for w in cells.windows(2) {
+            let step = w[0].0.abs_diff(w[1].0) + w[0].1.abs_diff(w[1].1);
+            assert_eq!(step, 1, "{:?} -> {:?}", w[0], w[1]);
+        }
+    }
+
+    #[test]
+    fn locality_order_is_a_permutation_with_bad_points_last() {
+        let mut points: Vec<[f64; 2]> = (0..64)
+            .map(|k| [f64::from(k % 8) * 3.0 - 10.0, f64::from(k / 8) * 3.0 + 5.0])
+            .collect();
+        points.insert(5, [f64::NAN, 0.0]);
+        let order = locality_order(&points);
+        assert!(check_permutation(&order, 65).is_ok());
+        assert_eq!(order[64], 5);
+        // Neighbours along the order are neighbours on the 8 x 8 lattice.
+        for w in order[..64].windows(2) {
+            let (p, q) = (points[w[0]], points[w[1]]);
+            let step = (p[0] - q[0]).abs() + (p[1] - q[1]).abs();
+            assert!((step - 3.0).abs() < 1e-12, "{p:?} -> {q:?}");
+        }
+    }
 }

@@ -28,40 +28,44 @@ const MIN_ROWS_PER_THREAD: usize = 128;
 const MAX_THREADS: usize = 8;
 
 /// `M = D A D` (strict upper triangle in f32; the diagonal, 1 or 0, apart), `b_hat = D b / mu`
-/// and the maps between `X` and `Z = X sqrt(A_ii) / mu`; `phi(X) = mu^2 phi_M(Z)`.
+/// and the maps between `X` and `Z = X sqrt(A_ii) / mu`; `phi(X) = mu^2 phi_M(Z)`. Stored with
+/// the unknowns in the order `order` (position `r` holds unknown `order[r]`; see
+/// [`super::QadpProblem::with_order`]): everything indexed by position.
 #[derive(Debug, Clone)]
 pub(crate) struct ScaledProblem {
     pub(crate) n: usize,
     upper: UpperTriangle,
+    order: Vec<usize>,
     diag: Vec<f64>,
     b_hat: Vec<f64>,
-    /// `Z_i = X_i * to_scaled[i]`.
+    /// `Z_r = X_order[r] * to_scaled[r]`.
     to_scaled: Vec<f64>,
     /// `mu^2`.
     objective_scale: f64,
 }
 
 impl ScaledProblem {
-    /// Assumes [`super::validate_system`] passed.
-    pub(crate) fn new(a: &[f64], b: &[f64], n: usize) -> Self {
-        let a_ii = |i: usize| a[i * n + i];
+    /// Assumes [`super::validate_system`] passed and `order` is a permutation of `0..n`.
+    pub(crate) fn new(a: &[f64], b: &[f64], n: usize, order: Vec<usize>) -> Self {
+        let a_ii = |r: usize| a[order[r] * n + order[r]];
         let d: Vec<f64> = (0..n)
-            .map(|i| {
-                if a_ii(i) > 0.0 {
-                    1.0 / a_ii(i).sqrt()
+            .map(|r| {
+                if a_ii(r) > 0.0 {
+                    1.0 / a_ii(r).sqrt()
                 } else {
                     1.0
                 }
             })
             .collect();
+        let b: Vec<f64> = order.iter().map(|&u| b[u]).collect();
         let mu = b
             .iter()
             .zip(&d)
-            .map(|(b_i, d_i)| (b_i * d_i).abs())
+            .map(|(b_r, d_r)| (b_r * d_r).abs())
             .fold(0.0, f64::max);
         let mu = if mu > 0.0 { mu } else { 1.0 };
-        let upper = UpperTriangle::new(n, |i, j| {
-            let v = a[i * n + j] * d[i] * d[j];
+        let upper = UpperTriangle::new(n, |r, s| {
+            let v = a[order[r] * n + order[s]] * d[r] * d[s];
             if v.abs() < MATRIX_FLUSH {
                 0.0
             } else {
@@ -72,12 +76,22 @@ impl ScaledProblem {
             n,
             upper,
             diag: (0..n)
-                .map(|i| if a_ii(i) > 0.0 { 1.0 } else { 0.0 })
+                .map(|r| if a_ii(r) > 0.0 { 1.0 } else { 0.0 })
                 .collect(),
-            b_hat: b.iter().zip(&d).map(|(b_i, d_i)| b_i * d_i / mu).collect(),
-            to_scaled: d.iter().map(|d_i| 1.0 / (d_i * mu)).collect(),
+            b_hat: b.iter().zip(&d).map(|(b_r, d_r)| b_r * d_r / mu).collect(),
+            to_scaled: d.iter().map(|d_r| 1.0 / (d_r * mu)).collect(),
             objective_scale: mu * mu,
+            order,
         }
+    }
+
+    /// `X` in the caller's order from `Z` in stored order.
+    fn unscaled(&self, z: &[AtomicU64]) -> Vec<f64> {
+        let mut x = vec![0.0; self.n];
+        for ((z, s), &u) in z.iter().zip(&self.to_scaled).zip(&self.order) {
+            x[u] = f64::from_bits(z.load(Ordering::Relaxed)) / s;
+        }
+        x
     }
 }
 
@@ -119,14 +133,15 @@ fn thread_count(requested: usize, n: usize) -> usize {
         .max(1)
 }
 
-/// Cuts `0..n` into `threads` bands of about equal stored entries, each starting at an even row.
-fn band_rows(n: usize, padded: usize, threads: usize) -> Vec<Range<usize>> {
-    let work = |i: usize| padded - UpperTriangle::start(i);
-    let total: usize = (0..n).map(work).sum();
+/// Cuts `0..n` into `threads` bands of about equal work ([`UpperTriangle::pair_cost`]), each
+/// starting at an even row.
+fn band_rows(upper: &UpperTriangle, threads: usize) -> Vec<Range<usize>> {
+    let n = upper.n;
+    let total: usize = (0..n).step_by(2).map(|i| upper.pair_cost(i)).sum();
     let mut cuts = vec![0];
     let mut done = 0;
     for i in (0..n).step_by(2) {
-        done += work(i) + if i + 1 < n { work(i + 1) } else { 0 };
+        done += upper.pair_cost(i);
         if done * threads >= total * cuts.len() && cuts.len() < threads && i + 2 < n {
             cuts.push(i + 2);
         }
@@ -147,13 +162,14 @@ pub(crate) fn run_chunks(
 ) -> Result<SolveOutcome, SolverError> {
     let n = p.n;
     let padded = p.upper.padded;
-    let ranges = band_rows(n, padded, thread_count(settings.threads, n));
+    let ranges = band_rows(&p.upper, thread_count(settings.threads, n));
     let atomics = |len: usize| (0..len).map(|_| AtomicU64::new(0)).collect::<Vec<_>>();
     let shared = Shared {
         z: [
-            x0.iter()
+            p.order
+                .iter()
                 .zip(&p.to_scaled)
-                .map(|(x, s)| AtomicU64::new((x * s).to_bits()))
+                .map(|(&u, s)| AtomicU64::new((x0[u] * s).to_bits()))
                 .collect(),
             atomics(n),
         ],
@@ -230,12 +246,7 @@ fn lead(
         callback,
         &mut |done, steps| {
             chunk(false, steps, done % 2);
-            let x = shared.z[(done + steps) % 2]
-                .iter()
-                .zip(&p.to_scaled)
-                .map(|(z, s)| f64::from_bits(z.load(Ordering::Relaxed)) / s)
-                .collect();
-            Some((x, objective(shared)))
+            Some((p.unscaled(&shared.z[(done + steps) % 2]), objective(shared)))
         },
     )
 }

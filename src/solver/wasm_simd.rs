@@ -22,6 +22,19 @@ pub(crate) fn madd_f32x4(p: v128, q: v128, acc: v128) -> v128 {
     }
 }
 
+/// `acc - p * q` on 4 f32 lanes (the same as `acc + (-p) * q`, to the bit).
+#[inline(always)]
+pub(crate) fn nmadd_f32x4(p: v128, q: v128, acc: v128) -> v128 {
+    #[cfg(target_feature = "relaxed-simd")]
+    {
+        core::arch::wasm32::f32x4_relaxed_nmadd(p, q, acc)
+    }
+    #[cfg(not(target_feature = "relaxed-simd"))]
+    {
+        core::arch::wasm32::f32x4_sub(acc, core::arch::wasm32::f32x4_mul(p, q))
+    }
+}
+
 /// `acc + p * q` on 2 f64 lanes.
 #[inline(always)]
 pub(crate) fn madd_f64x2(p: v128, q: v128, acc: v128) -> v128 {
