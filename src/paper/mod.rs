@@ -512,10 +512,10 @@ pub(super) struct Job<'a> {
 /// that ran it (so that only what `finish` keeps stays in memory); returns `finish`'s results in
 /// the jobs' order, or the first error in that order.
 ///
-/// With more than one core the jobs run side by side, one thread each: at the paper's size
-/// (n = 1085 unknowns) QADP's passes gain nothing from a second thread (BENCHMARKS.md: the
-/// barriers wait whenever the other thread is descheduled), while two runs at once use both
-/// cores. A job that fails stops the others from starting.
+/// With more than one core the jobs run side by side, one thread each: every stage of a run
+/// (system, solver, maps, image search) then keeps a core busy with no barriers, where one run
+/// on two threads gains less than twice (QADP's passes about 1.7x at the paper's n = 1085,
+/// BENCHMARKS.md). A job that fails stops the others from starting.
 fn run_all<T: Send>(
     simulation: &Simulation,
     mut jobs: Vec<Job<'_>>,

@@ -419,22 +419,34 @@ impl Drop for Release<'_> {
     }
 }
 
-/// A barrier for a fixed number of threads that spins for up to [`SPIN_TIME`] and then
-/// yields. Every thread of a run has a core of its own in the usual case, and the bands take
-/// about the same time, so a wait is a few microseconds and spinning answers it at once. A
-/// thread that gave up its core at every wait (as an earlier version did after 200 spins) let
-/// the scheduler put both bands on one core, where they took turns: no faster than one
-/// thread. A wait longer than [`SPIN_TIME`] means the machine is busy, and yielding then
-/// leaves the time slice to the thread that needs it. Generation counting makes it reusable.
+/// A barrier for a fixed number of threads that spins for a while and then yields, with the
+/// time it spins set by how waits have ended so far.
+///
+/// Every thread of a run has a core of its own in the usual case, and the bands take about the
+/// same time, so a wait is a few microseconds and spinning answers it at once. A thread that
+/// gave up its core at every wait (as an earlier version did after 200 spins) let the scheduler
+/// put both bands on one core, where they took turns: no faster than one thread. But when the
+/// machine has more threads to run than cores (two runs at once, or other programs), the thread
+/// waited for is often not running, and spinning takes the core it needs: two benchmark runs of
+/// two threads each on two cores took 4.2 s each with a fixed 200 us spin, 0.9 s with one
+/// thread each. So the spin time falls to a quarter whenever a wait outlasts it, down to
+/// [`SPIN_MIN`], and grows by [`SPIN_STEP`] after each wait that it answered, up to
+/// [`SPIN_MAX`]. Generation counting makes the barrier reusable.
 struct SpinBarrier {
     threads: usize,
     arrived: AtomicUsize,
     generation: AtomicUsize,
+    /// The current spin time in ns.
+    spin_ns: AtomicU64,
 }
 
-/// How long a thread spins at a [`SpinBarrier`] before yielding: about one update of the
-/// largest systems, ten of the usual ones.
-const SPIN_TIME: std::time::Duration = std::time::Duration::from_micros(200);
+/// Spin time at the start and at most: about one update of the largest systems, ten of the
+/// usual ones.
+const SPIN_MAX: std::time::Duration = std::time::Duration::from_micros(200);
+/// Spin time at least: about what an earlier version spun (200 spins).
+const SPIN_MIN: std::time::Duration = std::time::Duration::from_micros(1);
+/// Growth of the spin time after a wait that spinning answered.
+const SPIN_STEP: std::time::Duration = std::time::Duration::from_micros(2);
 /// Spins between looks at the clock.
 const SPINS_PER_CLOCK: u32 = 64;
 
@@ -444,6 +456,7 @@ impl SpinBarrier {
             threads,
             arrived: AtomicUsize::new(0),
             generation: AtomicUsize::new(0),
+            spin_ns: AtomicU64::new(SPIN_MAX.as_nanos() as u64),
         }
     }
 
@@ -459,15 +472,71 @@ impl SpinBarrier {
             self.generation.fetch_add(1, Ordering::Release);
             return;
         }
+        let spin = self.spin_ns.load(Ordering::Relaxed);
+        let limit = std::time::Duration::from_nanos(spin);
         let began = std::time::Instant::now();
+        let mut yielded = false;
         while self.generation.load(Ordering::Acquire) == generation {
-            if began.elapsed() < SPIN_TIME {
+            if !yielded && began.elapsed() < limit {
                 for _ in 0..SPINS_PER_CLOCK {
                     std::hint::spin_loop();
                 }
             } else {
+                yielded = true;
                 std::thread::yield_now();
             }
         }
+        self.spin_ns
+            .store(next_spin_ns(spin, yielded), Ordering::Relaxed);
+    }
+}
+
+/// The spin time after a wait that spun `spin_ns` and ended spinning or (`yielded`) not.
+fn next_spin_ns(spin_ns: u64, yielded: bool) -> u64 {
+    let ns = |d: std::time::Duration| d.as_nanos() as u64;
+    if yielded {
+        (spin_ns / 4).max(ns(SPIN_MIN))
+    } else {
+        (spin_ns + ns(SPIN_STEP)).min(ns(SPIN_MAX))
+    }
+}
+
+#[cfg(all(test, not(target_arch = "wasm32")))]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_wait_that_outlasts_the_spin_shortens_it() {
+        let barrier = SpinBarrier::new(2);
+        let spin = || std::time::Duration::from_nanos(barrier.spin_ns.load(Ordering::Relaxed));
+        assert_eq!(spin(), SPIN_MAX);
+        std::thread::scope(|s| {
+            s.spawn(|| {
+                // 100 times the spin: whichever thread waits, its wait outlasts the spin.
+                std::thread::sleep(SPIN_MAX * 100);
+                barrier.wait();
+            });
+            barrier.wait();
+        });
+        assert_eq!(spin(), SPIN_MAX / 4);
+    }
+
+    #[test]
+    fn the_spin_falls_fast_and_recovers_slowly_within_its_bounds() {
+        let ns = |d: std::time::Duration| d.as_nanos() as u64;
+        let mut spin = ns(SPIN_MAX);
+        let mut falls = 0;
+        while spin > ns(SPIN_MIN) {
+            spin = next_spin_ns(spin, true);
+            falls += 1;
+        }
+        assert_eq!((spin, falls), (ns(SPIN_MIN), 4));
+        let mut rises = 0;
+        while spin < ns(SPIN_MAX) {
+            spin = next_spin_ns(spin, false);
+            rises += 1;
+        }
+        assert_eq!((spin, rises), (ns(SPIN_MAX), 100));
+        assert_eq!(next_spin_ns(spin, false), ns(SPIN_MAX));
     }
 }
