@@ -18,22 +18,31 @@ use wslap::solver::{gram_weighted, locality_order, Control, QadpProblem, QadpSet
 mod rng;
 use rng::Rng;
 
+/// Side of the cell grid in arcsec, as in qadp_numpy.py.
+const FOV: f64 = 200.0;
+
+/// Centres of the `n_grid x n_grid` cells over [`FOV`], row-major (cell `row * n_grid + column`).
+fn cell_centres(n_grid: usize) -> Vec<[f64; 2]> {
+    let g = |k: usize| (k as f64 + 0.5) / n_grid as f64 * FOV - FOV / 2.0;
+    (0..n_grid * n_grid)
+        .map(|cell| [g(cell % n_grid), g(cell / n_grid)])
+        .collect()
+}
+
 /// `(Gamma, Theta, W)` as in `synthetic()` of qadp_numpy.py (fov 200 arcsec, Gaussian-smoothed
 /// point-mass deflection per cell, pixels uniform in +-60 arcsec, 30 sources).
 fn synthetic(n_grid: usize, n_pix: usize, n_src: usize) -> (Vec<f64>, Vec<f64>, Vec<f64>) {
     let mut rng = Rng(1);
-    let fov = 200.0;
-    let g = |k: usize| (k as f64 + 0.5) / n_grid as f64 * fov - fov / 2.0;
+    let centres = cell_centres(n_grid);
     let nc = n_grid * n_grid;
-    let sigma = fov / n_grid as f64;
+    let sigma = FOV / n_grid as f64;
     let cols = nc + 1 + 2 * n_src;
     let px: Vec<f64> = (0..n_pix).map(|_| rng.uniform() * 120.0 - 60.0).collect();
     let py: Vec<f64> = (0..n_pix).map(|_| rng.uniform() * 120.0 - 60.0).collect();
     let mut gamma = vec![0.0; 2 * n_pix * cols];
     for p in 0..n_pix {
         let src = (rng.next_u64() % n_src as u64) as usize;
-        for cell in 0..nc {
-            let (cx, cy) = (g(cell % n_grid), g(cell / n_grid));
+        for (cell, [cx, cy]) in centres.iter().enumerate() {
             let (dx, dy) = (px[p] - cx, py[p] - cy);
             let r2 = dx * dx + dy * dy + 1e-12;
             let f = (1.0 - (-r2 / (2.0 * sigma * sigma)).exp()) / r2;
@@ -72,17 +81,12 @@ fn run(n_grid: usize, n_pix: usize, iterations: usize, threads: usize) {
     let n = gamma.len() / w.len();
     let (a, b) = gram_weighted(&gamma, w.len(), n, &w, &theta).expect("valid system");
     let t_gram = t1.elapsed();
-    // As `wslap reconstruct` does: the cells along a Hilbert curve, the other columns after.
-    let fov = 200.0;
-    let g = |k: usize| (k as f64 + 0.5) / n_grid as f64 * fov - fov / 2.0;
-    let centres: Vec<[f64; 2]> = (0..n_grid * n_grid)
-        .map(|cell| [g(cell % n_grid), g(cell / n_grid)])
-        .collect();
-    let mut order = locality_order(&centres);
-    order.extend(n_grid * n_grid..n);
     let problem = if std::env::var_os("QADP_NO_ORDER").is_some() {
         QadpProblem::new(&a, &b, n)
     } else {
+        // As `wslap reconstruct` does: the cells along a Hilbert curve, the other columns after.
+        let mut order = locality_order(&cell_centres(n_grid));
+        order.extend(n_grid * n_grid..n);
         QadpProblem::with_order(&a, &b, n, order)
     }
     .expect("valid problem");

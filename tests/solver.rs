@@ -384,6 +384,7 @@ fn the_storage_order_changes_only_the_rounding() {
     let x0 = vec![0.01; n];
     let plain = QadpProblem::new(&a, &b, n).expect("valid problem");
     let (reference, reports) = run_recorded((&a, &b), &plain, &x0, &settings);
+    let x_max = reference.x.iter().fold(0.0f64, |m, &v| m.max(v));
     let reversed: Vec<usize> = (0..n).rev().collect();
     for (name, order) in [
         (
@@ -399,7 +400,6 @@ fn the_storage_order_changes_only_the_rounding() {
                 ..settings
             };
             let (outcome, ordered_reports) = run_recorded((&a, &b), &problem, &x0, &settings);
-            let x_max = reference.x.iter().fold(0.0f64, |m, &v| m.max(v));
             for (x, x_ref) in outcome.x.iter().zip(&reference.x) {
                 common::assert_abs(name, *x, *x_ref, ORDER_RTOL * x_max);
             }

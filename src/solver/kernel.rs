@@ -32,16 +32,16 @@ const _: () = assert!(CHUNK == 16);
 /// On wasm32 one 4-lane sum per row (not the 16 lanes of the generic code) keeps 32 terms per
 /// lane with a quarter of the columns.
 #[cfg(not(all(target_arch = "wasm32", target_feature = "simd128")))]
-pub(crate) const ROW_BLOCK: usize = 512;
+const ROW_BLOCK: usize = 512;
 #[cfg(all(target_arch = "wasm32", target_feature = "simd128"))]
-pub(crate) const ROW_BLOCK: usize = 128;
+const ROW_BLOCK: usize = 128;
 const _: () = assert!(ROW_BLOCK % CHUNK == 0);
 /// Column sums go from f32 to f64 every this many rows.
 const FLUSH_ROWS: usize = 32;
 
 /// How the entries of a stretch of a row pair compare with 0.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub(crate) enum Signs {
+enum Signs {
     /// Both signs: both sums get a share of each entry.
     Mixed,
     /// No negative entry: only `a` gets anything.
@@ -53,7 +53,7 @@ pub(crate) enum Signs {
 /// Columns `start..end` (whole chunks, counted from the pair's first stored column, within one
 /// [`ROW_BLOCK`]) of a row pair, all of one kind. All-zero chunks are in no run.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub(crate) struct Run {
+struct Run {
     start: u32,
     end: u32,
     signs: Signs,
@@ -107,7 +107,7 @@ impl UpperTriangle {
     }
 
     /// First stored column of row `i`.
-    pub(crate) fn start(i: usize) -> usize {
+    fn start(i: usize) -> usize {
         i / CHUNK * CHUNK
     }
 
