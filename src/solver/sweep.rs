@@ -10,7 +10,7 @@
 //! others wait for the next chunk.
 
 use std::ops::Range;
-use std::sync::atomic::{AtomicU64, AtomicUsize, Ordering};
+use std::sync::atomic::{AtomicBool, AtomicU64, AtomicUsize, Ordering};
 
 use super::kernel::{band_pass, PassSums, UpperTriangle};
 use super::qadp::{drive, Control, Progress, QadpSettings, SolveOutcome};
@@ -42,6 +42,9 @@ pub(crate) struct ScaledProblem {
     to_scaled: Vec<f64>,
     /// `mu^2`.
     objective_scale: f64,
+    /// Tests: the band whose pass panics (a stand-in for a bug in the pass).
+    #[cfg(test)]
+    panic_in_band: Option<usize>,
 }
 
 impl ScaledProblem {
@@ -82,6 +85,8 @@ impl ScaledProblem {
             to_scaled: d.iter().map(|d_r| 1.0 / (d_r * mu)).collect(),
             objective_scale: mu * mu,
             order,
+            #[cfg(test)]
+            panic_in_band: None,
         }
     }
 
@@ -203,7 +208,7 @@ pub(crate) fn run_chunks(
                 s.spawn(move || follow(p, shared, band));
             }
             // Releases the other threads however the run ends.
-            let _release = Release(&shared.orders);
+            let _release = Release(&shared);
             lead(p, x0, &shared, first, settings, callback)
         });
     }
@@ -234,6 +239,7 @@ fn lead(
             steps,
             parity,
         });
+        let _poison = PoisonOnPanic(&shared.barrier);
         sweep_band(p, shared, band, initial, steps, parity);
         shared.barrier.wait();
     };
@@ -255,6 +261,7 @@ fn lead(
 #[cfg(not(target_arch = "wasm32"))]
 fn follow(p: &ScaledProblem, shared: &Shared, band: &mut Band) {
     while let Some(chunk) = shared.orders.take() {
+        let _poison = PoisonOnPanic(&shared.barrier);
         sweep_band(p, shared, band, chunk.initial, chunk.steps, chunk.parity);
         shared.barrier.wait();
     }
@@ -272,6 +279,10 @@ fn sweep_band(
 ) {
     if initial {
         compute_sums(p, shared, parity, band);
+    }
+    #[cfg(test)]
+    if p.panic_in_band == Some(band.index) && steps > 0 {
+        panic!("band {} fails (test)", band.index);
     }
     for _ in 0..steps {
         update_rows(p, &shared.z[1 - parity], band);
@@ -407,15 +418,20 @@ impl Orders {
 }
 
 /// Tells the other threads that the run is over when dropped: after the last chunk, on an
-/// error, on a cancel.
+/// error, on a cancel, on a panic in the callback. Not after a panic during a chunk: the
+/// others have then panicked at the poisoned barrier and wait for nothing.
 #[cfg(not(target_arch = "wasm32"))]
-struct Release<'a>(&'a Orders);
+struct Release<'a>(&'a Shared);
 
 #[cfg(not(target_arch = "wasm32"))]
 impl Drop for Release<'_> {
     fn drop(&mut self) {
-        self.0.steps.store(Orders::STOP, Ordering::Relaxed);
-        self.0.start.wait();
+        if self.0.barrier.poisoned.load(Ordering::Acquire) {
+            return;
+        }
+        let orders = &self.0.orders;
+        orders.steps.store(Orders::STOP, Ordering::Relaxed);
+        orders.start.wait();
     }
 }
 
@@ -432,12 +448,17 @@ impl Drop for Release<'_> {
 /// thread each. So the spin time falls to a quarter whenever a wait outlasts it, down to
 /// [`SPIN_MIN`], and grows by [`SPIN_STEP`] after each wait that it answered, up to
 /// [`SPIN_MAX`]. Generation counting makes the barrier reusable.
+///
+/// A thread that panics during a chunk poisons the barrier ([`PoisonOnPanic`]): the threads
+/// waiting for it, and any that come to wait later, panic too instead of waiting forever, so
+/// the run ends with the panic rather than hanging.
 struct SpinBarrier {
     threads: usize,
     arrived: AtomicUsize,
     generation: AtomicUsize,
     /// The current spin time in ns.
     spin_ns: AtomicU64,
+    poisoned: AtomicBool,
 }
 
 /// Spin time at the start and at most: about one update of the largest systems, ten of the
@@ -457,15 +478,18 @@ impl SpinBarrier {
             arrived: AtomicUsize::new(0),
             generation: AtomicUsize::new(0),
             spin_ns: AtomicU64::new(SPIN_MAX.as_nanos() as u64),
+            poisoned: AtomicBool::new(false),
         }
     }
 
-    /// Blocks until all `threads` threads have called `wait`.
+    /// Blocks until all `threads` threads have called `wait`. Panics if another thread has
+    /// panicked during a chunk (and so will never come).
     fn wait(&self) {
         if self.threads == 1 {
             // Also keeps the clock (absent on wasm32) out of single-threaded runs.
             return;
         }
+        self.check_poison();
         let generation = self.generation.load(Ordering::Acquire);
         if self.arrived.fetch_add(1, Ordering::AcqRel) + 1 == self.threads {
             self.arrived.store(0, Ordering::Relaxed);
@@ -485,9 +509,28 @@ impl SpinBarrier {
                 yielded = true;
                 std::thread::yield_now();
             }
+            self.check_poison();
         }
         self.spin_ns
             .store(next_spin_ns(spin, yielded), Ordering::Relaxed);
+    }
+
+    fn check_poison(&self) {
+        if self.poisoned.load(Ordering::Acquire) {
+            panic!("another QADP thread panicked");
+        }
+    }
+}
+
+/// Poisons `barrier` if dropped while its thread unwinds from a panic: held by every thread
+/// around its part of a chunk.
+struct PoisonOnPanic<'a>(&'a SpinBarrier);
+
+impl Drop for PoisonOnPanic<'_> {
+    fn drop(&mut self) {
+        if std::thread::panicking() {
+            self.0.poisoned.store(true, Ordering::Release);
+        }
     }
 }
 
@@ -504,6 +547,60 @@ fn next_spin_ns(spin_ns: u64, yielded: bool) -> u64 {
 #[cfg(all(test, not(target_arch = "wasm32")))]
 mod tests {
     use super::*;
+
+    /// A small dense problem `A = G^T G + I`, `b = -G^T t`, in the given order.
+    fn problem(n: usize) -> ScaledProblem {
+        let rows = 2 * n;
+        let g = |r: usize, c: usize| (((r * 31 + c * 17) % 23) as f64 - 9.0) / 23.0;
+        let mut a = vec![0.0; n * n];
+        let mut b = vec![0.0; n];
+        for i in 0..n {
+            for j in 0..n {
+                a[i * n + j] = (0..rows).map(|r| g(r, i) * g(r, j)).sum::<f64>()
+                    + if i == j { 1.0 } else { 0.0 };
+            }
+            b[i] = -(0..rows)
+                .map(|r| g(r, i) * (1.0 + r as f64 % 3.0))
+                .sum::<f64>();
+        }
+        ScaledProblem::new(&a, &b, n, (0..n).collect())
+    }
+
+    /// Runs `p` on `threads` threads in a thread of its own (so that a hang is seen as one),
+    /// and returns whether it panicked, or `None` if it had not ended after 60 s.
+    fn panics(p: ScaledProblem, threads: usize, panic_in_callback: bool) -> Option<bool> {
+        let (done, ended) = std::sync::mpsc::channel();
+        std::thread::spawn(move || {
+            let settings = QadpSettings {
+                iterations: 400,
+                report_every: 100,
+                threads,
+            };
+            let result = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
+                let x0 = vec![0.1; p.n];
+                run_chunks(&p, &x0, &settings, &mut |progress| {
+                    assert!(
+                        !(panic_in_callback && progress.iteration == 200),
+                        "callback fails (test)"
+                    );
+                    Control::Continue
+                })
+            }));
+            let _ = done.send(result.is_err());
+        });
+        ended.recv_timeout(std::time::Duration::from_secs(60)).ok()
+    }
+
+    #[test]
+    fn a_panic_in_any_band_or_in_the_callback_ends_the_run_instead_of_hanging() {
+        assert_eq!(panics(problem(64), 3, false), Some(false), "no panic");
+        for band in 0..3 {
+            let mut p = problem(64);
+            p.panic_in_band = Some(band);
+            assert_eq!(panics(p, 3, false), Some(true), "band {band} panics");
+        }
+        assert_eq!(panics(problem(64), 3, true), Some(true), "callback panics");
+    }
 
     #[test]
     fn a_wait_that_outlasts_the_spin_shortens_it() {
