@@ -346,17 +346,26 @@ impl Session {
                 Series::line(format!("C{}", l + 1), pts, PALETTE[l % PALETTE.len()])
             })
             .collect();
-        let mut plots = vec![
+        let levels: Vec<usize> = records.iter().map(|r| r.level).collect();
+        let objectives: Vec<f64> = records.iter().map(|r| r.objective).collect();
+        let decrease = objective_decrease(&xs, &levels, &objectives);
+        let objective_panel = if decrease.iter().any(|&(_, d)| d > 0.0) {
+            panel(
+                "objective decrease per iteration",
+                Axis::linear("iteration"),
+                Axis::log("decrease per iteration"),
+                vec![Series::line("", decrease, PALETTE[0])],
+            )
+        } else {
             panel(
                 "objective",
                 Axis::linear("iteration"),
                 Axis::linear("objective"),
-                vec![Series::line(
-                    "",
-                    series(&|k| records[k].objective),
-                    PALETTE[0],
-                )],
-            ),
+                vec![Series::line("", series(&|k| objectives[k]), PALETTE[0])],
+            )
+        };
+        let mut plots = vec![
+            objective_panel,
             panel(
                 "grid mass",
                 Axis::linear("iteration"),
@@ -378,6 +387,23 @@ impl Session {
         }
         compose("convergence.png", &plots)
     }
+}
+
+/// How fast the objective still falls: between consecutive reports of one refinement level
+/// (a new level is a new problem), the decrease divided by the iterations between them, at the
+/// later report's iteration `x`. On a log axis this shows the slow late progress that a linear
+/// axis of the objective flattens into a line; a rise (or a change within the rounding of the
+/// single-precision sums) is not positive and not drawn.
+fn objective_decrease(x: &[f64], levels: &[usize], objectives: &[f64]) -> Vec<(f64, f64)> {
+    (1..objectives.len())
+        .filter(|&k| levels[k] == levels[k - 1] && x[k] > x[k - 1])
+        .map(|k| {
+            (
+                x[k],
+                (objectives[k - 1] - objectives[k]) / (x[k] - x[k - 1]),
+            )
+        })
+        .collect()
 }
 
 /// The reconstruction's origin in the model's frame and the geometry of the model's maps over
@@ -405,4 +431,23 @@ fn model_frame(result: &SessionResult, model: &ModelLens) -> Result<(DVec2, MapG
         ..g
     };
     Ok((origin, geometry))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::objective_decrease;
+
+    #[test]
+    fn the_objective_is_drawn_as_its_decrease_per_iteration_within_a_level() {
+        let x = [0.0, 100.0, 200.0, 250.0, 350.0];
+        let levels = [0, 0, 0, 0, 1];
+        let objectives = [-1.0, -3.0, -3.5, -3.25, -9.0];
+        // 100 -> 200: 0.5 over 100 iterations; 200 -> 250 rises (negative, not drawn on a log
+        // axis); 250 -> 350 changes level and is left out.
+        assert_eq!(
+            objective_decrease(&x, &levels, &objectives),
+            vec![(100.0, 0.02), (200.0, 0.005), (250.0, -0.005)]
+        );
+        assert!(objective_decrease(&[0.0], &[0], &[1.0]).is_empty());
+    }
 }
