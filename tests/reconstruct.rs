@@ -288,6 +288,46 @@ fn synthetic_lens_with_the_true_galaxy_layer() {
     assert!(compared >= 5, "{compared} images compared");
 }
 
+/// Point images on a grid with more unknowns than constraint rows: the run warns that the data
+/// cannot fix the map, nor C. The same systems as small arcs give more rows than unknowns and
+/// no such warning.
+#[cfg_attr(not(target_arch = "wasm32"), test)]
+#[cfg_attr(target_arch = "wasm32", wasm_bindgen_test::wasm_bindgen_test)]
+fn a_system_with_fewer_rows_than_unknowns_is_flagged() {
+    let truth = Truth::new();
+    let catalog = truth.catalog();
+    let arcs = truth.arcs(&catalog);
+    let layers = [truth.galaxy_layer()];
+    let mut config = ReconstructConfig::default();
+    config.grid.cells = 16;
+    config.solver.iterations = 100;
+    config.products.pixels = 32;
+    let run = |config: &ReconstructConfig, images| {
+        let inputs = Inputs {
+            images,
+            layers: LayerSource::Given(&layers),
+            plane: truth.plane,
+            reference: None,
+            holdout: &[],
+            catalog: Some(&catalog),
+        };
+        reconstruct(&inputs, config, &mut quiet).unwrap()
+    };
+    let flagged = |r: &wslap::reconstruct::Reconstruction| {
+        r.warnings
+            .iter()
+            .any(|w| w.contains("constraint rows") && w.contains("C are not measured"))
+    };
+    config.constraints.mode = ConstraintMode::Point;
+    let points = run(&config, ConstraintSource::Catalog(&catalog));
+    assert!(points.system.n_rows < points.system.n_columns());
+    assert!(flagged(&points), "{:?}", points.warnings);
+    config.constraints.mode = ConstraintMode::Arcs;
+    let pixels = run(&config, ConstraintSource::Arcs(&arcs));
+    assert!(pixels.system.n_rows >= pixels.system.n_columns());
+    assert!(!flagged(&pixels), "{:?}", pixels.warnings);
+}
+
 /// `system.threads` holds for the whole run: every parallel section (rows, normal equations,
 /// QADP passes, maps, image search) takes its thread count from `wslap::threads::available()`
 /// on the run's thread, which is also where the progress callback runs.
