@@ -278,6 +278,7 @@ impl Session {
         };
         let system = LinearSystem::build(&grid, &layers, &constraints, &plane, &config.system)
             .map_err(|e| run(&e))?;
+        warnings.extend(system.measurability_warnings());
         let lens = system.reconstructed_lens(&x).map_err(|e| run(&e))?;
         let opts = product_options(&config, &grid);
         let products =

@@ -25,4 +25,6 @@ pub use members::{
 };
 pub use npy::{export_system, npy_header, write_f64s, write_npy, NpyError};
 pub use regions::{arcs_from_regions, is_region_file, RegionArcs};
-pub use system::{ColumnInfo, LinearSystem, RowBlock, ScaledLens, SystemConfig, SystemError};
+pub use system::{
+    ColumnInfo, LinearSystem, RowBlock, ScaledLens, SystemConfig, SystemError, LAYER_SHARE_WARN,
+};

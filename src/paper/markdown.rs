@@ -19,17 +19,18 @@ pub fn markdown(report: &PaperReport) -> String {
     let _ = writeln!(s, "## The three cases\n");
     let _ = writeln!(
         s,
-        "| case | grid mass (Msun) | in arc region (Msun) | C | defl. err. median (\") | p90 (\") | max profile rel. err. | theta_E z=3 (\") | curve distance (\") | beta error (\"^2) | radial curve |"
+        "| case | grid mass (Msun) | in arc region (Msun) | C | C independence | defl. err. median (\") | p90 (\") | max profile rel. err. | theta_E z=3 (\") | curve distance (\") | beta error (\"^2) | radial curve |"
     );
-    let _ = writeln!(s, "|---|---|---|---|---|---|---|---|---|---|---|");
+    let _ = writeln!(s, "|---|---|---|---|---|---|---|---|---|---|---|---|");
     for key in ["no_galaxies", "galaxy_model", "galaxy_true"] {
         if let Some(c) = report.cases.get(key) {
             let _ = writeln!(
                 s,
-                "| {key} | {:.3e} | {:.3e} | {} | {:.2} | {:.2} | {:.3} | {:.1} | {} | {:.1} | {} |",
+                "| {key} | {:.3e} | {:.3e} | {} | {} | {:.2} | {:.2} | {:.3} | {:.1} | {} | {:.1} | {} |",
                 c.grid_mass_msun,
                 c.grid_mass_region_msun,
                 c_list(&c.c),
+                independence_list(&c.c_independence),
                 c.deflection_error_median_arcsec,
                 c.deflection_error_p90_arcsec,
                 c.profile_max_rel_error,
@@ -210,6 +211,15 @@ fn best_fit_markdown(s: &mut String, best: &BestFit, studies: &Studies, t: &Trut
 }
 
 /// Factors C, `"1.234, 0.567"` (also in the checks of `report.rs`).
+/// The layers' independent shares (see [`super::CaseReport::c_independence`]), "-" where not computed.
+fn independence_list(shares: &[Option<f64>]) -> String {
+    let each: Vec<String> = shares
+        .iter()
+        .map(|v| v.map_or("-".to_string(), |v| format!("{v:.1e}")))
+        .collect();
+    each.join(", ")
+}
+
 pub(super) fn c_list(c: &[f64]) -> String {
     let each: Vec<String> = c.iter().map(|v| format!("{v:.3}")).collect();
     each.join(", ")

@@ -274,11 +274,9 @@ fn reconstruct_limited(
         }
         break (system, outcome.x, outcome.status, outcome.iterations);
     };
-    // First: it bears on the whole result, and a long list of members outside the field
-    // would hide it.
-    if let Some(w) = underdetermined_warning(&system) {
-        warnings.insert(0, w);
-    }
+    // First: they bear on the whole result, and a long list of members outside the field
+    // would hide them.
+    warnings.splice(0..0, system.measurability_warnings());
     let lens = system.reconstructed_lens(&x)?;
     let t = crate::products::Clock::start();
     let opts = product_options(config, &system.grid);
@@ -306,28 +304,6 @@ fn reconstruct_limited(
         sources,
         warnings,
         timings,
-    })
-}
-
-/// A warning when `system` has fewer rows than unknowns. Many different maps then fit the
-/// data exactly, and the start and the iteration count choose among them: how the mass splits
-/// between the grid and the member layers in particular (measured on the synthetic lens of
-/// `tests/reconstruct.rs`, whose C went from 4.3 to 0.58 with the start at the same objective).
-/// Point images on the default 32 x 32 grid are always in this case.
-fn underdetermined_warning(system: &LinearSystem) -> Option<String> {
-    let (rows, unknowns) = (system.n_rows, system.n_columns());
-    let members = if system.layer_columns().is_empty() {
-        ""
-    } else {
-        ", and the member factors C are not measured"
-    };
-    (rows < unknowns).then(|| {
-        format!(
-            "{rows} constraint rows (two per image or arc pixel) for {unknowns} unknowns (cell \
-             masses, member factors, source positions): the data cannot fix the mass map on \
-             their own; the start and the iteration count choose among the maps that fit \
-             them{members}. Arc pixels or ellipses, or a coarser grid, give the data more say"
-        )
     })
 }
 

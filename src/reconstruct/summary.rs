@@ -79,6 +79,7 @@ impl<'a> Solved<'a> {
                 .collect(),
             layers: s.layers.iter().map(|l| l.name.as_str()).collect(),
             c_per_layer: self.layer_factors(),
+            c_independence: s.layer_independence.clone(),
             grid_mass_msun: self.grid_mass_msun(),
             grid_cells: s.grid.cells.len(),
             field_center_arcsec: s.grid.center.to_array(),
@@ -109,6 +110,11 @@ pub struct ReconstructSummary<'a> {
     pub systems_excluded: Vec<String>,
     pub layers: Vec<&'a str>,
     pub c_per_layer: Vec<f64>,
+    /// Per layer, how much the data measure `C_l`: the share of the layer's deflection at the
+    /// constraints that the other unknowns cannot reproduce (0 to 1; `None` when not computed,
+    /// above [`crate::solver::INDEPENDENCE_MAX_UNKNOWNS`] unknowns). See
+    /// [`LinearSystem::measurability_warnings`].
+    pub c_independence: Vec<Option<f64>>,
     pub grid_mass_msun: f64,
     pub grid_cells: usize,
     pub field_center_arcsec: [f64; 2],

@@ -12,11 +12,14 @@
 //!   solver option).
 //! - [`nnqp_exact`] is an exact active-set solver (Lawson–Hanson in QP form) for small problems,
 //!   the reference the tests compare QADP with.
+//! - [`column_independence`] says how much of some unknowns' effect the other unknowns cannot
+//!   reproduce: whether the data measure them at all.
 //!
 //! All matrices are dense, row-major `&[f64]` of `n * n` values.
 
 mod accelerated;
 mod gram;
+mod independence;
 mod kernel;
 mod nnls;
 mod qadp;
@@ -28,6 +31,9 @@ use thiserror::Error;
 
 pub use accelerated::accelerated_gradient;
 pub use gram::{gram_weighted, NormalEquations};
+pub use independence::{
+    column_independence, INDEPENDENCE_MAX_UNKNOWNS, RIDGE as INDEPENDENCE_RIDGE,
+};
 pub use nnls::{nnqp_exact, NNQP_EXACT_MAX_UNKNOWNS};
 pub use qadp::{Control, Progress, QadpProblem, QadpSettings, SolveOutcome, SolveStatus};
 
