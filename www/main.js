@@ -94,9 +94,12 @@ function caption(info) {
   const status = info.status ? `${info.status}, ${info.iterations} iterations${best}; ` : '';
   // A null map side: the tangential curve leaves every map measured, the radius is a lower bound.
   const bound = s.einstein_radius_map_arcsec === null ? '≥ ' : '';
-  // A reconstruction's member factors C: 1 is the M/L of the settings.
+  // A reconstruction's member factors C: 1 is the M/L of the settings. Where the data hardly
+  // measure them (the grid can do what the members do), the start and the iteration count set
+  // them, and the caption says so.
   const c = info.summary.c_per_layer ?? [];
-  const factors = c.length ? `member factor C = ${c.map((v) => v.toFixed(2)).join(', ')}; ` : '';
+  const unmeasured = info.summary.c_unmeasured ? ', which these data hardly measure (see the warnings)' : '';
+  const factors = c.length ? `member factor C = ${c.map((v) => v.toFixed(2)).join(', ')}${unmeasured}; ` : '';
   // Observed images against the predicted ones: the median (the typical image) and the rms
   // (which one image whose pair has merged can dominate); then the same for the held-out
   // systems: how well the model predicts images it was not given.

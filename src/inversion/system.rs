@@ -290,6 +290,18 @@ impl LinearSystem {
         Ok(system)
     }
 
+    /// True when these constraints hardly measure the member factors `C`: fewer rows than
+    /// unknowns, or a layer whose independent share is below [`LAYER_SHARE_WARN`]
+    /// ([`Self::measurability_warnings`] says which).
+    pub fn members_unmeasured(&self) -> bool {
+        !self.layers.is_empty()
+            && (self.n_rows < self.n_columns()
+                || self
+                    .layer_independence
+                    .iter()
+                    .any(|s| s.is_some_and(|s| s < LAYER_SHARE_WARN)))
+    }
+
     /// What these constraints cannot measure, in words: fewer rows than unknowns (many maps
     /// then fit the data exactly, and the start and the iteration count choose among them;
     /// point images on the default 32 x 32 grid are always in this case), or else a member

@@ -80,6 +80,7 @@ impl<'a> Solved<'a> {
             layers: s.layers.iter().map(|l| l.name.as_str()).collect(),
             c_per_layer: self.layer_factors(),
             c_independence: s.layer_independence.clone(),
+            c_unmeasured: s.members_unmeasured(),
             grid_mass_msun: self.grid_mass_msun(),
             grid_cells: s.grid.cells.len(),
             field_center_arcsec: s.grid.center.to_array(),
@@ -115,6 +116,9 @@ pub struct ReconstructSummary<'a> {
     /// above [`crate::solver::INDEPENDENCE_MAX_UNKNOWNS`] unknowns). See
     /// [`LinearSystem::measurability_warnings`].
     pub c_independence: Vec<Option<f64>>,
+    /// True when the data hardly measure `C` ([`LinearSystem::members_unmeasured`]; the
+    /// warnings say why).
+    pub c_unmeasured: bool,
     pub grid_mass_msun: f64,
     pub grid_cells: usize,
     pub field_center_arcsec: [f64; 2],

@@ -37,6 +37,12 @@ test('the built-in example reconstructs and shows a map with critical curves', a
     const before = await page.textContent('#summary');
     const r2 = Number(before.match(/Einstein radius (\d+\.\d)″/)[1]);
     assert.ok(r2 > 3, before);
+    // The arcs hardly measure C (the grid can do what the members do): the caption says so,
+    // and a warning says why.
+    assert.match(before, /member factor C = [\d.]+, which these data hardly measure/);
+    const warned = await page.locator('#run-warnings li').allTextContents();
+    assert.ok(warned.some((w) => /^member layer "members": the grid cells and source positions reproduce all but/.test(w)),
+      warned.join(' | '));
     await page.screenshot({ path: join(ARTIFACTS, 'app-example.png'), fullPage: true });
 
     // "Show: predicted" off removes the orange crosses of the predicted images (and their
