@@ -210,8 +210,8 @@ fn best_fit_markdown(s: &mut String, best: &BestFit, studies: &Studies, t: &Trut
     }
 }
 
-/// Factors C, `"1.234, 0.567"` (also in the checks of `report.rs`).
-/// The layers' independent shares (see [`super::CaseReport::c_independence`]), "-" where not computed.
+/// The layers' independent shares (see [`super::CaseReport::c_independence`]), "-" where not
+/// computed.
 fn independence_list(shares: &[Option<f64>]) -> String {
     let each: Vec<String> = shares
         .iter()
@@ -220,6 +220,7 @@ fn independence_list(shares: &[Option<f64>]) -> String {
     each.join(", ")
 }
 
+/// Factors C, `"1.234, 0.567"` (also in the checks of `report.rs`).
 pub(super) fn c_list(c: &[f64]) -> String {
     let each: Vec<String> = c.iter().map(|v| format!("{v:.3}")).collect();
     each.join(", ")
