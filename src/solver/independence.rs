@@ -21,8 +21,8 @@
 /// Added to the unit diagonal of the scaled matrix.
 pub const RIDGE: f64 = 1e-10;
 /// Most unknowns for which [`column_independence`] factorises the matrix (`n^3 / 6`
-/// multiply-adds: 0.05 s natively and 0.12 s in Chromium for the usual 1085, twelve times that
-/// at this size).
+/// multiply-adds: 0.05 s natively and in Chromium for the usual 1085, twelve times that at
+/// this size).
 pub const INDEPENDENCE_MAX_UNKNOWNS: usize = 2500;
 
 /// `share_l` (module documentation) of each column of `cols` in the symmetric positive
@@ -81,7 +81,7 @@ pub fn column_independence(a: &[f64], n: usize, cols: &[usize]) -> Vec<Option<f6
 ///
 /// Row by row in the dot-product form, four rows at a time, and each earlier row pair against
 /// those four at once ([`dot4x2`]), so that a value loaded serves more than one multiply-add.
-/// At `m` = 1085: 48 ms natively (80 ms one row at a time), 0.12 s in Chromium (0.28 s).
+/// At `m` = 1085: 48 ms natively (80 ms one row at a time), 0.05 s in Chromium (0.28 s).
 fn cholesky_in_place(l: &mut [f64], m: usize) -> bool {
     let mut r0 = 0;
     while r0 < m {
@@ -152,30 +152,44 @@ fn dot4x2(x: [&[f64]; 4], y: [&[f64]; 2]) -> [[f64; 2]; 4] {
 }
 
 /// [`dot4x2`] in WebAssembly SIMD, with the fused multiply-add of relaxed SIMD where the
-/// browser has it.
+/// browser has it. Not inlined, for the reason given at `gram.rs`'s `tile_product`: the whole
+/// factorisation is one call, which a browser would run in its baseline compiler's code
+/// throughout. Measured in Chromium at `m` = 1085: 0.128 s for the first factorisation inlined
+/// (0.029 s for the next ones), 0.049 s not inlined (0.030 - 0.036 s).
 #[cfg(all(target_arch = "wasm32", target_feature = "simd128"))]
+#[inline(never)]
 fn dot4x2(x: [&[f64]; 4], y: [&[f64]; 2]) -> [[f64; 2]; 4] {
-    use super::wasm_simd::madd_f64x2;
+    use super::wasm_simd::madd_f64x2 as madd;
     use core::arch::wasm32::{f64x2_extract_lane, f64x2_splat, v128, v128_load};
-    /// Two f64 from `s` at `i`.
+    /// The two f64 of a `chunks_exact(2)` chunk.
     #[inline(always)]
-    fn load(s: &[f64], i: usize) -> v128 {
-        let pair = &s[i..i + 2];
-        // SAFETY: `pair` holds two f64 (16 bytes; the slicing above checks the bounds);
-        // `v128_load` needs no alignment.
+    fn load(pair: &[f64]) -> v128 {
+        assert!(pair.len() == 2);
+        // SAFETY: `pair` holds two f64 (16 bytes, checked above); `v128_load` needs no
+        // alignment.
         unsafe { v128_load(pair.as_ptr().cast::<v128>()) }
     }
     debug_assert!(y[0].len() % 2 == 0);
     let zero = f64x2_splat(0.0);
-    let mut acc = [[zero; 2]; 4];
-    for i in (0..y[0].len()).step_by(2) {
-        let (y0, y1) = (load(y[0], i), load(y[1], i));
-        for (a, row) in acc.iter_mut().zip(x) {
-            let p = load(row, i);
-            a[0] = madd_f64x2(p, y0, a[0]);
-            a[1] = madd_f64x2(p, y1, a[1]);
-        }
+    // Eight separate sums (not an array) so that they stay in locals.
+    let (mut a0, mut b0, mut a1, mut b1) = (zero, zero, zero, zero);
+    let (mut a2, mut b2, mut a3, mut b3) = (zero, zero, zero, zero);
+    let steps = y[0]
+        .chunks_exact(2)
+        .zip(y[1].chunks_exact(2))
+        .zip(x[0].chunks_exact(2))
+        .zip(x[1].chunks_exact(2))
+        .zip(x[2].chunks_exact(2))
+        .zip(x[3].chunks_exact(2));
+    for (((((y0, y1), p0), p1), p2), p3) in steps {
+        let (y0, y1) = (load(y0), load(y1));
+        let (p0, p1, p2, p3) = (load(p0), load(p1), load(p2), load(p3));
+        (a0, b0) = (madd(p0, y0, a0), madd(p0, y1, b0));
+        (a1, b1) = (madd(p1, y0, a1), madd(p1, y1, b1));
+        (a2, b2) = (madd(p2, y0, a2), madd(p2, y1, b2));
+        (a3, b3) = (madd(p3, y0, a3), madd(p3, y1, b3));
     }
+    let acc = [[a0, b0], [a1, b1], [a2, b2], [a3, b3]];
     let lanes = |v: v128| f64x2_extract_lane::<0>(v) + f64x2_extract_lane::<1>(v);
     acc.map(|a| a.map(lanes))
 }
