@@ -327,7 +327,7 @@ fn a_system_with_fewer_rows_than_unknowns_is_flagged() {
     assert!(points.system.n_rows < points.system.n_columns());
     assert!(flagged(&points), "{:?}", points.warnings);
     // About the ridge of the computation (1e-10): none.
-    let share = |r: &wslap::reconstruct::Reconstruction| r.system.layer_independence[0].unwrap();
+    let share = |r: &wslap::reconstruct::Reconstruction| r.system.layer_independence()[0].unwrap();
     assert!(share(&points) < 1e-8, "{}", share(&points));
     config.constraints.mode = ConstraintMode::Arcs;
     let pixels = run(&config, ConstraintSource::Arcs(&arcs));

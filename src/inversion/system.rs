@@ -184,11 +184,8 @@ pub struct LinearSystem {
     pub distance_ratios: Vec<f64>,
     /// `D_l` in Mpc.
     pub d_l_mpc: f64,
-    /// Per layer, the share of its deflection at the constraints (weighted, as in `A`) that no
-    /// combination of the other unknowns reproduces ([`crate::solver::column_independence`]):
-    /// near 0, the data do not measure `C_l`. `None` above
-    /// [`crate::solver::INDEPENDENCE_MAX_UNKNOWNS`] unknowns.
-    pub layer_independence: Vec<Option<f64>>,
+    /// [`Self::layer_independence`], computed at its first use.
+    layer_independence: std::sync::OnceLock<Vec<Option<f64>>>,
     /// `a_l(theta_i)` for pixel `i`, layer `l` at `[i * L + l]`.
     layer_deflections: Vec<DVec2>,
     threads: usize,
@@ -279,28 +276,31 @@ impl LinearSystem {
             constraints: constraints.clone(),
             distance_ratios,
             d_l_mpc: plane.d_l_mpc,
-            layer_independence: Vec::new(),
+            layer_independence: std::sync::OnceLock::new(),
             layer_deflections,
             threads,
             rows_per_block,
         };
         system.accumulate_normal()?;
-        let layer_cols: Vec<usize> = system.layer_columns().collect();
-        system.layer_independence =
-            crate::solver::column_independence(&system.a, n_cols, &layer_cols);
         Ok(system)
     }
 
-    /// True when these constraints hardly measure the member factors `C`: fewer rows than
-    /// unknowns, or a layer whose independent share is below [`LAYER_SHARE_WARN`]
-    /// ([`Self::measurability_warnings`] says which).
+    /// Per layer, the share of its deflection at the constraints (weighted, as in `A`) that no
+    /// combination of the other unknowns reproduces ([`crate::solver::column_independence`]):
+    /// near 0, the data do not measure `C_l`. `None` above
+    /// [`crate::solver::INDEPENDENCE_MAX_UNKNOWNS`] unknowns. Factorises `A` at the first call
+    /// (not in [`Self::build`]: the systems of a refined grid's earlier levels never need it).
+    pub fn layer_independence(&self) -> &[Option<f64>] {
+        self.layer_independence.get_or_init(|| {
+            let layer_cols: Vec<usize> = self.layer_columns().collect();
+            crate::solver::column_independence(&self.a, self.n_columns(), &layer_cols)
+        })
+    }
+
+    /// True when these constraints hardly measure the member factors `C`: when there are
+    /// layers and [`Self::measurability_warnings`] has something to say.
     pub fn members_unmeasured(&self) -> bool {
-        !self.layers.is_empty()
-            && (self.n_rows < self.n_columns()
-                || self
-                    .layer_independence
-                    .iter()
-                    .any(|s| s.is_some_and(|s| s < LAYER_SHARE_WARN)))
+        !self.layers.is_empty() && !self.measurability_warnings().is_empty()
     }
 
     /// What these constraints cannot measure, in words: fewer rows than unknowns (many maps
@@ -325,7 +325,7 @@ impl LinearSystem {
         }
         self.layers
             .iter()
-            .zip(&self.layer_independence)
+            .zip(self.layer_independence())
             .filter_map(|(layer, share)| {
                 let share = share.filter(|&s| s < LAYER_SHARE_WARN)?;
                 Some(format!(

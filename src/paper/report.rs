@@ -102,7 +102,7 @@ impl CaseReport {
             // Filled in by the scorer, which has the grid-only map.
             grid_mass_region_msun: f64::NAN,
             c: rec.layer_factors(),
-            c_independence: rec.system.layer_independence.clone(),
+            c_independence: rec.system.layer_independence().to_vec(),
             deflection_error_median_arcsec: deflection.median_arcsec,
             deflection_error_p90_arcsec: deflection.p90_arcsec,
             deflection_offset_arcsec: deflection.offset_arcsec.to_array(),

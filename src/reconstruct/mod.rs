@@ -275,8 +275,10 @@ fn reconstruct_limited(
         break (system, outcome.x, outcome.status, outcome.iterations);
     };
     // First: they bear on the whole result, and a long list of members outside the field
-    // would hide them.
+    // would hide them. Timed with the system, whose matrix they factorise.
+    let t = crate::products::Clock::start();
     warnings.splice(0..0, system.measurability_warnings());
+    timings.system_ms += t.ms();
     let lens = system.reconstructed_lens(&x)?;
     let t = crate::products::Clock::start();
     let opts = product_options(config, &system.grid);

@@ -79,7 +79,7 @@ impl<'a> Solved<'a> {
                 .collect(),
             layers: s.layers.iter().map(|l| l.name.as_str()).collect(),
             c_per_layer: self.layer_factors(),
-            c_independence: s.layer_independence.clone(),
+            c_independence: s.layer_independence().to_vec(),
             c_unmeasured: s.members_unmeasured(),
             grid_mass_msun: self.grid_mass_msun(),
             grid_cells: s.grid.cells.len(),

@@ -31,9 +31,7 @@ use thiserror::Error;
 
 pub use accelerated::accelerated_gradient;
 pub use gram::{gram_weighted, NormalEquations};
-pub use independence::{
-    column_independence, INDEPENDENCE_MAX_UNKNOWNS, RIDGE as INDEPENDENCE_RIDGE,
-};
+pub use independence::{column_independence, INDEPENDENCE_MAX_UNKNOWNS};
 pub use nnls::{nnqp_exact, NNQP_EXACT_MAX_UNKNOWNS};
 pub use qadp::{Control, Progress, QadpProblem, QadpSettings, SolveOutcome, SolveStatus};
 
