@@ -140,12 +140,28 @@ pub struct Summary {
     #[serde(default)]
     pub einstein_radius_map_arcsec: Option<f64>,
     pub tangential_curves: usize,
+    /// Share of the area inside the tangential curves (on this map) that the largest one
+    /// holds: near 1 for one main curve with a few small ones beside it, small when the
+    /// critical region is broken into islands (`null` without a tangential curve).
+    #[serde(default)]
+    pub tangential_main_area_share: Option<f64>,
     pub radial_curves: usize,
     pub kappa_max: f64,
     /// Projected mass inside 10, 20 and 50 arcsec of (0, 0), Msun (`null` where the circle
     /// leaves the map).
     pub mass_within_arcsec: Vec<(f64, Option<f64>)>,
     pub timings_ms: Timings,
+}
+
+/// The largest of the areas enclosed by `curves` (a curve cut by the map border closed by its
+/// chord) over their sum; `None` when they enclose nothing.
+fn main_area_share(curves: &[crate::curves::Polyline]) -> Option<f64> {
+    let areas: Vec<f64> = curves
+        .iter()
+        .map(|c| crate::curves::signed_area_arcsec2(c).abs())
+        .collect();
+    let total: f64 = areas.iter().sum();
+    (total > 0.0).then(|| areas.iter().copied().fold(0.0, f64::max) / total)
 }
 
 /// When the tangential critical curve of a known lens leaves the products' map, its Einstein
@@ -314,6 +330,7 @@ impl Products {
             einstein_radius_arcsec: self.curves.einstein_radius_arcsec,
             einstein_radius_map_arcsec: self.einstein_radius_map_arcsec,
             tangential_curves: self.curves.tangential.len(),
+            tangential_main_area_share: main_area_share(&self.curves.tangential),
             radial_curves: self.curves.radial.len(),
             kappa_max: self.maps.kappa.min_max().1,
             mass_within_arcsec: SUMMARY_RADII_ARCSEC

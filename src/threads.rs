@@ -41,6 +41,32 @@ pub fn with_limit<R>(threads: usize, f: impl FnOnce() -> R) -> R {
     f()
 }
 
+/// `f` of every item, the items shared between the threads of [`available`], each thread
+/// running `f` with a limit of one thread (so that the whole stays within the caller's
+/// limit); in order. On one thread (and on wasm32) the items run here, one after another.
+pub fn map_items<T: Sync, R: Send>(items: &[T], f: impl Fn(&T) -> R + Sync) -> Vec<R> {
+    let threads = available().min(items.len());
+    if threads <= 1 {
+        return items.iter().map(f).collect();
+    }
+    let next = std::sync::atomic::AtomicUsize::new(0);
+    let mut out: Vec<Option<R>> = (0..items.len()).map(|_| None).collect();
+    let done = std::sync::Mutex::new(&mut out);
+    std::thread::scope(|scope| {
+        for _ in 0..threads {
+            scope.spawn(|| loop {
+                let i = next.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+                let Some(item) = items.get(i) else { break };
+                let r = with_limit(1, || f(item));
+                done.lock().unwrap_or_else(|e| e.into_inner())[i] = Some(r);
+            });
+        }
+    });
+    out.into_iter()
+        .map(|r| r.expect("every item was run"))
+        .collect()
+}
+
 #[cfg(all(test, not(target_arch = "wasm32")))]
 mod tests {
     use super::*;
@@ -60,5 +86,18 @@ mod tests {
         assert_eq!(available(), all);
         let _ = std::panic::catch_unwind(|| with_limit(1, || panic!("inside")));
         assert_eq!(available(), all);
+    }
+
+    #[test]
+    fn map_items_keeps_the_order_and_the_limit() {
+        let items: Vec<usize> = (0..9).collect();
+        let out = with_limit(2, || map_items(&items, |&i| (i * i, available())));
+        assert_eq!(
+            out.iter().map(|r| r.0).collect::<Vec<_>>(),
+            (0..9).map(|i| i * i).collect::<Vec<_>>()
+        );
+        assert!(out.iter().all(|r| r.1 == 1));
+        let one = with_limit(1, || map_items(&items, |_| available()));
+        assert!(one.iter().all(|&n| n == 1));
     }
 }

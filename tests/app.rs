@@ -240,7 +240,12 @@ fn reconstruction_gives_curves_views_hover_and_the_cli_files() {
     let n = offsets.len();
     assert!(n >= 6, "{n} offsets");
     let median = summary["image_offset_median_arcsec"].as_f64().unwrap();
-    assert_eq!(median, 0.5 * (offsets[(n - 1) / 2] + offsets[n / 2]));
+    // Equal but for the last bit that reading the decimal JSON back may change.
+    let recomputed = 0.5 * (offsets[(n - 1) / 2] + offsets[n / 2]);
+    assert!(
+        (median - recomputed).abs() <= 4.0 * f64::EPSILON * median,
+        "{median} vs {recomputed}"
+    );
     assert!(median <= summary["image_plane_rms_arcsec"].as_f64().unwrap());
     let opts = ViewOptions::default();
     for view in [
@@ -277,7 +282,19 @@ fn reconstruction_gives_curves_views_hover_and_the_cli_files() {
 #[cfg_attr(not(target_arch = "wasm32"), test)]
 #[cfg_attr(target_arch = "wasm32", wasm_bindgen_test::wasm_bindgen_test)]
 fn the_map_leaves_out_the_demagnified_predicted_images() {
-    let s = solved();
+    // The paper's QADP on the source-plane chi^2 makes a cuspy centre with demagnified images
+    // (the regularised default's smooth centre may have none).
+    let mut s = teaching_session();
+    for (path, value) in [
+        ("reconstruct.solver.method", json!("qadp")),
+        ("reconstruct.objective.regulariser", json!("none")),
+        ("reconstruct.objective.strength", json!(0)),
+        ("reconstruct.objective.image_plane_iterations", json!(0)),
+    ] {
+        s.set_field(path, value).unwrap();
+    }
+    s.run(RunKind::Reconstruct, &mut |_| Control::Continue)
+        .unwrap();
     let r = s.result().unwrap();
     let all: Vec<_> = r
         .reconstruction
@@ -1368,7 +1385,9 @@ fn a_refined_grid_runs_and_its_project_asks_for_a_new_solve() {
         .iter()
         .map(|c| c.level)
         .collect();
-    assert_eq!((levels[0], *levels.last().unwrap()), (0, 1));
+    // One series per solve: the refinement levels, then each update of the image-plane weights.
+    let passes = 1 + s.settings.reconstruct.objective.image_plane_iterations;
+    assert_eq!((levels[0], *levels.last().unwrap()), (0, passes));
     let mut t = Session::new();
     let report = t
         .open_project(&s.project_json().unwrap(), "p.json")

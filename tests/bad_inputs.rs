@@ -36,7 +36,7 @@ fn config_syntax_errors_say_the_place_once() {
     assert_eq!(err, "config.json: line 2, column 21: expected value");
     let err = config_err("{\"solver\": {\"method\": \"newton\"}}");
     assert!(
-        err.starts_with("config.json: line 1, column 30: unknown variant `newton`, expected `qadp` or `accelerated_gradient`"),
+        err.starts_with("config.json: line 1, column 30: unknown variant `newton`, expected one of `exact`, `qadp`, `accelerated_gradient`"),
         "{err}"
     );
     let err = config_err("{\"solver\": {\"iterations\": 10, \"speed\": 2}}");

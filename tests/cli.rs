@@ -269,7 +269,9 @@ fn reconstruct_writes_every_product_and_marks_held_out_systems() {
     let config = dir.join("config.json");
     fs::write(
         &config,
-        r#"{"grid": {"cells": 12}, "products": {"pixels": 64}}"#,
+        // The paper's QADP, whose iteration count --iterations sets (checked below).
+        r#"{"grid": {"cells": 12}, "products": {"pixels": 64}, "solver": {"method": "qadp"},
+            "objective": {"regulariser": "none", "strength": 0, "image_plane_iterations": 0}}"#,
     )
     .unwrap();
     let out_dir = dir.join("out");

@@ -20,6 +20,7 @@ impl ReconstructionResult {
             sources: &self.sources,
             warnings: &self.warnings,
             timings: self.timings,
+            strength_choice: self.strength_choice.as_ref(),
         }
     }
 }

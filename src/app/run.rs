@@ -14,7 +14,7 @@ use crate::profiles::Lens;
 use crate::reconstruct::{
     cross_validate, fitted_system_ids, map_geometry, product_options, reconstruct,
     ConvergenceRecord, CrossValidation, Inputs, LayerSource, ReconstructConfig, ReconstructError,
-    SourceReport, StageTimings, DEFAULT_FOLDS,
+    SourceReport, StageTimings, StrengthChoice, DEFAULT_FOLDS,
 };
 use crate::solver::Control;
 
@@ -51,6 +51,8 @@ pub struct ReconstructionResult {
     pub warnings: Vec<String>,
     pub timings: StageTimings,
     pub lens: Lens,
+    /// How an "auto" regulariser strength was chosen (not kept in a project file).
+    pub strength_choice: Option<StrengthChoice>,
 }
 
 /// The last result of a session.
@@ -185,6 +187,7 @@ impl Session {
                     warnings,
                     timings: r.timings,
                     lens: r.lens,
+                    strength_choice: r.strength_choice,
                 }),
                 elapsed_ms: 0.0,
             })
@@ -298,6 +301,7 @@ impl Session {
                 warnings,
                 timings: StageTimings::default(),
                 lens,
+                strength_choice: None,
             }),
             elapsed_ms: t.ms(),
         });

@@ -168,6 +168,13 @@ pub struct MemberConfig {
     /// `C_l` is free, as in the paper. Worth setting when the constraints are few (a catalogue
     /// of point images), which leave `C_l` to the start of QADP. Allowed (0, 100].
     pub c_prior_sigma: Option<f64>,
+    /// The prior's width given to a layer that has none when the data hardly measure its
+    /// factor (its independent share is below [`super::LAYER_SHARE_WARN`]: any change of
+    /// `C_l` can be undone by the grid, so without it the regulariser, which costs the cells
+    /// and not the members, would let `C_l` grow until the members are supercritical
+    /// islands). Default 0.1: `C_l` stays at the luminosity scaling the catalogue implies.
+    /// `null`: leave such a factor free. Allowed (0, 100].
+    pub c_prior_sigma_unmeasured: Option<f64>,
 }
 
 /// Bisection steps for the parent concentration (`log c` over [1e-3, 1e3]: 2^-100 of that
@@ -190,6 +197,7 @@ impl Default for MemberConfig {
             size_exponent: 1.0 / 3.0,
             outside_margin_fraction: 0.1,
             c_prior_sigma: None,
+            c_prior_sigma_unmeasured: Some(0.1),
         }
     }
 }
@@ -221,6 +229,9 @@ impl MemberConfig {
         check("size_exponent", self.size_exponent, 0.0, 2.0, false)?;
         if let Some(sigma) = self.c_prior_sigma {
             check("c_prior_sigma", sigma, 0.0, 100.0, true)?;
+        }
+        if let Some(sigma) = self.c_prior_sigma_unmeasured {
+            check("c_prior_sigma_unmeasured", sigma, 0.0, 100.0, true)?;
         }
         check(
             "outside_margin_fraction",

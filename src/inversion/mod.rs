@@ -9,6 +9,7 @@ mod grid_fft;
 mod members;
 mod npy;
 mod regions;
+mod regularise;
 mod system;
 
 pub use arcs::{parse_arcs, ArcCatalog, ArcSystem};
@@ -25,6 +26,11 @@ pub use members::{
 };
 pub use npy::{export_system, npy_header, write_f64s, write_npy, NpyError};
 pub use regions::{arcs_from_regions, is_region_file, RegionArcs};
+pub use regularise::{
+    capped_inverse_jacobian, cell_penalty, AutoWord, ObjectiveConfig, ObjectiveError, Regulariser,
+    Strength,
+};
 pub use system::{
-    ColumnInfo, LinearSystem, RowBlock, ScaledLens, SystemConfig, SystemError, LAYER_SHARE_WARN,
+    ColumnInfo, LinearSystem, ObjectiveTerms, RowBlock, ScaledLens, SystemConfig, SystemError,
+    LAYER_SHARE_WARN,
 };

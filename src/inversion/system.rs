@@ -39,6 +39,7 @@ use thiserror::Error;
 use super::constraints::ConstraintSet;
 use super::grid::{cell_unit_deflection, CellGrid, GridError, GridMass};
 use super::members::Layer;
+use super::regularise::{cell_penalty, Regulariser};
 use crate::cosmology::{CosmologyError, LensPlane};
 use crate::profiles::{Lens, MassComponent};
 use crate::solver::{NormalEquations, SolverError};
@@ -160,6 +161,22 @@ pub struct RowBlock {
     pub weights: Vec<f64>,
 }
 
+/// The terms of the objective beyond the paper's source-plane chi^2 (see the `regularise`
+/// module): per-pixel image-plane transforms of the rows and a regulariser on the cells.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct ObjectiveTerms {
+    /// Per constraint pixel, the 2 x 2 matrix `[m00, m01, m10, m11]` applied to its two rows
+    /// of `Gamma` and `Theta` (the capped inverse Jacobian); empty: none.
+    pub pixel_transforms: Vec<[f64; 4]>,
+    /// The regulariser on the cells.
+    pub regulariser: Regulariser,
+    /// Its relative strength (used when `penalty_weight` is `None`).
+    pub strength: f64,
+    /// The absolute weight `lambda` of the regulariser, to keep one objective while the
+    /// transforms change; `None`: `strength * tr(A_cells) / tr(R)` of this system.
+    pub penalty_weight: Option<f64>,
+}
+
 /// The assembled system: column layout, normal equations and what is needed to make rows and
 /// the reconstructed lens again.
 #[derive(Debug, Clone)]
@@ -184,6 +201,8 @@ pub struct LinearSystem {
     pub distance_ratios: Vec<f64>,
     /// `D_l` in Mpc.
     pub d_l_mpc: f64,
+    /// The objective's terms beyond the source-plane chi^2, with `penalty_weight` resolved.
+    pub terms: ObjectiveTerms,
     /// [`Self::layer_independence`], computed at its first use.
     layer_independence: std::sync::OnceLock<Vec<Option<f64>>>,
     /// `a_l(theta_i)` for pixel `i`, layer `l` at `[i * L + l]`.
@@ -234,7 +253,35 @@ impl LinearSystem {
         plane: &LensPlane,
         config: &SystemConfig,
     ) -> Result<Self, SystemError> {
+        Self::build_with(
+            grid,
+            layers,
+            constraints,
+            plane,
+            config,
+            ObjectiveTerms::default(),
+        )
+    }
+
+    /// As [`Self::build`], with the image-plane transforms and the regulariser of `terms`.
+    pub fn build_with(
+        grid: &CellGrid,
+        layers: &[Layer],
+        constraints: &ConstraintSet,
+        plane: &LensPlane,
+        config: &SystemConfig,
+        terms: ObjectiveTerms,
+    ) -> Result<Self, SystemError> {
         config.validate()?;
+        if !terms.pixel_transforms.is_empty()
+            && terms.pixel_transforms.len() != constraints.pixels.len()
+        {
+            return Err(SystemError::Length {
+                what: "pixel transforms",
+                expected: constraints.pixels.len(),
+                got: terms.pixel_transforms.len(),
+            });
+        }
         let distance_ratios = constraints
             .systems
             .iter()
@@ -276,6 +323,7 @@ impl LinearSystem {
             constraints: constraints.clone(),
             distance_ratios,
             d_l_mpc: plane.d_l_mpc,
+            terms,
             layer_independence: std::sync::OnceLock::new(),
             layer_deflections,
             threads,
@@ -290,11 +338,49 @@ impl LinearSystem {
     /// near 0, the data do not measure `C_l`. `None` above
     /// [`crate::solver::INDEPENDENCE_MAX_UNKNOWNS`] unknowns. Factorises `A` at the first call
     /// (not in [`Self::build`]: the systems of a refined grid's earlier levels never need it).
+    /// The share is that of the data: the regulariser, which would let no cell mimic a
+    /// layer for free, and the priors on `C` are taken out of `A` first.
     pub fn layer_independence(&self) -> &[Option<f64>] {
         self.layer_independence.get_or_init(|| {
             let layer_cols: Vec<usize> = self.layer_columns().collect();
-            crate::solver::column_independence(&self.a, self.n_columns(), &layer_cols)
+            let n = self.n_columns();
+            let lambda = self.terms.penalty_weight.unwrap_or(0.0);
+            let priors = self.layers.iter().any(|l| l.prior_sigma.is_some());
+            if (lambda == 0.0 && !priors) || layer_cols.is_empty() {
+                return crate::solver::column_independence(&self.a, n, &layer_cols);
+            }
+            let mut data = self.a.clone();
+            for (col, layer) in self.layer_columns().zip(&self.layers) {
+                if let Some(sigma) = layer.prior_sigma {
+                    data[col * n + col] -= 1.0 / (sigma * sigma);
+                }
+            }
+            let n_cells = self.grid.len();
+            let r = cell_penalty(&self.grid, self.terms.regulariser);
+            for j in 0..n_cells {
+                for k in 0..n_cells {
+                    data[j * n + k] -= lambda * r[j * n_cells + k];
+                }
+            }
+            crate::solver::column_independence(&data, n, &layer_cols)
         })
+    }
+
+    /// Adds the prior `C_l = 1 +- sigma` to layer `l` that has none (as the row of
+    /// [`Self::prior_rows`], straight into `A`, `b` and `Theta^T W Theta`); the layer keeps it
+    /// in `layers` for the systems built from them later.
+    pub fn add_layer_prior(&mut self, l: usize, sigma: f64) {
+        if self.layers[l].prior_sigma.is_some() {
+            return;
+        }
+        let n = self.n_columns();
+        let col = self.layer_columns().start + l;
+        let w = 1.0 / (sigma * sigma);
+        self.a[col * n + col] += w;
+        self.b[col] -= w;
+        self.theta_w_theta += w;
+        self.n_rows += 1;
+        self.layers[l].prior_sigma = Some(sigma);
     }
 
     /// True when these constraints hardly measure the member factors `C`: when there are
@@ -309,18 +395,30 @@ impl LinearSystem {
     /// layer whose deflection the other unknowns reproduce all but [`LAYER_SHARE_WARN`] of.
     pub fn measurability_warnings(&self) -> Vec<String> {
         let (rows, unknowns) = (self.n_rows, self.n_columns());
+        let regularised = self.terms.penalty_weight.unwrap_or(0.0) > 0.0;
+        let held = |layer: &Layer| match layer.prior_sigma {
+            Some(sigma) => format!("it is held near 1 by the prior C = 1 +- {sigma}"),
+            None if regularised => "nothing holds it (members.c_prior_sigma would)".to_string(),
+            None => "the start and the iteration count set it".to_string(),
+        };
         if rows < unknowns {
-            let members = if self.layers.is_empty() {
-                ""
+            let members = match self.layers.first() {
+                None => String::new(),
+                Some(layer) => format!(
+                    ", and the member factors C are not measured: {}",
+                    held(layer)
+                ),
+            };
+            let chooser = if regularised {
+                "the regulariser (the objective block) chooses the smoothest of the maps that fit them"
             } else {
-                ", and the member factors C are not measured"
+                "the start and the iteration count choose among the maps that fit them"
             };
             return vec![format!(
                 "{rows} constraint rows (two per image or arc pixel) for {unknowns} unknowns \
                  (cell masses, member factors, source positions): the data cannot fix the mass \
-                 map on their own; the start and the iteration count choose among the maps \
-                 that fit them{members}. Arc pixels or ellipses, or a coarser grid, give the \
-                 data more say"
+                 map on their own; {chooser}{members}. Arc pixels or ellipses, or a coarser \
+                 grid, give the data more say"
             )];
         }
         self.layers
@@ -331,9 +429,9 @@ impl LinearSystem {
                 Some(format!(
                     "member layer \"{}\": the grid cells and source positions reproduce all but \
                      {share:.1e} of its deflection at the constraints, so the data hardly \
-                     measure its factor C: the start and the iteration count set it. A prior \
-                     on C (members.c_prior_sigma) or more constraints pin it down",
-                    layer.name
+                     measure its factor C: {}",
+                    layer.name,
+                    held(layer)
                 ))
             })
             .collect()
@@ -444,11 +542,23 @@ impl LinearSystem {
                 row_y[by + pixel.system] = 1.0;
             }
         });
-        for pixel in &self.constraints.pixels[pixels] {
+        for pixel in &self.constraints.pixels[pixels.clone()] {
             out.theta.push(pixel.position.x + self.theta_shift_arcsec);
             out.theta.push(pixel.position.y + self.theta_shift_arcsec);
             out.weights.push(pixel.weight);
             out.weights.push(pixel.weight);
+        }
+        if let Some(transforms) = self.terms.pixel_transforms.get(pixels) {
+            for (k, m) in transforms.iter().enumerate() {
+                let (row_x, row_y) =
+                    out.gamma[2 * k * n_cols..(2 * k + 2) * n_cols].split_at_mut(n_cols);
+                for (u, v) in row_x.iter_mut().zip(row_y.iter_mut()) {
+                    (*u, *v) = (m[0] * *u + m[1] * *v, m[2] * *u + m[3] * *v);
+                }
+                let (tx, ty) = (out.theta[2 * k], out.theta[2 * k + 1]);
+                out.theta[2 * k] = m[0] * tx + m[1] * ty;
+                out.theta[2 * k + 1] = m[2] * tx + m[3] * ty;
+            }
         }
         Ok(())
     }
@@ -493,11 +603,38 @@ impl LinearSystem {
         let prior = self.prior_rows();
         acc.add_rows(&prior.gamma, &prior.weights, &prior.theta)?;
         theta_w_theta += prior.weights.iter().sum::<f64>();
-        let (a, b) = acc.finish();
+        let (mut a, b) = acc.finish();
+        self.add_penalty(&mut a);
         self.a = a;
         self.b = b;
         self.theta_w_theta = theta_w_theta;
         Ok(())
+    }
+
+    /// Adds `lambda R` to the cells' block of `a` and records `lambda` in
+    /// `terms.penalty_weight` (see the `regularise` module).
+    fn add_penalty(&mut self, a: &mut [f64]) {
+        let terms = &mut self.terms;
+        if terms.regulariser == Regulariser::None {
+            terms.penalty_weight = Some(0.0);
+            return;
+        }
+        let (n, n_cells) = (self.columns.len(), self.grid.len());
+        let r = cell_penalty(&self.grid, terms.regulariser);
+        let lambda = *terms.penalty_weight.get_or_insert_with(|| {
+            let trace_a: f64 = (0..n_cells).map(|j| a[j * n + j]).sum();
+            let trace_r: f64 = (0..n_cells).map(|j| r[j * n_cells + j]).sum();
+            if trace_r > 0.0 {
+                terms.strength * trace_a / trace_r
+            } else {
+                0.0
+            }
+        });
+        for j in 0..n_cells {
+            for k in 0..n_cells {
+                a[j * n + k] += lambda * r[j * n_cells + k];
+            }
+        }
     }
 
     /// Checks that `x` has one value per column.

@@ -256,7 +256,7 @@ impl PaperConfig {
     /// The reconstruction settings shared by every run: the grid over the simulation field,
     /// arc pixels as constraints, products at z_s = 3 on the common map.
     fn reconstruct_config(&self, field_arcsec: f64, iterations: usize) -> ReconstructConfig {
-        let mut c = ReconstructConfig::default();
+        let mut c = ReconstructConfig::paper();
         c.grid.cells = self.grid_cells;
         c.grid.center_arcsec = Some(DVec2::ZERO);
         c.grid.width_arcsec = Some(field_arcsec);

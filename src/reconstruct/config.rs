@@ -3,7 +3,9 @@
 
 use serde::{Deserialize, Serialize};
 
-use crate::inversion::{ConstraintConfig, GridConfig, MemberConfig, SystemConfig};
+use crate::inversion::{
+    ConstraintConfig, GridConfig, MemberConfig, ObjectiveConfig, Regulariser, SystemConfig,
+};
 use crate::limits::{json_error_message, InputKind, TooLarge};
 use crate::solver::QadpSettings;
 
@@ -22,7 +24,9 @@ pub struct ReconstructConfig {
     pub constraints: ConstraintConfig,
     /// The linear system (mass unit, frame shift, block size).
     pub system: SystemConfig,
-    /// The QADP iteration.
+    /// What is minimised: the regulariser, its strength, the image-plane weighting.
+    pub objective: ObjectiveConfig,
+    /// The solver.
     pub solver: SolverConfig,
     /// The maps and curves of the result.
     pub products: ProductConfig,
@@ -32,9 +36,13 @@ pub struct ReconstructConfig {
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum SolverMethod {
-    /// QADP, the paper's multiplicative update, stopped after `iterations` (default): the early
-    /// stop is the regulariser.
+    /// The exact minimiser of the regularised objective ([`crate::solver::minimise_exact`],
+    /// default): the answer depends on the objective alone, not on the start or an
+    /// iteration count. Needs a regulariser with a positive strength.
     #[default]
+    Exact,
+    /// QADP, the paper's multiplicative update, stopped after `iterations`: the early stop is
+    /// the regulariser.
     Qadp,
     /// The accelerated projected gradient of [`crate::solver::accelerated_gradient`]: it goes
     /// much further per iteration, towards the minimiser of the objective itself, which on
@@ -47,9 +55,10 @@ pub enum SolverMethod {
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields, default)]
 pub struct SolverConfig {
-    /// "qadp" (default, the paper) or "accelerated_gradient" (see [`SolverMethod`]).
+    /// "exact" (default), "qadp" (the paper) or "accelerated_gradient" (see [`SolverMethod`]).
     pub method: SolverMethod,
-    /// Iterations: for QADP the regulariser (default 8000, the paper's best; 50000 over-fits).
+    /// Iterations: for QADP the regulariser (default 8000, the paper's best; 50000 over-fits);
+    /// for "exact" the most exchanges of its free set.
     pub iterations: usize,
     /// Report objective, grid mass and C every this many iterations (default 100).
     pub report_every: usize,
@@ -63,7 +72,7 @@ pub struct SolverConfig {
 impl Default for SolverConfig {
     fn default() -> Self {
         Self {
-            method: SolverMethod::Qadp,
+            method: SolverMethod::Exact,
             iterations: 8000,
             report_every: 100,
             start_cell_mass_msun: 1e10,
@@ -110,13 +119,44 @@ impl ReconstructConfig {
         Ok(config)
     }
 
+    /// The paper's method: QADP stopped after `solver.iterations` on the source-plane chi^2,
+    /// with no regulariser and every member factor free (what `wslap paper` reproduces).
+    pub fn paper() -> Self {
+        let mut c = Self::default();
+        c.solver.method = SolverMethod::Qadp;
+        c.objective = ObjectiveConfig::paper();
+        c.members.c_prior_sigma_unmeasured = None;
+        c
+    }
+
     /// Checks every block.
     pub fn validate(&self) -> Result<(), ReconstructError> {
         self.grid.validate()?;
         self.members.validate()?;
         self.constraints.validate()?;
         self.system.validate()?;
+        self.objective
+            .validate()
+            .map_err(|e| ReconstructError::BadSetting {
+                field: e.field,
+                value: e.value,
+                reason: e.reason,
+            })?;
         self.solver_settings().validate()?;
+        if self.solver.method == SolverMethod::Exact {
+            let o = &self.objective;
+            let zero = o.strength.value() == Some(0.0)
+                || (o.strength.value().is_none() && o.candidates.contains(&0.0));
+            if o.regulariser == Regulariser::None || zero {
+                return Err(ReconstructError::BadSetting {
+                    field: "objective.strength",
+                    value: 0.0,
+                    reason: "the exact solver needs a regulariser with a positive strength: \
+                             without one the data leave the map undetermined (use solver.method \
+                             \"qadp\" for the paper's early stop)",
+                });
+            }
+        }
         let s = &self.solver;
         if !(s.start_cell_mass_msun.is_finite() && s.start_cell_mass_msun > 0.0) {
             return Err(ReconstructError::BadSetting {

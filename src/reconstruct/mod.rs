@@ -29,13 +29,17 @@ use crate::cosmology::LensPlane;
 use crate::grid::MapGeometry;
 use crate::images::ImageError;
 use crate::inversion::{
-    build_constraints, build_member_layers, CellGrid, ConstraintError, ConstraintSet,
-    ConstraintSource, GridError, GridMass, Layer, LinearSystem, MembersError, SystemError,
+    build_constraints, build_member_layers, capped_inverse_jacobian, CellGrid, ConstraintError,
+    ConstraintSet, ConstraintSource, GridError, GridMass, Layer, LinearSystem, MembersError,
+    ObjectiveTerms, Strength, SystemError,
 };
 use crate::products::{ProductOptions, Products, ProductsError};
-use crate::profiles::Lens;
+use crate::profiles::{Lens, MassComponent};
 use crate::sky::SkyReference;
-use crate::solver::{accelerated_gradient, Control, QadpProblem, SolveStatus, SolverError};
+use crate::solver::{
+    accelerated_gradient, minimise_exact, Control, QadpProblem, SolveOutcome, SolveStatus,
+    SolverError,
+};
 
 /// What can stop a reconstruction.
 #[derive(Debug, Error)]
@@ -69,6 +73,8 @@ pub enum ReconstructError {
     TooLarge(#[from] crate::limits::TooLarge),
     #[error("no system is left to constrain the lens ({0})")]
     NoConstraints(String),
+    #[error("cancelled")]
+    Cancelled,
     #[error("folds = {folds}: cross-validation holds out each of at least 2 groups of the fitted systems, at most one group per system ({systems} fitted here)")]
     Folds { folds: usize, systems: usize },
 }
@@ -100,7 +106,8 @@ pub struct Inputs<'a> {
 /// One report of the QADP iteration (`convergence.json`).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct ConvergenceRecord {
-    /// Refinement level (0 = the regular grid).
+    /// Solve pass: the refinement levels (0 = the regular grid), then one per update of the
+    /// image-plane weights.
     pub level: usize,
     pub iteration: usize,
     pub objective: f64,
@@ -136,6 +143,33 @@ pub struct Reconstruction {
     pub sources: Vec<SourceReport>,
     pub warnings: Vec<String>,
     pub timings: StageTimings,
+    /// How the regulariser's strength was chosen, when it was "auto".
+    pub strength_choice: Option<StrengthChoice>,
+}
+
+/// One candidate strength of an "auto" regulariser and how well it predicted.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct StrengthCandidate {
+    pub strength: f64,
+    /// Median and rms offset of the held-out images from their predictions (arcsec) over the
+    /// folds of the cross-validation (`None` when none was matched).
+    pub holdout_median_arcsec: Option<f64>,
+    pub holdout_rms_arcsec: Option<f64>,
+    /// Held-out images with no predicted image at all.
+    pub holdout_unmatched: usize,
+    /// Median offset of the fitted images in the folds (arcsec).
+    pub fit_median_arcsec: Option<f64>,
+}
+
+/// The curve "auto" chose the strength from (`summary.json`'s `strength_choice`).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct StrengthChoice {
+    pub folds: usize,
+    pub candidates: Vec<StrengthCandidate>,
+    /// The strength used.
+    pub chosen: f64,
+    /// Why it was chosen, in words.
+    pub rule: String,
 }
 
 impl Reconstruction {
@@ -149,6 +183,7 @@ impl Reconstruction {
             sources: &self.sources,
             warnings: &self.warnings,
             timings: self.timings,
+            strength_choice: self.strength_choice.as_ref(),
         }
     }
 
@@ -190,9 +225,106 @@ pub fn reconstruct(
     progress: &mut dyn FnMut(&ConvergenceRecord) -> Control,
 ) -> Result<Reconstruction, ReconstructError> {
     crate::threads::with_limit(config.system.threads, || {
-        reconstruct_limited(inputs, config, progress)
+        let Some(choice) = choose_strength(inputs, config, progress)? else {
+            return reconstruct_limited(inputs, config, progress);
+        };
+        let mut fixed = config.clone();
+        fixed.objective.strength = Strength::Value(choice.chosen);
+        let mut r = reconstruct_limited(inputs, &fixed, progress)?;
+        r.config = config.clone();
+        r.strength_choice = Some(choice);
+        Ok(r)
     })
 }
+
+/// For an "auto" strength, the cross-validation of every candidate and the one chosen: the
+/// fewest held-out images with no predicted image, then the smallest held-out median offset
+/// (`None`
+/// when the strength is a number, or when there are too few systems to hold any out: then
+/// the middle candidate is used, and said so).
+fn choose_strength(
+    inputs: &Inputs<'_>,
+    config: &ReconstructConfig,
+    progress: &mut dyn FnMut(&ConvergenceRecord) -> Control,
+) -> Result<Option<StrengthChoice>, ReconstructError> {
+    if config.objective.strength.value().is_some() {
+        return Ok(None);
+    }
+    let candidates = &config.objective.candidates;
+    let fitted = fitted_system_ids(inputs, config)?.len();
+    let folds = config.objective.folds.min(fitted);
+    if folds < 2 {
+        let chosen = candidates[candidates.len() / 2];
+        return Ok(Some(StrengthChoice {
+            folds: 0,
+            candidates: Vec::new(),
+            chosen,
+            rule: format!(
+                "{fitted} fitted system(s): too few to hold any out, so the middle candidate"
+            ),
+        }));
+    }
+    let trial = |strength: f64, progress: &mut dyn FnMut(&ConvergenceRecord) -> Control| {
+        let mut trial = config.clone();
+        trial.objective.strength = Strength::Value(strength);
+        // The maps of a trial only serve to predict the held-out images.
+        trial.products.pixels = trial.products.pixels.min(CHOICE_MAP_PIXELS);
+        let mut cancelled = false;
+        let cv = cross_validate(inputs, &trial, folds, None, &mut |_, record| {
+            let control = progress(record);
+            cancelled |= control == Control::Cancel;
+            control
+        })?;
+        if cancelled {
+            return Err(ReconstructError::Cancelled);
+        }
+        Ok(StrengthCandidate {
+            strength,
+            holdout_median_arcsec: cv.holdout_image_offset_median_arcsec,
+            holdout_rms_arcsec: cv.holdout_image_plane_rms_arcsec,
+            holdout_unmatched: cv.holdout_images_unmatched,
+            fit_median_arcsec: cv.fit_image_offset_median_arcsec,
+        })
+    };
+    // Side by side where there are threads (each trial on one; their iterations are not
+    // reported), else one after another with every report.
+    let rows: Vec<StrengthCandidate> = if crate::threads::available() > 1 {
+        crate::threads::map_items(candidates, |&s| trial(s, &mut |_| Control::Continue))
+            .into_iter()
+            .collect::<Result<_, _>>()?
+    } else {
+        candidates
+            .iter()
+            .map(|&s| trial(s, progress))
+            .collect::<Result<_, _>>()?
+    };
+    // Fewest held-out images without any predicted image first, then the smallest median.
+    let score = |c: &StrengthCandidate| {
+        (
+            c.holdout_unmatched,
+            c.holdout_median_arcsec.unwrap_or(f64::INFINITY),
+        )
+    };
+    let best = rows
+        .iter()
+        .min_by(|p, q| {
+            let (a, b) = (score(p), score(q));
+            a.0.cmp(&b.0).then(a.1.total_cmp(&b.1))
+        })
+        .map_or(candidates[0], |c| c.strength);
+    Ok(Some(StrengthChoice {
+        folds,
+        candidates: rows,
+        chosen: best,
+        rule: format!(
+            "the fewest unmatched, then the smallest median offset of held-out images over \
+             {folds} folds"
+        ),
+    }))
+}
+
+/// Map side (pixels) of the trial reconstructions of an "auto" strength.
+const CHOICE_MAP_PIXELS: usize = 256;
 
 fn reconstruct_limited(
     inputs: &Inputs<'_>,
@@ -210,7 +342,7 @@ fn reconstruct_limited(
     let mut warnings = constraints.warnings.clone();
     let positions: Vec<DVec2> = constraints.pixels.iter().map(|p| p.position).collect();
     let mut grid = CellGrid::from_config(&config.grid, &positions)?;
-    let layers: Vec<Layer> = match inputs.layers {
+    let mut layers: Vec<Layer> = match inputs.layers {
         LayerSource::None => Vec::new(),
         LayerSource::Given(layers) => layers.to_vec(),
         LayerSource::Members(catalog) => {
@@ -219,14 +351,29 @@ fn reconstruct_limited(
             model.layers
         }
     };
-    let settings = config.solver_settings();
     let mut convergence = Vec::new();
     let mut timings = StageTimings::default();
     let mut level = 0;
     let (system, x, status, iterations) = loop {
         let t = crate::products::Clock::start();
-        let system =
-            LinearSystem::build(&grid, &layers, &constraints, &inputs.plane, &config.system)?;
+        let mut system = LinearSystem::build_with(
+            &grid,
+            &layers,
+            &constraints,
+            &inputs.plane,
+            &config.system,
+            ObjectiveTerms {
+                regulariser: config.objective.regulariser,
+                strength: config.objective.strength.value().unwrap_or(0.0),
+                ..ObjectiveTerms::default()
+            },
+        )?;
+        if level == 0 {
+            if let Some(sigma) = config.members.c_prior_sigma_unmeasured {
+                hold_unmeasured_layers(&mut system, sigma);
+                layers.clone_from(&system.layers);
+            }
+        }
         timings.system_ms += t.ms();
         let t = crate::products::Clock::start();
         let x0 = start_values(&system, &config.solver);
@@ -252,21 +399,13 @@ fn reconstruct_limited(
             convergence.push(record);
             control
         };
-        let n = system.n_columns();
-        let outcome = match config.solver.method {
-            SolverMethod::Qadp => {
-                QadpProblem::with_order(&system.a, &system.b, n, system.solver_order())?.run(
-                    &x0,
-                    &settings,
-                    &mut callback,
-                )?
-            }
-            SolverMethod::AcceleratedGradient => {
-                accelerated_gradient(&system.a, &system.b, n, &x0, &settings, &mut callback)?
-            }
-        };
+        let outcome = solve(&system, config, &x0, &mut callback)?;
         timings.solve_ms += t.ms();
-        if level < config.grid.refinements && outcome.status == SolveStatus::Completed {
+        let finished = matches!(
+            outcome.status,
+            SolveStatus::Completed | SolveStatus::Converged
+        );
+        if level < config.grid.refinements && finished {
             let masses = system.cell_masses_msun(&outcome.x)?;
             grid = grid.refine(&masses, config.grid.refine_fraction)?;
             level += 1;
@@ -274,6 +413,65 @@ fn reconstruct_limited(
         }
         break (system, outcome.x, outcome.status, outcome.iterations);
     };
+    // The image-plane weights: solve again with each pixel's residual stretched by the
+    // previous solution's magnification tensor (the `regularise` module of the inversion).
+    let (mut system, mut x, mut status, mut iterations) = (system, x, status, iterations);
+    for _ in 0..config.objective.image_plane_iterations {
+        if status == SolveStatus::Cancelled {
+            break;
+        }
+        let t = crate::products::Clock::start();
+        let lens = system.reconstructed_lens(&x)?;
+        let pixel_transforms = system
+            .constraints
+            .pixels
+            .iter()
+            .map(|p| {
+                let f = system.distance_ratios[p.system];
+                capped_inverse_jacobian(lens.hessian(p.position), f, config.objective.max_stretch)
+            })
+            .collect();
+        let terms = ObjectiveTerms {
+            pixel_transforms,
+            ..system.terms.clone()
+        };
+        system = LinearSystem::build_with(
+            &system.grid,
+            &layers,
+            &constraints,
+            &inputs.plane,
+            &config.system,
+            terms,
+        )?;
+        timings.system_ms += t.ms();
+        let t = crate::products::Clock::start();
+        level += 1;
+        let shift = system.theta_shift_arcsec;
+        let cells = system.cell_columns();
+        let layer_cols = system.layer_columns();
+        let unit = system.mass_unit_msun;
+        let (bx, by) = (system.beta_x_columns(), system.beta_y_columns());
+        let mut callback = |p: &crate::solver::Progress| {
+            let record = ConvergenceRecord {
+                level,
+                iteration: p.iteration,
+                objective: p.objective,
+                grid_mass_msun: p.x[cells.clone()].iter().sum::<f64>() * unit,
+                c: p.x[layer_cols.clone()].to_vec(),
+                beta_arcsec: bx
+                    .clone()
+                    .zip(by.clone())
+                    .map(|(i, j)| DVec2::new(p.x[i] - shift, p.x[j] - shift))
+                    .collect(),
+            };
+            let control = progress(&record);
+            convergence.push(record);
+            control
+        };
+        let outcome = solve(&system, config, &x, &mut callback)?;
+        timings.solve_ms += t.ms();
+        (x, status, iterations) = (outcome.x, outcome.status, iterations + outcome.iterations);
+    }
     // First: they bear on the whole result, and a long list of members outside the field
     // would hide them. Timed with the system, whose matrix they factorise.
     let t = crate::products::Clock::start();
@@ -306,6 +504,47 @@ fn reconstruct_limited(
         sources,
         warnings,
         timings,
+        strength_choice: None,
+    })
+}
+
+/// Gives every layer without a prior whose factor the data hardly measure (independent share
+/// below [`crate::inversion::LAYER_SHARE_WARN`]) the prior `C = 1 +- sigma`
+/// ([`crate::inversion::MemberConfig::c_prior_sigma_unmeasured`]).
+fn hold_unmeasured_layers(system: &mut LinearSystem, sigma: f64) {
+    let unmeasured: Vec<usize> = system
+        .layer_independence()
+        .iter()
+        .enumerate()
+        .filter(|(_, share)| share.is_some_and(|s| s < crate::inversion::LAYER_SHARE_WARN))
+        .map(|(l, _)| l)
+        .collect();
+    for l in unmeasured {
+        system.add_layer_prior(l, sigma);
+    }
+}
+
+/// Minimises `system`'s objective with the configured method from `x0` (the exact solver
+/// needs no start).
+fn solve(
+    system: &LinearSystem,
+    config: &ReconstructConfig,
+    x0: &[f64],
+    callback: &mut dyn FnMut(&crate::solver::Progress) -> Control,
+) -> Result<SolveOutcome, ReconstructError> {
+    let n = system.n_columns();
+    let settings = config.solver_settings();
+    Ok(match config.solver.method {
+        SolverMethod::Exact => {
+            minimise_exact(&system.a, &system.b, n, config.solver.iterations, callback)?
+        }
+        SolverMethod::Qadp => {
+            QadpProblem::with_order(&system.a, &system.b, n, system.solver_order())?
+                .run(x0, &settings, callback)?
+        }
+        SolverMethod::AcceleratedGradient => {
+            accelerated_gradient(&system.a, &system.b, n, x0, &settings, callback)?
+        }
     })
 }
 

@@ -4,7 +4,7 @@
 
 use serde::Serialize;
 
-use super::{ReconstructConfig, SourceReport, StageTimings};
+use super::{ReconstructConfig, SourceReport, StageTimings, StrengthChoice};
 use crate::inversion::LinearSystem;
 use crate::products::Summary;
 
@@ -19,6 +19,8 @@ pub struct Solved<'a> {
     pub sources: &'a [SourceReport],
     pub warnings: &'a [String],
     pub timings: StageTimings,
+    /// How an "auto" regulariser strength was chosen.
+    pub strength_choice: Option<&'a StrengthChoice>,
 }
 
 impl<'a> Solved<'a> {
@@ -93,6 +95,8 @@ impl<'a> Solved<'a> {
             holdout_image_plane_rms_arcsec: self.image_plane_rms_arcsec(true),
             image_offset_median_arcsec: self.image_offset_median_arcsec(false),
             holdout_image_offset_median_arcsec: self.image_offset_median_arcsec(true),
+            regulariser_weight: s.terms.penalty_weight,
+            strength_choice: self.strength_choice,
             warnings: self.warnings,
             maps,
             timings_ms: self.timings,
@@ -131,6 +135,11 @@ pub struct ReconstructSummary<'a> {
     pub holdout_image_plane_rms_arcsec: Option<f64>,
     pub image_offset_median_arcsec: Option<f64>,
     pub holdout_image_offset_median_arcsec: Option<f64>,
+    /// The regulariser's absolute weight `lambda` in the objective (0 without one).
+    pub regulariser_weight: Option<f64>,
+    /// The cross-validation curve an "auto" strength was chosen from (candidate, held-out
+    /// median and rms), and the strength chosen.
+    pub strength_choice: Option<&'a StrengthChoice>,
     pub warnings: &'a [String],
     pub maps: Summary,
     pub timings_ms: StageTimings,

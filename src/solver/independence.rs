@@ -82,7 +82,7 @@ pub fn column_independence(a: &[f64], n: usize, cols: &[usize]) -> Vec<Option<f6
 /// Row by row in the dot-product form, four rows at a time, and each earlier row pair against
 /// those four at once ([`dot4x2`]), so that a value loaded serves more than one multiply-add.
 /// At `m` = 1085: 48 ms natively (80 ms one row at a time), 0.05 s in Chromium (0.28 s).
-fn cholesky_in_place(l: &mut [f64], m: usize) -> bool {
+pub(super) fn cholesky_in_place(l: &mut [f64], m: usize) -> bool {
     let mut r0 = 0;
     while r0 < m {
         let r1 = (r0 + 4).min(m);

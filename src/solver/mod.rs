@@ -10,6 +10,9 @@
 //! - [`accelerated_gradient`] is an accelerated projected gradient for the same problem: it
 //!   approaches the minimiser itself, which QADP's early stop avoids (for reports, and as a
 //!   solver option).
+//! - [`minimise_exact`] finds the minimiser of a positive definite (regularised) problem
+//!   exactly by block principal pivoting: the default, whose answer depends on the objective
+//!   alone, not on a start or an iteration count.
 //! - [`nnqp_exact`] is an exact active-set solver (Lawson–Hanson in QP form) for small problems,
 //!   the reference the tests compare QADP with.
 //! - [`column_independence`] says how much of some unknowns' effect the other unknowns cannot
@@ -22,6 +25,7 @@ mod gram;
 mod independence;
 mod kernel;
 mod nnls;
+mod pivoting;
 mod qadp;
 mod sweep;
 #[cfg(all(target_arch = "wasm32", target_feature = "simd128"))]
@@ -33,6 +37,7 @@ pub use accelerated::accelerated_gradient;
 pub use gram::{gram_weighted, NormalEquations};
 pub use independence::{column_independence, INDEPENDENCE_MAX_UNKNOWNS};
 pub use nnls::{nnqp_exact, NNQP_EXACT_MAX_UNKNOWNS};
+pub use pivoting::minimise_exact;
 pub use qadp::{Control, Progress, QadpProblem, QadpSettings, SolveOutcome, SolveStatus};
 
 /// What can be wrong with a quadratic program, its start or the solver settings.

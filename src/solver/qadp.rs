@@ -89,6 +89,9 @@ pub enum Control {
 pub enum SolveStatus {
     /// All requested iterations were done.
     Completed,
+    /// The exact solver ([`super::minimise_exact`]) found the minimiser: every optimality
+    /// condition holds.
+    Converged,
     /// The callback returned [`Control::Cancel`]; the outcome is the state it was shown.
     Cancelled,
     /// The objective stopped being finite (only possible when `A` is not positive
