@@ -108,6 +108,22 @@ impl Cluster {
     }
 }
 
+/// The catalogue's point images as the constraints, with `layers`.
+fn point_inputs<'a>(
+    cluster: &Cluster,
+    catalog: &'a ImageCatalog,
+    layers: LayerSource<'a>,
+) -> Inputs<'a> {
+    Inputs {
+        images: ConstraintSource::Catalog(catalog),
+        layers,
+        plane: cluster.plane,
+        reference: None,
+        holdout: &[],
+        catalog: Some(catalog),
+    }
+}
+
 /// A small configuration: 12 x 12 cells, point constraints, small maps.
 fn small_config() -> ReconstructConfig {
     let mut c = ReconstructConfig::default();
@@ -174,14 +190,7 @@ fn image_plane_offsets_match_the_forward_lens_equation() {
 fn the_minimiser_does_not_depend_on_the_start() {
     let cluster = Cluster::new();
     let catalog = cluster.catalog();
-    let inputs = Inputs {
-        images: ConstraintSource::Catalog(&catalog),
-        layers: LayerSource::None,
-        plane: cluster.plane,
-        reference: None,
-        holdout: &[],
-        catalog: Some(&catalog),
-    };
+    let inputs = point_inputs(&cluster, &catalog, LayerSource::None);
     let mut exact = small_config();
     exact.objective.strength = Strength::Value(0.1);
     exact.objective.image_plane_iterations = 0;
@@ -223,14 +232,7 @@ fn an_unmeasured_member_factor_is_held_near_one() {
     let cluster = Cluster::new();
     let catalog = cluster.catalog();
     let layers = [cluster.layer()];
-    let inputs = Inputs {
-        images: ConstraintSource::Catalog(&catalog),
-        layers: LayerSource::Given(&layers),
-        plane: cluster.plane,
-        reference: None,
-        holdout: &[],
-        catalog: Some(&catalog),
-    };
+    let inputs = point_inputs(&cluster, &catalog, LayerSource::Given(&layers));
     let mut config = small_config();
     config.objective.strength = Strength::Value(0.1);
     let held = reconstruct(&inputs, &config, &mut quiet).unwrap();
@@ -250,14 +252,7 @@ fn an_unmeasured_member_factor_is_held_near_one() {
 fn auto_strength_takes_the_best_predicting_candidate() {
     let cluster = Cluster::new();
     let catalog = cluster.catalog();
-    let inputs = Inputs {
-        images: ConstraintSource::Catalog(&catalog),
-        layers: LayerSource::None,
-        plane: cluster.plane,
-        reference: None,
-        holdout: &[],
-        catalog: Some(&catalog),
-    };
+    let inputs = point_inputs(&cluster, &catalog, LayerSource::None);
     let mut config = small_config();
     config.objective.candidates = vec![1e-3, 1.0, 1e3];
     config.objective.folds = 3;

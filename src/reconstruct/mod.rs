@@ -119,6 +119,25 @@ pub struct ConvergenceRecord {
     pub beta_arcsec: Vec<DVec2>,
 }
 
+impl ConvergenceRecord {
+    /// The record of solver state `p` of `system` in solve pass `level`.
+    fn of(system: &LinearSystem, level: usize, p: &crate::solver::Progress) -> Self {
+        let shift = system.theta_shift_arcsec;
+        Self {
+            level,
+            iteration: p.iteration,
+            objective: p.objective,
+            grid_mass_msun: p.x[system.cell_columns()].iter().sum::<f64>() * system.mass_unit_msun,
+            c: p.x[system.layer_columns()].to_vec(),
+            beta_arcsec: system
+                .beta_x_columns()
+                .zip(system.beta_y_columns())
+                .map(|(i, j)| DVec2::new(p.x[i] - shift, p.x[j] - shift))
+                .collect(),
+        }
+    }
+}
+
 /// Wall-clock time of each stage in milliseconds.
 #[derive(Debug, Clone, Copy, Default, PartialEq, Serialize, Deserialize)]
 pub struct StageTimings {
@@ -377,24 +396,8 @@ fn reconstruct_limited(
         timings.system_ms += t.ms();
         let t = crate::products::Clock::start();
         let x0 = start_values(&system, &config.solver);
-        let cells = system.cell_columns();
-        let layer_cols = system.layer_columns();
-        let unit = system.mass_unit_msun;
-        let (bx, by) = (system.beta_x_columns(), system.beta_y_columns());
-        let shift = system.theta_shift_arcsec;
         let mut callback = |p: &crate::solver::Progress| {
-            let record = ConvergenceRecord {
-                level,
-                iteration: p.iteration,
-                objective: p.objective,
-                grid_mass_msun: p.x[cells.clone()].iter().sum::<f64>() * unit,
-                c: p.x[layer_cols.clone()].to_vec(),
-                beta_arcsec: bx
-                    .clone()
-                    .zip(by.clone())
-                    .map(|(i, j)| DVec2::new(p.x[i] - shift, p.x[j] - shift))
-                    .collect(),
-            };
+            let record = ConvergenceRecord::of(&system, level, p);
             let control = progress(&record);
             convergence.push(record);
             control
@@ -446,24 +449,8 @@ fn reconstruct_limited(
         timings.system_ms += t.ms();
         let t = crate::products::Clock::start();
         level += 1;
-        let shift = system.theta_shift_arcsec;
-        let cells = system.cell_columns();
-        let layer_cols = system.layer_columns();
-        let unit = system.mass_unit_msun;
-        let (bx, by) = (system.beta_x_columns(), system.beta_y_columns());
         let mut callback = |p: &crate::solver::Progress| {
-            let record = ConvergenceRecord {
-                level,
-                iteration: p.iteration,
-                objective: p.objective,
-                grid_mass_msun: p.x[cells.clone()].iter().sum::<f64>() * unit,
-                c: p.x[layer_cols.clone()].to_vec(),
-                beta_arcsec: bx
-                    .clone()
-                    .zip(by.clone())
-                    .map(|(i, j)| DVec2::new(p.x[i] - shift, p.x[j] - shift))
-                    .collect(),
-            };
+            let record = ConvergenceRecord::of(&system, level, p);
             let control = progress(&record);
             convergence.push(record);
             control
