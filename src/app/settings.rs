@@ -29,10 +29,17 @@ pub struct AppSettings {
     pub holdout: Vec<String>,
 }
 
+/// The regulariser's strength in the app, until its candidates run in parallel workers:
+/// "auto" cross-validates 20 reconstructions one after another in the single worker (about a
+/// minute for AS1063). 0.1 is the middle of what "auto" chose natively on the six synthetic
+/// clusters of `tests/data/fidelity` (0.001 to 1) and on AS1063 (0.1).
+pub const APP_STRENGTH: f64 = 0.1;
+
 impl Default for AppSettings {
     fn default() -> Self {
         let mut reconstruct = ReconstructConfig::default();
         reconstruct.products.pixels = APP_MAP_PIXELS;
+        reconstruct.objective.strength = crate::inversion::Strength::Value(APP_STRENGTH);
         Self {
             z_lens: 0.35,
             h0: 70.0,
