@@ -1497,3 +1497,40 @@ fn a_lenstool_par_is_a_model_file_with_the_member_catalogue_as_its_potfile() {
     let why = s.model_not_compared(s.result().unwrap()).unwrap();
     assert!(why.contains("needs the member catalogue"), "{why}");
 }
+
+/// An "auto" strength in pieces, as the app's parallel workers run it: the plan, one trial
+/// per candidate, then the reconstruction with the trials gives what one "auto" run gives.
+#[cfg_attr(not(target_arch = "wasm32"), test)]
+#[cfg_attr(target_arch = "wasm32", wasm_bindgen_test::wasm_bindgen_test)]
+fn auto_strength_in_pieces_equals_one_auto_run() {
+    let mut s = teaching_session();
+    s.set_field("reconstruct.objective.strength", json!("auto"))
+        .unwrap();
+    s.set_field("reconstruct.objective.candidates", json!([0.01, 1.0]))
+        .unwrap();
+    let (candidates, folds) = s.strength_plan().unwrap().expect("auto has a plan");
+    assert_eq!(candidates, vec![0.01, 1.0]);
+    assert!(folds >= 2, "{folds} folds");
+    let trials: Vec<_> = candidates
+        .iter()
+        .map(|&c| {
+            s.strength_trial(c, folds, &mut |_| Control::Continue)
+                .unwrap()
+        })
+        .collect();
+    s.run_with_trials(trials, folds, &mut |_| Control::Continue)
+        .unwrap();
+    let pieces: serde_json::Value =
+        serde_json::from_str(&s.result().unwrap().summary_json().unwrap()).unwrap();
+    s.run(RunKind::Reconstruct, &mut |_| Control::Continue)
+        .unwrap();
+    let whole: serde_json::Value =
+        serde_json::from_str(&s.result().unwrap().summary_json().unwrap()).unwrap();
+    assert_eq!(pieces["strength_choice"], whole["strength_choice"]);
+    assert_eq!(pieces["grid_mass_msun"], whole["grid_mass_msun"]);
+    assert_eq!(pieces["settings"]["objective"]["strength"], "auto");
+    // A number needs no plan.
+    s.set_field("reconstruct.objective.strength", json!(0.1))
+        .unwrap();
+    assert!(s.strength_plan().unwrap().is_none());
+}

@@ -13,8 +13,9 @@ use crate::products::{own_map_side, ProductOptions, Products};
 use crate::profiles::Lens;
 use crate::reconstruct::{
     cross_validate, fitted_system_ids, map_geometry, product_options, reconstruct,
-    ConvergenceRecord, CrossValidation, Inputs, LayerSource, ReconstructConfig, ReconstructError,
-    SourceReport, StageTimings, StrengthChoice, DEFAULT_FOLDS,
+    reconstruct_with_choice, strength_folds, ConvergenceRecord, CrossValidation, Inputs,
+    LayerSource, ReconstructConfig, ReconstructError, SourceReport, StageTimings,
+    StrengthCandidate, StrengthChoice, DEFAULT_FOLDS,
 };
 use crate::solver::Control;
 
@@ -101,6 +102,34 @@ fn run_error(e: ReconstructError) -> AppError {
     AppError::Run(e.to_string())
 }
 
+/// The session's result of reconstruction `r` of `parsed` (its warnings after the data's).
+fn reconstruction_result(
+    r: crate::reconstruct::Reconstruction,
+    parsed: &ParsedData,
+) -> SessionResult {
+    let mut warnings = parsed.warnings.clone();
+    warnings.extend(r.warnings);
+    SessionResult {
+        kind: RunKind::Reconstruct,
+        products: r.products,
+        marks: parsed.marks(),
+        reconstruction: Some(ReconstructionResult {
+            config: r.config,
+            system: r.system,
+            x: r.x,
+            status: format!("{:?}", r.status),
+            iterations: r.iterations,
+            convergence: r.convergence,
+            sources: r.sources,
+            warnings,
+            timings: r.timings,
+            lens: r.lens,
+            strength_choice: r.strength_choice,
+        }),
+        elapsed_ms: 0.0,
+    }
+}
+
 /// The constraint source of the data with the configuration's mode (arcs force mode "arcs"
 /// when they are the only constraints, as in the CLI).
 fn constraint_source<'a>(
@@ -170,28 +199,56 @@ impl Session {
     ) -> Result<SessionResult, AppError> {
         self.with_inputs(|inputs, config, parsed| {
             let r = reconstruct(inputs, config, progress).map_err(run_error)?;
-            let mut warnings = parsed.warnings.clone();
-            warnings.extend(r.warnings);
-            Ok(SessionResult {
-                kind: RunKind::Reconstruct,
-                products: r.products,
-                marks: parsed.marks(),
-                reconstruction: Some(ReconstructionResult {
-                    config: r.config,
-                    system: r.system,
-                    x: r.x,
-                    status: format!("{:?}", r.status),
-                    iterations: r.iterations,
-                    convergence: r.convergence,
-                    sources: r.sources,
-                    warnings,
-                    timings: r.timings,
-                    lens: r.lens,
-                    strength_choice: r.strength_choice,
-                }),
-                elapsed_ms: 0.0,
-            })
+            Ok(reconstruction_result(r, parsed))
         })
+    }
+
+    /// For an "auto" regulariser strength, the candidates and the number of folds each is
+    /// cross-validated with (below 2: too few systems); `None` when the strength is a number.
+    /// The app runs [`Self::strength_trial`] for the candidates in parallel workers, then
+    /// [`Self::run_with_trials`].
+    pub fn strength_plan(&self) -> Result<Option<(Vec<f64>, usize)>, AppError> {
+        self.with_inputs(|inputs, config, _| {
+            if config.objective.strength.value().is_some() {
+                return Ok(None);
+            }
+            let folds = strength_folds(inputs, config).map_err(run_error)?;
+            Ok(Some((config.objective.candidates.clone(), folds)))
+        })
+    }
+
+    /// The cross-validation of one candidate strength on the loaded data and settings (as a
+    /// reconstruction with "auto" runs it); the session's result is not touched.
+    pub fn strength_trial(
+        &self,
+        strength: f64,
+        folds: usize,
+        progress: &mut dyn FnMut(&ConvergenceRecord) -> Control,
+    ) -> Result<StrengthCandidate, AppError> {
+        self.with_inputs(|inputs, config, _| {
+            crate::reconstruct::strength_trial(inputs, config, strength, folds, progress)
+                .map_err(run_error)
+        })
+    }
+
+    /// The reconstruction of an "auto" strength whose candidates were tried elsewhere
+    /// (`trials`, one per candidate, over `folds` folds): the strength they choose is used
+    /// and the result carries the curve. Replaces the result on success, as [`Self::run`].
+    pub fn run_with_trials(
+        &mut self,
+        trials: Vec<StrengthCandidate>,
+        folds: usize,
+        progress: &mut dyn FnMut(&ConvergenceRecord) -> Control,
+    ) -> Result<(), AppError> {
+        let t = crate::products::Clock::start();
+        let mut result = self.with_inputs(|inputs, config, parsed| {
+            let choice = StrengthChoice::from_trials(config, folds, trials);
+            let r = reconstruct_with_choice(inputs, config, choice, progress).map_err(run_error)?;
+            Ok(reconstruction_result(r, parsed))
+        })?;
+        result.elapsed_ms = t.ms();
+        self.result = Some(result);
+        Ok(())
     }
 
     /// The app's number of cross-validation folds: [`DEFAULT_FOLDS`], or one per fitted system

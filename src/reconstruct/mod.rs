@@ -243,24 +243,22 @@ pub fn reconstruct(
     config: &ReconstructConfig,
     progress: &mut dyn FnMut(&ConvergenceRecord) -> Control,
 ) -> Result<Reconstruction, ReconstructError> {
-    crate::threads::with_limit(config.system.threads, || {
-        let Some(choice) = choose_strength(inputs, config, progress)? else {
-            return reconstruct_limited(inputs, config, progress);
-        };
-        let mut fixed = config.clone();
-        fixed.objective.strength = Strength::Value(choice.chosen);
-        let mut r = reconstruct_limited(inputs, &fixed, progress)?;
-        r.config = config.clone();
-        r.strength_choice = Some(choice);
-        Ok(r)
-    })
+    let choice = crate::threads::with_limit(config.system.threads, || {
+        choose_strength(inputs, config, progress)
+    })?;
+    match choice {
+        Some(choice) => reconstruct_with_choice(inputs, config, choice, progress),
+        None => crate::threads::with_limit(config.system.threads, || {
+            reconstruct_limited(inputs, config, progress)
+        }),
+    }
 }
 
-/// For an "auto" strength, the cross-validation of every candidate and the one chosen: the
-/// fewest held-out images with no predicted image, then the smallest held-out median offset
-/// (`None`
-/// when the strength is a number, or when there are too few systems to hold any out: then
-/// the middle candidate is used, and said so).
+/// For an "auto" strength, the cross-validation of every candidate and the one chosen
+/// ([`StrengthChoice::from_trials`]); `None` when the strength is a number. Natively the
+/// candidates run side by side (each trial on one thread; their iterations are not reported),
+/// elsewhere one after another with every report. The app runs [`strength_trial`] in one web
+/// worker per candidate instead.
 fn choose_strength(
     inputs: &Inputs<'_>,
     config: &ReconstructConfig,
@@ -270,80 +268,128 @@ fn choose_strength(
         return Ok(None);
     }
     let candidates = &config.objective.candidates;
-    let fitted = fitted_system_ids(inputs, config)?.len();
-    let folds = config.objective.folds.min(fitted);
+    let folds = strength_folds(inputs, config)?;
     if folds < 2 {
-        let chosen = candidates[candidates.len() / 2];
-        return Ok(Some(StrengthChoice {
-            folds: 0,
-            candidates: Vec::new(),
-            chosen,
-            rule: format!(
-                "{fitted} fitted system(s): too few to hold any out, so the middle candidate"
-            ),
-        }));
+        return Ok(Some(StrengthChoice::from_trials(config, folds, Vec::new())));
     }
-    let trial = |strength: f64, progress: &mut dyn FnMut(&ConvergenceRecord) -> Control| {
-        let mut trial = config.clone();
-        trial.objective.strength = Strength::Value(strength);
-        // The maps of a trial only serve to predict the held-out images.
-        trial.products.pixels = trial.products.pixels.min(CHOICE_MAP_PIXELS);
-        let mut cancelled = false;
-        let cv = cross_validate(inputs, &trial, folds, None, &mut |_, record| {
-            let control = progress(record);
-            cancelled |= control == Control::Cancel;
-            control
-        })?;
-        if cancelled {
-            return Err(ReconstructError::Cancelled);
-        }
-        Ok(StrengthCandidate {
-            strength,
-            holdout_median_arcsec: cv.holdout_image_offset_median_arcsec,
-            holdout_rms_arcsec: cv.holdout_image_plane_rms_arcsec,
-            holdout_unmatched: cv.holdout_images_unmatched,
-            fit_median_arcsec: cv.fit_image_offset_median_arcsec,
-        })
-    };
-    // Side by side where there are threads (each trial on one; their iterations are not
-    // reported), else one after another with every report.
     let rows: Vec<StrengthCandidate> = if crate::threads::available() > 1 {
-        crate::threads::map_items(candidates, |&s| trial(s, &mut |_| Control::Continue))
-            .into_iter()
-            .collect::<Result<_, _>>()?
+        crate::threads::map_items(candidates, |&s| {
+            strength_trial(inputs, config, s, folds, &mut |_| Control::Continue)
+        })
+        .into_iter()
+        .collect::<Result<_, _>>()?
     } else {
         candidates
             .iter()
-            .map(|&s| trial(s, progress))
+            .map(|&s| strength_trial(inputs, config, s, folds, progress))
             .collect::<Result<_, _>>()?
     };
-    // Fewest held-out images without any predicted image first, then the smallest median.
-    let score = |c: &StrengthCandidate| {
-        (
-            c.holdout_unmatched,
-            c.holdout_median_arcsec.unwrap_or(f64::INFINITY),
-        )
-    };
-    let best = rows
-        .iter()
-        .min_by(|p, q| {
-            let (a, b) = (score(p), score(q));
-            a.0.cmp(&b.0).then(a.1.total_cmp(&b.1))
-        })
-        .map_or(candidates[0], |c| c.strength);
-    Ok(Some(StrengthChoice {
-        folds,
-        candidates: rows,
-        chosen: best,
-        rule: format!(
-            "the fewest unmatched, then the smallest median offset of held-out images over \
-             {folds} folds"
-        ),
-    }))
+    Ok(Some(StrengthChoice::from_trials(config, folds, rows)))
+}
+
+/// The folds an "auto" strength is cross-validated with: `objective.folds`, at most one per
+/// fitted system (below 2: too few systems to hold any out).
+pub fn strength_folds(
+    inputs: &Inputs<'_>,
+    config: &ReconstructConfig,
+) -> Result<usize, ReconstructError> {
+    let fitted = fitted_system_ids(inputs, config)?.len();
+    Ok(config.objective.folds.min(fitted))
+}
+
+/// The cross-validation of one candidate `strength` over `folds` folds (maps of at most
+/// [`CHOICE_MAP_PIXELS`]: they only serve to predict the held-out images).
+pub fn strength_trial(
+    inputs: &Inputs<'_>,
+    config: &ReconstructConfig,
+    strength: f64,
+    folds: usize,
+    progress: &mut dyn FnMut(&ConvergenceRecord) -> Control,
+) -> Result<StrengthCandidate, ReconstructError> {
+    let mut trial = config.clone();
+    trial.objective.strength = Strength::Value(strength);
+    trial.products.pixels = trial.products.pixels.min(CHOICE_MAP_PIXELS);
+    let mut cancelled = false;
+    let cv = cross_validate(inputs, &trial, folds, None, &mut |_, record| {
+        let control = progress(record);
+        cancelled |= control == Control::Cancel;
+        control
+    })?;
+    if cancelled {
+        return Err(ReconstructError::Cancelled);
+    }
+    Ok(StrengthCandidate {
+        strength,
+        holdout_median_arcsec: cv.holdout_image_offset_median_arcsec,
+        holdout_rms_arcsec: cv.holdout_image_plane_rms_arcsec,
+        holdout_unmatched: cv.holdout_images_unmatched,
+        fit_median_arcsec: cv.fit_image_offset_median_arcsec,
+    })
+}
+
+impl StrengthChoice {
+    /// The choice among the `trials` of `config`'s candidates: the fewest held-out images with
+    /// no predicted image, then the smallest held-out median offset. With fewer than 2 folds
+    /// (no trials), the middle candidate, and said so.
+    pub fn from_trials(
+        config: &ReconstructConfig,
+        folds: usize,
+        trials: Vec<StrengthCandidate>,
+    ) -> Self {
+        let candidates = &config.objective.candidates;
+        if folds < 2 || trials.is_empty() {
+            return Self {
+                folds: 0,
+                candidates: Vec::new(),
+                chosen: candidates[candidates.len() / 2],
+                rule: "too few fitted systems to hold any out, so the middle candidate".to_string(),
+            };
+        }
+        let score = |c: &StrengthCandidate| {
+            (
+                c.holdout_unmatched,
+                c.holdout_median_arcsec.unwrap_or(f64::INFINITY),
+            )
+        };
+        let chosen = trials
+            .iter()
+            .min_by(|p, q| {
+                let (a, b) = (score(p), score(q));
+                a.0.cmp(&b.0).then(a.1.total_cmp(&b.1))
+            })
+            .map_or(candidates[0], |c| c.strength);
+        Self {
+            folds,
+            candidates: trials,
+            chosen,
+            rule: format!(
+                "the fewest unmatched, then the smallest median offset of held-out images \
+                 over {folds} folds"
+            ),
+        }
+    }
+}
+
+/// [`reconstruct`] with an "auto" strength already chosen (e.g. by trials run elsewhere):
+/// the result carries `choice`, and its settings keep "auto".
+pub fn reconstruct_with_choice(
+    inputs: &Inputs<'_>,
+    config: &ReconstructConfig,
+    choice: StrengthChoice,
+    progress: &mut dyn FnMut(&ConvergenceRecord) -> Control,
+) -> Result<Reconstruction, ReconstructError> {
+    crate::threads::with_limit(config.system.threads, || {
+        let mut fixed = config.clone();
+        fixed.objective.strength = Strength::Value(choice.chosen);
+        let mut r = reconstruct_limited(inputs, &fixed, progress)?;
+        r.config = config.clone();
+        r.strength_choice = Some(choice);
+        Ok(r)
+    })
 }
 
 /// Map side (pixels) of the trial reconstructions of an "auto" strength.
-const CHOICE_MAP_PIXELS: usize = 256;
+pub const CHOICE_MAP_PIXELS: usize = 256;
 
 fn reconstruct_limited(
     inputs: &Inputs<'_>,

@@ -159,6 +159,65 @@ impl AppSession {
         self.result_info()
     }
 
+    /// For an "auto" regulariser strength, `{candidates, folds}` (each candidate is
+    /// cross-validated over `folds` folds by [`AppSession::strength_trial`], one web worker per
+    /// candidate, then [`AppSession::run_with_trials`] reconstructs); `null` when the strength
+    /// is a number or too few systems can be held out (then [`AppSession::run`] does it all).
+    pub fn strength_plan(&self) -> Result<JsValue, JsError> {
+        match self.inner.strength_plan().map_err(err)? {
+            Some((candidates, folds)) if folds >= 2 => to_js(&serde_json::json!({
+                "candidates": candidates,
+                "folds": folds,
+            })),
+            _ => Ok(JsValue::NULL),
+        }
+    }
+
+    /// The cross-validation of one candidate strength (a row of `strength_choice`:
+    /// `{strength, holdout_median_arcsec, holdout_rms_arcsec, holdout_unmatched,
+    /// fit_median_arcsec}`); `progress` gets the reports as [`AppSession::run`]'s, with
+    /// `strength`. The session's result is not touched.
+    pub fn strength_trial(
+        &self,
+        strength: f64,
+        folds: usize,
+        progress: &js_sys::Function,
+    ) -> Result<JsValue, JsError> {
+        let mut throttle = Throttle::new(progress);
+        let mut report = |r: &ConvergenceRecord| {
+            throttle.report(r, &[("strength", strength)]);
+            Control::Continue
+        };
+        let row = self
+            .inner
+            .strength_trial(strength, folds, &mut report)
+            .map_err(err)?;
+        to_js(&row)
+    }
+
+    /// The reconstruction with the strength chosen from `trials` (the rows of
+    /// [`AppSession::strength_trial`], one per candidate, over `folds` folds); as
+    /// [`AppSession::run`] otherwise.
+    pub fn run_with_trials(
+        &mut self,
+        trials: JsValue,
+        folds: usize,
+        progress: &js_sys::Function,
+    ) -> Result<JsValue, JsError> {
+        let trials: Vec<crate::reconstruct::StrengthCandidate> =
+            serde_wasm_bindgen::from_value(trials)
+                .map_err(|e| JsError::new(&format!("trials: {e}")))?;
+        let mut throttle = Throttle::new(progress);
+        let mut report = |r: &ConvergenceRecord| {
+            throttle.report(r, &[]);
+            Control::Continue
+        };
+        self.inner
+            .run_with_trials(trials, folds, &mut report)
+            .map_err(err)?;
+        self.result_info()
+    }
+
     /// K-fold cross-validation of the settings on the loaded data
     /// ([`Session::cross_validate`], default folds): `crossval.json` as an object. The
     /// session's result is not touched. `progress` gets each QADP report throttled like
