@@ -44,6 +44,9 @@ export TMPDIR="$ROOT/target/tmp/browsers"
 rm -rf "$TMPDIR" && mkdir -p "$TMPDIR"
 trap 'rm -rf "$TMPDIR"' EXIT
 export CARGO_TARGET_WASM32_UNKNOWN_UNKNOWN_RUNNER=wasm-bindgen-test-runner
+# The runner's time for one test binary in the browser (its default, 20 s, is near what the
+# app's tests take in a debug build).
+export WASM_BINDGEN_TEST_TIMEOUT=300
 
 run_step "cargo fmt" cargo fmt --all -- --check
 run_step "clippy native" cargo clippy --all-targets -- -D warnings
