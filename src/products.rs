@@ -56,6 +56,10 @@ pub struct ProductOptions {
     pub pixels: usize,
     /// Colour scale of the kappa figure (default log).
     pub scale: ColorScale,
+    /// Maps only: no critical curves, caustics or Einstein radius (for runs whose maps only
+    /// serve to find images, as the trials of an "auto" regulariser strength). Not a setting.
+    #[serde(skip)]
+    pub maps_only: bool,
 }
 
 impl Default for ProductOptions {
@@ -65,6 +69,7 @@ impl Default for ProductOptions {
             size_arcsec: 200.0,
             pixels: 512,
             scale: ColorScale::Log,
+            maps_only: false,
         }
     }
 }
@@ -214,6 +219,9 @@ impl Products {
         let t = Clock::start();
         let maps = LensMaps::from_lens(lens, geometry);
         let maps_ms = t.ms();
+        if opts.maps_only {
+            return Self::finish_maps_only(maps, plane, reference, f, opts.z_source, maps_ms);
+        }
         Self::finish(
             maps,
             plane,
@@ -251,6 +259,42 @@ impl Products {
         let maps = LensMaps::from_deflection(alpha_x, alpha_y)?;
         let maps_ms = t.ms();
         Self::finish(maps, plane, reference, f, z_source, None, maps_ms)
+    }
+
+    /// The products of `maps` without curves: an empty [`CriticalCurves`] (Einstein radius 0)
+    /// and no profile bins beyond one.
+    fn finish_maps_only(
+        maps: LensMaps,
+        plane: LensPlane,
+        reference: Option<SkyReference>,
+        f: f64,
+        z_source: f64,
+        maps_ms: f64,
+    ) -> Result<Self, ProductsError> {
+        let geometry = maps.geometry();
+        let bins = RadialBins::Linear {
+            r_min_arcsec: 0.0,
+            r_max_arcsec: geometry.pixel_arcsec(),
+            count: 1,
+        };
+        let profile = radial_profile(&maps.kappa, DVec2::ZERO, &bins, &plane)?;
+        Ok(Self {
+            plane,
+            reference,
+            distance_ratio: f,
+            magnification: maps.magnification(f),
+            curves: CriticalCurves {
+                z_source,
+                ..CriticalCurves::default()
+            },
+            einstein_radius_map_arcsec: None,
+            profile,
+            maps,
+            timings: Timings {
+                maps_ms,
+                ..Timings::default()
+            },
+        })
     }
 
     fn finish(

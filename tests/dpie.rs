@@ -571,6 +571,7 @@ mod published {
         size_arcsec: 200.0,
         pixels: 250,
         scale: ColorScale::Log,
+        maps_only: false,
     };
 
     struct Evaluated {

@@ -19,6 +19,7 @@ fn small_options(z_source: f64) -> ProductOptions {
         size_arcsec: 160.0,
         pixels: 160,
         scale: ColorScale::Log,
+        maps_only: false,
     }
 }
 

@@ -84,6 +84,7 @@ pub fn run(args: &MapsArgs) -> Result<(), String> {
         size_arcsec: args.size,
         pixels: args.pixels,
         scale: args.scale.into(),
+        maps_only: false,
     };
     let products = if let Some(path) = &args.model {
         let text = read_text(path, InputKind::Model)?;

@@ -91,6 +91,10 @@ pub struct ProductConfig {
     pub pixels: usize,
     /// Map width in arcsec (default: the grid's field).
     pub size_arcsec: Option<f64>,
+    /// Maps only, no curves (see [`crate::products::ProductOptions::maps_only`]). Not a
+    /// setting: the trials of an "auto" strength set it.
+    #[serde(skip)]
+    pub maps_only: bool,
 }
 
 impl Default for ProductConfig {
@@ -99,6 +103,7 @@ impl Default for ProductConfig {
             z_source: 2.0,
             pixels: 512,
             size_arcsec: None,
+            maps_only: false,
         }
     }
 }

@@ -298,7 +298,7 @@ pub fn strength_folds(
 }
 
 /// The cross-validation of one candidate `strength` over `folds` folds (maps of at most
-/// [`CHOICE_MAP_PIXELS`]: they only serve to predict the held-out images).
+/// [`CHOICE_MAP_PIXELS`] and no curves: they only serve to predict the held-out images).
 pub fn strength_trial(
     inputs: &Inputs<'_>,
     config: &ReconstructConfig,
@@ -309,6 +309,7 @@ pub fn strength_trial(
     let mut trial = config.clone();
     trial.objective.strength = Strength::Value(strength);
     trial.products.pixels = trial.products.pixels.min(CHOICE_MAP_PIXELS);
+    trial.products.maps_only = true;
     let mut cancelled = false;
     let cv = cross_validate(inputs, &trial, folds, None, &mut |_, record| {
         let control = progress(record);
@@ -627,6 +628,7 @@ pub fn product_options(config: &ReconstructConfig, grid: &CellGrid) -> ProductOp
         requested
     };
     ProductOptions {
+        maps_only: config.products.maps_only,
         z_source: config.products.z_source,
         size_arcsec,
         pixels,
