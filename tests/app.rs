@@ -1513,12 +1513,21 @@ fn auto_strength_in_pieces_equals_one_auto_run() {
     s.set_field("reconstruct.objective.candidates", json!([0.01, 1.0]))
         .unwrap();
     let (candidates, folds) = s.strength_plan().unwrap().expect("auto has a plan");
-    assert_eq!(candidates, vec![0.01, 1.0]);
+    use wslap::inversion::Regulariser::{Curvature, Gradient};
+    assert_eq!(
+        candidates,
+        vec![
+            (Gradient, 0.01),
+            (Gradient, 1.0),
+            (Curvature, 0.01),
+            (Curvature, 1.0)
+        ]
+    );
     assert!(folds >= 2, "{folds} folds");
     let trials: Vec<_> = candidates
         .iter()
-        .map(|&c| {
-            s.strength_trial(c, folds, &mut |_| Control::Continue)
+        .map(|&(kind, c)| {
+            s.strength_trial(kind, c, folds, &mut |_| Control::Continue)
                 .unwrap()
         })
         .collect();

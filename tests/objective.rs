@@ -6,7 +6,7 @@
 use glam::DVec2;
 use wslap::catalog::{Image, ImageCatalog, ImageSystem};
 use wslap::images::{find_images, ImageSearch, SearchGrid};
-use wslap::inversion::{capped_inverse_jacobian, ConstraintSource, Layer, Strength};
+use wslap::inversion::{capped_inverse_jacobian, ConstraintSource, Layer, Regulariser, Strength};
 use wslap::profiles::{Lens, MassComponent, Nfw, TruncatedNfw};
 use wslap::reconstruct::{
     cross_validate, reconstruct, Inputs, LayerSource, ReconstructConfig, SolverMethod,
@@ -258,14 +258,20 @@ fn auto_strength_takes_the_best_predicting_candidate() {
     config.objective.folds = 3;
     let r = reconstruct(&inputs, &config, &mut quiet).unwrap();
     let choice = r.strength_choice.as_ref().expect("auto writes its choice");
-    assert_eq!(choice.candidates.len(), 3);
-    let mut best = (usize::MAX, f64::INFINITY, 0.0);
-    for (row, &strength) in choice.candidates.iter().zip(&config.objective.candidates) {
+    // Every regulariser of the list with every strength.
+    assert_eq!(
+        choice.candidates.len(),
+        3 * config.objective.auto_regularisers.len()
+    );
+    let mut best = (usize::MAX, f64::INFINITY, (Regulariser::None, 0.0));
+    for row in &choice.candidates {
+        let strength = row.strength;
+        assert!(config.objective.candidates.contains(&strength));
         let mut fixed = config.clone();
         fixed.objective.strength = Strength::Value(strength);
+        fixed.objective.regulariser = row.regulariser;
         fixed.products.pixels = 96;
         let cv = cross_validate(&inputs, &fixed, 3, None, &mut |_, _| Control::Continue).unwrap();
-        assert_eq!(row.strength, strength);
         assert_eq!(
             row.holdout_median_arcsec,
             cv.holdout_image_offset_median_arcsec
@@ -274,13 +280,13 @@ fn auto_strength_takes_the_best_predicting_candidate() {
         let m = cv.holdout_image_offset_median_arcsec.unwrap();
         let u = cv.holdout_images_unmatched;
         if u < best.0 || (u == best.0 && m < best.1) {
-            best = (u, m, strength);
+            best = (u, m, (row.regulariser, strength));
         }
     }
-    assert_eq!(choice.chosen, best.2);
+    assert_eq!((choice.chosen_regulariser, choice.chosen), best.2);
     // The heaviest smoothing predicts worst here: the halo's cusp is real.
     assert_ne!(choice.chosen, 1e3);
     let summary = serde_json::to_value(r.summary()).unwrap();
-    assert_eq!(summary["strength_choice"]["chosen"], best.2);
+    assert_eq!(summary["strength_choice"]["chosen"], best.2 .1);
     assert_eq!(summary["settings"]["objective"]["strength"], "auto");
 }

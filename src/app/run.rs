@@ -5,6 +5,7 @@ use glam::DVec2;
 use serde::{Deserialize, Serialize};
 
 use crate::curves::critical_curves;
+use crate::inversion::Regulariser;
 use crate::inversion::{
     build_constraints, build_member_layers, CellGrid, ConstraintMode, ConstraintSource, Layer,
     LinearSystem,
@@ -13,9 +14,9 @@ use crate::products::{own_map_side, ProductOptions, Products};
 use crate::profiles::Lens;
 use crate::reconstruct::{
     cross_validate, fitted_system_ids, map_geometry, product_options, reconstruct,
-    reconstruct_with_choice, strength_folds, ConvergenceRecord, CrossValidation, Inputs,
-    LayerSource, ReconstructConfig, ReconstructError, SourceReport, StageTimings,
-    StrengthCandidate, StrengthChoice, DEFAULT_FOLDS,
+    reconstruct_with_choice, strength_candidates, strength_folds, ConvergenceRecord,
+    CrossValidation, Inputs, LayerSource, ReconstructConfig, ReconstructError, SourceReport,
+    StageTimings, StrengthCandidate, StrengthChoice, DEFAULT_FOLDS,
 };
 use crate::solver::Control;
 
@@ -207,27 +208,37 @@ impl Session {
     /// cross-validated with (below 2: too few systems); `None` when the strength is a number.
     /// The app runs [`Self::strength_trial`] for the candidates in parallel workers, then
     /// [`Self::run_with_trials`].
-    pub fn strength_plan(&self) -> Result<Option<(Vec<f64>, usize)>, AppError> {
+    #[allow(clippy::type_complexity)]
+    pub fn strength_plan(&self) -> Result<Option<(Vec<(Regulariser, f64)>, usize)>, AppError> {
         self.with_inputs(|inputs, config, _| {
             if config.objective.strength.value().is_some() {
                 return Ok(None);
             }
             let folds = strength_folds(inputs, config).map_err(run_error)?;
-            Ok(Some((config.objective.candidates.clone(), folds)))
+            Ok(Some((strength_candidates(config), folds)))
         })
     }
 
-    /// The cross-validation of one candidate strength on the loaded data and settings (as a
-    /// reconstruction with "auto" runs it); the session's result is not touched.
+    /// The cross-validation of one candidate (`regulariser` at `strength`) on the loaded data
+    /// and settings, as a reconstruction with "auto" runs it; the session's result is not
+    /// touched.
     pub fn strength_trial(
         &self,
+        regulariser: Regulariser,
         strength: f64,
         folds: usize,
         progress: &mut dyn FnMut(&ConvergenceRecord) -> Control,
     ) -> Result<StrengthCandidate, AppError> {
         self.with_inputs(|inputs, config, _| {
-            crate::reconstruct::strength_trial(inputs, config, strength, folds, progress)
-                .map_err(run_error)
+            crate::reconstruct::strength_trial(
+                inputs,
+                config,
+                regulariser,
+                strength,
+                folds,
+                progress,
+            )
+            .map_err(run_error)
         })
     }
 

@@ -150,9 +150,13 @@ impl ReconstructConfig {
         self.solver_settings().validate()?;
         if self.solver.method == SolverMethod::Exact {
             let o = &self.objective;
-            let zero = o.strength.value() == Some(0.0)
-                || (o.strength.value().is_none() && o.candidates.contains(&0.0));
-            if o.regulariser == Regulariser::None || zero {
+            let auto = o.strength.value().is_none();
+            let zero = o.strength.value() == Some(0.0) || (auto && o.candidates.contains(&0.0));
+            let none = match auto {
+                true => o.auto_regularisers.contains(&Regulariser::None),
+                false => o.regulariser == Regulariser::None,
+            };
+            if none || zero {
                 return Err(ReconstructError::BadSetting {
                     field: "objective.strength",
                     value: 0.0,

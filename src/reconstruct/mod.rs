@@ -31,7 +31,7 @@ use crate::images::ImageError;
 use crate::inversion::{
     build_constraints, build_member_layers, capped_inverse_jacobian, CellGrid, ConstraintError,
     ConstraintSet, ConstraintSource, GridError, GridMass, Layer, LinearSystem, MembersError,
-    ObjectiveTerms, Strength, SystemError,
+    ObjectiveTerms, Regulariser, Strength, SystemError,
 };
 use crate::products::{ProductOptions, Products, ProductsError};
 use crate::profiles::{Lens, MassComponent};
@@ -166,9 +166,11 @@ pub struct Reconstruction {
     pub strength_choice: Option<StrengthChoice>,
 }
 
-/// One candidate strength of an "auto" regulariser and how well it predicted.
+/// One candidate (regulariser and strength) of an "auto" strength and how well it predicted.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct StrengthCandidate {
+    #[serde(default)]
+    pub regulariser: Regulariser,
     pub strength: f64,
     /// Median and rms offset of the held-out images from their predictions (arcsec) over the
     /// folds of the cross-validation (`None` when none was matched).
@@ -187,6 +189,8 @@ pub struct StrengthChoice {
     pub candidates: Vec<StrengthCandidate>,
     /// The strength used.
     pub chosen: f64,
+    /// The regulariser used with it.
+    pub chosen_regulariser: Regulariser,
     /// Why it was chosen, in words.
     pub rule: String,
 }
@@ -267,24 +271,34 @@ fn choose_strength(
     if config.objective.strength.value().is_some() {
         return Ok(None);
     }
-    let candidates = &config.objective.candidates;
+    let candidates = strength_candidates(config);
     let folds = strength_folds(inputs, config)?;
     if folds < 2 {
         return Ok(Some(StrengthChoice::from_trials(config, folds, Vec::new())));
     }
     let rows: Vec<StrengthCandidate> = if crate::threads::available() > 1 {
-        crate::threads::map_items(candidates, |&s| {
-            strength_trial(inputs, config, s, folds, &mut |_| Control::Continue)
+        crate::threads::map_items(&candidates, |&(kind, s)| {
+            strength_trial(inputs, config, kind, s, folds, &mut |_| Control::Continue)
         })
         .into_iter()
         .collect::<Result<_, _>>()?
     } else {
         candidates
             .iter()
-            .map(|&s| strength_trial(inputs, config, s, folds, progress))
+            .map(|&(kind, s)| strength_trial(inputs, config, kind, s, folds, progress))
             .collect::<Result<_, _>>()?
     };
     Ok(Some(StrengthChoice::from_trials(config, folds, rows)))
+}
+
+/// The (regulariser, strength) pairs an "auto" strength tries: every one of
+/// `objective.auto_regularisers` with every one of `objective.candidates`.
+pub fn strength_candidates(config: &ReconstructConfig) -> Vec<(Regulariser, f64)> {
+    let o = &config.objective;
+    o.auto_regularisers
+        .iter()
+        .flat_map(|&kind| o.candidates.iter().map(move |&s| (kind, s)))
+        .collect()
 }
 
 /// The folds an "auto" strength is cross-validated with: `objective.folds`, at most one per
@@ -297,17 +311,19 @@ pub fn strength_folds(
     Ok(config.objective.folds.min(fitted))
 }
 
-/// The cross-validation of one candidate `strength` over `folds` folds (maps of at most
+/// The cross-validation of one candidate `regulariser` and `strength` over `folds` folds (maps of at most
 /// [`CHOICE_MAP_PIXELS`] and no curves: they only serve to predict the held-out images).
 pub fn strength_trial(
     inputs: &Inputs<'_>,
     config: &ReconstructConfig,
+    regulariser: Regulariser,
     strength: f64,
     folds: usize,
     progress: &mut dyn FnMut(&ConvergenceRecord) -> Control,
 ) -> Result<StrengthCandidate, ReconstructError> {
     let mut trial = config.clone();
     trial.objective.strength = Strength::Value(strength);
+    trial.objective.regulariser = regulariser;
     trial.products.pixels = trial.products.pixels.min(CHOICE_MAP_PIXELS);
     trial.products.maps_only = true;
     let mut cancelled = false;
@@ -320,6 +336,7 @@ pub fn strength_trial(
         return Err(ReconstructError::Cancelled);
     }
     Ok(StrengthCandidate {
+        regulariser,
         strength,
         holdout_median_arcsec: cv.holdout_image_offset_median_arcsec,
         holdout_rms_arcsec: cv.holdout_image_plane_rms_arcsec,
@@ -343,6 +360,7 @@ impl StrengthChoice {
                 folds: 0,
                 candidates: Vec::new(),
                 chosen: candidates[candidates.len() / 2],
+                chosen_regulariser: config.objective.regulariser,
                 rule: "too few fitted systems to hold any out, so the middle candidate".to_string(),
             };
         }
@@ -352,17 +370,19 @@ impl StrengthChoice {
                 c.holdout_median_arcsec.unwrap_or(f64::INFINITY),
             )
         };
-        let chosen = trials
-            .iter()
-            .min_by(|p, q| {
-                let (a, b) = (score(p), score(q));
-                a.0.cmp(&b.0).then(a.1.total_cmp(&b.1))
-            })
-            .map_or(candidates[0], |c| c.strength);
+        let best = trials.iter().min_by(|p, q| {
+            let (a, b) = (score(p), score(q));
+            a.0.cmp(&b.0).then(a.1.total_cmp(&b.1))
+        });
+        let (chosen_regulariser, chosen) = best
+            .map_or((config.objective.regulariser, candidates[0]), |c| {
+                (c.regulariser, c.strength)
+            });
         Self {
             folds,
             candidates: trials,
             chosen,
+            chosen_regulariser,
             rule: format!(
                 "the fewest unmatched, then the smallest median offset of held-out images \
                  over {folds} folds"
@@ -382,6 +402,7 @@ pub fn reconstruct_with_choice(
     crate::threads::with_limit(config.system.threads, || {
         let mut fixed = config.clone();
         fixed.objective.strength = Strength::Value(choice.chosen);
+        fixed.objective.regulariser = choice.chosen_regulariser;
         let mut r = reconstruct_limited(inputs, &fixed, progress)?;
         r.config = config.clone();
         r.strength_choice = Some(choice);

@@ -165,24 +165,48 @@ impl AppSession {
     /// is a number or too few systems can be held out (then [`AppSession::run`] does it all).
     pub fn strength_plan(&self) -> Result<JsValue, JsError> {
         match self.inner.strength_plan().map_err(err)? {
-            Some((candidates, folds)) if folds >= 2 => to_js(&serde_json::json!({
-                "candidates": candidates,
-                "folds": folds,
-            })),
+            Some((candidates, folds)) if folds >= 2 => {
+                let candidates: Vec<serde_json::Value> = candidates
+                    .iter()
+                    .map(|(regulariser, strength)| {
+                        serde_json::json!({"regulariser": regulariser, "strength": strength})
+                    })
+                    .collect();
+                to_js(&serde_json::json!({"candidates": candidates, "folds": folds}))
+            }
             _ => Ok(JsValue::NULL),
         }
     }
 
-    /// The cross-validation of one candidate strength (a row of `strength_choice`:
-    /// `{strength, holdout_median_arcsec, holdout_rms_arcsec, holdout_unmatched,
-    /// fit_median_arcsec}`); `progress` gets the reports as [`AppSession::run`]'s, with
+    /// The cross-validation of one candidate of the plan, `{regulariser, strength}` (or a bare
+    /// strength with the settings' regulariser): a row of `strength_choice`, `{regulariser,
+    /// strength, holdout_median_arcsec, holdout_rms_arcsec, holdout_unmatched,
+    /// fit_median_arcsec}`. `progress` gets the reports as [`AppSession::run`]'s, with
     /// `strength`. The session's result is not touched.
     pub fn strength_trial(
         &self,
-        strength: f64,
+        candidate: JsValue,
         folds: usize,
         progress: &js_sys::Function,
     ) -> Result<JsValue, JsError> {
+        #[derive(serde::Deserialize)]
+        #[serde(untagged)]
+        enum Candidate {
+            Strength(f64),
+            Pair {
+                regulariser: crate::inversion::Regulariser,
+                strength: f64,
+            },
+        }
+        let candidate: Candidate = serde_wasm_bindgen::from_value(candidate)
+            .map_err(|e| JsError::new(&format!("candidate: {e}")))?;
+        let (regulariser, strength) = match candidate {
+            Candidate::Strength(s) => (self.inner.settings.reconstruct.objective.regulariser, s),
+            Candidate::Pair {
+                regulariser,
+                strength,
+            } => (regulariser, strength),
+        };
         let mut throttle = Throttle::new(progress);
         let mut report = |r: &ConvergenceRecord| {
             throttle.report(r, &[("strength", strength)]);
@@ -190,7 +214,7 @@ impl AppSession {
         };
         let row = self
             .inner
-            .strength_trial(strength, folds, &mut report)
+            .strength_trial(regulariser, strength, folds, &mut report)
             .map_err(err)?;
         to_js(&row)
     }
