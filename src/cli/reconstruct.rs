@@ -12,7 +12,7 @@ use wslap::inversion::{
 use wslap::limits::InputKind;
 use wslap::reconstruct::{
     cross_validate, fold_groups, image_regions, reconstruct, ConvergenceRecord, CrossValidation,
-    Inputs, LayerSource, ReconstructConfig, Reconstruction,
+    Inputs, LayerSource, ReconstructConfig, Reconstruction, SolverMethod,
 };
 use wslap::render::ColorScale;
 use wslap::solver::Control;
@@ -196,8 +196,17 @@ pub fn run(args: &ReconstructArgs) -> Result<(), String> {
         fold_groups(&inputs, &config, folds).map_err(|e| e.to_string())?;
     }
     let total = config.solver.iterations;
+    let exact = config.solver.method == SolverMethod::Exact;
     let mut progress = |r: &ConvergenceRecord| {
-        if r.iteration % 1000 == 0 || r.iteration == total {
+        if exact {
+            // One line per exchange of the free set (the start, X = 0, says nothing).
+            if r.iteration > 0 {
+                eprintln!(
+                    "pass {} exchange {:>3}: objective {:.6e}, grid mass {:.4e} Msun, C = {:?}",
+                    r.level, r.iteration, r.objective, r.grid_mass_msun, r.c
+                );
+            }
+        } else if r.iteration % 1000 == 0 || r.iteration == total {
             eprintln!(
                 "level {} iteration {:>6}/{total}: objective {:.6e}, grid mass {:.4e} Msun, C = {:?}",
                 r.level, r.iteration, r.objective, r.grid_mass_msun, r.c
