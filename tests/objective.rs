@@ -3,8 +3,10 @@
 //! long accelerated-gradient run from two starts, the member factor held where the data do
 //! not measure it, and the "auto" strength against its own cross-validation.
 
+mod common;
+
 use glam::DVec2;
-use wslap::catalog::{Image, ImageCatalog, ImageSystem};
+use wslap::catalog::ImageCatalog;
 use wslap::images::{find_images, ImageSearch, SearchGrid};
 use wslap::inversion::{capped_inverse_jacobian, ConstraintSource, Layer, Regulariser, Strength};
 use wslap::profiles::{Lens, MassComponent, Nfw, TruncatedNfw};
@@ -68,43 +70,14 @@ impl Cluster {
 
     /// Point images (|mu| > 0.2) of 14 sources at z 1.2 to 4, found on the true lens.
     fn catalog(&self) -> ImageCatalog {
-        let lens = self.lens();
-        let search = SearchGrid::Lens(MapGeometry::centered(120.0, 240));
-        let mut systems = Vec::new();
-        for k in 0..14 {
+        let sources = (0..14).map(|k| {
             let t = k as f64;
             let z = 1.2 + 2.8 * ((t * 0.618_034) % 1.0);
-            let f = self.plane.distance_ratio(z).unwrap();
             let beta = DVec2::new((1.7 * t).cos(), (1.3 * t + 0.5).sin())
                 * (1.0 + 3.0 * ((t * 0.37) % 1.0));
-            let found = find_images(&lens, search, f, beta, &ImageSearch::default()).unwrap();
-            let images: Vec<Image> = found
-                .iter()
-                .filter(|i| i.magnification.abs() > 0.2)
-                .enumerate()
-                .map(|(j, i)| Image {
-                    id: format!("{}.{}", k + 1, j + 1),
-                    position: i.position,
-                    a_arcsec: 0.1,
-                    b_arcsec: 0.1,
-                    theta_deg: 0.0,
-                    mag: 0.0,
-                    line: 0,
-                })
-                .collect();
-            if images.len() >= 2 {
-                systems.push(ImageSystem {
-                    id: (k + 1).to_string(),
-                    z: Some(z),
-                    images,
-                });
-            }
-        }
-        ImageCatalog {
-            source_name: "synthetic".into(),
-            reference: None,
-            systems,
-        }
+            (z, beta)
+        });
+        common::point_image_catalog(&self.lens(), &self.plane, sources)
     }
 }
 

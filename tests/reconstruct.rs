@@ -4,14 +4,13 @@
 mod common;
 
 use glam::DVec2;
-use wslap::catalog::{Image, ImageCatalog, ImageSystem};
+use wslap::catalog::ImageCatalog;
 use wslap::images::source_position;
-use wslap::images::{find_images, ImageSearch, SearchGrid};
 use wslap::inversion::{ArcCatalog, ArcSystem, ConstraintMode, ConstraintSource, Layer};
 use wslap::profiles::{Lens, MassComponent, Nfw, TruncatedNfw};
 use wslap::reconstruct::{reconstruct, Inputs, LayerSource, ReconstructConfig};
 use wslap::solver::Control;
-use wslap::{Cosmology, LensPlane, MapGeometry};
+use wslap::{Cosmology, LensPlane};
 
 /// Median deflection error (arcsec, at D_ls/D_s = 1) at the observed images.
 /// A constant deflection is absorbed by the betas, so it is removed before comparing.
@@ -74,43 +73,14 @@ impl Truth {
     /// Point images of sources on a fixed pattern, at redshifts 1.2 to 4, found by solving the
     /// lens equation forward; systems with fewer than 2 images are dropped.
     fn catalog(&self) -> ImageCatalog {
-        let lens = self.lens();
-        let search = SearchGrid::Lens(MapGeometry::centered(120.0, 240));
-        let mut systems = Vec::new();
-        for k in 0..16 {
+        let sources = (0..16).map(|k| {
             let t = k as f64;
             let z = 1.2 + 2.8 * ((t * 0.618_034) % 1.0);
-            let f = self.plane.distance_ratio(z).unwrap();
             let beta = DVec2::new(4.0 * (1.7 * t).cos(), 4.0 * (1.3 * t + 0.5).sin())
                 * (0.3 + 0.7 * ((t * 0.37) % 1.0));
-            let found = find_images(&lens, search, f, beta, &ImageSearch::default()).unwrap();
-            let images: Vec<Image> = found
-                .iter()
-                .filter(|i| i.magnification.abs() > 0.2)
-                .enumerate()
-                .map(|(j, i)| Image {
-                    id: format!("{}.{}", k + 1, j + 1),
-                    position: i.position,
-                    a_arcsec: 0.1,
-                    b_arcsec: 0.1,
-                    theta_deg: 0.0,
-                    mag: 0.0,
-                    line: 0,
-                })
-                .collect();
-            if images.len() >= 2 {
-                systems.push(ImageSystem {
-                    id: (k + 1).to_string(),
-                    z: Some(z),
-                    images,
-                });
-            }
-        }
-        ImageCatalog {
-            source_name: "synthetic".into(),
-            reference: None,
-            systems,
-        }
+            (z, beta)
+        });
+        common::point_image_catalog(&self.lens(), &self.plane, sources)
     }
 
     /// Lensed arcs of small circular sources (radius `SOURCE_RADIUS_ARCSEC`) centred on the
@@ -559,7 +529,7 @@ pub(crate) mod real {
         .unwrap();
         einstein_radius_for(
             &published.lens,
-            MapGeometry::centered(160.0, 200),
+            wslap::MapGeometry::centered(160.0, 200),
             &published.plane,
             2.0,
         )

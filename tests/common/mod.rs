@@ -36,3 +36,48 @@ pub fn assert_abs(what: &str, a: f64, b: f64, atol: f64) {
         (a - b).abs()
     );
 }
+
+/// The Lenstool-style catalogue of the point images (`|mu| > 0.2`) that `lens` makes of
+/// `sources` (`(z, beta)` in arcsec), found by solving the lens equation on a 120 arcsec
+/// grid; system `k + 1` is the `k`-th source, and sources with fewer than 2 images are left
+/// out.
+pub fn point_image_catalog(
+    lens: &dyn wslap::profiles::MassComponent,
+    plane: &wslap::LensPlane,
+    sources: impl Iterator<Item = (f64, glam::DVec2)>,
+) -> wslap::catalog::ImageCatalog {
+    use wslap::catalog::{Image, ImageCatalog, ImageSystem};
+    use wslap::images::{find_images, ImageSearch, SearchGrid};
+    let search = SearchGrid::Lens(wslap::MapGeometry::centered(120.0, 240));
+    let mut systems = Vec::new();
+    for (k, (z, beta)) in sources.enumerate() {
+        let f = plane.distance_ratio(z).unwrap();
+        let found = find_images(lens, search, f, beta, &ImageSearch::default()).unwrap();
+        let images: Vec<Image> = found
+            .iter()
+            .filter(|i| i.magnification.abs() > 0.2)
+            .enumerate()
+            .map(|(j, i)| Image {
+                id: format!("{}.{}", k + 1, j + 1),
+                position: i.position,
+                a_arcsec: 0.1,
+                b_arcsec: 0.1,
+                theta_deg: 0.0,
+                mag: 0.0,
+                line: 0,
+            })
+            .collect();
+        if images.len() >= 2 {
+            systems.push(ImageSystem {
+                id: (k + 1).to_string(),
+                z: Some(z),
+                images,
+            });
+        }
+    }
+    ImageCatalog {
+        source_name: "synthetic".into(),
+        reference: None,
+        systems,
+    }
+}
