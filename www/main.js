@@ -4,7 +4,7 @@
 import { LensClient } from './lens-client.js';
 import { loadProject, saveProject } from './js/store.js';
 import { buildFileRows, setFileStatus, ROLES } from './js/files.js';
-import { buildSettings, showSettings, valueAt } from './js/settings.js';
+import { buildSettings, showSettings } from './js/settings.js';
 import { wireViews, showPng, showSystems, showCrossval, viewOptions, currentView, refreshReadout } from './js/views.js';
 import { showDownloads, save } from './js/downloads.js';
 
@@ -283,15 +283,15 @@ async function leaveExample(ex, role) {
     await ask('clear', { role: f.role });
     setFileStatus(f.role, '');
   }
-  const current = await ask('settings');
-  const defaults = await ask('defaultSettings');
-  for (const [path, value] of Object.entries({ z_lens: ex.z_lens, ...ex.settings })) {
-    if (valueAt(current, path) === value) await ask('setField', { path, value: valueAt(defaults, path) });
-  }
+  // In one job of the worker, so that a setting you change meanwhile is changed before or after
+  // it, never in between (where it would be put back to its default).
+  settings = await askSettings('resetSettings', { fields: Object.entries({ z_lens: ex.z_lens, ...ex.settings }) });
   await ask('setName', { name: OWN_DATA });
   describe(OWN_DATA, `Your files replace the example "${ex.name}": its other files and the ` +
     'settings it had set are gone (settings you changed stay). Check z_lens before you run.');
-  await showSessionSettings();
+  // Not forced: an input whose change is on its way keeps it.
+  showSettings(settings);
+  $('z-curves').value = settings.reconstruct.products.z_source;
 }
 
 /** The status line of a loaded file: its LoadReport's summary and warnings. */

@@ -27,16 +27,34 @@ async function loadCore() {
 
 let session = null;
 
+/** The value at dot path `path` (e.g. 'reconstruct.grid.cells') of `obj`, or undefined. */
+const valueAt = (obj, path) => path.split('.').reduce((o, k) => (o == null ? undefined : o[k]), obj);
+
 const handlers = {
   loadText: (m) => session.load_text(m.role, m.name, m.text),
   clear: (m) => session.clear(m.role),
   loadFits: (m) => session.load_fits(m.axis, m.name, new Uint8Array(m.bytes)),
   settings: () => session.settings(),
-  defaultSettings: () => {
-    const fresh = new core.AppSession();
-    try { return fresh.settings(); } finally { fresh.free(); }
-  },
   setField: (m) => session.set_field(m.path, m.value),
+  // The settings of `m.fields` ([dot path, value] pairs: an example's) that still have those
+  // values go back to their defaults, in one job. A reset refused with the others as they are
+  // (the exact solver while the example's regulariser is still "none") is tried again after
+  // them, until a round changes nothing. Returns the settings.
+  resetSettings: (m) => {
+    const fresh = new core.AppSession();
+    let defaults;
+    try { defaults = fresh.settings(); } finally { fresh.free(); }
+    const current = session.settings();
+    let todo = m.fields.filter(([path, value]) => valueAt(current, path) === value);
+    while (todo.length) {
+      const refused = todo.filter(([path]) => {
+        try { session.set_field(path, valueAt(defaults, path)); return false; } catch { return true; }
+      });
+      if (refused.length === todo.length) break;
+      todo = refused;
+    }
+    return session.settings();
+  },
   setName: (m) => session.set_name(m.name),
   // Throttled progress (at most every 100 ms) is posted from inside the Rust loop.
   run: (m, progress) => session.run(m.kind, progress),
