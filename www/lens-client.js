@@ -1,5 +1,6 @@
-// The only module that owns the Worker: it starts it, sends jobs, routes progress and results
-// back to their callers, and cancels by terminating the worker and starting a fresh one.
+// The only module that owns Workers: it starts one, sends jobs, routes progress and results
+// back to their callers, and cancels by terminating the worker and starting a fresh one (the
+// pool of js/pool.js closes its workers instead).
 
 const WORKER_URL = new URL('./worker.js', import.meta.url);
 // `?simd=baseline` on the page makes the worker use the baseline-SIMD core (see worker.js).
@@ -7,16 +8,20 @@ const simdChoice = new URLSearchParams(globalThis.location?.search ?? '').get('s
 if (simdChoice) WORKER_URL.searchParams.set('simd', simdChoice);
 
 export class LensClient {
-  constructor({ onReady, onCrash } = {}) {
+  /** `name`, when given, is added to the worker's URL (`?worker=name`), which tells a pool
+   * worker from the main one in the browser's tools and in tests; the worker ignores it. */
+  constructor({ onReady, onCrash, name } = {}) {
     this.onReady = onReady ?? (() => {});
     this.onCrash = onCrash ?? (() => {});
+    this.url = new URL(WORKER_URL);
+    if (name) this.url.searchParams.set('worker', name);
     this.nextId = 1;
     this.pending = new Map();
     this.start();
   }
 
   start() {
-    this.worker = new Worker(WORKER_URL, { type: 'module' });
+    this.worker = new Worker(this.url, { type: 'module' });
     this.ready = new Promise((resolve, reject) => {
       this.resolveReady = resolve;
       this.rejectReady = reject;
@@ -74,14 +79,25 @@ export class LensClient {
 
   /** Stops every running job at once and starts a fresh worker. */
   cancel() {
-    this.worker.terminate();
-    const jobs = [...this.pending.values()];
-    this.pending.clear();
-    for (const job of jobs) {
-      const err = new Error('Cancelled');
-      err.cancelled = true;
-      job.reject(err);
-    }
+    this.close();
     this.start();
   }
+
+  /** Stops the worker and every running job at once (they fail as cancelled). */
+  close() {
+    this.worker.terminate();
+    this.worker.onmessage = null;
+    this.worker.onerror = null;
+    this.rejectReady(cancelled());
+    this.ready.catch(() => {});
+    const jobs = [...this.pending.values()];
+    this.pending.clear();
+    for (const job of jobs) job.reject(cancelled());
+  }
+}
+
+function cancelled() {
+  const err = new Error('Cancelled');
+  err.cancelled = true;
+  return err;
 }

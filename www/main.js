@@ -5,8 +5,9 @@ import { LensClient } from './lens-client.js';
 import { loadProject, saveProject } from './js/store.js';
 import { buildFileRows, setFileStatus, ROLES } from './js/files.js';
 import { buildSettings, showSettings } from './js/settings.js';
-import { wireViews, showPng, showSystems, showCrossval, viewOptions, currentView, refreshReadout } from './js/views.js';
+import { wireViews, showPng, showSystems, showCrossval, showStrengthChoice, viewOptions, currentView, refreshReadout } from './js/views.js';
 import { showDownloads, save } from './js/downloads.js';
+import { StrengthPool, poolSize, projectForTrials } from './js/pool.js';
 
 const $ = (id) => document.getElementById(id);
 // Page parameters: `?example=ID` opens that built-in example (in the full app only when no
@@ -149,6 +150,7 @@ async function showResult(info) {
   resultKind = info.kind;
   caption(info);
   runNotes(info.summary);
+  showStrengthChoice(info.summary?.strength_choice);
   showDownloads(info.kind, app);
 }
 
@@ -186,17 +188,69 @@ async function inWorker(status, job, position, done) {
   }
 }
 
+// The pool of an "auto" strength's candidates while they run (Cancel closes it).
+let pool = null;
+
 function run(kind) {
   const total = settings?.reconstruct?.solver?.iterations ?? 1;
+  const iterations = (p) => `iteration ${p.iteration} / ${total}, objective ${p.objective.toExponential(4)}`;
+  // The wall time of an "auto" run: its candidates, then the reconstruction.
+  const t0 = performance.now();
   return inWorker(kind === 'reconstruct' ? 'Reconstructing…' : 'Computing…',
-    (onProgress) => ask('run', { kind }, onProgress),
-    (p) => [p.iteration, total, `iteration ${p.iteration} / ${total}, objective ${p.objective.toExponential(4)}`],
+    async (onProgress) => {
+      const plan = kind === 'reconstruct' ? (await ask('strengthPlan')).plan : null;
+      if (!plan) return ask('run', { kind }, onProgress);
+      return autoStrength(plan, total, onProgress);
+    },
+    // A report of `autoStrength` carries its own position; the others are the solver's.
+    (p) => (p.words ? [p.units, p.total, p.words] : [p.iteration, total, iterations(p)]),
     async (info) => {
-      setStatus(`Done in ${(info.elapsed_ms / 1000).toFixed(2)} s.`);
+      const wall = info.summary?.strength_choice?.candidates?.length ? performance.now() - t0 : info.elapsed_ms;
+      setStatus(`Done in ${(wall / 1000).toFixed(2)} s.`);
       await showResult(info);
       await persist();
       await render();
     });
+}
+
+/** An "auto" regulariser strength: each candidate of `plan` is cross-validated in a pool
+ * worker (js/pool.js) on the main session's project, then the main worker reconstructs with
+ * the strength their rows choose. `onProgress` gets `{elapsed_ms, units, total, words}`: the
+ * folds done of every candidate's folds plus the final solve. */
+async function autoStrength(plan, iterations, onProgress) {
+  const t0 = performance.now();
+  const n = plan.candidates.length;
+  const total = n * plan.folds + 1;
+  const project = projectForTrials(await ask('textFile', { name: 'project.json' }));
+  const mine = new StrengthPool(poolSize(n));
+  pool = mine;
+  let trials;
+  try {
+    trials = await mine.trials(project, plan, ({ done, folds, running }) => {
+      const at = [...running].map(([c, p]) => `${c} (${p ? `iteration ${p.iteration}` : 'starting'})`);
+      const workers = `${mine.size} worker${mine.size === 1 ? '' : 's'}`;
+      onProgress({
+        elapsed_ms: performance.now() - t0,
+        units: folds,
+        total,
+        words: `Choosing the regulariser: ${done} of ${n} candidates done; ${
+          at.length ? `${workers} trying ${at.join(', ')}` : `starting ${workers}`}`,
+      });
+    });
+  } finally {
+    mine.close();
+    if (pool === mine) pool = null;
+  }
+  // The rows are of the project the pool was given: the session must still be it.
+  if (projectForTrials(await ask('textFile', { name: 'project.json' })) !== project) {
+    throw new Error('The data or settings changed while the regulariser was being chosen: press Reconstruct again.');
+  }
+  return ask('runWithTrials', { trials, folds: plan.folds }, (p) => onProgress({
+    elapsed_ms: performance.now() - t0,
+    units: n * plan.folds + Math.min(1, p.iteration / iterations),
+    total,
+    words: `Reconstructing with the chosen strength: iteration ${p.iteration} / ${iterations}`,
+  }));
 }
 
 // The last cross-validation, shown until the data or a setting changes (it was made with them).
@@ -218,6 +272,15 @@ function crossValidate() {
 }
 
 async function cancel() {
+  // While the candidates run, the main worker waits with the session as it was: stopping the
+  // pool is enough.
+  if (pool) {
+    pool.close();
+    pool = null;
+    showProgress(false);
+    setStatus('Cancelled. The loaded data and the previous result are kept.');
+    return;
+  }
   client.cancel();
   showProgress(false);
   setStatus('Cancelled; restoring the session…');
@@ -240,7 +303,7 @@ async function afterOpen(report) {
   for (const { role } of ROLES) setFileStatus(role, loaded[role] ? `${loaded[role]}: loaded` : '');
   resultKind = null;
   if (report?.result === 'restored' || report?.result === 'recomputed') await showResult(await ask('resultInfo'));
-  else { $('summary').textContent = ''; runNotes(null); }
+  else { $('summary').textContent = ''; runNotes(null); showStrengthChoice(null); }
   await render();
 }
 

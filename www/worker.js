@@ -58,6 +58,12 @@ const handlers = {
   setName: (m) => session.set_name(m.name),
   // Throttled progress (at most every 100 ms) is posted from inside the Rust loop.
   run: (m, progress) => session.run(m.kind, progress),
+  // An "auto" regulariser strength in pieces (js/pool.js): the plan (`{plan: null}` when the
+  // strength is a number or too few systems can be held out), one candidate's
+  // cross-validation (in a pool worker), then the reconstruction with the strength they choose.
+  strengthPlan: () => ({ plan: session.strength_plan() }),
+  strengthTrial: (m, progress) => session.strength_trial(m.candidate, m.folds, progress),
+  runWithTrials: (m, progress) => session.run_with_trials(m.trials, m.folds, progress),
   crossValidate: (m, progress) => session.cross_validate(progress),
   crossvalFiles: () => session.crossval_files(),
   resultInfo: () => session.result_info(),

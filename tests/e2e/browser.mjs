@@ -20,8 +20,9 @@ const CHROMIUM_FLAGS = [
 ];
 
 /** Starts the server and the browser and opens the page (with `query`, e.g. '?simd=baseline');
- * returns { page, url, consoleErrors, close }. */
-export async function openApp({ width = 1280, height = 900, query = '' } = {}) {
+ * returns { page, url, consoleErrors, close }. `serviceWorkers: 'block'` keeps the app's
+ * service worker out (so that `page.route` sees the workers' requests). */
+export async function openApp({ width = 1280, height = 900, query = '', serviceWorkers = 'allow' } = {}) {
   await mkdir(ARTIFACTS, { recursive: true });
   const server = await serve(join(ROOT, 'www'), 0, '127.0.0.1');
   const url = `http://127.0.0.1:${server.address().port}/`;
@@ -29,7 +30,7 @@ export async function openApp({ width = 1280, height = 900, query = '' } = {}) {
     executablePath: process.env.CHROMIUM ?? '/usr/bin/chromium',
     args: CHROMIUM_FLAGS,
   });
-  const page = await browser.newPage({ viewport: { width, height } });
+  const page = await browser.newPage({ viewport: { width, height }, serviceWorkers });
   const consoleErrors = [];
   page.on('console', (m) => { if (m.type() === 'error') consoleErrors.push(m.text()); });
   page.on('pageerror', (e) => consoleErrors.push(String(e)));

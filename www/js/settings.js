@@ -36,6 +36,9 @@ export const FIELDS = [
   { path: 'reconstruct.objective.regulariser', label: 'Regulariser', type: 'select',
     options: [['gradient', 'smoothest mass (default)'], ['curvature', 'least curved'], ['density', 'least concentrated'], ['none', 'none (QADP\'s early stop)']],
     hint: 'among the maps that fit the images, the one the regulariser prefers; its strength is chosen by cross-validation (the held-out images)' },
+  { path: 'reconstruct.objective.strength', label: 'Regulariser strength ("auto" or a number)', type: 'strength',
+    options: ['auto', '0.001', '0.01', '0.1', '1', '10'],
+    hint: 'auto (default): each candidate strength is cross-validated, in parallel workers, and the one whose held-out images are predicted best is used; a number fixes it (0: no regulariser)' },
   { path: 'reconstruct.objective.image_plane_iterations', label: 'Image-plane updates', type: 'int',
     hint: 'times the residuals are re-weighted by the magnification (default 2; 0: source-plane residuals)' },
   { path: 'reconstruct.solver.iterations', label: 'Iterations', type: 'int' },
@@ -64,6 +67,8 @@ export function valueAt(obj, path) {
 
 function parse(field, raw) {
   if (field.type === 'text' || field.type === 'select') return raw;
+  // The strength is the string "auto" or a JSON number (a numeric string is refused).
+  if (field.type === 'strength' && raw.trim().toLowerCase() === 'auto') return 'auto';
   if (field.type === 'list') return raw.split(/[\s,]+/).filter((t) => t !== '');
   if (field.type === 'optional' && raw.trim() === '') return null;
   const v = Number(raw);
@@ -80,7 +85,10 @@ export function buildSettings(form, apply) {
       ? `<select id="${id(f.path)}">${f.options.map((o) => (Array.isArray(o)
         ? `<option value="${o[0]}">${o[1]}</option>`
         : `<option>${o}</option>`)).join('')}</select>`
-      : `<input id="${id(f.path)}" type="${['text', 'list'].includes(f.type) ? 'text' : 'number'}" ${f.step ? `step="${f.step}"` : ''}>`;
+      : f.type === 'strength'
+        ? `<input id="${id(f.path)}" type="text" inputmode="decimal" list="${id(f.path)}-list">
+          <datalist id="${id(f.path)}-list">${f.options.map((o) => `<option value="${o}"></option>`).join('')}</datalist>`
+        : `<input id="${id(f.path)}" type="${['text', 'list'].includes(f.type) ? 'text' : 'number'}" ${f.step ? `step="${f.step}"` : ''}>`;
     row.innerHTML = `<label for="${id(f.path)}">${f.label}</label>${control}
       ${f.hint ? `<small class="hint">${f.hint}</small>` : ''}
       <span class="field-error" id="${id(f.path)}-error" role="alert"></span>`;

@@ -147,6 +147,55 @@ export function showSystems(sources) {
   document.getElementById('figure').hidden = true;
 }
 
+/** The curve an "auto" regulariser strength was chosen from (summary.json's
+ * `strength_choice`): per candidate strength (and regulariser, when several were tried) the
+ * held-out images' median and rms offsets from their predictions, with a bar for the median,
+ * and the fitted images' median; the chosen row is marked. `null` (or a choice without
+ * candidates) hides it. */
+export function showStrengthChoice(choice) {
+  const box = document.getElementById('strength-box');
+  const rows = choice?.candidates ?? [];
+  if (!rows.length) {
+    box.replaceChildren();
+    box.hidden = true;
+    return;
+  }
+  const medians = rows.map((r) => r.holdout_median_arcsec).filter((v) => v != null);
+  const top = Math.max(...medians, 1e-9);
+  const unmatched = rows.some((r) => r.holdout_unmatched > 0);
+  // A regulariser column when the candidates pair several regularisers with the strengths.
+  const kinds = new Set(rows.map((r) => r.regulariser).filter((k) => k != null));
+  const byKind = kinds.size > 1;
+  const isChosen = (r) => r.strength === choice.chosen
+    && (choice.chosen_regulariser == null || r.regulariser == null || r.regulariser === choice.chosen_regulariser);
+  const bar = (v) => `<span class="bar-track" aria-hidden="true">${v == null ? ''
+    : `<span class="bar" style="width:${(100 * v / top).toFixed(1)}%"></span>`}</span>`;
+  const mark = ' <span class="mark">✓ chosen</span>';
+  const body = rows.map((r) => {
+    const chosen = isChosen(r);
+    // The candidate: its strength, after its regulariser when several were tried.
+    const name = byKind ? `${esc(r.regulariser)} ${esc(r.strength)}` : esc(r.strength);
+    return `<tr${chosen ? ' class="chosen"' : ''} data-strength="${esc(r.strength)}" data-regulariser="${esc(r.regulariser ?? '')}">
+      <th scope="row">${name}${chosen ? mark : ''}</th>
+      <td><span class="bar-cell"><span class="value">${fmt(r.holdout_median_arcsec)}</span>${bar(r.holdout_median_arcsec)}</span></td>
+      <td>${fmt(r.holdout_rms_arcsec)}</td><td>${fmt(r.fit_median_arcsec)}</td>${
+  unmatched ? `<td>${r.holdout_unmatched}</td>` : ''}</tr>`;
+  }).join('');
+  const what = byKind && choice.chosen_regulariser != null
+    ? `${esc(choice.chosen_regulariser)} at strength ${esc(choice.chosen)}` : `strength ${esc(choice.chosen)}`;
+  box.innerHTML = `<h3>Regulariser ${what}, chosen by cross-validation</h3>
+    <p id="strength-summary">The ${byKind ? 'regulariser and strength' : 'strength'} whose held-out images were
+    predicted best. Each candidate was tried over ${choice.folds} folds: every fold fits the lens without some of
+    the systems and predicts their images, so the held-out offsets say how well the map finds images it was not
+    given (smaller is better), while the fitted median says how closely it reproduces those it was given.
+    Offsets from the predictions in arcsec${unmatched ? '; unmatched: held-out images with no predicted image, which count first' : ''}.</p>
+    <div class="table-scroll"><table id="strength-table">
+    <thead><tr><th scope="col">${byKind ? 'candidate' : 'strength'}</th><th scope="col">held-out median</th>
+    <th scope="col">held-out rms</th><th scope="col">fitted median</th>${unmatched ? '<th scope="col">unmatched</th>' : ''}</tr></thead>
+    <tbody>${body}</tbody></table></div>`;
+  box.hidden = false;
+}
+
 // The object URL of the cross-validation's spread figure on screen (revoked when it goes).
 let spreadUrl = null;
 

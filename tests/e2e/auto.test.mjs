@@ -1,0 +1,162 @@
+// End-to-end: the regulariser's strength "auto" cross-validates
+// its candidates in a pool of extra workers (www/js/pool.js), then reconstructs; the result
+// shows the curve it chose from. Cancel during the candidates stops every worker; a worker
+// that fails fails the run with its message.
+import { test } from 'node:test';
+import assert from 'node:assert/strict';
+import { join } from 'node:path';
+import { readFile } from 'node:fs/promises';
+import { openApp, runToMap, ARTIFACTS, ROOT, setField, waitStatus } from './browser.mjs';
+
+const AS1063 = join(ROOT, '..', 'shared', 'data', 'AS1063', 'lenstool_cats');
+// The pool workers' URLs carry `worker=pool-N` (lens-client.js).
+const POOL = /[?&]worker=pool-\d+/;
+
+/** Opens the app and loads the AS1063 gold catalogues (images and members) at z_lens 0.348,
+ * with the app's defaults otherwise and the strength "auto". */
+async function openAs1063(options) {
+  const app = await openApp(options);
+  const { page } = app;
+  await waitStatus(page, /^Ready/);
+  await page.setInputFiles('#file-images', join(AS1063, 'cats_gold_mul_gold.cat'));
+  await page.waitForFunction(() => /19 systems, 50 images/.test(document.getElementById('status-images').textContent));
+  await page.waitForFunction(() => document.getElementById('project-name').textContent === 'Your data');
+  await page.setInputFiles('#file-members', join(AS1063, 'cats_gold_ref_potential_w_clumpNE.cat'));
+  await page.waitForFunction(() => /members/.test(document.getElementById('status-members').textContent));
+  await setField(page, '#set-z_lens', 0.348);
+  await setField(page, '#set-reconstruct-objective-strength', 'auto');
+  return app;
+}
+
+/** The pool workers alive in the page. */
+const poolWorkers = (page) => page.workers().filter((w) => POOL.test(w.url()));
+
+test('AS1063 gold with the strength "auto": the candidates run in workers and the curve is shown', async () => {
+  const app = await openAs1063();
+  try {
+    const { page } = app;
+    const t0 = Date.now();
+    await page.click('#reconstruct');
+    // One progress bar: the candidates done, and those being tried at their iteration.
+    await page.waitForFunction(() => /^Choosing the regulariser: \d+ of \d+ candidates done; \d workers? trying [\w. ]+ \(iteration \d+\)/
+      .test(document.getElementById('progress-text').textContent), null, { timeout: 60_000 });
+    const candidates = Number((await page.textContent('#progress-text')).match(/of (\d+) candidates/)[1]);
+    const workers = Math.min(await page.evaluate(() => navigator.hardwareConcurrency), 4, candidates);
+    assert.equal(poolWorkers(page).length, workers);
+    await page.screenshot({ path: join(ARTIFACTS, 'app-auto-progress.png') });
+    await waitStatus(page, /^Done in/, 600_000);
+    const seconds = (Date.now() - t0) / 1000;
+    // The pool is gone once the candidates are done.
+    assert.equal(poolWorkers(page).length, 0);
+
+    // The curve: one row per candidate, the chosen one marked, and what it means.
+    assert.equal(await page.locator('#strength-table tbody tr').count(), candidates);
+    assert.equal(await page.locator('#strength-table tr.chosen').count(), 1);
+    const chosen = await page.textContent('#strength-table tr.chosen th');
+    assert.match(chosen, /✓ chosen/);
+    assert.match(await page.innerText('#strength-summary'), /whose held-out images were predicted best/);
+    const strengths = (await page.$$eval('#strength-table tbody tr', (trs) => trs.map((tr) => Number(tr.dataset.strength))));
+    const chosenRow = await page.$eval('#strength-table tr.chosen', (tr) => ({ ...tr.dataset }));
+
+    await page.click('#downloads-panel summary');
+    const [dl] = await Promise.all([page.waitForEvent('download'), page.click('#dl-summary-json')]);
+    const summary = JSON.parse(await readFile(await dl.path(), 'utf8'));
+    const choice = summary.strength_choice;
+    assert.ok(choice, 'summary.json has strength_choice');
+    assert.equal(summary.settings.objective.strength, 'auto');
+    // Every candidate strength of the settings (with each regulariser "auto" tries, if several).
+    const o = summary.settings.objective;
+    assert.equal(choice.candidates.length, o.candidates.length * (o.auto_regularisers?.length ?? 1));
+    assert.deepEqual(choice.candidates.map((c) => c.strength), strengths);
+    assert.deepEqual([...new Set(strengths)].sort((a, b) => a - b), [...o.candidates].sort((a, b) => a - b));
+    assert.equal(choice.folds, o.folds);
+    assert.ok(choice.candidates.every((c) => Number.isFinite(c.holdout_median_arcsec)), JSON.stringify(choice));
+    assert.equal(Number(chosenRow.strength), choice.chosen);
+    if (choice.chosen_regulariser !== undefined) assert.equal(chosenRow.regulariser, choice.chosen_regulariser);
+    // The rule: the fewest unmatched held-out images, then the smallest held-out median.
+    const best = [...choice.candidates].sort((a, b) => a.holdout_unmatched - b.holdout_unmatched
+      || a.holdout_median_arcsec - b.holdout_median_arcsec)[0];
+    assert.equal(choice.chosen, best.strength);
+    if (choice.chosen_regulariser !== undefined) assert.equal(choice.chosen_regulariser, best.regulariser);
+    // One main tangential curve: the largest holds most of the area inside them.
+    assert.ok(summary.maps.tangential_main_area_share > 0.8,
+      `main tangential curve holds ${summary.maps.tangential_main_area_share} of the area`);
+    await page.click('#downloads-panel summary');
+
+    await page.locator('#strength-box').scrollIntoViewIfNeeded();
+    await page.screenshot({ path: join(ARTIFACTS, 'app-auto-result.png'), fullPage: true });
+    await page.setViewportSize({ width: 390, height: 844 });
+    const overflow = await page.evaluate(() => document.documentElement.scrollWidth - window.innerWidth);
+    assert.ok(overflow <= 0, `page is ${overflow}px wider than a phone`);
+    await page.locator('#strength-box').screenshot({ path: join(ARTIFACTS, 'app-auto-result-phone.png') });
+    assert.deepEqual(app.consoleErrors, []);
+    console.log(`AS1063 gold, auto, ${candidates} candidates in ${workers} pool workers: ${seconds.toFixed(1)} s`);
+  } finally {
+    await app.close();
+  }
+});
+
+test('Cancel during the candidates stops every worker and a later Reconstruct works', async () => {
+  const app = await openAs1063();
+  try {
+    const { page } = app;
+    await page.click('#reconstruct');
+    await page.waitForFunction(() => /trying .*\(iteration \d+\)/.test(document.getElementById('progress-text').textContent),
+      null, { timeout: 60_000 });
+    assert.ok(poolWorkers(page).length >= 1);
+    const closed = poolWorkers(page).map((w) => new Promise((resolve) => w.once('close', resolve)));
+    const t0 = Date.now();
+    await page.click('#cancel');
+    await waitStatus(page, /^Cancelled\./);
+    await Promise.all(closed);
+    assert.ok(Date.now() - t0 < 5000, 'cancel took too long');
+    assert.equal(poolWorkers(page).length, 0);
+    assert.equal(await page.isHidden('#progress-box'), true);
+    assert.equal(await page.isEnabled('#reconstruct'), true);
+    // The data are still loaded, and a new run (here at a fixed strength, quicker) works.
+    await setField(page, '#set-reconstruct-objective-strength', 0.1);
+    await runToMap(page, '#reconstruct', 120_000);
+    assert.match(await page.textContent('#summary'), /Einstein radius/);
+    // A fixed strength has no curve to show.
+    assert.equal(await page.isHidden('#strength-box'), true);
+    assert.deepEqual(app.consoleErrors, []);
+  } finally {
+    await app.close();
+  }
+});
+
+test('a pool worker that fails fails the run with its message, and the app still works', async () => {
+  const app = await openApp({ query: '?workers=2', serviceWorkers: 'block' });
+  try {
+    const { page } = app;
+    await waitStatus(page, /^Ready/);
+    // The teaching example with the strength "auto" (its settings pin the paper's method: the
+    // regulariser and the exact solver are set back first).
+    await page.selectOption('#example-select', { label: 'Teaching example: one halo, four sources' });
+    await page.waitForFunction(() => /Teaching/.test(document.getElementById('project-name').textContent));
+    await setField(page, '#set-reconstruct-objective-regulariser', 'gradient');
+    await setField(page, '#set-reconstruct-objective-strength', 'auto');
+    await setField(page, '#set-reconstruct-solver-method', 'exact');
+    // A number typed as text is sent as a number, "auto" as the word; anything else is refused.
+    await page.fill('#set-reconstruct-objective-strength', 'strong');
+    await page.dispatchEvent('#set-reconstruct-objective-strength', 'change');
+    await page.waitForFunction(() => document.getElementById('set-reconstruct-objective-strength-error').textContent !== '');
+    await setField(page, '#set-reconstruct-objective-strength', 'auto');
+    // The second pool worker's script fails to load.
+    await page.route(/worker\.js\?.*worker=pool-2/, (route) => route.fulfill({
+      contentType: 'text/javascript', body: 'throw new Error("simulated crash");',
+    }));
+    await page.click('#reconstruct');
+    await waitStatus(page, /^Failed\./, 60_000);
+    assert.match(await page.textContent('#error'), /Choosing the regulariser failed: .*simulated crash/);
+    assert.equal(poolWorkers(page).length, 0);
+    assert.equal(await page.isHidden('#progress-box'), true);
+    // Without the broken worker the same run completes, with its curve.
+    await page.unroute(/worker\.js\?.*worker=pool-2/);
+    await runToMap(page, '#reconstruct', 120_000);
+    assert.equal(await page.locator('#strength-table tr.chosen').count(), 1);
+    await page.screenshot({ path: join(ARTIFACTS, 'app-auto-teaching.png'), fullPage: true });
+  } finally {
+    await app.close();
+  }
+});
