@@ -22,24 +22,21 @@ pub struct AppSettings {
     pub h0: f64,
     /// Omega_m of flat LCDM (default 0.3).
     pub omega_m: f64,
-    /// The reconstruction settings (`CONFIG.json` of `wslap reconstruct`); the app's default
-    /// map side is [`APP_MAP_PIXELS`].
+    /// The reconstruction settings (`CONFIG.json` of `wslap reconstruct`, with its defaults,
+    /// "auto" regulariser strength included); the app's default map side is
+    /// [`APP_MAP_PIXELS`].
     pub reconstruct: ReconstructConfig,
     /// Systems left out of the fit and predicted (`wslap reconstruct --holdout`), by id.
     pub holdout: Vec<String>,
 }
 
-/// The regulariser's strength in the app, until its candidates run in parallel workers:
-/// "auto" cross-validates 20 reconstructions one after another in the single worker (about a
-/// minute for AS1063). 0.1 is the middle of what "auto" chose natively on the six synthetic
-/// clusters of `tests/data/fidelity` (0.001 to 1) and on AS1063 (0.1).
-pub const APP_STRENGTH: f64 = 0.1;
-
 impl Default for AppSettings {
+    /// The CLI's reconstruction settings (the regulariser's strength "auto" too: the web app
+    /// cross-validates its candidates in parallel workers, `www/js/pool.js`) with
+    /// [`APP_MAP_PIXELS`]-pixel maps.
     fn default() -> Self {
         let mut reconstruct = ReconstructConfig::default();
         reconstruct.products.pixels = APP_MAP_PIXELS;
-        reconstruct.objective.strength = crate::inversion::Strength::Value(APP_STRENGTH);
         Self {
             z_lens: 0.35,
             h0: 70.0,

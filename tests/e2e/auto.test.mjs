@@ -1,4 +1,4 @@
-// End-to-end: the regulariser's strength "auto" cross-validates
+// End-to-end: the regulariser's strength "auto" (the default for your own data) cross-validates
 // its candidates in a pool of extra workers (www/js/pool.js), then reconstructs; the result
 // shows the curve it chose from. Cancel during the candidates stops every worker; a worker
 // that fails fails the run with its message.
@@ -13,7 +13,7 @@ const AS1063 = join(ROOT, '..', 'shared', 'data', 'AS1063', 'lenstool_cats');
 const POOL = /[?&]worker=pool-\d+/;
 
 /** Opens the app and loads the AS1063 gold catalogues (images and members) at z_lens 0.348,
- * with the app's defaults otherwise and the strength "auto". */
+ * with the app's defaults otherwise: the strength "auto". */
 async function openAs1063(options) {
   const app = await openApp(options);
   const { page } = app;
@@ -24,7 +24,7 @@ async function openAs1063(options) {
   await page.setInputFiles('#file-members', join(AS1063, 'cats_gold_ref_potential_w_clumpNE.cat'));
   await page.waitForFunction(() => /members/.test(document.getElementById('status-members').textContent));
   await setField(page, '#set-z_lens', 0.348);
-  await setField(page, '#set-reconstruct-objective-strength', 'auto');
+  assert.equal(await page.inputValue('#set-reconstruct-objective-strength'), 'auto');
   return app;
 }
 
@@ -141,7 +141,7 @@ test('a pool worker that fails fails the run with its message, and the app still
     await page.fill('#set-reconstruct-objective-strength', 'strong');
     await page.dispatchEvent('#set-reconstruct-objective-strength', 'change');
     await page.waitForFunction(() => document.getElementById('set-reconstruct-objective-strength-error').textContent !== '');
-    await setField(page, '#set-reconstruct-objective-strength', 'auto');
+    assert.equal(await page.inputValue('#set-reconstruct-objective-strength'), 'auto');
     // The second pool worker's script fails to load.
     await page.route(/worker\.js\?.*worker=pool-2/, (route) => route.fulfill({
       contentType: 'text/javascript', body: 'throw new Error("simulated crash");',
