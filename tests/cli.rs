@@ -472,6 +472,13 @@ fn reconstruct_from_arc_pixels() {
         ]}"#,
     )
     .unwrap();
+    // A fixed strength: "auto" would run its candidates (tested in tests/objective.rs).
+    let config = dir.join("fixed.json");
+    fs::write(
+        &config,
+        r#"{"grid": {"cells": 16}, "objective": {"strength": 0.1}, "products": {"pixels": 64}}"#,
+    )
+    .unwrap();
     let out_dir = dir.join("out");
     let out = wslap(&[
         "reconstruct",
@@ -479,8 +486,8 @@ fn reconstruct_from_arc_pixels() {
         arcs.to_str().unwrap(),
         "--z-lens",
         "0.3",
-        "--iterations",
-        "100",
+        "--config",
+        config.to_str().unwrap(),
         "--out",
         out_dir.to_str().unwrap(),
     ]);
@@ -492,19 +499,31 @@ fn reconstruct_from_arc_pixels() {
     let s = summary(&out_dir);
     assert_eq!(s["constraint_pixels"], 10);
     assert_eq!(s["settings"]["constraints"]["mode"], "arcs");
-    // Images and arcs together are refused: one source of constraints at a time.
+    // With a catalogue too, the mode chooses (the rule itself: `reconstruct::Dataset`'s tests):
+    // the default fits the catalogue and says that the arcs are not fitted.
+    let images = dir.join("images.cat");
+    fs::write(
+        &images,
+        wslap::app::examples::teaching_image_catalog().unwrap(),
+    )
+    .unwrap();
     let out = wslap(&[
         "reconstruct",
         "--arcs",
         arcs.to_str().unwrap(),
         "--images",
-        arcs.to_str().unwrap(),
+        images.to_str().unwrap(),
         "--z-lens",
         "0.3",
+        "--config",
+        config.to_str().unwrap(),
         "--out",
         out_dir.to_str().unwrap(),
     ]);
-    assert!(!out.status.success());
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "{stderr}");
+    assert!(stderr.contains("its arc pixels are not fitted"), "{stderr}");
+    assert_ne!(summary(&out_dir)["settings"]["constraints"]["mode"], "arcs");
 }
 
 /// `--folds K` also writes crossval.json: K hold-out runs, every fitted system predicted once
@@ -839,7 +858,9 @@ fn reconstruct_from_a_ds9_region_file() {
     let stderr = String::from_utf8_lossy(&out.stderr);
     assert!(out.status.success(), "{stderr}");
     assert!(
-        stderr.contains("arcs.reg: the frame's origin is the regions' mean position"),
+        stderr.contains(
+            "arcs.reg: no catalogue gives a frame, so its origin is the regions' mean position"
+        ),
         "{stderr}"
     );
     let s = summary(&out_dir);

@@ -4,14 +4,15 @@
 use glam::DVec2;
 use serde::{Deserialize, Serialize};
 
-use crate::catalog::{parse_image_catalog, parse_member_catalog, ImageCatalog, MemberCatalog};
+use crate::catalog::{parse_image_catalog, parse_member_catalog, ImageCatalog};
 use crate::cosmology::LensPlane;
 use crate::fits::read_image;
 use crate::grid::Map;
-use crate::inversion::{arcs_from_regions, is_region_file, parse_arcs, ArcCatalog};
+use crate::inversion::{is_region_file, ArcCatalog};
 use crate::lenstool_par::parse_par;
 use crate::model::ModelFile;
 use crate::profiles::Lens;
+use crate::reconstruct::{Dataset, InputText, InputTexts};
 use crate::sky::SkyReference;
 
 use super::AppError;
@@ -24,7 +25,7 @@ pub enum DataRole {
     Images,
     /// Lenstool member catalogue (`id x y a b theta mag lum`).
     Members,
-    /// Arc pixels, JSON (see [`parse_arcs`]).
+    /// Arc pixels, JSON or DS9 regions (see [`crate::inversion::parse_arcs`]).
     Arcs,
     /// Parametric model file (forward mode).
     Model,
@@ -102,7 +103,7 @@ fn is_lenstool_par(text: &str) -> bool {
 
 /// Arc pixel side assumed when it cannot be measured (milliarcsec).
 pub const DEFAULT_ARC_PIXEL_MAS: u32 = 200;
-/// Pixels of one image whose nearest neighbours [`ParsedData::arc_pixel_mas`] measures.
+/// Pixels of one image whose nearest neighbours [`DataViews::arc_pixel_mas`] measures.
 const ARC_PIXEL_SAMPLES: usize = 64;
 /// Largest arc pixel side drawn (milliarcsec; sparser "pixels" are points, not pixels).
 const MAX_ARC_PIXEL_MAS: f64 = 5000.0;
@@ -121,7 +122,7 @@ pub struct DataMarks {
     /// Catalogue image positions (no arc pixels).
     pub observed: Vec<DVec2>,
     pub arcs: Vec<ArcPixels>,
-    /// Side of one arc pixel (milliarcsec), see [`ParsedData::arc_pixel_mas`].
+    /// Side of one arc pixel (milliarcsec), see [`DataViews::arc_pixel_mas`].
     pub arc_pixel_mas: u32,
     pub members: Vec<DVec2>,
 }
@@ -156,29 +157,23 @@ fn too_large_to_keep(name: &str, len: usize) -> String {
     )
 }
 
-/// The catalogues of a session in one frame, the way `wslap reconstruct` reads them: images
-/// first, members in the images' frame.
-#[derive(Debug, Clone, Default)]
-pub struct ParsedData {
-    pub images: Option<ImageCatalog>,
-    pub arcs: Option<ArcCatalog>,
-    pub members: Option<MemberCatalog>,
-    /// The frame of arcs read from a DS9 region file without a catalogue to give one (the
-    /// regions' mean position).
-    pub arcs_reference: Option<SkyReference>,
-    pub warnings: Vec<String>,
+/// What the app draws of a session's data (its catalogues read into one frame by
+/// [`Dataset::read`], as `wslap reconstruct` reads them).
+pub trait DataViews {
+    /// Observed image positions (catalogue positions, or every arc pixel), arcsec.
+    fn observed_arcsec(&self) -> Vec<DVec2>;
+    /// What the views draw of this data.
+    fn marks(&self) -> DataMarks;
+    /// The arc pixels of each system (all its images together), in file order.
+    fn arc_systems(&self) -> Vec<ArcPixels>;
+    /// Side of one arc pixel in milliarcsec (see the implementation for [`Dataset`]).
+    fn arc_pixel_mas(&self) -> u32;
+    /// Member positions, arcsec.
+    fn members_arcsec(&self) -> Vec<DVec2>;
 }
 
-impl ParsedData {
-    /// The frame's sky reference (images first, else members, else the region file's).
-    pub fn reference(&self) -> Option<SkyReference> {
-        let images = self.images.as_ref().and_then(|c| c.reference);
-        let members = self.members.as_ref().and_then(|m| m.reference);
-        images.or(members).or(self.arcs_reference)
-    }
-
-    /// Observed image positions (catalogue positions, or every arc pixel), arcsec.
-    pub fn observed_arcsec(&self) -> Vec<DVec2> {
+impl DataViews for Dataset {
+    fn observed_arcsec(&self) -> Vec<DVec2> {
         if let Some(c) = &self.images {
             return c.images().map(|i| i.position).collect();
         }
@@ -187,8 +182,7 @@ impl ParsedData {
             .collect()
     }
 
-    /// What the views draw of this data.
-    pub fn marks(&self) -> DataMarks {
+    fn marks(&self) -> DataMarks {
         let catalog = self.images.iter().flat_map(|c| c.images());
         DataMarks {
             observed: catalog.map(|i| i.position).collect(),
@@ -198,8 +192,7 @@ impl ParsedData {
         }
     }
 
-    /// The arc pixels of each system (all its images together), in file order.
-    pub fn arc_systems(&self) -> Vec<ArcPixels> {
+    fn arc_systems(&self) -> Vec<ArcPixels> {
         let systems = self.arcs.iter().flat_map(|a| a.systems.iter());
         systems
             .map(|s| ArcPixels {
@@ -209,13 +202,13 @@ impl ParsedData {
             .collect()
     }
 
-    /// Side of one arc pixel in milliarcsec: the median distance from a pixel to its nearest
+    /// The median distance from a pixel to its nearest
     /// neighbour in the same image (`DEFAULT_ARC_PIXEL_MAS` if no image has two pixels).
     /// Of an image with more than `ARC_PIXEL_SAMPLES` pixels only that many, evenly spaced
     /// in file order, are measured (against all of its pixels), so the cost grows linearly with
     /// the pixel count: every pixel of a 20000-pixel arc took 1.7 s, and each view of the data
     /// asks again. Arc pixels lie on a regular grid, where the sample's median is the same.
-    pub fn arc_pixel_mas(&self) -> u32 {
+    fn arc_pixel_mas(&self) -> u32 {
         let mut nearest: Vec<f64> = Vec::new();
         let images = self
             .arcs
@@ -243,8 +236,7 @@ impl ParsedData {
         median_mas.round().clamp(1.0, MAX_ARC_PIXEL_MAS) as u32
     }
 
-    /// Member positions, arcsec.
-    pub fn members_arcsec(&self) -> Vec<DVec2> {
+    fn members_arcsec(&self) -> Vec<DVec2> {
         let members = self.members.iter().flat_map(|m| m.members.iter());
         members.map(|m| m.position).collect()
     }
@@ -254,22 +246,15 @@ fn describe_images(c: &ImageCatalog) -> String {
     format!("{} systems, {} images", c.systems.len(), c.image_count())
 }
 
-/// Arcs from a DS9 region file (see [`arcs_from_regions`]) in the frame of `reference`, pixels
-/// at `pixel_arcsec`; systems without a redshift in their labels take the one of the same
-/// system in `images`.
-fn region_arcs(
-    text: &str,
-    name: &str,
-    reference: Option<SkyReference>,
-    pixel_arcsec: f64,
-    images: Option<&ImageCatalog>,
-) -> Result<crate::inversion::RegionArcs, AppError> {
-    let catalog_z = |id: &str| {
-        let systems = images.into_iter().flat_map(|c| c.systems.iter());
-        systems.filter(|s| s.id == id).find_map(|s| s.z)
+/// An arcs file read on its own (DS9 regions in their own frame), to check it.
+fn arcs_alone(name: &str, text: &str, pixel_arcsec: f64) -> Result<ArcCatalog, AppError> {
+    let files = InputTexts {
+        arcs: Some(InputText { name, text }),
+        ..InputTexts::default()
     };
-    arcs_from_regions(text, name, reference, pixel_arcsec, &catalog_z)
-        .map_err(|e| AppError::File(e.to_string()))
+    let data = Dataset::read(&files, pixel_arcsec).map_err(|e| AppError::File(e.to_string()))?;
+    data.arcs
+        .ok_or_else(|| AppError::File(format!("{name}: no arcs were read")))
 }
 
 impl LoadedData {
@@ -338,11 +323,7 @@ impl LoadedData {
             }
             DataRole::Arcs => {
                 let regions = is_region_file(text);
-                let a = if regions {
-                    region_arcs(text, name, None, arc_pixel_arcsec, None)?.arcs
-                } else {
-                    parse_arcs(text, name).map_err(|e| file(&e))?
-                };
+                let a = arcs_alone(name, text, arc_pixel_arcsec)?;
                 let pixels: usize = a.systems.iter().flat_map(|s| &s.images).map(Vec::len).sum();
                 let n = a.systems.len();
                 let from = if regions {
@@ -401,7 +382,7 @@ impl LoadedData {
     pub fn check_region_arcs(&self, pixel_arcsec: f64) -> Result<(), AppError> {
         match &self.arcs {
             Some(f) if is_region_file(&f.text) => {
-                region_arcs(&f.text, &f.name, None, pixel_arcsec, None).map(|_| ())
+                arcs_alone(&f.name, &f.text, pixel_arcsec).map(|_| ())
             }
             _ => Ok(()),
         }
@@ -479,45 +460,20 @@ impl LoadedData {
         })
     }
 
-    /// The catalogues parsed into one frame (images first, members in their frame, then arcs:
-    /// DS9 regions in that frame, or their own mean position without a catalogue, with pixels
-    /// of `arc_pixel_arcsec`).
-    pub fn parse(&self, arc_pixel_arcsec: f64) -> Result<ParsedData, AppError> {
-        let file = |e: &dyn std::fmt::Display| AppError::File(e.to_string());
-        let mut out = ParsedData::default();
-        if let Some(f) = &self.images {
-            let (c, w) = parse_image_catalog(&f.text, &f.name, None).map_err(|e| file(&e))?;
-            out.warnings.extend(w.iter().map(|w| w.to_string()));
-            out.images = Some(c);
+    /// The loaded files read into one frame (see [`Dataset::read`]); DS9 region arcs are
+    /// sampled at `arc_pixel_arcsec`.
+    pub fn parse(&self, arc_pixel_arcsec: f64) -> Result<Dataset, AppError> {
+        fn text(f: &Option<NamedText>) -> Option<InputText<'_>> {
+            f.as_ref().map(|f| InputText {
+                name: &f.name,
+                text: &f.text,
+            })
         }
-        if let Some(f) = &self.members {
-            let frame = out.images.as_ref().and_then(|c| c.reference);
-            let (m, w) = parse_member_catalog(&f.text, &f.name, frame).map_err(|e| file(&e))?;
-            out.warnings.extend(w.iter().map(|w| w.to_string()));
-            out.members = Some(m);
-        }
-        if let Some(f) = &self.arcs {
-            out.arcs = Some(if is_region_file(&f.text) {
-                let frame = out.reference();
-                let r = region_arcs(
-                    &f.text,
-                    &f.name,
-                    frame,
-                    arc_pixel_arcsec,
-                    out.images.as_ref(),
-                )?;
-                if frame.is_none() {
-                    out.arcs_reference = Some(r.reference);
-                    out.warnings.push(format!(
-                        "{}: no catalogue gives a frame, so its origin is the regions' mean position (RA {:.6}, Dec {:.6} deg): the maps are centred there",
-                        f.name, r.reference.ra_deg, r.reference.dec_deg
-                    ));
-                }
-                r.arcs
-            } else {
-                parse_arcs(&f.text, &f.name).map_err(|e| file(&e))?
-            });
-        }
-        Ok(out)
+        let files = InputTexts {
+            images: text(&self.images),
+            members: text(&self.members),
+            arcs: text(&self.arcs),
+        };
+        Dataset::read(&files, arc_pixel_arcsec).map_err(|e| AppError::File(e.to_string()))
     }
 }

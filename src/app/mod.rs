@@ -16,11 +16,11 @@ mod views;
 
 use thiserror::Error;
 
-pub use crate::reconstruct::ReconstructSummary;
 pub use crate::reconstruct::SHOWN_MIN_MAGNIFICATION;
+pub use crate::reconstruct::{Dataset, ReconstructSummary};
 pub use data::{
-    ArcPixels, DataMarks, DataRole, LoadReport, LoadedData, ModelLens, NamedMap, NamedText,
-    ParsedData, MAX_STORED_FITS_BYTES,
+    ArcPixels, DataMarks, DataRole, DataViews, LoadReport, LoadedData, ModelLens, NamedMap,
+    NamedText, MAX_STORED_FITS_BYTES,
 };
 pub use plots::{profile_relative_differences, ModelCurves};
 pub use project::{Project, ProjectResult, StoredFits, PROJECT_FORMAT, PROJECT_VERSION};
@@ -80,7 +80,7 @@ impl Session {
     }
 
     /// The loaded files parsed into one frame (see [`LoadedData::parse`]).
-    pub fn parsed(&self) -> Result<ParsedData, AppError> {
+    pub fn parsed(&self) -> Result<Dataset, AppError> {
         self.data
             .parse(self.settings.reconstruct.constraints.pixel_arcsec)
     }

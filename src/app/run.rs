@@ -6,21 +6,18 @@ use serde::{Deserialize, Serialize};
 
 use crate::curves::critical_curves;
 use crate::inversion::Regulariser;
-use crate::inversion::{
-    build_constraints, build_member_layers, CellGrid, ConstraintMode, ConstraintSource, Layer,
-    LinearSystem,
-};
+use crate::inversion::{build_constraints, build_member_layers, CellGrid, Layer, LinearSystem};
 use crate::products::{own_map_side, ProductOptions, Products};
 use crate::profiles::Lens;
 use crate::reconstruct::{
     cross_validate, fitted_system_ids, map_geometry, product_options, reconstruct,
     reconstruct_with_choice, strength_candidates, strength_folds, ConvergenceRecord,
-    CrossValidation, Inputs, LayerSource, ReconstructConfig, ReconstructError, SourceReport,
-    StageTimings, StrengthCandidate, StrengthChoice, DEFAULT_FOLDS,
+    CrossValidation, Dataset, DatasetError, Inputs, ReconstructConfig, ReconstructError,
+    SourceReport, StageTimings, StrengthCandidate, StrengthChoice, DEFAULT_FOLDS,
 };
 use crate::solver::Control;
 
-use super::data::{DataMarks, ParsedData};
+use super::data::{DataMarks, DataViews};
 use super::{AppError, Session};
 
 /// Map width of a forward model without a `products.size_arcsec` setting (arcsec).
@@ -99,15 +96,22 @@ impl SessionResult {
     }
 }
 
+/// "Nothing to fit" is something missing; a file that does not read is the file's error.
+fn dataset_error(e: DatasetError) -> AppError {
+    match e {
+        DatasetError::NoConstraints => {
+            AppError::Missing("load an image catalogue or an arcs file to reconstruct".to_string())
+        }
+        other => AppError::File(other.to_string()),
+    }
+}
+
 fn run_error(e: ReconstructError) -> AppError {
     AppError::Run(e.to_string())
 }
 
 /// The session's result of reconstruction `r` of `parsed` (its warnings after the data's).
-fn reconstruction_result(
-    r: crate::reconstruct::Reconstruction,
-    parsed: &ParsedData,
-) -> SessionResult {
+fn reconstruction_result(r: crate::reconstruct::Reconstruction, parsed: &Dataset) -> SessionResult {
     let mut warnings = parsed.warnings.clone();
     warnings.extend(r.warnings);
     SessionResult {
@@ -128,27 +132,6 @@ fn reconstruction_result(
             strength_choice: r.strength_choice,
         }),
         elapsed_ms: 0.0,
-    }
-}
-
-/// The constraint source of the data with the configuration's mode (arcs force mode "arcs"
-/// when they are the only constraints, as in the CLI).
-fn constraint_source<'a>(
-    parsed: &'a ParsedData,
-    config: &mut ReconstructConfig,
-) -> Result<ConstraintSource<'a>, AppError> {
-    match (&parsed.images, &parsed.arcs) {
-        (Some(_), Some(a)) if config.constraints.mode == ConstraintMode::Arcs => {
-            Ok(ConstraintSource::Arcs(a))
-        }
-        (Some(c), _) => Ok(ConstraintSource::Catalog(c)),
-        (None, Some(a)) => {
-            config.constraints.mode = ConstraintMode::Arcs;
-            Ok(ConstraintSource::Arcs(a))
-        }
-        (None, None) => Err(AppError::Missing(
-            "load an image catalogue or an arcs file to reconstruct".to_string(),
-        )),
     }
 }
 
@@ -174,24 +157,23 @@ impl Session {
     /// Runs `f` on the reconstruction's inputs (the loaded data in one frame) and settings.
     fn with_inputs<T>(
         &self,
-        f: impl FnOnce(&Inputs<'_>, &ReconstructConfig, &ParsedData) -> Result<T, AppError>,
+        f: impl FnOnce(&Inputs<'_>, &ReconstructConfig, &Dataset) -> Result<T, AppError>,
     ) -> Result<T, AppError> {
         let parsed = self.parsed()?;
         let plane = self.settings.lens_plane()?;
         let mut config = self.settings.reconstruct.clone();
-        let images = constraint_source(&parsed, &mut config)?;
-        let inputs = Inputs {
-            images,
-            layers: parsed
-                .members
-                .as_ref()
-                .map_or(LayerSource::None, LayerSource::Members),
-            plane,
-            reference: parsed.reference(),
-            holdout: &self.settings.holdout,
-            catalog: parsed.images.as_ref(),
-        };
-        f(&inputs, &config, &parsed)
+        let (inputs, note) = parsed
+            .inputs(plane, &self.settings.holdout, &mut config)
+            .map_err(dataset_error)?;
+        match note {
+            // The result lists the data's warnings: add the note to a copy of the data.
+            Some(note) => {
+                let mut noted = parsed.clone();
+                noted.warnings.push(note);
+                f(&inputs, &config, &noted)
+            }
+            None => f(&inputs, &config, &parsed),
+        }
     }
 
     fn run_reconstruction(
@@ -332,12 +314,16 @@ impl Session {
                 "a refined grid cannot be rebuilt from X: solve again".to_string(),
             ));
         }
-        let source = constraint_source(&parsed, &mut config)?;
+        let (source, mode, note) = parsed
+            .constraints(config.constraints.mode)
+            .map_err(dataset_error)?;
+        config.constraints.mode = mode;
         let constraints = build_constraints(source, &config.constraints, &self.settings.holdout)
             .map_err(|e| run(&e))?;
         let positions: Vec<DVec2> = constraints.pixels.iter().map(|p| p.position).collect();
         let grid = CellGrid::from_config(&config.grid, &positions).map_err(|e| run(&e))?;
         let mut warnings = parsed.warnings.clone();
+        warnings.extend(note);
         let layers: Vec<Layer> = match &parsed.members {
             None => Vec::new(),
             Some(m) => {

@@ -9,6 +9,7 @@ use crate::render::OverlayPoints;
 use crate::render::{render_kappa_png, ColorScale, Colormap, KappaPlotOptions, Marker, Overlay};
 use crate::CriticalCurves;
 
+use super::data::DataViews;
 use super::views::{
     arc_overlays, ViewOptions, ViewPng, COUNTER_IMAGE_RGB, MEMBER_RGB, OBSERVED_RGB,
 };

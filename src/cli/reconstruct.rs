@@ -5,14 +5,11 @@ use std::path::{Path, PathBuf};
 
 use clap::Args;
 use serde::Serialize;
-use wslap::catalog::{parse_image_catalog, parse_member_catalog};
-use wslap::inversion::{
-    arcs_from_regions, export_system, is_region_file, parse_arcs, ConstraintMode, ConstraintSource,
-};
+use wslap::inversion::export_system;
 use wslap::limits::InputKind;
 use wslap::reconstruct::{
     cross_validate, fold_groups, image_regions, reconstruct, ConvergenceRecord, CrossValidation,
-    Inputs, LayerSource, ReconstructConfig, Reconstruction, SolverMethod,
+    Dataset, InputText, InputTexts, ReconstructConfig, Reconstruction, SolverMethod,
 };
 use wslap::render::ColorScale;
 use wslap::solver::Control;
@@ -31,12 +28,18 @@ use super::maps::write_products;
 /// radius, image-plane rms, timings); with --folds also crossval.json and the folds' convergence
 /// (crossval-kappa-mean.fits, crossval-kappa-spread.fits, crossval-kappa-spread.png).
 #[derive(Debug, Args)]
-#[command(group(clap::ArgGroup::new("constraints").required(true).args(["images", "arcs"])))]
+#[command(group(
+    clap::ArgGroup::new("constraints")
+        .required(true)
+        .multiple(true)
+        .args(["images", "arcs"])
+))]
 pub struct ReconstructArgs {
     /// Lenstool multiple-image catalogue (id x y a b theta z mag).
     #[arg(long, value_name = "IMAGES.cat")]
     images: Option<PathBuf>,
-    /// Arc pixels instead of a catalogue; sets the constraint mode to "arcs". Either JSON
+    /// Arc pixels. Alone they are fitted as arcs; with --images, constraints.mode "arcs" fits
+    /// them and the catalogue gives the frame and the redshifts of regions without one. Either JSON
     /// ({"systems": [{"id", "z", "images": [[[x, y], ...], ...]}]}, arcsec) or a DS9 region file
     /// in fk5: one region per image (polygon, circle, ellipse, box or point) labelled
     /// text={1.1 z=2.5}, sampled at constraints.pixel_arcsec; '-' regions cut pixels out.
@@ -117,80 +120,36 @@ pub fn run(args: &ReconstructArgs) -> Result<(), String> {
     }
     let cosmology = Cosmology::new(args.h0, args.omega_m).map_err(|e| e.to_string())?;
     let plane = LensPlane::new(cosmology, args.z_lens).map_err(|e| e.to_string())?;
-    let mut warnings = Vec::new();
-    let catalog = match &args.images {
-        Some(path) => {
-            let (c, w) =
-                parse_image_catalog(&read_text(path, InputKind::Catalog)?, &name(path), None)
-                    .map_err(|e| e.to_string())?;
-            warnings.extend(w);
-            Some(c)
-        }
-        None => None,
+    let texts = [&args.images, &args.members, &args.arcs].map(|path| {
+        let kind = if path == &args.arcs {
+            InputKind::Arcs
+        } else {
+            InputKind::Catalog
+        };
+        path.as_ref()
+            .map(|p| Ok::<_, String>((name(p), read_text(p, kind)?)))
+            .transpose()
+    });
+    let [images, members, arcs] = texts;
+    let (images, members, arcs) = (images?, members?, arcs?);
+    fn text(f: &Option<(String, String)>) -> Option<InputText<'_>> {
+        f.as_ref().map(|(name, text)| InputText { name, text })
+    }
+    let files = InputTexts {
+        images: text(&images),
+        members: text(&members),
+        arcs: text(&arcs),
     };
-    let mut reference = catalog.as_ref().and_then(|c| c.reference);
-    let members = match &args.members {
-        Some(path) => {
-            let (m, w) = parse_member_catalog(
-                &read_text(path, InputKind::Catalog)?,
-                &name(path),
-                reference,
-            )
-            .map_err(|e| e.to_string())?;
-            warnings.extend(w);
-            Some(m)
-        }
-        None => None,
-    };
-    reference = reference.or(members.as_ref().and_then(|m| m.reference));
-    let arcs = match (&catalog, &args.arcs) {
-        (None, Some(path)) => {
-            config.constraints.mode = ConstraintMode::Arcs;
-            let text = read_text(path, InputKind::Arcs)?;
-            Some(if is_region_file(&text) {
-                let r = arcs_from_regions(
-                    &text,
-                    &name(path),
-                    reference,
-                    config.constraints.pixel_arcsec,
-                    &|_| None,
-                )
-                .map_err(|e| e.to_string())?;
-                if r.reference_from_regions {
-                    eprintln!(
-                        "note: {}: the frame's origin is the regions' mean position, RA {:.6}, Dec {:.6} deg (give --members to use its catalogue's)",
-                        name(path),
-                        r.reference.ra_deg,
-                        r.reference.dec_deg
-                    );
-                }
-                reference = Some(r.reference);
-                r.arcs
-            } else {
-                parse_arcs(&text, &name(path)).map_err(|e| e.to_string())?
-            })
-        }
-        (None, None) => return Err("give --images or --arcs".to_string()),
-        (Some(_), _) => None,
-    };
-    for w in &warnings {
+    let data = Dataset::read(&files, config.constraints.pixel_arcsec).map_err(|e| e.to_string())?;
+    for w in &data.warnings {
         eprintln!("warning: {w}");
     }
-    let images = match (&catalog, &arcs) {
-        (Some(c), _) => ConstraintSource::Catalog(c),
-        (None, Some(a)) => ConstraintSource::Arcs(a),
-        (None, None) => unreachable!("one of them was read above"),
-    };
-    let inputs = Inputs {
-        images,
-        layers: members
-            .as_ref()
-            .map_or(LayerSource::None, LayerSource::Members),
-        plane,
-        reference,
-        holdout: &args.holdout,
-        catalog: catalog.as_ref(),
-    };
+    let (inputs, note) = data
+        .inputs(plane, &args.holdout, &mut config)
+        .map_err(|e| e.to_string())?;
+    if let Some(note) = note {
+        eprintln!("warning: {note}");
+    }
     if let Some(folds) = args.folds {
         // A number of folds that cannot work is refused before the first run.
         fold_groups(&inputs, &config, folds).map_err(|e| e.to_string())?;

@@ -107,7 +107,8 @@ pub enum ConstraintMode {
 }
 
 impl ConstraintMode {
-    fn name(self) -> &'static str {
+    /// The mode's name in settings files.
+    pub fn name(self) -> &'static str {
         match self {
             Self::Point => "point",
             Self::Ellipse => "ellipse",

@@ -6,6 +6,7 @@
 
 mod config;
 mod crossval;
+mod dataset;
 mod sources;
 mod summary;
 
@@ -18,6 +19,7 @@ pub use crossval::{
     cross_validate, fitted_system_ids, fold_groups, CrossValidation, FoldRun, KappaSpread,
     PredictedSystem, DEFAULT_FOLDS,
 };
+pub use dataset::{Dataset, DatasetError, InputText, InputTexts};
 pub use sources::{
     image_regions, images_on_maps, source_on_maps, ImageReport, PredictedImage, SourceReport,
     IMAGE_REGION_RADIUS_ARCSEC, SHOWN_MIN_MAGNIFICATION,

@@ -1,0 +1,261 @@
+//! A reconstruction's data read from the user's files, the same way in every shell (the CLI
+//! and the app): one frame for every file, DS9 region arcs with the catalogue's redshifts, and
+//! one rule for which constraints are fitted.
+//!
+//! - **Frame.** The image catalogue's `#REFERENCE` sets the frame; the member catalogue is read
+//!   in it (or sets it when there is no image catalogue); DS9 region arcs are read in that frame,
+//!   or, with no catalogue at all, in a frame centred on the regions' mean position (a warning
+//!   says so).
+//! - **Redshifts of region arcs.** A region labelled without `z=` takes the redshift of the
+//!   system of the same id in the image catalogue.
+//! - **Which constraints.** With an image catalogue and arcs, the setting
+//!   `constraints.mode` chooses: `"arcs"` fits the arc pixels, `"point"` and `"ellipse"` the
+//!   catalogue (a warning says that the arcs are not fitted). Arcs alone are fitted as arcs
+//!   whatever the mode says.
+
+use thiserror::Error;
+
+use super::{Inputs, LayerSource, ReconstructConfig};
+use crate::catalog::{
+    parse_image_catalog, parse_member_catalog, CatalogError, ImageCatalog, MemberCatalog,
+};
+use crate::cosmology::LensPlane;
+use crate::inversion::{
+    arcs_from_regions, is_region_file, parse_arcs, ArcCatalog, ConstraintError, ConstraintMode,
+    ConstraintSource, RegionArcs,
+};
+use crate::sky::SkyReference;
+
+/// One input file: the name used in messages and its text.
+#[derive(Debug, Clone, Copy)]
+pub struct InputText<'a> {
+    pub name: &'a str,
+    pub text: &'a str,
+}
+
+/// The files a reconstruction can be given; each is optional.
+#[derive(Debug, Clone, Copy, Default)]
+pub struct InputTexts<'a> {
+    /// Lenstool multiple-image catalogue.
+    pub images: Option<InputText<'a>>,
+    /// Lenstool member catalogue.
+    pub members: Option<InputText<'a>>,
+    /// Arc pixels: a JSON arcs file or a DS9 region file.
+    pub arcs: Option<InputText<'a>>,
+}
+
+/// What went wrong reading the files (each message names the file and, where there is one,
+/// the line).
+#[derive(Debug, Error)]
+pub enum DatasetError {
+    #[error(transparent)]
+    Catalog(#[from] CatalogError),
+    #[error(transparent)]
+    Arcs(#[from] ConstraintError),
+    #[error("give an image catalogue or an arcs file to reconstruct")]
+    NoConstraints,
+}
+
+/// The catalogues read into one frame (see the module documentation).
+#[derive(Debug, Clone, Default)]
+pub struct Dataset {
+    pub images: Option<ImageCatalog>,
+    pub arcs: Option<ArcCatalog>,
+    pub members: Option<MemberCatalog>,
+    /// The frame of arcs read from a DS9 region file without a catalogue to give one (the
+    /// regions' mean position).
+    pub arcs_reference: Option<SkyReference>,
+    /// What the reading noticed, one sentence each, naming the file.
+    pub warnings: Vec<String>,
+}
+
+impl Dataset {
+    /// Reads `files`; DS9 region arcs are sampled at `arc_pixel_arcsec`.
+    pub fn read(files: &InputTexts<'_>, arc_pixel_arcsec: f64) -> Result<Self, DatasetError> {
+        let mut out = Self::default();
+        if let Some(f) = files.images {
+            let (c, w) = parse_image_catalog(f.text, f.name, None)?;
+            out.warnings.extend(w.iter().map(ToString::to_string));
+            out.images = Some(c);
+        }
+        if let Some(f) = files.members {
+            let frame = out.images.as_ref().and_then(|c| c.reference);
+            let (m, w) = parse_member_catalog(f.text, f.name, frame)?;
+            out.warnings.extend(w.iter().map(ToString::to_string));
+            out.members = Some(m);
+        }
+        if let Some(f) = files.arcs {
+            out.arcs = Some(if is_region_file(f.text) {
+                let frame = out.reference();
+                let r = region_arcs(f, frame, arc_pixel_arcsec, out.images.as_ref())?;
+                if frame.is_none() {
+                    out.arcs_reference = Some(r.reference);
+                    out.warnings.push(format!(
+                        "{}: no catalogue gives a frame, so its origin is the regions' mean position (RA {:.6}, Dec {:.6} deg): the maps are centred there",
+                        f.name, r.reference.ra_deg, r.reference.dec_deg
+                    ));
+                }
+                r.arcs
+            } else {
+                parse_arcs(f.text, f.name)?
+            });
+        }
+        Ok(out)
+    }
+
+    /// The frame's sky reference: the image catalogue's, else the member catalogue's, else the
+    /// region file's mean position.
+    pub fn reference(&self) -> Option<SkyReference> {
+        let images = self.images.as_ref().and_then(|c| c.reference);
+        let members = self.members.as_ref().and_then(|m| m.reference);
+        images.or(members).or(self.arcs_reference)
+    }
+
+    /// The constraints fitted under `mode` and the mode they are fitted with (see the module
+    /// documentation), with a warning when loaded arcs are not fitted.
+    pub fn constraints(
+        &self,
+        mode: ConstraintMode,
+    ) -> Result<(ConstraintSource<'_>, ConstraintMode, Option<String>), DatasetError> {
+        match (&self.images, &self.arcs) {
+            (Some(_), Some(a)) if mode == ConstraintMode::Arcs => {
+                Ok((ConstraintSource::Arcs(a), mode, None))
+            }
+            (Some(c), arcs) => {
+                let note = arcs.as_ref().map(|a| {
+                    format!(
+                        "{}: its arc pixels are not fitted: constraints.mode is \"{}\", so the image catalogue {} is (set the mode to \"arcs\" to fit the arcs)",
+                        a.source_name,
+                        mode.name(),
+                        c.source_name
+                    )
+                });
+                Ok((ConstraintSource::Catalog(c), mode, note))
+            }
+            (None, Some(a)) => Ok((ConstraintSource::Arcs(a), ConstraintMode::Arcs, None)),
+            (None, None) => Err(DatasetError::NoConstraints),
+        }
+    }
+
+    /// The reconstruction's inputs from this data, in lens plane `plane` with the systems
+    /// `holdout` left out of the fit. Sets `config.constraints.mode` to the mode the constraints
+    /// are fitted with (see [`Self::constraints`]); a warning, if any, is returned beside them.
+    pub fn inputs<'a>(
+        &'a self,
+        plane: LensPlane,
+        holdout: &'a [String],
+        config: &mut ReconstructConfig,
+    ) -> Result<(Inputs<'a>, Option<String>), DatasetError> {
+        let (images, mode, note) = self.constraints(config.constraints.mode)?;
+        config.constraints.mode = mode;
+        let inputs = Inputs {
+            images,
+            layers: self
+                .members
+                .as_ref()
+                .map_or(LayerSource::None, LayerSource::Members),
+            plane,
+            reference: self.reference(),
+            holdout,
+            catalog: self.images.as_ref(),
+        };
+        Ok((inputs, note))
+    }
+}
+
+/// Arcs from a DS9 region file in the frame of `reference`, pixels at `pixel_arcsec`; systems
+/// without a redshift in their labels take the one of the same system in `images`.
+fn region_arcs(
+    file: InputText<'_>,
+    reference: Option<SkyReference>,
+    pixel_arcsec: f64,
+    images: Option<&ImageCatalog>,
+) -> Result<RegionArcs, ConstraintError> {
+    let catalog_z = |id: &str| {
+        let systems = images.into_iter().flat_map(|c| c.systems.iter());
+        systems.filter(|s| s.id == id).find_map(|s| s.z)
+    };
+    arcs_from_regions(file.text, file.name, reference, pixel_arcsec, &catalog_z)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::Cosmology;
+
+    /// Two systems at RA 150, Dec 2 (system 2 has no redshift in the catalogue).
+    const IMAGES: &str = "#REFERENCE 3 150.0 2.0\n\
+        1.1 10.0 5.0 0.5 0.5 0 2.5 25\n\
+        1.2 -8.0 3.0 0.5 0.5 0 2.5 25\n\
+        2.1 4.0 -9.0 0.5 0.5 0 0 25\n\
+        2.2 -4.0 9.0 0.5 0.5 0 0 25\n";
+    /// Arc 1 without a redshift in its label, 2 with one; positions in fk5 near RA 150, Dec 2.
+    const REGIONS: &str = "fk5\n\
+        circle(149.99722,2.00139,0.5\") # text={1.1}\n\
+        circle(150.00222,2.00083,0.5\") # text={1.2}\n\
+        circle(149.99889,1.99750,0.5\") # text={2.1 z=3.0}\n\
+        circle(150.00111,2.00250,0.5\") # text={2.2 z=3.0}\n";
+
+    fn files<'a>(images: bool, arcs: bool) -> InputTexts<'a> {
+        InputTexts {
+            images: images.then_some(InputText {
+                name: "images.cat",
+                text: IMAGES,
+            }),
+            members: None,
+            arcs: arcs.then_some(InputText {
+                name: "arcs.reg",
+                text: REGIONS,
+            }),
+        }
+    }
+
+    fn plane() -> LensPlane {
+        LensPlane::new(Cosmology::new(70.0, 0.3).unwrap(), 0.3).unwrap()
+    }
+
+    #[test]
+    fn region_arcs_take_the_catalogue_frame_and_redshifts() {
+        let data = Dataset::read(&files(true, true), 0.1).unwrap();
+        let arcs = data.arcs.as_ref().unwrap();
+        let z: Vec<_> = arcs.systems.iter().map(|s| (s.id.as_str(), s.z)).collect();
+        assert_eq!(z, [("1", Some(2.5)), ("2", Some(3.0))]);
+        assert_eq!(data.arcs_reference, None);
+        let sky = data.reference().unwrap();
+        assert_eq!((sky.ra_deg, sky.dec_deg), (150.0, 2.0));
+        // Alone, the regions have no redshift for system 1 and their own frame.
+        let alone = Dataset::read(&files(false, true), 0.1).unwrap();
+        assert_eq!(alone.arcs.as_ref().unwrap().systems[0].z, None);
+        assert!(alone.arcs_reference.is_some());
+        assert!(
+            alone.warnings[0].contains("mean position"),
+            "{:?}",
+            alone.warnings
+        );
+    }
+
+    #[test]
+    fn the_mode_chooses_between_catalogue_and_arcs() {
+        let both = Dataset::read(&files(true, true), 0.1).unwrap();
+        let mut config = ReconstructConfig::default();
+        config.constraints.mode = ConstraintMode::Point;
+        let (inputs, note) = both.inputs(plane(), &[], &mut config).unwrap();
+        assert!(matches!(inputs.images, ConstraintSource::Catalog(_)));
+        assert!(note
+            .unwrap()
+            .contains("arcs.reg: its arc pixels are not fitted"));
+        config.constraints.mode = ConstraintMode::Arcs;
+        let (inputs, note) = both.inputs(plane(), &[], &mut config).unwrap();
+        assert!(matches!(inputs.images, ConstraintSource::Arcs(_)));
+        assert_eq!(note, None);
+        // Arcs alone are fitted as arcs whatever the mode.
+        let arcs = Dataset::read(&files(false, true), 0.1).unwrap();
+        config.constraints.mode = ConstraintMode::Ellipse;
+        let (inputs, _) = arcs.inputs(plane(), &[], &mut config).unwrap();
+        assert!(matches!(inputs.images, ConstraintSource::Arcs(_)));
+        assert_eq!(config.constraints.mode, ConstraintMode::Arcs);
+        let none = Dataset::read(&InputTexts::default(), 0.1).unwrap();
+        let err = none.inputs(plane(), &[], &mut config).err().unwrap();
+        assert!(matches!(err, DatasetError::NoConstraints));
+    }
+}
