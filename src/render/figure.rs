@@ -1,113 +1,17 @@
 //! The convergence figure: layout, map, axes, colour bar, overlays and legend.
 
 use glam::DVec2;
-use tiny_skia::{Color, Paint, PathBuilder, Pixmap, Rect, Stroke, Transform};
+use tiny_skia::{Color, Pixmap, Rect, Transform};
 
 use super::axes::nice_ticks;
 use super::colormap::{color_limits, value_rgb};
-use super::font::{draw_text, fit, text_width, Anchor, CAP};
+use super::font::{draw_text, fit, text_width, Anchor};
+use super::layout::Layout;
 use super::overlay::{below_height, draw_legend, draw_overlay, legend_entries, Key};
+use super::paint::{color, frame, paint};
 use super::{check_map, KappaPlotOptions, Overlay, RenderError};
 use super::{ColorScale, LegendPlace};
 use crate::grid::{Map, MapGeometry};
-
-/// Pixel positions of the parts of the figure.
-pub(super) struct Layout {
-    /// Font scale: pixels per font unit.
-    pub(super) s: u32,
-    /// Map side on screen.
-    pub(super) m: f32,
-    pub(super) left: f32,
-    pub(super) top: f32,
-    pub(super) cb_x: f32,
-    pub(super) cb_w: f32,
-    pub(super) width: u32,
-    pub(super) height: u32,
-    /// Top of the legend under the map (when it goes there).
-    pub(super) legend_top: f32,
-}
-
-impl Layout {
-    fn new(m: u32, title: bool, y_label_w: f32, cb_label_w: f32) -> Self {
-        let s = (m / 256).max(1);
-        let sf = s as f32;
-        let (ch, tick, gap, pad) = (
-            (CAP * s) as f32,
-            3.0 * sf + 2.0,
-            2.0 * sf + 2.0,
-            4.0 * sf + 4.0,
-        );
-        let m = m as f32;
-        let top = (if title {
-            pad + ch + 3.0 * gap
-        } else {
-            pad + ch / 2.0
-        })
-        .round();
-        let left = (pad + ch + 2.0 * gap + y_label_w + gap + tick).round();
-        let bottom = tick + gap + ch + 3.0 * gap + ch + pad;
-        let legend_top = (top + m + bottom - pad + 2.0 * gap).round();
-        let cb_x = (left + m + 4.0 * sf + 8.0).round();
-        let cb_w = (m / 24.0).round().max(10.0);
-        let right_edge = cb_x + cb_w + tick + gap + cb_label_w + 2.0 * gap + ch + pad;
-        Self {
-            s,
-            m,
-            left,
-            top,
-            cb_x,
-            cb_w,
-            width: right_edge.ceil() as u32,
-            height: (top + m + bottom).ceil() as u32,
-            legend_top,
-        }
-    }
-
-    /// Width available to a row of the legend under the map (from the map's left edge).
-    pub(super) fn legend_avail(&self) -> f32 {
-        self.width as f32 - self.left - (4.0 * self.s as f32 + 4.0)
-    }
-
-    /// Makes room for a legend of `entries` under the map.
-    fn add_legend_below(&mut self, entries: &[(String, Key)]) {
-        let h = below_height(self, entries, self.legend_avail());
-        if h > 0.0 {
-            self.height = (self.legend_top + h).ceil() as u32;
-        }
-    }
-
-    pub(super) fn ch(&self) -> f32 {
-        (CAP * self.s) as f32
-    }
-    fn tick(&self) -> f32 {
-        3.0 * self.s as f32 + 2.0
-    }
-    pub(super) fn gap(&self) -> f32 {
-        2.0 * self.s as f32 + 2.0
-    }
-
-    /// Screen position of `p` (arcsec) on a map of geometry `g`.
-    pub(super) fn screen(&self, g: &MapGeometry, p: DVec2) -> (f32, f32) {
-        let half = g.size_arcsec / 2.0;
-        let u = (p.x - (g.center.x - half)) / g.size_arcsec;
-        let v = ((g.center.y + half) - p.y) / g.size_arcsec;
-        (
-            self.left + (u * self.m as f64) as f32,
-            self.top + (v * self.m as f64) as f32,
-        )
-    }
-}
-
-pub(super) fn color([r, g, b]: [u8; 3], alpha: f32) -> Color {
-    Color::from_rgba8(r, g, b, (alpha * 255.0).round() as u8)
-}
-
-pub(super) fn paint(c: Color, anti_alias: bool) -> Paint<'static> {
-    let mut p = Paint::default();
-    p.set_color(c);
-    p.anti_alias = anti_alias;
-    p
-}
 
 /// Where the map lies in a figure of [`render_kappa_png`] (screen pixels, origin top-left),
 /// e.g. to turn a click on the PNG into arcsec.
@@ -179,7 +83,7 @@ fn plan(kappa: &Map, overlay: &Overlay, opts: &KappaPlotOptions) -> Result<Plan,
     );
     let legend = legend_entries(overlay, opts.show_caustics);
     if opts.legend == LegendPlace::Below {
-        layout.add_legend_below(&legend);
+        add_legend_below(&mut layout, &legend);
     }
     Ok(Plan {
         layout,
@@ -189,6 +93,14 @@ fn plan(kappa: &Map, overlay: &Overlay, opts: &KappaPlotOptions) -> Result<Plan,
         y_ticks,
         cb_ticks,
     })
+}
+
+/// Makes room for a legend of `entries` under the map.
+fn add_legend_below(layout: &mut Layout, entries: &[(String, Key)]) {
+    let h = below_height(layout, entries, layout.legend_avail());
+    if h > 0.0 {
+        layout.height = (layout.legend_top + h).ceil() as u32;
+    }
 }
 
 /// The [`FigureFrame`] of the figure [`render_kappa_png`] draws for `kappa` and `opts` with
@@ -287,22 +199,6 @@ fn draw_map(pm: &mut Pixmap, kappa: &Map, l: &Layout, opts: &KappaPlotOptions, l
             let k = ((y0 + b) * width + x0 + a) * 4;
             data[k..k + 4].copy_from_slice(&[r, g, bl, 255]);
         }
-    }
-}
-
-pub(super) fn frame(pm: &mut Pixmap, x: f32, y: f32, w: f32, h: f32) {
-    if let Some(r) = Rect::from_xywh(x - 0.5, y - 0.5, w + 1.0, h + 1.0) {
-        let stroke = Stroke {
-            width: 1.0,
-            ..Stroke::default()
-        };
-        pm.stroke_path(
-            &PathBuilder::from_rect(r),
-            &paint(Color::BLACK, false),
-            &stroke,
-            Transform::identity(),
-            None,
-        );
     }
 }
 

@@ -18,7 +18,9 @@ mod colormap_tables;
 mod compose;
 mod figure;
 mod font;
+mod layout;
 mod overlay;
+mod paint;
 mod plot;
 
 pub use colormap::{

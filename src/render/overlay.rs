@@ -6,8 +6,9 @@ use tiny_skia::{
     Transform,
 };
 
-use super::figure::{color, frame, paint, Layout};
 use super::font::{draw_text, text_width, Anchor};
+use super::layout::Layout;
+use super::paint::{color, frame, paint};
 use super::{LegendPlace, Marker, Overlay, MIN_PIXEL_SIDE_PX, PIXEL_ALPHA};
 use crate::ds9::polyline_is_open;
 use crate::grid::MapGeometry;

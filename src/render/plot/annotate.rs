@@ -6,8 +6,8 @@ use super::draw::{area_mask, fill, fit, screen_points, stroke};
 use super::layout::Plan;
 use super::scale::PlotFrame;
 use super::{LineStyle, Reference, Series};
-use crate::render::figure::{color, paint};
 use crate::render::font::{draw_text, text_width, Anchor};
+use crate::render::paint::{color, paint};
 
 /// Spacing in pixels of the sample points along lines used to place labels and the legend.
 pub(super) const SAMPLE_STEP_PX: f32 = 3.0;

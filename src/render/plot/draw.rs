@@ -9,9 +9,9 @@ use tiny_skia::{
 use super::layout::Plan;
 use super::scale::PlotFrame;
 use super::{LinePlot, LineStyle, Series};
-use crate::render::figure::{color, frame, paint};
 pub(super) use crate::render::font::fit;
 use crate::render::font::{draw_text, text_width, Anchor};
+use crate::render::paint::{color, frame, paint};
 
 /// Light grey of the grid lines at the major ticks.
 const GRID_RGB: [u8; 3] = [225, 225, 225];

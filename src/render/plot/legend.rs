@@ -8,8 +8,8 @@ use super::draw::{fit, marker_radius, stroke};
 use super::layout::Plan;
 use super::scale::PlotFrame;
 use super::{Reference, Series};
-use crate::render::figure::{color, frame, paint};
 use crate::render::font::{draw_text, text_width, Anchor};
+use crate::render::paint::{color, frame, paint};
 
 /// Points along the reference lines inside the plot area, every `SAMPLE_STEP_PX`.
 fn reference_samples(f: &PlotFrame, refs: &[Reference]) -> Vec<(f32, f32)> {
