@@ -310,28 +310,15 @@ fn lens_offsets(lens: &dyn MassComponent, g: &MapGeometry, f: f64, beta: DVec2) 
             *o = p - f * lens.deflection(p) - beta;
         }
     };
-    #[cfg(not(target_arch = "wasm32"))]
-    {
-        let threads = crate::threads::available();
-        let rows_per_band = n.div_ceil(threads * 4).max(1);
-        let mut bands: Vec<(usize, &mut [DVec2])> = out
-            .chunks_mut(rows_per_band * n)
-            .enumerate()
-            .map(|(b, rows)| (b * rows_per_band, rows))
-            .collect();
-        let jobs = std::sync::Mutex::new(&mut bands);
-        std::thread::scope(|s| {
-            for _ in 0..threads {
-                s.spawn(|| loop {
-                    let job = jobs.lock().map(|mut j| j.pop()).unwrap_or(None);
-                    let Some((row, rows)) = job else { break };
-                    fill(row, rows);
-                });
-            }
-        });
-    }
-    #[cfg(target_arch = "wasm32")]
-    fill(0, &mut out);
+    let threads = crate::threads::available();
+    // A few bands per thread balance rows of uneven cost.
+    let rows_per_band = n.div_ceil(threads * 4).max(1);
+    let bands: Vec<(usize, &mut [DVec2])> = out
+        .chunks_mut(rows_per_band * n)
+        .enumerate()
+        .map(|(b, rows)| (b * rows_per_band, rows))
+        .collect();
+    crate::threads::for_each(bands, threads, |(row, rows)| fill(row, rows));
     out
 }
 

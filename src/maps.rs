@@ -317,7 +317,7 @@ fn fill_parallel(parts: &[&dyn MassComponent], geometry: &MapGeometry, out: RowS
     let rows_per_band = n.div_ceil(bands);
     let chunk = rows_per_band * n;
     let [k, g1, g2, ax, ay] = out;
-    let mut work: Vec<(usize, RowSlices)> = k
+    let work: Vec<(usize, RowSlices)> = k
         .chunks_mut(chunk)
         .zip(g1.chunks_mut(chunk))
         .zip(g2.chunks_mut(chunk))
@@ -326,25 +326,8 @@ fn fill_parallel(parts: &[&dyn MassComponent], geometry: &MapGeometry, out: RowS
         .enumerate()
         .map(|(b, ((((k, g1), g2), ax), ay))| (b * rows_per_band, [k, g1, g2, ax, ay]))
         .collect();
-    if threads == 1 {
-        for (row, slices) in work {
-            fill_rows(parts, geometry, row, slices);
-        }
-        return;
-    }
-    // Band b goes to thread b % threads: each thread gets an interleaved set of bands.
-    let mut per_thread: Vec<Vec<(usize, RowSlices)>> = (0..threads).map(|_| Vec::new()).collect();
-    for (b, item) in work.drain(..).enumerate() {
-        per_thread[b % threads].push(item);
-    }
-    std::thread::scope(|s| {
-        for jobs in per_thread {
-            s.spawn(move || {
-                for (row, slices) in jobs {
-                    fill_rows(parts, geometry, row, slices);
-                }
-            });
-        }
+    crate::threads::for_each(work, threads, |(row, slices)| {
+        fill_rows(parts, geometry, row, slices);
     });
 }
 

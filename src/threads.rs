@@ -41,6 +41,47 @@ pub fn with_limit<R>(threads: usize, f: impl FnOnce() -> R) -> R {
     f()
 }
 
+/// Threads for a parallel section over `items` items with at least `min_per_thread` items each:
+/// `requested`, or [`available`] when 0; always 1 on wasm32.
+pub fn count(requested: usize, items: usize, min_per_thread: usize) -> usize {
+    if cfg!(target_arch = "wasm32") {
+        return 1;
+    }
+    let wanted = if requested > 0 {
+        requested
+    } else {
+        available()
+    };
+    wanted.min(items / min_per_thread.max(1)).max(1)
+}
+
+/// Runs `f` on every job, the jobs dealt in turn to at most `threads` scoped threads (job `k`
+/// to thread `k % threads`, so that a few jobs per thread balance uneven ones); on this thread
+/// when `threads <= 1` or there is one job, and always on wasm32. The only way the native code
+/// splits work over threads, apart from the QADP sweep, whose bands are long-lived threads that
+/// meet at barriers every iteration (`solver/sweep.rs`).
+pub fn for_each<T: Send>(jobs: Vec<T>, threads: usize, f: impl Fn(T) + Sync) {
+    let threads = if cfg!(target_arch = "wasm32") {
+        1
+    } else {
+        threads.min(jobs.len())
+    };
+    if threads <= 1 {
+        jobs.into_iter().for_each(f);
+        return;
+    }
+    let mut per_thread: Vec<Vec<T>> = (0..threads).map(|_| Vec::new()).collect();
+    for (k, job) in jobs.into_iter().enumerate() {
+        per_thread[k % threads].push(job);
+    }
+    let f = &f;
+    std::thread::scope(|scope| {
+        for mine in per_thread {
+            scope.spawn(move || mine.into_iter().for_each(f));
+        }
+    });
+}
+
 /// `f` of every item, the items shared between the threads of [`available`], each thread
 /// running `f` with a limit of one thread (so that the whole stays within the caller's
 /// limit); in order. On one thread (and on wasm32) the items run here, one after another.

@@ -429,25 +429,7 @@ fn transpose(src: &[Complex64], rows: usize, cols: usize, dst: &mut [Complex64])
     });
 }
 
-/// Runs `f` on every item, natively spread over [`crate::threads::available`] scoped threads
-/// (items dealt in turn), serially on wasm32.
+/// Runs `f` on every item, spread over [`crate::threads::available`] threads.
 fn for_each_band<T: Send>(items: Vec<T>, f: impl Fn(T) + Sync) {
-    let t = crate::threads::available();
-    if t <= 1 || items.len() <= 1 {
-        items.into_iter().for_each(f);
-        return;
-    }
-    let mut per_thread: Vec<Vec<T>> = (0..t).map(|_| Vec::new()).collect();
-    for (k, item) in items.into_iter().enumerate() {
-        per_thread[k % t].push(item);
-    }
-    let f = &f;
-    #[cfg(not(target_arch = "wasm32"))]
-    std::thread::scope(|s| {
-        for jobs in per_thread {
-            s.spawn(move || jobs.into_iter().for_each(f));
-        }
-    });
-    #[cfg(target_arch = "wasm32")]
-    per_thread.into_iter().flatten().for_each(f);
+    crate::threads::for_each(items, crate::threads::available(), f);
 }

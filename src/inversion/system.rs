@@ -211,18 +211,6 @@ pub struct LinearSystem {
     rows_per_block: usize,
 }
 
-/// Threads to use: `requested`, or [`crate::threads::available`] when 0; always 1 on wasm32.
-fn thread_count(requested: usize) -> usize {
-    if cfg!(target_arch = "wasm32") {
-        return 1;
-    }
-    if requested > 0 {
-        requested
-    } else {
-        crate::threads::available()
-    }
-}
-
 /// Calls `fill(first_item, chunk)` on consecutive chunks of `out` (`stride` values per item),
 /// split over `threads` threads (in this thread when 1).
 fn parallel_fill<F>(out: &mut [f64], stride: usize, threads: usize, fill: F)
@@ -235,12 +223,8 @@ where
         return;
     }
     let per = items.div_ceil(threads);
-    std::thread::scope(|scope| {
-        for (k, chunk) in out.chunks_mut(per * stride).enumerate() {
-            let fill = &fill;
-            scope.spawn(move || fill(k * per, chunk));
-        }
-    });
+    let chunks: Vec<(usize, &mut [f64])> = out.chunks_mut(per * stride).enumerate().collect();
+    crate::threads::for_each(chunks, threads, |(k, chunk)| fill(k * per, chunk));
 }
 
 impl LinearSystem {
@@ -304,7 +288,7 @@ impl LinearSystem {
                 .fold(0.0, f64::max);
             (reach + grid.width_arcsec).ceil()
         });
-        let threads = thread_count(config.threads);
+        let threads = crate::threads::count(config.threads, constraints.pixels.len(), 1);
         let layer_deflections = layer_deflections(layers, constraints, threads)?;
         let bytes_per_pixel = 2.0 * n_cols as f64 * 8.0;
         let rows_per_block =

@@ -71,10 +71,11 @@ pub struct SolverConfig {
 
 impl Default for SolverConfig {
     fn default() -> Self {
+        let run = QadpSettings::default();
         Self {
             method: SolverMethod::Exact,
-            iterations: 8000,
-            report_every: 100,
+            iterations: run.iterations,
+            report_every: run.report_every,
             start_cell_mass_msun: 1e10,
             start_c: 0.1,
         }

@@ -21,8 +21,9 @@
 //! One product with `A` (f64, the whole matrix) per iteration; natively its rows are shared
 //! between threads, on wasm32 it runs on one.
 
-use super::qadp::{drive, Control, Progress, QadpSettings, SolveOutcome};
+use super::run::drive;
 use super::{check_finite, check_len, validate_system, SolverError};
+use super::{Control, Progress, QadpSettings, SolveOutcome};
 
 /// Power-iteration steps for the largest eigenvalue of the scaled Hessian.
 const POWER_STEPS: usize = 60;
@@ -52,7 +53,7 @@ pub fn accelerated_gradient(
             value: x0[index],
         });
     }
-    let threads = thread_count(settings.threads, n);
+    let threads = crate::threads::count(settings.threads, n, MIN_ROWS_PER_THREAD);
     // d_i = 1 / sqrt(A_ii); 0 marks an unknown with a zero row (fixed).
     let d: Vec<f64> = (0..n)
         .map(|i| {
@@ -133,20 +134,6 @@ pub fn accelerated_gradient(
     })
 }
 
-/// Threads for the products: `requested`, or all available when 0, at most one per
-/// [`MIN_ROWS_PER_THREAD`] rows; always 1 on wasm32.
-fn thread_count(requested: usize, n: usize) -> usize {
-    if cfg!(target_arch = "wasm32") {
-        return 1;
-    }
-    let available = if requested > 0 {
-        requested
-    } else {
-        crate::threads::available()
-    };
-    available.min(n / MIN_ROWS_PER_THREAD).max(1)
-}
-
 /// `out = A x` for `A` row-major `n x n`, the rows shared between `threads` threads.
 fn mat_vec(a: &[f64], n: usize, x: &[f64], out: &mut [f64], threads: usize) {
     let rows = |first: usize, out: &mut [f64]| {
@@ -155,19 +142,9 @@ fn mat_vec(a: &[f64], n: usize, x: &[f64], out: &mut [f64], threads: usize) {
             *o = dot(row, x);
         }
     };
-    #[cfg(not(target_arch = "wasm32"))]
-    if threads > 1 {
-        let per = n.div_ceil(threads);
-        std::thread::scope(|s| {
-            for (k, chunk) in out.chunks_mut(per).enumerate() {
-                let rows = &rows;
-                s.spawn(move || rows(k * per, chunk));
-            }
-        });
-        return;
-    }
-    let _ = threads;
-    rows(0, out);
+    let per = n.div_ceil(threads.max(1)).max(1);
+    let chunks: Vec<(usize, &mut [f64])> = out.chunks_mut(per).enumerate().collect();
+    crate::threads::for_each(chunks, threads, |(k, chunk)| rows(k * per, chunk));
 }
 
 /// `sum_j a_j x_j` with eight running sums (so that it vectorises).

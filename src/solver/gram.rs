@@ -174,18 +174,10 @@ fn add_block(a: &mut [f64], n: usize, block: &[f64], packed_b: &[f64], k: usize)
         bands.push((pair[0], pair[1], band));
         rest = tail;
     }
-    #[cfg(not(target_arch = "wasm32"))]
-    if bands.len() > 1 {
-        std::thread::scope(|s| {
-            for (q0, q1, band) in bands {
-                s.spawn(move || band_update(band, n, block, packed_b, k, q0, q1));
-            }
-        });
-        return;
-    }
-    for (q0, q1, band) in bands {
+    let threads = bands.len();
+    crate::threads::for_each(bands, threads, |(q0, q1, band)| {
         band_update(band, n, block, packed_b, k, q0, q1);
-    }
+    });
 }
 
 /// Row panels `q0..q1` of `A` (their rows are `band`).

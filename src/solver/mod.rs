@@ -27,6 +27,9 @@ mod kernel;
 mod nnls;
 mod pivoting;
 mod qadp;
+mod run;
+mod settings;
+mod status;
 mod sweep;
 #[cfg(all(target_arch = "wasm32", target_feature = "simd128"))]
 mod wasm_simd;
@@ -38,7 +41,9 @@ pub use gram::{gram_weighted, NormalEquations};
 pub use independence::{column_independence, INDEPENDENCE_MAX_UNKNOWNS};
 pub use nnls::{nnqp_exact, NNQP_EXACT_MAX_UNKNOWNS};
 pub use pivoting::minimise_exact;
-pub use qadp::{Control, Progress, QadpProblem, QadpSettings, SolveOutcome, SolveStatus};
+pub use qadp::QadpProblem;
+pub use settings::QadpSettings;
+pub use status::{Control, Progress, SolveOutcome, SolveStatus};
 
 /// What can be wrong with a quadratic program, its start or the solver settings.
 #[derive(Debug, Error, Clone, PartialEq)]

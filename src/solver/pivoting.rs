@@ -22,8 +22,8 @@
 //! whose row of `A` is zero are fixed as in QADP.
 
 use super::independence::cholesky_in_place;
-use super::qadp::{Control, Progress, SolveOutcome, SolveStatus};
 use super::{check_len, validate_system, SolverError};
+use super::{Control, Progress, SolveOutcome, SolveStatus};
 
 /// Added to the unit diagonal of the scaled matrix.
 pub const RIDGE: f64 = 1e-12;

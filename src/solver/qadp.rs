@@ -24,92 +24,10 @@
 //!   per thread, with two barriers per iteration.
 
 use super::sweep::{run_chunks, ScaledProblem};
-use super::{check_finite, check_len, check_permutation, validate_system, SolverError};
-
-/// Settings of a QADP run.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub struct QadpSettings {
-    /// Number of multiplicative updates (default 8000, the paper's best; the iteration count is
-    /// the regulariser: ~50000 over-fits towards the "point-source solution").
-    pub iterations: usize,
-    /// The callback sees the state every this many updates (default 100; must be >= 1).
-    pub report_every: usize,
-    /// Threads for the matrix passes; 0 (default) = automatic (all available natively, at
-    /// least 128 rows per thread; always 1 on wasm32). A given count gives reproducible results;
-    /// different counts group the single-precision sums differently, so their iterates agree
-    /// to ~1e-7 relative.
-    pub threads: usize,
-}
-
-impl Default for QadpSettings {
-    fn default() -> Self {
-        Self {
-            iterations: 8000,
-            report_every: 100,
-            threads: 0,
-        }
-    }
-}
-
-impl QadpSettings {
-    /// Checks `report_every >= 1`.
-    pub fn validate(&self) -> Result<(), SolverError> {
-        if self.report_every == 0 {
-            return Err(SolverError::BadSetting {
-                name: "report_every",
-                value: 0,
-                reason: "must be at least 1",
-            });
-        }
-        Ok(())
-    }
-}
-
-/// The state shown to the callback: `x` after `iteration` updates and `phi(x)`.
-#[derive(Debug, Clone, Copy)]
-pub struct Progress<'a> {
-    /// Number of updates done so far.
-    pub iteration: usize,
-    /// `phi(x) = 1/2 x^T A x + b^T x`, from the sums of the single-precision pass (relative
-    /// accuracy ~1e-7 of `x^T |A| x`).
-    pub objective: f64,
-    /// The current solution, in the units of the problem.
-    pub x: &'a [f64],
-}
-
-/// What the callback asks for.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum Control {
-    Continue,
-    Cancel,
-}
-
-/// How a run ended (a run is not an error).
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum SolveStatus {
-    /// All requested iterations were done.
-    Completed,
-    /// The exact solver ([`super::minimise_exact`]) found the minimiser: every optimality
-    /// condition holds.
-    Converged,
-    /// The callback returned [`Control::Cancel`]; the outcome is the state it was shown.
-    Cancelled,
-    /// The objective stopped being finite (only possible when `A` is not positive
-    /// semi-definite or the objective is unbounded); the outcome is the last finite state.
-    Diverged,
-}
-
-/// The result of a run.
-#[derive(Debug, Clone, PartialEq)]
-pub struct SolveOutcome {
-    /// The solution after `iterations` updates (all `>= 0`).
-    pub x: Vec<f64>,
-    /// Number of updates done.
-    pub iterations: usize,
-    /// `phi(x)` (see [`Progress::objective`]).
-    pub objective: f64,
-    pub status: SolveStatus,
-}
+use super::{
+    check_finite, check_len, check_permutation, validate_system, Control, Progress, QadpSettings,
+    SolveOutcome, SolverError,
+};
 
 /// A non-negative quadratic program prepared for QADP: build once, run from any start.
 #[derive(Debug, Clone)]
@@ -176,59 +94,5 @@ impl QadpProblem {
             });
         }
         run_chunks(&self.scaled, x0, settings, callback)
-    }
-}
-
-/// The run protocol the solvers share: the callback sees `x0` (iteration 0), the state every
-/// `settings.report_every` steps and after the last one, and may cancel;
-/// `advance(done, steps)` does `steps` more steps after `done` and returns the new `x` and
-/// objective, or `None` when they stopped being finite (the run then ends as
-/// [`SolveStatus::Diverged`] with the last finite state).
-pub(crate) fn drive(
-    x0: Vec<f64>,
-    objective0: f64,
-    settings: &QadpSettings,
-    callback: &mut dyn FnMut(&Progress) -> Control,
-    advance: &mut dyn FnMut(usize, usize) -> Option<(Vec<f64>, f64)>,
-) -> Result<SolveOutcome, SolverError> {
-    if !objective0.is_finite() {
-        return Err(SolverError::NonFinite {
-            what: "objective at x0",
-            index: 0,
-            value: objective0,
-        });
-    }
-    let mut outcome = SolveOutcome {
-        x: x0,
-        iterations: 0,
-        objective: objective0,
-        status: SolveStatus::Completed,
-    };
-    loop {
-        let progress = Progress {
-            iteration: outcome.iterations,
-            objective: outcome.objective,
-            x: &outcome.x,
-        };
-        if callback(&progress) == Control::Cancel {
-            outcome.status = SolveStatus::Cancelled;
-            return Ok(outcome);
-        }
-        let done = outcome.iterations;
-        if done >= settings.iterations {
-            return Ok(outcome);
-        }
-        let steps = settings.report_every.min(settings.iterations - done);
-        match advance(done, steps) {
-            Some((x, objective)) if objective.is_finite() && x.iter().all(|v| v.is_finite()) => {
-                outcome.x = x;
-                outcome.objective = objective;
-                outcome.iterations = done + steps;
-            }
-            _ => {
-                outcome.status = SolveStatus::Diverged;
-                return Ok(outcome);
-            }
-        }
     }
 }

@@ -13,8 +13,9 @@ use std::ops::Range;
 use std::sync::atomic::{AtomicBool, AtomicU64, AtomicUsize, Ordering};
 
 use super::kernel::{band_pass, PassSums, UpperTriangle};
-use super::qadp::{drive, Control, Progress, QadpSettings, SolveOutcome};
+use super::run::drive;
 use super::SolverError;
+use super::{Control, Progress, QadpSettings, SolveOutcome};
 
 /// Entries of the unit-diagonal matrix below this are stored as 0: they change a sum by less
 /// than `1e-15 sum_j x_j`, far below f32 rounding, and could give subnormal (slow) products.
@@ -124,18 +125,14 @@ struct Band {
     z_f32: Vec<f32>,
 }
 
+/// Bands of the sweep: `requested` (at most one per two rows), or every available thread up to
+/// [`MAX_THREADS`] with at least [`MIN_ROWS_PER_THREAD`] rows each.
 fn thread_count(requested: usize, n: usize) -> usize {
-    if cfg!(target_arch = "wasm32") {
-        return 1;
-    }
     if requested > 0 {
-        return requested.min(n.div_ceil(2));
+        // At most ceil(n / 2): `n + 1` items of two each.
+        return crate::threads::count(requested, n + 1, 2);
     }
-    let available = crate::threads::available();
-    available
-        .min(MAX_THREADS)
-        .min(n / MIN_ROWS_PER_THREAD)
-        .max(1)
+    crate::threads::count(0, n, MIN_ROWS_PER_THREAD).min(MAX_THREADS)
 }
 
 /// Cuts `0..n` into `threads` bands of about equal work ([`UpperTriangle::pair_cost`]), each

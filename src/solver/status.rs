@@ -1,0 +1,48 @@
+//! What a run shows its caller while it goes (progress, and the caller's answer) and how it
+//! ended.
+
+/// The state shown to the callback: `x` after `iteration` updates and `phi(x)`.
+#[derive(Debug, Clone, Copy)]
+pub struct Progress<'a> {
+    /// Number of updates done so far.
+    pub iteration: usize,
+    /// `phi(x) = 1/2 x^T A x + b^T x`, from the sums of the single-precision pass (relative
+    /// accuracy ~1e-7 of `x^T |A| x`).
+    pub objective: f64,
+    /// The current solution, in the units of the problem.
+    pub x: &'a [f64],
+}
+
+/// What the callback asks for.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Control {
+    Continue,
+    Cancel,
+}
+
+/// How a run ended (a run is not an error).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum SolveStatus {
+    /// All requested iterations were done.
+    Completed,
+    /// The exact solver ([`super::minimise_exact`]) found the minimiser: every optimality
+    /// condition holds.
+    Converged,
+    /// The callback returned [`Control::Cancel`]; the outcome is the state it was shown.
+    Cancelled,
+    /// The objective stopped being finite (only possible when `A` is not positive
+    /// semi-definite or the objective is unbounded); the outcome is the last finite state.
+    Diverged,
+}
+
+/// The result of a run.
+#[derive(Debug, Clone, PartialEq)]
+pub struct SolveOutcome {
+    /// The solution after `iterations` updates (all `>= 0`).
+    pub x: Vec<f64>,
+    /// Number of updates done.
+    pub iterations: usize,
+    /// `phi(x)` (see [`Progress::objective`]).
+    pub objective: f64,
+    pub status: SolveStatus,
+}
