@@ -201,7 +201,10 @@ impl Hdu<'_> {
         let (bscale, bzero) = (self.real_or("BSCALE", 1.0)?, self.real_or("BZERO", 0.0)?);
         let blank = self.card("BLANK").and_then(Card::as_f64);
         let raw = &bytes[self.data_start..needed];
-        let scale = |v: f64| bzero + bscale * v;
+        // The identity scaling returns the stored value itself: `0.0 + 1.0 * -0.0` would be
+        // +0.0, and a map must read back bit-identical to what was written.
+        let identity = bscale == 1.0 && bzero == 0.0;
+        let scale = |v: f64| if identity { v } else { bzero + bscale * v };
         let int = |v: i64| {
             if blank == Some(v as f64) {
                 f64::NAN
@@ -234,5 +237,32 @@ impl Hdu<'_> {
             data,
             header: self.header,
         })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::fits::{write_image, FitsWriteOptions};
+    use crate::grid::{Map, MapGeometry};
+
+    /// Found by fuzzing (fuzz/regressions/fits_roundtrip/): `BZERO + BSCALE * v` turned a
+    /// written -0.0 into +0.0.
+    #[test]
+    fn written_pixels_read_back_bit_identical() {
+        let values = [-0.0, 0.0, 1e-40, -3.5, f32::MAX as f64];
+        let map = Map {
+            geometry: MapGeometry::centered(1.0, 1),
+            data: vec![values[0]],
+        };
+        for v in values {
+            let map = Map {
+                data: vec![v],
+                ..map.clone()
+            };
+            let bytes = write_image(&map, &FitsWriteOptions::default()).unwrap();
+            let read = read_image(&bytes, "map.fits").unwrap();
+            assert_eq!(read.data[0].to_bits(), (v as f32 as f64).to_bits(), "{v}");
+        }
     }
 }
