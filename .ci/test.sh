@@ -53,6 +53,9 @@ run_step "clippy native" cargo clippy --all-targets -- -D warnings
 run_step "clippy wasm32" cargo clippy --all-targets --target wasm32-unknown-unknown -- -D warnings
 run_step "docs" env RUSTDOCFLAGS="-D warnings" cargo doc --no-deps
 run_step "native tests" cargo test
+# The committed fuzz corpus and regressions replay in the native tests (tests/fuzz_corpus.rs);
+# when nightly and cargo-fuzz are installed, each target also fuzzes briefly (a minute in all).
+run_step "fuzz (short)" bash .ci/fuzz.sh --ci 6
 run_step "wasm tests in a worker" cargo test --target wasm32-unknown-unknown --test '*'
 run_step "wasm build" build_wasm
 run_step "browser end-to-end tests" node --test --test-concurrency=1 tests/e2e/
