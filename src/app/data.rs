@@ -139,14 +139,6 @@ impl Default for DataMarks {
     }
 }
 
-impl DataMarks {
-    /// The colour of system `id`'s arc pixels (`None` when it has none: catalogue systems).
-    pub fn system_rgb(&self, id: &str) -> Option<[u8; 3]> {
-        let k = self.arcs.iter().position(|a| a.id == id)?;
-        Some(super::views::system_rgb(k))
-    }
-}
-
 /// The warning for a FITS file of `len` bytes that the project file does not keep.
 fn too_large_to_keep(name: &str, len: usize) -> String {
     const MIB: f64 = 1024.0 * 1024.0;

@@ -9,7 +9,7 @@ use crate::render::{
     LegendPlace, Marker, Overlay, OverlayLines, OverlayPoints,
 };
 
-use super::data::ArcPixels;
+use super::data::{ArcPixels, DataMarks};
 use super::{AppError, Session, SHOWN_MIN_MAGNIFICATION};
 use crate::ds9::{write_marks, Mark};
 use crate::reconstruct::{
@@ -349,5 +349,13 @@ impl Session {
             magnification: r.products.magnification.sample(p),
             z_source: r.products.curves.z_source,
         }))
+    }
+}
+
+impl DataMarks {
+    /// The colour of system `id`'s arc pixels (`None` when it has none: catalogue systems).
+    pub fn system_rgb(&self, id: &str) -> Option<[u8; 3]> {
+        let k = self.arcs.iter().position(|a| a.id == id)?;
+        Some(system_rgb(k))
     }
 }

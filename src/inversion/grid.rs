@@ -25,6 +25,7 @@ use thiserror::Error;
 use super::grid_fft::{self, MapPlan};
 use crate::grid::MapGeometry;
 use crate::maps::LensMaps;
+use crate::profiles::cell_unit_deflection;
 
 /// What can be wrong with a grid setting or a refinement request.
 #[derive(Debug, Error, Clone, PartialEq)]
@@ -338,29 +339,6 @@ impl CellGrid {
             cells,
         })
     }
-}
-
-/// Beyond this `u = r^2 / (2 s^2)`, `1 - e^-u` rounds to 1 in double precision
-/// (`e^-40 = 4e-18`): the cell deflects as a point mass.
-const POINT_LIKE_U: f64 = 40.0;
-
-/// Deflection of a unit Gaussian cell (`K m / D_l = 1` arcsec^2) at offset `(dx, dy)` arcsec,
-/// given `inv_2s2 = 1 / (2 s^2)` in 1/arcsec^2: `(1 - e^-u) (dx, dy) / r^2`, `u = r^2 inv_2s2`,
-/// equal to `(dx, dy) inv_2s2` at `r = 0` (METHOD.md section 2). The same function as
-/// [`crate::profiles::gaussian_unit_deflection`] (to ~1e-15 relative), written for the inner
-/// loop of the linear system: one `exp_m1` near the cell, none far from it.
-#[inline]
-pub fn cell_unit_deflection(dx: f64, dy: f64, inv_2s2: f64) -> (f64, f64) {
-    let r2 = dx * dx + dy * dy;
-    let u = r2 * inv_2s2;
-    let g = if u > POINT_LIKE_U {
-        1.0 / r2
-    } else if u > 0.0 {
-        -(-u).exp_m1() / r2
-    } else {
-        inv_2s2
-    };
-    (g * dx, g * dy)
 }
 
 /// The mass of a grid as one component: cell `j` a Gaussian with `K m_j / D_l = b2[j]`

@@ -24,10 +24,9 @@ use glam::DVec2;
 use rustfft::num_complex::Complex64;
 use rustfft::{Fft, FftPlanner};
 
-use super::grid::cell_unit_deflection;
 use crate::grid::MapGeometry;
 use crate::maps::LensMaps;
-use crate::profiles::gaussian_unit_hessian;
+use crate::profiles::{cell_unit_deflection, gaussian_unit_hessian};
 
 /// Largest distance (pixels) of a cell centre from the pixel lattice that still counts as on it:
 /// far below the rounding of centres computed as `centre + offset * size`, and a shift of

@@ -12,13 +12,14 @@ mod regions;
 mod regularise;
 mod system;
 
+pub use crate::profiles::cell_unit_deflection;
 pub use arcs::{parse_arcs, ArcCatalog, ArcSystem};
 pub use constraints::{
     build_constraints, ellipse_pixels, ConstraintConfig, ConstraintError, ConstraintMode,
     ConstraintPixel, ConstraintSet, ConstraintSource, ConstraintSystem, ExcludedSystem, Exclusion,
     Weighting,
 };
-pub use grid::{cell_unit_deflection, Cell, CellGrid, GridConfig, GridError, GridMass};
+pub use grid::{Cell, CellGrid, GridConfig, GridError, GridMass};
 pub use grid_fft::MapPlan;
 pub use members::{
     build_member_layers, HaloProfile, Layer, LayerSplit, MemberConfig, MemberHalo, MemberModel,

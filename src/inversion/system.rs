@@ -37,10 +37,11 @@ use serde::{Deserialize, Serialize};
 use thiserror::Error;
 
 use super::constraints::ConstraintSet;
-use super::grid::{cell_unit_deflection, CellGrid, GridError, GridMass};
+use super::grid::{CellGrid, GridError, GridMass};
 use super::members::Layer;
 use super::regularise::{cell_penalty, Regulariser};
 use crate::cosmology::{CosmologyError, LensPlane};
+use crate::profiles::cell_unit_deflection;
 use crate::profiles::{Lens, MassComponent};
 use crate::solver::{NormalEquations, SolverError};
 use crate::units::point_mass_deflection_arcsec2;

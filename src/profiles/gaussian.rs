@@ -134,6 +134,29 @@ pub fn gaussian_unit_deflection(dx: f64, dy: f64, sigma_arcsec: f64) -> (f64, f6
     }
 }
 
+/// Beyond this `u = r^2 / (2 s^2)`, `1 - e^-u` rounds to 1 in double precision
+/// (`e^-40 = 4e-18`): the cell deflects as a point mass.
+const CELL_POINT_LIKE_U: f64 = 40.0;
+
+/// Deflection of a unit Gaussian cell (`K m / D_l = 1` arcsec^2) at offset `(dx, dy)` arcsec,
+/// given `inv_2s2 = 1 / (2 s^2)` in 1/arcsec^2: `(1 - e^-u) (dx, dy) / r^2`, `u = r^2 inv_2s2`,
+/// equal to `(dx, dy) inv_2s2` at `r = 0` (METHOD.md section 2). The same function as
+/// [`gaussian_unit_deflection`] (to ~1e-15 relative), written for the inner loops of the
+/// linear system and the grid's maps: one `exp_m1` near the cell, none far from it.
+#[inline]
+pub fn cell_unit_deflection(dx: f64, dy: f64, inv_2s2: f64) -> (f64, f64) {
+    let r2 = dx * dx + dy * dy;
+    let u = r2 * inv_2s2;
+    let g = if u > CELL_POINT_LIKE_U {
+        1.0 / r2
+    } else if u > 0.0 {
+        -(-u).exp_m1() / r2
+    } else {
+        inv_2s2
+    };
+    (g * dx, g * dy)
+}
+
 /// Hessian `[psi_xx, psi_xy, psi_yy]` of a unit Gaussian (`b^2 = 1` arcsec^2) at offset
 /// `(dx, dy)` arcsec, in 1/arcsec^2. With `G(t) = (1 - e^-u)/t`, `t = r^2`:
 /// `psi_ij = G delta_ij + 2 G'(t) d_i d_j`, `2 G'(t) r^2 = -2 (1 - (1 + u) e^-u) / u / (2 s^2)`;

@@ -22,7 +22,8 @@ mod tnfw_near;
 pub use dpie::{dpie_b0_arcsec, kk_epsilon, Dpie, CIRCULAR_EPSILON as DPIE_CIRCULAR_EPSILON};
 pub use error::ProfileError;
 pub use gaussian::{
-    gaussian_unit_deflection, gaussian_unit_hessian, gaussian_unit_kappa, Gaussian,
+    cell_unit_deflection, gaussian_unit_deflection, gaussian_unit_hessian, gaussian_unit_kappa,
+    Gaussian,
 };
 pub use nfw::{nfw_deflection, nfw_hessian, nfw_kappa, nfw_mass_cylinder_msun, Nfw};
 pub use nfw_ellipse::{NfwEllipse, CSE_TERMS};
