@@ -55,7 +55,7 @@ TARGETS = dict(theta_e_pct=5.0, deflection_arcsec=1.0, fitted_arcsec=0.5, held_o
 class FitsMap:
     """A wslap FITS map and its geometry in the arcsec frame of the catalogues.
 
-    wslap writes (src/fits.rs): CDELT1 = -pixel/3600 (pixel i grows to +x, West),
+    wslap writes (src/fits/mod.rs): CDELT1 = -pixel/3600 (pixel i grows to +x, West),
     CDELT2 = +pixel/3600, CRPIX = n/2 + 0.5 (the map centre), CRVAL the sky position of the map
     centre, REFRA/REFDEC the frame origin (or NOSKYREF = T). Pixel (i, j) has its centre at
     centre + ((i + 0.5 - n/2) p, (j + 0.5 - n/2) p) (src/grid.rs). The frame is Lenstool's
