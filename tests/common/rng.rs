@@ -1,5 +1,5 @@
 //! splitmix64: a small fixed-seed generator for test and benchmark data (quality is
-//! irrelevant here; reproducibility is the point). Shared by `tests/solver.rs` and
+//! irrelevant here; reproducibility is the point). Shared by `tests/inversion/solver.rs` and
 //! `benches/qadp_bench.rs` (which includes this file by path).
 
 pub struct Rng(pub u64);

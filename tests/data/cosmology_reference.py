@@ -1,4 +1,4 @@
-"""Reference distances for tests/physics.rs, from astropy's FlatLambdaCDM (Tcmb0 = 0).
+"""Reference distances for tests/physics/physics.rs, from astropy's FlatLambdaCDM (Tcmb0 = 0).
 
 Run: python3 tests/data/cosmology_reference.py > tests/data/cosmology.json
 """

@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Reference values for tests/dpie.rs (dPIE, Lenstool profile 81).
+"""Reference values for tests/physics/dpie.rs (dPIE, Lenstool profile 81).
 
 Run from the repository root:  python3 tests/data/dpie_reference.py  > writes tests/data/dpie.json
 

@@ -1,4 +1,4 @@
-"""Reference data for tests/files.rs (FITS and DS9 regions), from astropy and `regions`.
+"""Reference data for tests/files/formats.rs (FITS and DS9 regions), from astropy and `regions`.
 
 1. Writes two small FITS files with astropy for our reader: files_astropy_f32.fits (16 x 12
    float32, BUNIT) and files_astropy_i16.fits (8 x 8 int16 with BSCALE/BZERO/BLANK and an HFF-like

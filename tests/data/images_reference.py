@@ -1,6 +1,6 @@
 #!/usr/bin/env python3
-"""Reference images for tests/images.rs: lenstronomy's LensEquationSolver on the elliptical NFW
-cluster of the tests.
+"""Reference images for tests/physics/images.rs: lenstronomy's LensEquationSolver on the
+elliptical NFW cluster of the tests.
 
 Run from the repository root:  python3 tests/data/images_reference.py  > writes
 tests/data/images.json

@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Reference values for tests/nfw.rs (NFW, elliptical NFW, truncated NFW).
+"""Reference values for tests/physics/nfw.rs (NFW, elliptical NFW, truncated NFW).
 
 Run from the repository root:  python3 tests/data/nfw_reference.py  > writes tests/data/nfw.json
 

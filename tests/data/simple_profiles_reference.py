@@ -1,4 +1,5 @@
-"""Reference fields of the SIS, point mass and Gaussian for tests/physics.rs, from lenstronomy.
+"""Reference fields of the SIS, point mass and Gaussian for tests/physics/physics.rs, from
+lenstronomy.
 
 Lens plane z_l = 0.3 in FlatLambdaCDM(H0=70, Om0=0.3, Tcmb0=0). Physical parameters are
 converted to lenstronomy's angular ones with astropy constants, as the Rust code does:

@@ -30,11 +30,11 @@ test('uploading the AS1063 catalogues reconstructs them', async () => {
     await page.waitForFunction(() => /members/.test(document.getElementById('status-members').textContent));
     await setField(page, '#set-z_lens', 0.348);
     // 50 point images do not fix the member factor C: a prior holds it near the M/L of 20
-    // (tests/reconstruct.rs measures the same run natively). Default iterations (8000).
+    // (tests/inversion/reconstruct.rs measures the same run natively). Default iterations (8000).
     await setField(page, '#set-reconstruct-members-c_prior_sigma', 0.1);
     await setField(page, '#set-reconstruct-products-size_arcsec', '');
     await runToMap(page, '#reconstruct', 120_000);
-    // The published CATS model's Einstein radius at z_s = 2 is 29.8 arcsec (tests/reconstruct.rs
+    // The published CATS model's Einstein radius at z_s = 2 is 29.8 arcsec (tests/inversion/reconstruct.rs
     // evaluates it); the issue asks for 25%.
     const caption = await page.textContent('#summary');
     const thetaE = Number(caption.match(/Einstein radius (?:≥ )?([\d.]+)/)[1]);

@@ -182,7 +182,7 @@ test('a published Lenstool model (.par) with its member catalogue draws in forwa
     await runToMap(page, '#forward');
     const stats = await imageStats(page, '#view-image');
     assert.ok(stats.reddish > 50, `only ${stats.reddish} red curve pixels`);
-    // The CATS model's Einstein radius at z_s = 2 (tests/app.rs: the library's, 29.8″ on its map).
+    // The CATS model's Einstein radius at z_s = 2 (tests/app/model.rs: the library's, 29.8″ on its map).
     const r = Number((await page.textContent('#summary')).match(/Einstein radius (\d+\.\d)″ at z_s = 2/)[1]);
     assert.ok(r > 25 && r < 35, `Einstein radius ${r}`);
     await page.screenshot({ path: join(ARTIFACTS, 'app-lenstool-par.png'), fullPage: true });

@@ -4,7 +4,7 @@
 //! down to 3e-4 arcsec apart, the same images from coarse grids and from precomputed maps;
 //! known images of a 100-component cluster recovered; the source-plane helpers; bad input.
 
-mod common;
+use crate::common;
 
 use common::{assert_abs, assert_rel};
 use glam::DVec2;
@@ -210,7 +210,7 @@ struct ReferenceImage {
 #[cfg_attr(target_arch = "wasm32", wasm_bindgen_test::wasm_bindgen_test)]
 fn elliptical_nfw_matches_lenstronomy() {
     let reference: Reference =
-        serde_json::from_str(include_str!("data/images.json")).expect("tests/data/images.json");
+        serde_json::from_str(include_str!("../data/images.json")).expect("tests/data/images.json");
     let (halo, f) = cluster();
     assert_eq!(halo.center(), DVec2::from(reference.center));
     assert_eq!(
@@ -222,7 +222,7 @@ fn elliptical_nfw_matches_lenstronomy() {
             reference.pa_deg
         )
     );
-    // Our distances match astropy's to ~1e-13 (tests/physics.rs).
+    // Our distances match astropy's to ~1e-13 (tests/physics/physics.rs).
     assert_rel("f = D_ls/D_s", f, reference.f, 1e-9);
     for source in &reference.sources {
         let beta = DVec2::from(source.beta);

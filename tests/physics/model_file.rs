@@ -1,6 +1,6 @@
 //! The model file (`src/model.rs`): the documented example, defaults, and one error per bad input.
 
-mod common;
+use crate::common;
 
 use common::assert_rel;
 use glam::DVec2;

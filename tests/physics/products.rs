@@ -1,7 +1,7 @@
 //! Map products (METHOD.md section 6): lens maps, magnification, critical curves, caustics,
 //! Einstein radius and radial profiles, checked on analytic lenses.
 
-mod common;
+use crate::common;
 
 use common::{assert_abs, assert_rel};
 use glam::DVec2;

@@ -1,7 +1,7 @@
 //! Product maps of a grid mass by FFT convolution (`src/inversion/grid_fft.rs`) against the
 //! direct per-pixel sum of the cells (`LensMaps::from_lens_pixelwise`, the path used before).
 
-mod common;
+use crate::common;
 
 use common::rng::Rng;
 use glam::DVec2;

@@ -2,7 +2,7 @@
 //! non-negative quadratic programs, the run protocol (reports, cancel, positivity, monotone
 //! objective), the normal-equations accumulator against a naive product, and bad inputs.
 
-mod common;
+use crate::common;
 
 use common::assert_rel;
 use wslap::solver::{

@@ -2,7 +2,7 @@
 //! truncated NFW, against lenstronomy and mpmath (tests/data/nfw_reference.py), analytic
 //! identities, consistency loops, finiteness everywhere, and bad parameters.
 
-mod common;
+use crate::common;
 
 use common::{assert_abs, assert_rel};
 use glam::DVec2;
@@ -124,7 +124,7 @@ struct Reference {
 }
 
 fn reference() -> Reference {
-    serde_json::from_str(include_str!("data/nfw.json")).expect("tests/data/nfw.json parses")
+    serde_json::from_str(include_str!("../data/nfw.json")).expect("tests/data/nfw.json parses")
 }
 
 fn center(c: [f64; 2]) -> DVec2 {

@@ -1,9 +1,8 @@
 //! Line plots and multi-panel figures: pixels land where `PlotFrame` says, styles, log axes,
 //! references, legend, composition and bad input.
 
-mod common;
+use crate::common;
 #[cfg(not(target_arch = "wasm32"))]
-#[path = "plot/examples.rs"]
 mod examples;
 
 use tiny_skia::Pixmap;

@@ -3,7 +3,7 @@
 //! long accelerated-gradient run from two starts, the member factor held where the data do
 //! not measure it, and the "auto" strength against its own cross-validation.
 
-mod common;
+use crate::common;
 
 use glam::DVec2;
 use wslap::catalog::ImageCatalog;

@@ -1,7 +1,7 @@
 //! The WSLAP+ reconstruction end to end: a synthetic lens with known truth, the two real
 //! clusters of ../shared/data, hold-out predictions and bad inputs.
 
-mod common;
+use crate::common;
 
 use glam::DVec2;
 use wslap::catalog::ImageCatalog;

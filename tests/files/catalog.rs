@@ -2,7 +2,7 @@
 //! ../shared/data (native only), the formats' variants and frame changes, and one test per bad
 //! input, each expecting its specific error text.
 
-mod common;
+use crate::common;
 
 use common::assert_abs;
 use glam::DVec2;

@@ -6,7 +6,7 @@
 //! cost) so the file stays fast in a debug build; the cluster itself does not depend on the
 //! pixel size.
 
-mod common;
+use crate::common;
 
 use std::collections::HashMap;
 use std::sync::OnceLock;
@@ -466,7 +466,7 @@ fn the_app_example_is_the_default_simulation() {
         let committed = std::fs::read_to_string(dir.join(name)).unwrap_or_default();
         assert!(
             committed == *fresh,
-            "www/examples/a1689-sim/{name} is out of date: run `WSLAP_REGENERATE=1 cargo test --test simulate the_app_example`"
+            "www/examples/a1689-sim/{name} is out of date: run `WSLAP_REGENERATE=1 cargo test --test files simulate::the_app_example`"
         );
     }
 }

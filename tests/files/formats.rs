@@ -2,8 +2,6 @@
 //! package), and the kappa figure (golden PNGs and pixel checks). Reference data come from
 //! tests/data/files_reference.py; regenerate our own committed outputs with MAKE_REF=1.
 
-mod common;
-
 use glam::DVec2;
 use serde_json::Value;
 use wslap::curves::{Caustics, CriticalCurves};
@@ -11,16 +9,16 @@ use wslap::fits::{Card, FitsWriteOptions};
 use wslap::sky::SkyReference;
 use wslap::{Map, MapGeometry};
 
-const REFERENCE_JSON: &str = include_str!("data/files.json");
-const OURS_FITS: &[u8] = include_bytes!("data/files_ours.fits");
-const OURS_FK5_REG: &str = include_str!("data/files_ours_fk5.reg");
-const OURS_IMAGE_REG: &str = include_str!("data/files_ours_image.reg");
-const OURS_MARKS_FK5_REG: &str = include_str!("data/files_ours_marks_fk5.reg");
-const OURS_MARKS_IMAGE_REG: &str = include_str!("data/files_ours_marks_image.reg");
-const ASTROPY_F32: &[u8] = include_bytes!("data/files_astropy_f32.fits");
-const ASTROPY_I16: &[u8] = include_bytes!("data/files_astropy_i16.fits");
-const GOLDEN_LINEAR: &[u8] = include_bytes!("data/golden/kappa_linear.png");
-const GOLDEN_LOG: &[u8] = include_bytes!("data/golden/kappa_log_magma.png");
+const REFERENCE_JSON: &str = include_str!("../data/files.json");
+const OURS_FITS: &[u8] = include_bytes!("../data/files_ours.fits");
+const OURS_FK5_REG: &str = include_str!("../data/files_ours_fk5.reg");
+const OURS_IMAGE_REG: &str = include_str!("../data/files_ours_image.reg");
+const OURS_MARKS_FK5_REG: &str = include_str!("../data/files_ours_marks_fk5.reg");
+const OURS_MARKS_IMAGE_REG: &str = include_str!("../data/files_ours_marks_image.reg");
+const ASTROPY_F32: &[u8] = include_bytes!("../data/files_astropy_f32.fits");
+const ASTROPY_I16: &[u8] = include_bytes!("../data/files_astropy_i16.fits");
+const GOLDEN_LINEAR: &[u8] = include_bytes!("../data/golden/kappa_linear.png");
+const GOLDEN_LOG: &[u8] = include_bytes!("../data/golden/kappa_log_magma.png");
 
 /// float32 storage: relative precision 2^-24 ~ 6e-8; values here are O(1).
 const F32_ATOL: f64 = 1e-6;
@@ -115,9 +113,6 @@ fn maybe_make_ref(name: &str, bytes: &[u8]) {
     let _ = (name, bytes);
 }
 
-#[path = "files/ds9.rs"]
 mod ds9;
-#[path = "files/fits.rs"]
 mod fits;
-#[path = "files/render.rs"]
 mod render;

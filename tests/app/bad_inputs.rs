@@ -1,8 +1,6 @@
 //! Bad JSON and FITS inputs in memory (what the browser app passes to the core): each error
 //! names the file, says line and column once, and the size limits refuse a huge input before
-//! it is parsed. Catalogue cases are in tests/catalog.rs, command-line ones in tests/cli.rs.
-
-mod common;
+//! it is parsed. Catalogue cases are in tests/files/catalog.rs, command-line ones in tests/cli.rs.
 
 use wslap::fits::{read_image, FitsError};
 use wslap::inversion::{parse_arcs, ConstraintError};

@@ -1,8 +1,6 @@
 //! The forward path the app's worker runs (`Products::from_model` on the built-in examples),
 //! natively and as WebAssembly in a browser worker.
 
-mod common;
-
 use wslap::demo::{CLUSTER_MODEL_JSON, TEACHING_MODEL_JSON};
 use wslap::model::ModelFile;
 use wslap::products::{ProductOptions, Products, ProductsError};

@@ -1,7 +1,7 @@
 //! Cosmology and the simple mass components (SIS, point mass, Gaussian) against astropy and
 //! lenstronomy, analytic limits, consistency loops.
 
-mod common;
+use crate::common;
 
 use common::{assert_abs, assert_rel};
 use glam::DVec2;
@@ -69,7 +69,7 @@ struct PairRow {
 #[cfg_attr(target_arch = "wasm32", wasm_bindgen_test::wasm_bindgen_test)]
 fn cosmology_matches_astropy() {
     let reference: CosmologyRef =
-        serde_json::from_str(include_str!("data/cosmology.json")).expect("cosmology.json");
+        serde_json::from_str(include_str!("../data/cosmology.json")).expect("cosmology.json");
     assert_eq!(reference.cosmologies.len(), 2);
     for case in &reference.cosmologies {
         let cosmo = Cosmology::new(case.h0, case.omega_m).expect("valid cosmology");
@@ -168,7 +168,7 @@ fn assert_close(what: &str, a: f64, b: f64, hessian_scale: f64) {
 #[cfg_attr(target_arch = "wasm32", wasm_bindgen_test::wasm_bindgen_test)]
 fn simple_profiles_match_lenstronomy() {
     let reference: ProfilesRef =
-        serde_json::from_str(include_str!("data/simple_profiles.json")).expect("profiles json");
+        serde_json::from_str(include_str!("../data/simple_profiles.json")).expect("profiles json");
     let lp = LensPlane::new(reference.cosmology, reference.z_lens).expect("lens plane");
     assert_eq!(reference.cases.len(), 5);
     for case in &reference.cases {

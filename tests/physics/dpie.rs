@@ -2,7 +2,7 @@
 //! against lenstronomy and independent 1-D integrals (tests/data/dpie_reference.py), consistency
 //! loops, finiteness, bad input, and the two published cluster models of ../shared/data.
 
-mod common;
+use crate::common;
 
 use common::{assert_abs, assert_rel};
 use glam::DVec2;
@@ -57,7 +57,7 @@ struct Reference {
 }
 
 fn reference() -> Reference {
-    serde_json::from_str(include_str!("data/dpie.json")).expect("dpie.json")
+    serde_json::from_str(include_str!("../data/dpie.json")).expect("dpie.json")
 }
 
 fn dpie_of(c: &Case) -> Dpie {

@@ -1,0 +1,268 @@
+//! Loading files without losing data, and settings: the teaching example's catalogue, a bad
+//! file or a bad setting refused with the old one kept, DS9 regions loaded as arcs.
+
+use crate::fixtures::teaching_session;
+use serde_json::json;
+use wslap::app::examples::{teaching_image_catalog, TEACHING_SOURCES};
+use wslap::app::{DataRole, RunKind, Session};
+use wslap::solver::Control;
+
+#[cfg_attr(not(target_arch = "wasm32"), test)]
+#[cfg_attr(target_arch = "wasm32", wasm_bindgen_test::wasm_bindgen_test)]
+fn teaching_catalogue_has_multiple_images_of_every_source() {
+    let cat = teaching_image_catalog().unwrap();
+    for (id, _, _) in TEACHING_SOURCES {
+        let n = cat
+            .lines()
+            .filter(|l| l.starts_with(&format!("{id}.")))
+            .count();
+        assert!(n >= 2, "system {id} has {n} images:\n{cat}");
+    }
+}
+
+#[cfg(not(target_arch = "wasm32"))]
+#[test]
+fn committed_teaching_catalogue_is_up_to_date() {
+    let path =
+        std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("www/examples/teaching/images.cat");
+    let fresh = teaching_image_catalog().unwrap();
+    if std::env::var_os("WSLAP_REGENERATE").is_some() {
+        std::fs::write(&path, &fresh).unwrap();
+    }
+    let committed = std::fs::read_to_string(&path).unwrap_or_default();
+    assert_eq!(
+        committed,
+        fresh,
+        "run with WSLAP_REGENERATE=1 to rewrite {}",
+        path.display()
+    );
+}
+
+#[cfg_attr(not(target_arch = "wasm32"), test)]
+#[cfg_attr(target_arch = "wasm32", wasm_bindgen_test::wasm_bindgen_test)]
+fn a_bad_file_names_its_line_and_keeps_what_was_loaded() {
+    let mut s = teaching_session();
+    let before = s.data.images.clone();
+    let err = s
+        .load_text(
+            DataRole::Images,
+            "bad.cat",
+            "1.1 1.0 2.0 0.1 0.1 0 1.5\n1.2 x 2.0 0.1 0.1 0 1.5\n",
+        )
+        .unwrap_err()
+        .to_string();
+    assert!(err.contains("bad.cat") && err.contains("line 2"), "{err}");
+    assert_eq!(s.data.images, before);
+    let err = s
+        .load_text(DataRole::Arcs, "arcs.json", "{\n  \"systems\": [\n   oops")
+        .unwrap_err();
+    assert!(err.to_string().contains("line 3"), "{err}");
+    assert!(s.data.arcs.is_none());
+}
+
+#[cfg_attr(not(target_arch = "wasm32"), test)]
+#[cfg_attr(target_arch = "wasm32", wasm_bindgen_test::wasm_bindgen_test)]
+fn a_bad_setting_is_refused_and_the_old_value_kept() {
+    let mut s = Session::new();
+    let err = s
+        .set_field("reconstruct.grid.cells", json!(0))
+        .unwrap_err()
+        .to_string();
+    assert!(err.contains("cells"), "{err}");
+    assert_eq!(s.settings.reconstruct.grid.cells, 32);
+    assert!(s.set_field("z_lens", json!(-1.0)).is_err());
+    assert!(s.set_field("no.such.field", json!(1)).is_err());
+    assert!(s
+        .set_field("reconstruct.constraints.mode", json!("sideways"))
+        .is_err());
+    s.set_field("reconstruct.constraints.mode", json!("point"))
+        .unwrap();
+    s.set_field("reconstruct.grid.width_arcsec", json!(80.0))
+        .unwrap();
+    s.set_field("reconstruct.grid.width_arcsec", json!(null))
+        .unwrap();
+    assert_eq!(s.settings.reconstruct.grid.width_arcsec, None);
+    let err = s
+        .set_field("reconstruct.members.c_prior_sigma", json!(-0.1))
+        .unwrap_err()
+        .to_string();
+    assert!(err.contains("c_prior_sigma"), "{err}");
+    assert_eq!(s.settings.reconstruct.members.c_prior_sigma, None);
+    s.set_field("reconstruct.members.c_prior_sigma", json!(0.1))
+        .unwrap();
+    assert_eq!(s.settings.reconstruct.members.c_prior_sigma, Some(0.1));
+    // The curves' source behind the lens, whichever of the two redshifts is changed.
+    let z_lens = s.settings.z_lens;
+    let err = s
+        .set_field("reconstruct.products.z_source", json!(z_lens))
+        .unwrap_err()
+        .to_string();
+    assert!(
+        err.starts_with("reconstruct.products.z_source: the curves' z_s = ")
+            && err.contains("is not behind the lens"),
+        "{err}"
+    );
+    let z_s = s.settings.reconstruct.products.z_source;
+    assert!(z_s > z_lens);
+    let err = s.set_field("z_lens", json!(z_s + 0.5)).unwrap_err();
+    assert!(
+        err.to_string().starts_with("z_lens: the curves' z_s"),
+        "{err}"
+    );
+    assert_eq!(s.settings.z_lens, z_lens);
+    assert_eq!(s.settings.reconstruct.products.z_source, z_s);
+    // So must the redshift given to images with z = 0, and it keeps the lens where it is.
+    let err = s
+        .set_field("reconstruct.constraints.default_z", json!(z_lens))
+        .unwrap_err()
+        .to_string();
+    assert!(
+        err.starts_with(
+            "reconstruct.constraints.default_z: the redshift for images with z = 0: z_s = "
+        ) && err.contains("is not behind the lens"),
+        "{err}"
+    );
+    assert_eq!(s.settings.reconstruct.constraints.default_z, None);
+    s.set_field("reconstruct.constraints.default_z", json!(1.0))
+        .unwrap();
+    assert_eq!(s.settings.reconstruct.constraints.default_z, Some(1.0));
+    assert!(z_s > 1.5);
+    let err = s.set_field("z_lens", json!(1.5)).unwrap_err().to_string();
+    assert!(err.contains("images with z = 0"), "{err}");
+    assert_eq!(s.settings.z_lens, z_lens);
+    s.set_field("reconstruct.constraints.default_z", json!(null))
+        .unwrap();
+    assert_eq!(
+        s.settings.reconstruct.products.pixels,
+        wslap::app::APP_MAP_PIXELS
+    );
+}
+
+/// The teaching images drawn as DS9 circles (fk5) without redshifts in their labels, loaded as
+/// arcs next to the image catalogue: the systems take the catalogue's redshifts, and the
+/// reconstruction uses the regions' pixels (mode "arcs").
+#[cfg_attr(not(target_arch = "wasm32"), test)]
+#[cfg_attr(target_arch = "wasm32", wasm_bindgen_test::wasm_bindgen_test)]
+fn ds9_regions_load_as_arcs_with_the_catalogue_redshifts() {
+    let mut s = teaching_session();
+    let cat = teaching_image_catalog().unwrap();
+    let (catalog, _) = wslap::catalog::parse_image_catalog(&cat, "images.cat", None).unwrap();
+    let sky = catalog.reference.unwrap();
+    let mut reg = String::from("# Region file format: DS9 version 4.1\nfk5\n");
+    for im in catalog.images() {
+        let (ra, dec) = sky.offset_to_radec(im.position);
+        reg += &format!("circle({ra:.8},{dec:.8},0.4\") # text={{{}}}\n", im.id);
+    }
+    let report = s.load_text(DataRole::Arcs, "arcs.reg", &reg).unwrap();
+    assert!(
+        report.summary.starts_with("4 systems, ") && report.summary.contains("DS9 regions"),
+        "{}",
+        report.summary
+    );
+    s.set_field("reconstruct.constraints.mode", json!("arcs"))
+        .unwrap();
+    // A bad region file is refused with its line, and the good one stays.
+    let bad = s
+        .load_text(
+            DataRole::Arcs,
+            "bad.reg",
+            "fk5\ncircle(150,2.2,1\") # text={1}\n",
+        )
+        .unwrap_err()
+        .to_string();
+    assert!(bad.contains("bad.reg: line 2: label '1'"), "{bad}");
+    assert_eq!(s.data.arcs.as_ref().unwrap().name, "arcs.reg");
+    s.run(RunKind::Reconstruct, &mut |_| Control::Continue)
+        .unwrap();
+    let r = s.result().unwrap();
+    let rec = r.reconstruction.as_ref().unwrap();
+    let pixels = rec.config.constraints.pixel_arcsec;
+    assert_eq!(
+        rec.config.constraints.mode,
+        wslap::inversion::ConstraintMode::Arcs
+    );
+    assert_eq!(rec.sources.len(), TEACHING_SOURCES.len());
+    for (src, system) in rec.sources.iter().zip(&catalog.systems) {
+        assert_eq!(src.z, system.z.unwrap(), "system {}", src.id);
+    }
+    // Arc pixels (about 12 per circle), drawn in the data's marks, in the catalogue's frame.
+    let arcs = &r.marks.arcs;
+    assert_eq!(arcs.len(), 4);
+    for (a, system) in arcs.iter().zip(&catalog.systems) {
+        for p in &a.pixels_arcsec {
+            let nearest = system
+                .images
+                .iter()
+                .map(|im| im.position.distance(*p))
+                .fold(f64::INFINITY, f64::min);
+            assert!(
+                nearest <= 0.4 + 1e-6,
+                "pixel {p} of {} is {nearest} arcsec off",
+                a.id
+            );
+        }
+        assert!(
+            a.pixels_arcsec.len() >= 8 * system.images.len(),
+            "{} pixels",
+            a.pixels_arcsec.len()
+        );
+    }
+    assert_eq!(r.marks.arc_pixel_mas, (pixels * 1000.0).round() as u32);
+}
+
+/// The constraint pixel samples loaded DS9 region arcs: a finer one gives more pixels (the
+/// reloaded report says how many), and one that would exceed the arcs' pixel limit is refused,
+/// keeping the old value.
+#[cfg_attr(not(target_arch = "wasm32"), test)]
+#[cfg_attr(target_arch = "wasm32", wasm_bindgen_test::wasm_bindgen_test)]
+fn the_constraint_pixel_resamples_region_arcs() {
+    let mut s = Session::new();
+    let reg = "fk5\ncircle(150,2.2,20\") # text={1.1 z=2}\ncircle(150.01,2.2,20\") # text={1.2}\n";
+    let count = |r: &wslap::app::LoadReport| -> usize {
+        r.summary
+            .split(", ")
+            .nth(1)
+            .unwrap()
+            .split(' ')
+            .next()
+            .unwrap()
+            .parse()
+            .unwrap()
+    };
+    let at_02 = count(&s.load_text(DataRole::Arcs, "arcs.reg", reg).unwrap());
+    s.set_field("reconstruct.constraints.pixel_arcsec", json!(0.1))
+        .unwrap();
+    let at_01 = count(&s.reload(DataRole::Arcs).unwrap().unwrap());
+    // Twice the resolution, four times the pixels (2 x pi 20^2 / 0.01 = 251327).
+    assert!(
+        (at_01 as f64 / at_02 as f64 - 4.0).abs() < 0.01,
+        "{at_02} -> {at_01}"
+    );
+    let err = s
+        .set_field("reconstruct.constraints.pixel_arcsec", json!(0.02))
+        .unwrap_err()
+        .to_string();
+    assert!(
+        err.contains(
+            "reconstruct.constraints.pixel_arcsec: arcs.reg: line 2: the regions up to here hold"
+        ),
+        "{err}"
+    );
+    assert_eq!(s.settings.reconstruct.constraints.pixel_arcsec, 0.1);
+    assert!(s.reload(DataRole::Members).unwrap().is_none());
+    // Without a catalogue the frame is the regions' mean position, and the run says so.
+    let parsed = s.parsed().unwrap();
+    let r = parsed.reference().unwrap();
+    assert!(
+        (r.ra_deg - 150.005).abs() < 1e-9 && (r.dec_deg - 2.2).abs() < 1e-9,
+        "{r:?}"
+    );
+    assert!(
+        parsed
+            .warnings
+            .iter()
+            .any(|w| w.contains("arcs.reg: no catalogue gives a frame")),
+        "{:?}",
+        parsed.warnings
+    );
+}

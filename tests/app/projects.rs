@@ -1,0 +1,122 @@
+//! Project files: a reconstruction reopens with its maps rebuilt from X, a look-up keeps its
+//! deflection maps, and a broken or oversized FITS in a project is refused.
+
+use crate::fixtures::{forward_session, solved};
+use serde_json::json;
+use wslap::app::{RunKind, Session, MAX_STORED_FITS_BYTES};
+use wslap::solver::Control;
+
+#[cfg_attr(not(target_arch = "wasm32"), test)]
+#[cfg_attr(target_arch = "wasm32", wasm_bindgen_test::wasm_bindgen_test)]
+fn a_project_reopens_with_the_maps_rebuilt_from_x() {
+    let s = solved();
+    let text = s.project_json().unwrap();
+    let mut t = Session::new();
+    let report = t.open_project(&text, "p.json").unwrap();
+    assert_eq!(report.result, "restored", "{}", report.message);
+    let (a, b) = (s.result().unwrap(), t.result().unwrap());
+    // serde_json's float parsing may differ from the written value in the last bit.
+    const KAPPA_RTOL: f64 = 1e-9;
+    let worst = a
+        .products
+        .maps
+        .kappa
+        .data
+        .iter()
+        .zip(&b.products.maps.kappa.data)
+        .map(|(p, q)| (p - q).abs() / p.abs().max(1e-12))
+        .fold(0.0, f64::max);
+    assert!(worst <= KAPPA_RTOL, "kappa differs by {worst:e} (relative)");
+    assert_eq!(t.settings, s.settings);
+    assert_eq!(t.data.images, s.data.images);
+    // A broken project changes nothing.
+    let err = t
+        .open_project("{\"format\": \"other\", \"version\": 1}", "q.json")
+        .unwrap_err();
+    assert!(err.to_string().contains("q.json"), "{err}");
+    // Not JSON: the place is said once.
+    let err = t.open_project("{\"format\": wslap}", "r.json").unwrap_err();
+    assert_eq!(err.to_string(), "r.json: line 1, column 12: expected value");
+    assert!(t.result.is_some());
+}
+
+#[cfg_attr(not(target_arch = "wasm32"), test)]
+#[cfg_attr(target_arch = "wasm32", wasm_bindgen_test::wasm_bindgen_test)]
+fn a_lookup_project_keeps_its_deflection_maps() {
+    let (_, fx, fy) = forward_session();
+    let mut s = Session::new();
+    s.set_field("z_lens", json!(0.3)).unwrap();
+    s.set_field("reconstruct.products.z_source", json!(3.0))
+        .unwrap();
+    s.load_fits(0, "alpha_x.fits", &fx).unwrap();
+    s.load_fits(1, "alpha_y.fits", &fy).unwrap();
+    s.run(RunKind::Lookup, &mut |_| Control::Continue).unwrap();
+    let text = s.project_json().unwrap();
+    let project: serde_json::Value = serde_json::from_str(&text).unwrap();
+    assert_eq!(project["data"]["deflection_x"]["name"], "alpha_x.fits");
+
+    let mut t = Session::new();
+    let report = t.open_project(&text, "lookup.json").unwrap();
+    assert_eq!(report.result, "recomputed", "{}", report.message);
+    for axis in 0..2 {
+        let (a, b) = (
+            s.data.deflection[axis].as_ref().unwrap(),
+            t.data.deflection[axis].as_ref().unwrap(),
+        );
+        assert_eq!(a.name, b.name);
+        assert_eq!(a.map.data, b.map.data, "axis {axis}: the map changed");
+        assert_eq!(
+            b.fits.as_deref(),
+            Some([fx.as_slice(), fy.as_slice()][axis])
+        );
+    }
+    let (a, b) = (s.result().unwrap(), t.result().unwrap());
+    assert_eq!(b.kind, RunKind::Lookup);
+    assert_eq!(b.products.curves.z_source, 3.0);
+    assert_eq!(
+        a.products.curves.einstein_radius_arcsec,
+        b.products.curves.einstein_radius_arcsec
+    );
+    // The reopened session writes the same data (the summary's timings differ).
+    let again: serde_json::Value = serde_json::from_str(&t.project_json().unwrap()).unwrap();
+    assert!(again["data"] == project["data"], "the stored data changed");
+}
+
+#[cfg_attr(not(target_arch = "wasm32"), test)]
+#[cfg_attr(target_arch = "wasm32", wasm_bindgen_test::wasm_bindgen_test)]
+fn a_project_with_a_broken_or_oversized_fits_is_refused_and_changes_nothing() {
+    let (mut s, fx, _) = forward_session();
+    s.load_fits(0, "alpha_x.fits", &fx).unwrap();
+    let text = s.project_json().unwrap();
+    let mut project: serde_json::Value = serde_json::from_str(&text).unwrap();
+    project["data"]["deflection_x"]["fits_base64"] = json!("AAAA*AAA");
+    let before = s.project_json().unwrap();
+    let err = s
+        .open_project(&project.to_string(), "p.json")
+        .unwrap_err()
+        .to_string();
+    assert!(
+        err.contains("p.json") && err.contains("alpha_x.fits") && err.contains("not base64"),
+        "{err}"
+    );
+    // Just above the stated limit (base64 of MAX_STORED_FITS_BYTES + 3 bytes and more).
+    let too_big = "A".repeat((MAX_STORED_FITS_BYTES / 3 + 2) * 4);
+    project["data"]["deflection_x"]["fits_base64"] = json!(too_big);
+    let err = s
+        .open_project(&project.to_string(), "p.json")
+        .unwrap_err()
+        .to_string();
+    assert!(
+        err.contains(&MAX_STORED_FITS_BYTES.to_string()) && err.contains("alpha_x.fits"),
+        "{err}"
+    );
+    assert_eq!(s.project_json().unwrap(), before);
+    // A project written before FITS maps were stored still opens.
+    project["data"]
+        .as_object_mut()
+        .unwrap()
+        .remove("deflection_x");
+    let report = s.open_project(&project.to_string(), "old.json").unwrap();
+    assert_eq!(report.result, "recomputed", "{}", report.message);
+    assert!(s.data.deflection[0].is_none());
+}

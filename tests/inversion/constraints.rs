@@ -1,0 +1,217 @@
+//! Constraint pixels and weights (METHOD.md section 4): ellipse pixels, the three weightings,
+//! systems left out (redshift, single image, hold-out), and arcs files.
+
+use crate::common::assert_rel;
+use crate::fixtures::{image, system, three_systems};
+use glam::DVec2;
+use wslap::inversion::{
+    build_constraints, ellipse_pixels, parse_arcs, ConstraintConfig, ConstraintError,
+    ConstraintMode, ConstraintSet, ConstraintSource, Exclusion, Weighting,
+};
+
+/// Ellipse pixel count vs `pi a b / pixel^2` (lattice-point count error ~ perimeter / pixel).
+const ELLIPSE_COUNT_RTOL: f64 = 0.1;
+
+#[cfg_attr(not(target_arch = "wasm32"), test)]
+#[cfg_attr(target_arch = "wasm32", wasm_bindgen_test::wasm_bindgen_test)]
+fn ellipse_pixels_fill_the_ellipse() {
+    let (a, b, theta, pix) = (2.0, 1.0, 30.0, 0.1);
+    let c = DVec2::new(3.0, -4.0);
+    let pixels = ellipse_pixels(c, a, b, theta, pix);
+    let expected = std::f64::consts::PI * a * b / (pix * pix);
+    assert_rel(
+        "pixel count",
+        pixels.len() as f64,
+        expected,
+        ELLIPSE_COUNT_RTOL,
+    );
+    let (s, co) = theta.to_radians().sin_cos();
+    for p in &pixels {
+        let d = *p - c;
+        let (u, v) = (d.x * co + d.y * s, -d.x * s + d.y * co);
+        assert!((u / a).powi(2) + (v / b).powi(2) <= 1.0 + 1e-12);
+    }
+    // The far end of the major axis is reached along theta.
+    let reach = pixels
+        .iter()
+        .map(|p| (*p - c).dot(DVec2::new(co, s)))
+        .fold(0.0, f64::max);
+    assert!(reach > a - 2.0 * pix, "{reach}");
+    assert_eq!(ellipse_pixels(c, 0.01, 0.01, 0.0, 0.2), vec![c]);
+    assert_eq!(ellipse_pixels(c, 0.0, 0.0, 0.0, 0.2), vec![c]);
+}
+
+fn weight_sums(set: &ConstraintSet) -> (Vec<f64>, Vec<Vec<f64>>) {
+    let mut per_system = vec![0.0; set.systems.len()];
+    let mut per_image: Vec<Vec<f64>> = set
+        .systems
+        .iter()
+        .map(|s| vec![0.0; s.images.len()])
+        .collect();
+    for p in &set.pixels {
+        per_system[p.system] += p.weight;
+        per_image[p.system][p.image] += p.weight;
+    }
+    (per_system, per_image)
+}
+
+#[cfg_attr(not(target_arch = "wasm32"), test)]
+#[cfg_attr(target_arch = "wasm32", wasm_bindgen_test::wasm_bindgen_test)]
+fn weights_per_image_system_and_pixel() {
+    let cat = three_systems();
+    let sigma = 0.5;
+    let inv_var = 1.0 / (sigma * sigma);
+    for weighting in [
+        Weighting::EqualPerImage,
+        Weighting::EqualPerSystem,
+        Weighting::EqualPerPixel,
+    ] {
+        let config = ConstraintConfig {
+            weighting,
+            sigma_pos_arcsec: sigma,
+            ..ConstraintConfig::default()
+        };
+        let set = build_constraints(ConstraintSource::Catalog(&cat), &config, &[]).unwrap();
+        assert_eq!(set.systems.len(), 3);
+        assert!(set.pixels.len() > 100, "{}", set.pixels.len());
+        let (per_system, per_image) = weight_sums(&set);
+        for (s, sys) in set.systems.iter().enumerate() {
+            let n: usize = set.pixels.iter().filter(|p| p.system == s).count();
+            assert_eq!(n, sys.n_pixels);
+            match weighting {
+                Weighting::EqualPerImage => {
+                    for w in &per_image[s] {
+                        assert_rel("image weight", *w, inv_var, 1e-12);
+                    }
+                }
+                Weighting::EqualPerSystem => {
+                    assert_rel("system weight", per_system[s], inv_var, 1e-12)
+                }
+                Weighting::EqualPerPixel => {
+                    assert_rel("pixel weights", per_system[s], n as f64 * inv_var, 1e-12)
+                }
+            }
+        }
+    }
+    let point = ConstraintConfig {
+        mode: ConstraintMode::Point,
+        ..ConstraintConfig::default()
+    };
+    let set = build_constraints(ConstraintSource::Catalog(&cat), &point, &[]).unwrap();
+    assert_eq!(set.pixels.len(), 7);
+    assert!(set.pixels.iter().all(|p| (p.weight - 4.0).abs() < 1e-12));
+    assert_eq!(set.pixels[3].position, DVec2::new(-5.0, 19.0));
+    assert_eq!((set.pixels[3].system, set.pixels[3].image), (1, 0));
+}
+
+#[cfg_attr(not(target_arch = "wasm32"), test)]
+#[cfg_attr(target_arch = "wasm32", wasm_bindgen_test::wasm_bindgen_test)]
+fn systems_are_excluded_for_redshift_single_image_and_hold_out() {
+    let mut cat = three_systems();
+    cat.systems[1].z = None;
+    cat.systems.push(system(
+        "4",
+        Some(2.0),
+        vec![image("4.1", 1.0, 1.0, 0.5, 0.5, 0.0)],
+    ));
+    let config = ConstraintConfig::default();
+    let set =
+        build_constraints(ConstraintSource::Catalog(&cat), &config, &["3".to_string()]).unwrap();
+    let ids: Vec<&str> = set.systems.iter().map(|s| s.id.as_str()).collect();
+    assert_eq!(ids, ["1"]);
+    let excluded: Vec<(&str, Exclusion)> = set
+        .excluded
+        .iter()
+        .map(|e| (e.id.as_str(), e.reason))
+        .collect();
+    assert_eq!(
+        excluded,
+        [
+            ("2", Exclusion::UnknownRedshift),
+            ("3", Exclusion::HeldOut),
+            ("4", Exclusion::SingleImage)
+        ]
+    );
+    assert_eq!(
+        set.warnings,
+        [
+            "test.cat: system 2 has no redshift and no default_z is set: not used",
+            "test.cat: system 4 has a single image: not used"
+        ]
+    );
+    let with_default = ConstraintConfig {
+        default_z: Some(2.5),
+        ..config.clone()
+    };
+    let set = build_constraints(ConstraintSource::Catalog(&cat), &with_default, &[]).unwrap();
+    assert_eq!(set.systems[1].z, 2.5);
+    assert!(set.systems[1].z_assumed && !set.systems[0].z_assumed);
+    assert_eq!(
+        set.warnings[0],
+        "test.cat: system 2 has no redshift: default_z = 2.5 assumed"
+    );
+    let err = build_constraints(ConstraintSource::Catalog(&cat), &config, &["9".to_string()])
+        .unwrap_err();
+    assert!(
+        matches!(err, ConstraintError::UnknownHoldOut { ref id, .. } if id == "9"),
+        "{err}"
+    );
+    let all: Vec<String> = ["1", "2", "3", "4"].iter().map(|s| s.to_string()).collect();
+    let err = build_constraints(ConstraintSource::Catalog(&cat), &config, &all).unwrap_err();
+    assert!(matches!(err, ConstraintError::NoSystems { .. }), "{err}");
+}
+
+#[cfg_attr(not(target_arch = "wasm32"), test)]
+#[cfg_attr(target_arch = "wasm32", wasm_bindgen_test::wasm_bindgen_test)]
+fn arc_files_parse_and_report_errors() {
+    let text = r#"{"systems": [
+        {"id": "1", "z": 2.1, "pixels": [[1.0, 2.0], [1.1, 2.0], [1.2, 2.0]]},
+        {"id": 2, "images": [[[5.0, 5.0]], [[-5.0, -5.0], [-5.1, -5.0]]]}]}"#;
+    let arcs = parse_arcs(text, "arcs.json").unwrap();
+    assert_eq!(arcs.systems[1].id, "2");
+    assert_eq!(arcs.systems[1].z, None);
+    assert_eq!(arcs.systems[1].images.len(), 2);
+    let config = ConstraintConfig {
+        mode: ConstraintMode::Arcs,
+        default_z: Some(3.0),
+        ..ConstraintConfig::default()
+    };
+    let set = build_constraints(ConstraintSource::Arcs(&arcs), &config, &[]).unwrap();
+    assert_eq!(set.pixels.len(), 6);
+    let (per_system, _) = weight_sums(&set);
+    assert_rel("flat arc = one image", per_system[0], 4.0, 1e-12);
+    assert_rel("two images", per_system[1], 8.0, 1e-12);
+    let err = build_constraints(
+        ConstraintSource::Arcs(&arcs),
+        &ConstraintConfig::default(),
+        &[],
+    )
+    .unwrap_err();
+    assert!(matches!(err, ConstraintError::ModeMismatch { .. }), "{err}");
+
+    for (bad, needle) in [
+        (
+            r#"{"systems": [{"id": "7", "z": 2, "pixels": []}]}"#,
+            "system 7",
+        ),
+        (
+            r#"{"systems": [{"id": "7", "z": -1, "pixels": [[0, 0]]}]}"#,
+            "z = -1",
+        ),
+        (
+            r#"{"systems": [{"id": "7", "pixels": [[0, 0]], "images": [[[0, 0]]]}]}"#,
+            "exactly one",
+        ),
+        (
+            r#"{"systems": [{"id": "7", "pixels": [[0, 0]]}, {"id": "7", "pixels": [[0, 0]]}]}"#,
+            "twice",
+        ),
+        (
+            "{\"systems\": [\n{\"id\": \"7\", \"pixel\": []}]}",
+            "line 2",
+        ),
+    ] {
+        let err = parse_arcs(bad, "arcs.json").unwrap_err().to_string();
+        assert!(err.contains("arcs.json") && err.contains(needle), "{err}");
+    }
+}
