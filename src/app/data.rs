@@ -198,8 +198,8 @@ impl DataViews for Dataset {
     /// neighbour in the same image (`DEFAULT_ARC_PIXEL_MAS` if no image has two pixels).
     /// Of an image with more than `ARC_PIXEL_SAMPLES` pixels only that many, evenly spaced
     /// in file order, are measured (against all of its pixels), so the cost grows linearly with
-    /// the pixel count: every pixel of a 20000-pixel arc took 1.7 s, and each view of the data
-    /// asks again. Arc pixels lie on a regular grid, where the sample's median is the same.
+    /// the pixel count, not with its square (each view of the data asks again, and arcs of
+    /// ten thousands of pixels are common). Arc pixels lie on a regular grid, where the sample's median is the same.
     fn arc_pixel_mas(&self) -> u32 {
         let mut nearest: Vec<f64> = Vec::new();
         let images = self

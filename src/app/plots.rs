@@ -59,8 +59,7 @@ fn compose(name: &str, plots: &[LinePlot]) -> Result<ViewPng, AppError> {
 /// profile view's bins are two product pixels wide, so at 256 product pixels a 128-pixel map
 /// has one pixel per bin; against a 512-pixel map of the built-in example's true lens its
 /// profile differs by at most 1.2% in kappa and 0.8% in enclosed mass (a line width on the
-/// plot). The maps take 0.27 s natively for the example's 97 elliptical NFW halos on an idle
-/// machine (a quarter of the 256-pixel time).
+/// plot), for a quarter of the cost of 256 pixels.
 const MODEL_MAPS_MAX_PIXELS: usize = 128;
 
 /// A model file's name and its profile.
@@ -90,7 +89,8 @@ pub(crate) struct ModelMaps {
 
 /// The last model maps computed, keyed by a hash of the model file's name and text and of the
 /// maps' geometry, so that switching views, hovering, redrawing and the next reconstruction of
-/// the same field do not compute them again (they take ~0.3 s natively, ~0.7 s in a browser).
+/// the same field do not compute them again (a model of many halos takes a noticeable part of a
+/// second).
 #[derive(Debug, Default)]
 pub(crate) struct ModelCache {
     maps: RefCell<Option<(u64, ModelMaps)>>,

@@ -287,7 +287,7 @@ fn tile_product<const FUSED: bool>(panel_a: &[f64], panel_b: &[f64]) -> [[f64; N
 /// purpose: browsers compile a wasm function with a quick baseline compiler first and optimise
 /// it only after it has been called often (no on-stack replacement), and the normal equations
 /// of a whole system are one call of `add_rows`. As its own function the tile is optimised
-/// after its first few calls (measured in Node: `add_rows` of the app example 1.9 s inlined).
+/// after its first few calls (the figures: BENCHMARKS.md).
 #[cfg(all(target_arch = "wasm32", target_feature = "simd128"))]
 #[inline(never)]
 fn tile_product<const FUSED: bool>(panel_a: &[f64], panel_b: &[f64]) -> [[f64; NR]; MR] {

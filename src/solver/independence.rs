@@ -21,8 +21,8 @@
 /// Added to the unit diagonal of the scaled matrix.
 pub const RIDGE: f64 = 1e-10;
 /// Most unknowns for which [`column_independence`] factorises the matrix (`n^3 / 6`
-/// multiply-adds: 0.05 s natively and in Chromium for the usual 1085, twelve times that at
-/// this size).
+/// multiply-adds, twelve times those of the usual ~1085 unknowns at this size: BENCHMARKS.md,
+/// "Figures behind choices in the code").
 pub const INDEPENDENCE_MAX_UNKNOWNS: usize = 2500;
 
 /// `share_l` (module documentation) of each column of `cols` in the symmetric positive
@@ -80,8 +80,8 @@ pub fn column_independence(a: &[f64], n: usize, cols: &[usize]) -> Vec<Option<f6
 /// (row-major), in place; false if a pivot is not positive or not finite.
 ///
 /// Row by row in the dot-product form, four rows at a time, and each earlier row pair against
-/// those four at once ([`dot4x2`]), so that a value loaded serves more than one multiply-add.
-/// At `m` = 1085: 48 ms natively (80 ms one row at a time), 0.05 s in Chromium (0.28 s).
+/// those four at once ([`dot4x2`]), so that a value loaded serves more than one multiply-add
+/// (faster than one row at a time natively and much faster in a browser: BENCHMARKS.md).
 pub(super) fn cholesky_in_place(l: &mut [f64], m: usize) -> bool {
     let mut r0 = 0;
     while r0 < m {
@@ -154,8 +154,8 @@ fn dot4x2(x: [&[f64]; 4], y: [&[f64]; 2]) -> [[f64; 2]; 4] {
 /// [`dot4x2`] in WebAssembly SIMD, with the fused multiply-add of relaxed SIMD where the
 /// browser has it. Not inlined, for the reason given at `gram.rs`'s `tile_product`: the whole
 /// factorisation is one call, which a browser would run in its baseline compiler's code
-/// throughout. Measured in Chromium at `m` = 1085: 0.128 s for the first factorisation inlined
-/// (0.029 s for the next ones), 0.049 s not inlined (0.030 - 0.036 s).
+/// throughout; not inlined, the first factorisation is nearly as fast as the next ones
+/// (BENCHMARKS.md).
 #[cfg(all(target_arch = "wasm32", target_feature = "simd128"))]
 #[inline(never)]
 fn dot4x2(x: [&[f64]; 4], y: [&[f64]; 2]) -> [[f64; 2]; 4] {

@@ -440,9 +440,9 @@ impl Drop for Release<'_> {
 /// gave up its core at every wait (as an earlier version did after 200 spins) let the scheduler
 /// put both bands on one core, where they took turns: no faster than one thread. But when the
 /// machine has more threads to run than cores (two runs at once, or other programs), the thread
-/// waited for is often not running, and spinning takes the core it needs: two benchmark runs of
-/// two threads each on two cores took 4.2 s each with a fixed 200 us spin, 0.9 s with one
-/// thread each. So the spin time falls to a quarter whenever a wait outlasts it, down to
+/// waited for is often not running, and spinning takes the core it needs (two runs of two
+/// threads on two cores were several times slower than one thread each with a fixed spin:
+/// BENCHMARKS.md). So the spin time falls to a quarter whenever a wait outlasts it, down to
 /// [`SPIN_MIN`], and grows by [`SPIN_STEP`] after each wait that it answered, up to
 /// [`SPIN_MAX`]. Generation counting makes the barrier reusable.
 ///
