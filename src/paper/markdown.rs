@@ -3,8 +3,7 @@
 
 use std::fmt::Write as _;
 
-use super::report::{PaperReport, RunSeries, TruthReport};
-use super::studies::{BestFit, Studies};
+use super::report::{c_list, BestFit, PaperReport, RunSeries, Studies, TruthReport};
 
 /// `report.md`: what was run, the numbers, the checks.
 pub fn markdown(report: &PaperReport) -> String {
@@ -217,11 +216,5 @@ fn independence_list(shares: &[Option<f64>]) -> String {
         .iter()
         .map(|v| v.map_or("-".to_string(), |v| format!("{v:.1e}")))
         .collect();
-    each.join(", ")
-}
-
-/// Factors C, `"1.234, 0.567"` (also in the checks of `report.rs`).
-pub(super) fn c_list(c: &[f64]) -> String {
-    let each: Vec<String> = c.iter().map(|v| format!("{v:.3}")).collect();
     each.join(", ")
 }

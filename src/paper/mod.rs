@@ -41,8 +41,10 @@ use thiserror::Error;
 
 pub use figures::{render_figures, Figure, TRUE_CURVE_RGB};
 pub use markdown::markdown as report_markdown;
-pub use report::{CaseReport, Check, ConvergenceReport, PaperReport, RunSeries, TruthReport};
-pub use studies::{BestFit, StartRun, Studies, SweepRow};
+pub use report::{
+    BestFit, CaseReport, Check, ConvergenceReport, PaperReport, RunSeries, StartRun, Studies,
+    SweepRow, TruthReport,
+};
 
 use crate::inversion::{ConstraintMode, ConstraintSource, Layer, Weighting};
 use crate::maps::LensMaps;
@@ -132,7 +134,7 @@ pub struct PaperConfig {
     /// `iterations`, the data's best fit, the sweep of the open defaults); default true.
     pub studies: bool,
     /// Iterations of the accelerated projected gradient that finds the data's best fit in the
-    /// studies (default 10000: chi2 within ~5% of its limit, 4 s natively).
+    /// studies (default 10000: chi2 within ~5% of its limit).
     pub best_fit_iterations: usize,
 }
 
@@ -276,75 +278,205 @@ impl PaperConfig {
 
 /// Runs the simulation, the three cases and the convergence study, and scores them.
 /// `say` receives one line per stage.
+///
+/// Like the studies' runs, in three phases: plan the runs (`plan_batch`), run them side by
+/// side and score each (`run_plan`), then sort the results into the report's parts with a line
+/// each (`collect_batch`).
 pub fn run_paper(config: &PaperConfig, say: &mut dyn FnMut(&str)) -> Result<PaperRun, PaperError> {
     config.validate()?;
     let t_all = Clock::start();
-    let t = Clock::start();
-    let simulation = Simulation::new(&config.simulation)?;
-    let simulate_ms = t.ms();
-    say(&format!(
-        "simulated {} systems, {} arc pixels in {:.1} s",
-        simulation.arcs.systems.len(),
-        n_arc_pixels(&simulation),
-        simulate_ms / 1e3
-    ));
-    let field = simulation.config.field_arcsec;
-    let plane = simulation.plane;
-    let opts = ProductOptions {
-        z_source: Z_SOURCE_CURVES,
-        size_arcsec: field,
-        pixels: config.map_pixels,
-        ..ProductOptions::default()
+    let setup = Setup::new(config, say)?;
+    let scorer = setup.scorer();
+    let done = run_plan(&setup.simulation, plan_batch(config, &setup), |run, rec| {
+        Ok(match *run {
+            Run::Case(case) => {
+                let scored = scorer.score(&rec, case.key())?;
+                Done::Case(case, Box::new(scored), Box::new(rec))
+            }
+            Run::Long(name) => Done::Long(
+                name,
+                RunSeries::from_records(&rec, &setup.truth_betas),
+                rec.convergence.clone(),
+                run_seconds(&rec),
+            ),
+        })
+    })?;
+    let done = done
+        .into_iter()
+        .map(|(_, done)| done.expect("every run has a job"));
+    let (cases, series) = collect_batch(config, done, say);
+    let studies = if config.studies {
+        let inputs = studies::StudyInputs {
+            layer_true: &setup.layer_true,
+            layer_model: &setup.layer_model,
+            case_ii: case_run(&cases, Case::GalaxyModel),
+            case_iii: case_run(&cases, Case::GalaxyTrue),
+        };
+        studies::run_studies(config, &setup.simulation, &scorer, &inputs, say)?
+    } else {
+        Studies::default()
     };
-    let truth = Products::from_model(&simulation.truth_model(), &opts)?;
-    let geometry = truth.maps.geometry();
-    let soft_lens = simulation.soft_model().build_lens()?;
-    let truth_soft_kappa = LensMaps::from_lens(&soft_lens, geometry).kappa;
-    let pixels: Vec<DVec2> = simulation
-        .arcs
-        .systems
-        .iter()
-        .flat_map(|s| s.images.iter().flatten().copied())
-        .collect();
-    let region = ArcRegion::enclosing(DVec2::ZERO, &pixels);
-    let bins = profile_bins(&region, field);
-    let truth_profile = radial_profile(&truth.maps.kappa, DVec2::ZERO, &bins, &plane)?;
-    let truth_betas: Vec<(String, DVec2)> = simulation
-        .sources
-        .iter()
-        .map(|s| (s.id.clone(), s.beta_arcsec))
-        .collect();
-    let layer_true = simulation.layer(GalaxySet::True)?;
-    let layer_model = simulation.layer(GalaxySet::Model)?;
 
-    let scorer = Scorer {
-        truth: &truth,
-        truth_profile: &truth_profile,
-        truth_betas: &truth_betas,
+    let convergence = ConvergenceReport::from_runs(series);
+    let report = PaperReport::assemble(
+        config,
+        &setup.simulation,
+        &setup.truth,
+        &setup.truth_profile,
+        &setup.region,
+        &cases,
+        convergence,
+        studies,
+        report::RegionMasses::of_truth(
+            &setup.truth,
+            &setup.truth_soft_kappa,
+            &setup.region,
+            &setup.simulation.plane,
+        ),
+        [setup.simulate_ms, t_all.ms()],
+    );
+    let Setup {
+        simulation,
+        truth,
+        truth_profile,
+        truth_soft_kappa,
         region,
-        bins: &bins,
-        plane,
-    };
-    // The three cases and the convergence study (the galaxy-true layer from the reasonable and
-    // the bad start, and the grid alone, each for `long_iterations`) run as one batch.
+        ..
+    } = setup;
+    Ok(PaperRun {
+        config: config.clone(),
+        simulation,
+        truth,
+        truth_profile,
+        truth_soft_kappa,
+        region,
+        cases,
+        report,
+    })
+}
+
+/// The simulated data, the truth every run is scored against, and the galaxy layers.
+struct Setup {
+    simulation: Simulation,
+    /// Milliseconds the simulation took.
+    simulate_ms: f64,
+    /// Truth products at z_s = 3 on the common map.
+    truth: Products,
+    /// Kappa of the true soft component alone.
+    truth_soft_kappa: crate::grid::Map,
+    region: ArcRegion,
+    bins: RadialBins,
+    truth_profile: RadialProfile,
+    truth_betas: Vec<(String, DVec2)>,
+    layer_true: Layer,
+    layer_model: Layer,
+}
+
+impl Setup {
+    /// Simulates the cluster (one line to `say`) and computes the truth on the common map.
+    fn new(config: &PaperConfig, say: &mut dyn FnMut(&str)) -> Result<Self, PaperError> {
+        let t = Clock::start();
+        let simulation = Simulation::new(&config.simulation)?;
+        let simulate_ms = t.ms();
+        say(&format!(
+            "simulated {} systems, {} arc pixels in {:.1} s",
+            simulation.arcs.systems.len(),
+            n_arc_pixels(&simulation),
+            simulate_ms / 1e3
+        ));
+        let field = simulation.config.field_arcsec;
+        let plane = simulation.plane;
+        let opts = ProductOptions {
+            z_source: Z_SOURCE_CURVES,
+            size_arcsec: field,
+            pixels: config.map_pixels,
+            ..ProductOptions::default()
+        };
+        let truth = Products::from_model(&simulation.truth_model(), &opts)?;
+        let geometry = truth.maps.geometry();
+        let soft_lens = simulation.soft_model().build_lens()?;
+        let truth_soft_kappa = LensMaps::from_lens(&soft_lens, geometry).kappa;
+        let pixels: Vec<DVec2> = simulation
+            .arcs
+            .systems
+            .iter()
+            .flat_map(|s| s.images.iter().flatten().copied())
+            .collect();
+        let region = ArcRegion::enclosing(DVec2::ZERO, &pixels);
+        let bins = profile_bins(&region, field);
+        let truth_profile = radial_profile(&truth.maps.kappa, DVec2::ZERO, &bins, &plane)?;
+        let truth_betas: Vec<(String, DVec2)> = simulation
+            .sources
+            .iter()
+            .map(|s| (s.id.clone(), s.beta_arcsec))
+            .collect();
+        let layer_true = simulation.layer(GalaxySet::True)?;
+        let layer_model = simulation.layer(GalaxySet::Model)?;
+        Ok(Self {
+            simulation,
+            simulate_ms,
+            truth,
+            truth_soft_kappa,
+            region,
+            bins,
+            truth_profile,
+            truth_betas,
+            layer_true,
+            layer_model,
+        })
+    }
+
+    fn scorer(&self) -> Scorer<'_> {
+        Scorer {
+            truth: &self.truth,
+            truth_profile: &self.truth_profile,
+            truth_betas: &self.truth_betas,
+            region: self.region,
+            bins: &self.bins,
+            plane: self.simulation.plane,
+        }
+    }
+}
+
+/// One run of the paper's batch: a case, or a convergence-study run (named as in
+/// `report.json`).
+#[derive(Clone, Copy)]
+enum Run {
+    Case(Case),
+    Long(&'static str),
+}
+
+/// What the batch keeps of a run: a case's scores and reconstruction, or a convergence-study
+/// run's series, records and seconds.
+enum Done {
+    Case(Case, Box<Scored>, Box<Reconstruction>),
+    Long(&'static str, RunSeries, Vec<ConvergenceRecord>, f64),
+}
+
+/// The three cases and the convergence study (the galaxy-true layer from the reasonable and
+/// the bad start, and the grid alone, each for `long_iterations`), run as one batch.
+fn plan_batch<'a>(config: &PaperConfig, setup: &'a Setup) -> Vec<(Run, Option<Job<'a>>)> {
+    let field = setup.simulation.config.field_arcsec;
+    let layer_true = std::slice::from_ref(&setup.layer_true);
     let case_layers = |case: Case| -> &[Layer] {
         match case {
             Case::NoGalaxies => &[],
-            Case::GalaxyModel => std::slice::from_ref(&layer_model),
-            Case::GalaxyTrue => std::slice::from_ref(&layer_true),
+            Case::GalaxyModel => std::slice::from_ref(&setup.layer_model),
+            Case::GalaxyTrue => layer_true,
         }
     };
-    let soft_per_cell = simulation.soft_mass_msun / (config.grid_cells * config.grid_cells) as f64;
+    let soft_per_cell =
+        setup.simulation.soft_mass_msun / (config.grid_cells * config.grid_cells) as f64;
     let long_runs = [
         (
             "reasonable",
-            std::slice::from_ref(&layer_true),
+            layer_true,
             config.reasonable_start_cell_mass_msun,
             config.reasonable_start_c,
         ),
         (
             "bad_start",
-            std::slice::from_ref(&layer_true),
+            layer_true,
             config.bad_start_cell_factor * soft_per_cell,
             config.bad_start_c,
         ),
@@ -355,12 +487,15 @@ pub fn run_paper(config: &PaperConfig, say: &mut dyn FnMut(&str)) -> Result<Pape
             config.reasonable_start_c,
         ),
     ];
-    let mut jobs: Vec<Job> = Case::ALL
+    let mut plan: Vec<(Run, Option<Job>)> = Case::ALL
         .iter()
-        .map(|&case| Job {
-            layers: given(case_layers(case)),
-            config: config.reconstruct_config(field, config.iterations),
-            name: case.key(),
+        .map(|&case| {
+            let job = Job {
+                layers: given(case_layers(case)),
+                config: config.reconstruct_config(field, config.iterations),
+                name: case.key(),
+            };
+            (Run::Case(case), Some(job))
         })
         .collect();
     for (name, layers, start_mass, start_c) in long_runs {
@@ -369,32 +504,31 @@ pub fn run_paper(config: &PaperConfig, say: &mut dyn FnMut(&str)) -> Result<Pape
         rc.solver.start_c = start_c;
         // Only the convergence records are used: coarse product maps save time.
         rc.products.pixels = 64;
-        jobs.push(Job {
+        let job = Job {
             layers: given(layers),
             config: rc,
             name,
-        });
+        };
+        plan.push((Run::Long(name), Some(job)));
     }
-    enum Done {
-        Case(Box<Scored>, Box<Reconstruction>),
-        Long(RunSeries, Vec<ConvergenceRecord>, f64),
-    }
-    let done = run_all(&simulation, jobs, |k, rec| {
-        Ok(match Case::ALL.get(k) {
-            Some(case) => Done::Case(Box::new(scorer.score(&rec, case.key())?), Box::new(rec)),
-            None => Done::Long(
-                RunSeries::from_records(&rec, &truth_betas),
-                rec.convergence.clone(),
-                run_seconds(&rec),
-            ),
-        })
-    })?;
+    plan
+}
+
+/// The batch's cases and convergence-study series, in plan order, with one line each to `say`.
+#[allow(clippy::type_complexity)]
+fn collect_batch(
+    config: &PaperConfig,
+    done: impl Iterator<Item = Done>,
+    say: &mut dyn FnMut(&str),
+) -> (
+    Vec<CaseRun>,
+    Vec<(&'static str, RunSeries, Vec<ConvergenceRecord>)>,
+) {
     let mut cases = Vec::new();
     let mut series = Vec::new();
-    for (k, done) in done.into_iter().enumerate() {
+    for done in done {
         match done {
-            Done::Case(scored, rec) => {
-                let case = Case::ALL[k];
+            Done::Case(case, scored, rec) => {
                 let report = &scored.report;
                 say(&format!(
                     "{}: grid mass {:.3e} Msun ({:.3e} inside the arc region), C {:?}, deflection error median {:.2}\" p90 {:.2}\", theta_E(z=3) {:.1}\" ({:.1} s)",
@@ -422,8 +556,7 @@ pub fn run_paper(config: &PaperConfig, say: &mut dyn FnMut(&str)) -> Result<Pape
                     reconstruction: *rec,
                 });
             }
-            Done::Long(run, records, seconds) => {
-                let name = long_runs[k - Case::ALL.len()].0;
+            Done::Long(name, run, records, seconds) => {
                 say(&format!(
                     "convergence, {name}: {} iterations, final grid mass {:.3e} Msun, C {:?} ({seconds:.1} s)",
                     config.long_iterations,
@@ -434,41 +567,7 @@ pub fn run_paper(config: &PaperConfig, say: &mut dyn FnMut(&str)) -> Result<Pape
             }
         }
     }
-    let studies = if config.studies {
-        let inputs = studies::StudyInputs {
-            layer_true: &layer_true,
-            layer_model: &layer_model,
-            case_ii: case_run(&cases, Case::GalaxyModel),
-            case_iii: case_run(&cases, Case::GalaxyTrue),
-        };
-        studies::run_studies(config, &simulation, &scorer, &inputs, say)?
-    } else {
-        Studies::default()
-    };
-
-    let convergence = ConvergenceReport::from_runs(series);
-    let report = PaperReport::assemble(
-        config,
-        &simulation,
-        &truth,
-        &truth_profile,
-        &region,
-        &cases,
-        convergence,
-        studies,
-        report::RegionMasses::of_truth(&truth, &truth_soft_kappa, &region, &plane),
-        [simulate_ms, t_all.ms()],
-    );
-    Ok(PaperRun {
-        config: config.clone(),
-        simulation,
-        truth,
-        truth_profile,
-        truth_soft_kappa,
-        region,
-        cases,
-        report,
-    })
+    (cases, series)
 }
 
 /// Given galaxy layers as a run's layer source: none at all is the grid alone.
@@ -514,8 +613,8 @@ pub(super) struct Job<'a> {
 ///
 /// With more than one core the jobs run side by side, one thread each: every stage of a run
 /// (system, solver, maps, image search) then keeps a core busy with no barriers, where one run
-/// on two threads gains less than twice (QADP's passes about 1.7x at the paper's n = 1085,
-/// BENCHMARKS.md). A job that fails stops the others from starting.
+/// on two threads gains less than twice (QADP's passes; the figures are in BENCHMARKS.md). A
+/// job that fails stops the others from starting.
 fn run_all<T: Send>(
     simulation: &Simulation,
     mut jobs: Vec<Job<'_>>,
@@ -562,6 +661,31 @@ fn run_all<T: Send>(
                 .expect("every job before the first failure ran")
         })
         .collect()
+}
+
+/// Runs the jobs of `plan` side by side ([`run_all`]) and hands each reconstruction, with its
+/// row, to `finish` on the thread that ran it. Returns every row in plan order with its result;
+/// a row without a job (one that reuses a run made elsewhere) gets `None`.
+fn run_plan<R: Sync, T: Send>(
+    simulation: &Simulation,
+    plan: Vec<(R, Option<Job<'_>>)>,
+    finish: impl Fn(&R, Reconstruction) -> Result<T, PaperError> + Sync,
+) -> Result<Vec<(R, Option<T>)>, PaperError> {
+    let (rows, jobs): (Vec<R>, Vec<Option<Job>>) = plan.into_iter().unzip();
+    let ran_rows: Vec<usize> = (0..rows.len()).filter(|&k| jobs[k].is_some()).collect();
+    let jobs: Vec<Job> = jobs.into_iter().flatten().collect();
+    let ran = run_all(simulation, jobs, |k, rec| finish(&rows[ran_rows[k]], rec))?;
+    let mut ran = ran.into_iter();
+    Ok(rows
+        .into_iter()
+        .enumerate()
+        .map(|(k, row)| {
+            let result = ran_rows
+                .contains(&k)
+                .then(|| ran.next().expect("one result per job"));
+            (row, result)
+        })
+        .collect())
 }
 
 /// Seconds a reconstruction took (its stages, from its own timings).

@@ -7,7 +7,6 @@ use glam::DVec2;
 use serde::{Deserialize, Serialize};
 
 use super::metrics::{self, ArcRegion, DeflectionError};
-use super::studies::Studies;
 use super::{CaseRun, PaperConfig, RADIAL_MIN_POINTS, RADIAL_TOLERANCE_ARCSEC};
 use crate::products::Products;
 use crate::radial::RadialProfile;
@@ -256,6 +255,71 @@ impl RegionMasses {
     }
 }
 
+/// One run of the start study.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct StartRun {
+    pub label: String,
+    pub start_cell_mass_msun: f64,
+    pub start_c: f64,
+    /// Final C of the galaxy-true layer.
+    pub c: f64,
+    /// Final objective `phi` in f64 (comparable between starts: same system). It carries the
+    /// large constant `-Theta^T W Theta / 2` of the frame shift, so compare `chi2`.
+    pub objective: f64,
+    /// Weighted squared residual of the lens equation, `2 phi + Theta^T W Theta`
+    /// (dimensionless: weights in 1/arcsec^2).
+    pub chi2: f64,
+    /// `sqrt(chi2 / sum of row weights)`: the weighted rms source-plane residual, arcsec.
+    pub source_rms_arcsec: f64,
+    /// Root mean square of observed - predicted image positions, arcsec (None when no image
+    /// was matched).
+    pub image_plane_rms_arcsec: Option<f64>,
+    pub grid_mass_msun: f64,
+    pub grid_mass_region_msun: f64,
+    pub deflection_error_median_arcsec: f64,
+}
+
+/// One run of the sweep of defaults.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct SweepRow {
+    /// "cell_sigma_factor", "weighting" or "member_r_s_law".
+    pub parameter: String,
+    pub value: String,
+    /// The product default.
+    pub is_default: bool,
+    /// Lowest median deflection error of its parameter group.
+    pub best: bool,
+    pub c: Vec<f64>,
+    pub deflection_error_median_arcsec: f64,
+    pub deflection_error_p90_arcsec: f64,
+    pub profile_max_rel_error: f64,
+    pub einstein_radius_arcsec_z3: f64,
+}
+
+/// The data's best fit against the truth, on case (iii)'s rows.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct BestFit {
+    /// Iterations of the accelerated projected gradient.
+    pub iterations: usize,
+    /// chi2 of the simulated lens itself (galaxies and soft halo, C = 1) on the same rows, with
+    /// each system's best beta for it ([`super::metrics::lens_equation_chi2`]).
+    pub truth_chi2: f64,
+    /// `sqrt(truth_chi2 / sum of row weights)`, arcsec.
+    pub truth_source_rms_arcsec: f64,
+    /// The best fit from the reasonable start and from the bad start.
+    pub runs: Vec<StartRun>,
+}
+
+/// The studies of `report.md` (empty when `PaperConfig::studies` is off; run by `studies.rs`).
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
+pub struct Studies {
+    pub starts: Vec<StartRun>,
+    /// The bad start at the case iteration count (also one of `starts`).
+    pub bad_start: Option<StartRun>,
+    pub best_fit: Option<BestFit>,
+    pub sweep: Vec<SweepRow>,
+}
+
 /// `report.json`.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct PaperReport {
@@ -425,7 +489,7 @@ fn checks(
         let lowest = b.runs.iter().map(|r| r.chi2).fold(f64::INFINITY, f64::min);
         format!(
             " (the data's best fit: C = {} at chi2 {lowest:.1}, the truth's chi2 {:.1})",
-            super::markdown::c_list(&cs),
+            c_list(&cs),
             b.truth_chi2
         )
     });
@@ -500,12 +564,14 @@ fn checks(
         push(
             "(iii) C does not depend on the start (spread within 10%)",
             hi - lo <= C_TOLERANCE,
-            format!(
-                "C from the {} starts: {}{best_fit}",
-                cs.len(),
-                super::markdown::c_list(&cs)
-            ),
+            format!("C from the {} starts: {}{best_fit}", cs.len(), c_list(&cs)),
         );
     }
     out
+}
+
+/// Factors C, `"1.234, 0.567"` (in the checks and in `report.md`).
+pub(super) fn c_list(c: &[f64]) -> String {
+    let each: Vec<String> = c.iter().map(|v| format!("{v:.3}")).collect();
+    each.join(", ")
 }

@@ -13,79 +13,13 @@
 //!   scored by case (ii)'s median deflection error in the arc region (the realistic case:
 //!   galaxy positions known, masses not).
 
-use serde::{Deserialize, Serialize};
-
 use super::metrics::lens_equation_chi2;
-use super::{run_all, CaseReport, CaseRun, Job, PaperConfig, PaperError, Scorer};
-use crate::catalog::parse_member_catalog;
+use super::report::{BestFit, CaseReport, StartRun, Studies, SweepRow};
+use super::{run_plan, CaseRun, Job, PaperConfig, PaperError, Scorer};
+use crate::catalog::{parse_member_catalog, MemberCatalog};
 use crate::inversion::{Layer, MemberConfig, Weighting};
 use crate::reconstruct::{LayerSource, ReconstructConfig, Reconstruction, SolverMethod};
 use crate::simulate::Simulation;
-
-/// One run of the start study.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-pub struct StartRun {
-    pub label: String,
-    pub start_cell_mass_msun: f64,
-    pub start_c: f64,
-    /// Final C of the galaxy-true layer.
-    pub c: f64,
-    /// Final objective `phi` in f64 (comparable between starts: same system). It carries the
-    /// large constant `-Theta^T W Theta / 2` of the frame shift, so compare `chi2`.
-    pub objective: f64,
-    /// Weighted squared residual of the lens equation, `2 phi + Theta^T W Theta`
-    /// (dimensionless: weights in 1/arcsec^2).
-    pub chi2: f64,
-    /// `sqrt(chi2 / sum of row weights)`: the weighted rms source-plane residual, arcsec.
-    pub source_rms_arcsec: f64,
-    /// Root mean square of observed - predicted image positions, arcsec (None when no image
-    /// was matched).
-    pub image_plane_rms_arcsec: Option<f64>,
-    pub grid_mass_msun: f64,
-    pub grid_mass_region_msun: f64,
-    pub deflection_error_median_arcsec: f64,
-}
-
-/// One run of the sweep of defaults.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-pub struct SweepRow {
-    /// "cell_sigma_factor", "weighting" or "member_r_s_law".
-    pub parameter: String,
-    pub value: String,
-    /// The product default.
-    pub is_default: bool,
-    /// Lowest median deflection error of its parameter group.
-    pub best: bool,
-    pub c: Vec<f64>,
-    pub deflection_error_median_arcsec: f64,
-    pub deflection_error_p90_arcsec: f64,
-    pub profile_max_rel_error: f64,
-    pub einstein_radius_arcsec_z3: f64,
-}
-
-/// The data's best fit against the truth, on case (iii)'s rows.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-pub struct BestFit {
-    /// Iterations of the accelerated projected gradient.
-    pub iterations: usize,
-    /// chi2 of the simulated lens itself (galaxies and soft halo, C = 1) on the same rows, with
-    /// each system's best beta for it ([`super::metrics::lens_equation_chi2`]).
-    pub truth_chi2: f64,
-    /// `sqrt(truth_chi2 / sum of row weights)`, arcsec.
-    pub truth_source_rms_arcsec: f64,
-    /// The best fit from the reasonable start and from the bad start.
-    pub runs: Vec<StartRun>,
-}
-
-/// The studies of `report.md` (empty when `PaperConfig::studies` is off).
-#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
-pub struct Studies {
-    pub starts: Vec<StartRun>,
-    /// The bad start at the case iteration count (also one of `starts`).
-    pub bad_start: Option<StartRun>,
-    pub best_fit: Option<BestFit>,
-    pub sweep: Vec<SweepRow>,
-}
 
 /// Cell widths of the sweep (Gaussian sigma over the cell size).
 const CELL_SIGMA_FACTORS: [f64; 5] = [0.5, 0.75, 1.0, 1.25, 1.5];
@@ -110,7 +44,11 @@ pub(super) struct StudyInputs<'a> {
     pub case_iii: &'a CaseRun,
 }
 
-/// Runs the start study and the sweep.
+/// Runs the start study, the best fit and the sweep.
+///
+/// In the three phases of [`super::run_paper`]: plan the rows ([`plan_studies`]), run the new
+/// ones side by side and score each ([`run_plan`]), then sort them into the tables with a line
+/// each ([`collect_studies`]); last, the truth's own chi2 for the best fit ([`best_fit`]).
 pub(super) fn run_studies(
     config: &PaperConfig,
     simulation: &Simulation,
@@ -118,16 +56,45 @@ pub(super) fn run_studies(
     inputs: &StudyInputs<'_>,
     say: &mut dyn FnMut(&str),
 ) -> Result<Studies, PaperError> {
-    let StudyInputs {
-        layer_true,
-        layer_model,
-        case_ii,
-        case_iii,
-    } = *inputs;
-    let field = simulation.config.field_arcsec;
+    // The galaxy-model layer with a prior on C of each width (made here: the jobs borrow them).
+    let held_layers: Vec<Layer> = C_PRIOR_SIGMAS
+        .iter()
+        .map(|&sigma| Layer {
+            prior_sigma: Some(sigma),
+            ..inputs.layer_model.clone()
+        })
+        .collect();
+    // The member layer from members.cat (what a user of `wslap reconstruct --members` gets).
+    let (catalog, _) = parse_member_catalog(
+        &simulation.member_catalog_text(),
+        "members.cat",
+        Some(simulation.reference),
+    )
+    .map_err(|e| PaperError::Members(Box::new(e)))?;
+    let plan = plan_studies(config, simulation, inputs, &held_layers, &catalog);
+    // Each new run keeps its scores and its f64 chi2.
+    let done = run_plan(simulation, plan, |row, rec| {
+        let report = scorer.score(&rec, row.job_name())?.report;
+        Ok(Scores::of(&rec, report))
+    })?;
+    let (starts, best_runs, mut sweep) = collect_studies(config, inputs, done, say);
+    let bad_start = starts.iter().find(|r| r.label == "bad").cloned();
+    let best_fit = best_fit(config, simulation, inputs.case_iii, best_runs, say)?;
+    mark_best(&mut sweep);
+    Ok(Studies {
+        starts,
+        bad_start,
+        best_fit: Some(best_fit),
+        sweep,
+    })
+}
+
+/// The starts of the start study, `(label, cell mass in Msun, C0)`; the best fit starts from
+/// the "reasonable" and the "bad" one.
+fn start_specs(config: &PaperConfig, simulation: &Simulation) -> [(&'static str, f64, f64); 6] {
     let soft_per_cell = simulation.soft_mass_msun / (config.grid_cells * config.grid_cells) as f64;
     let reasonable_mass = config.reasonable_start_cell_mass_msun;
-    let starts_spec = [
+    [
         ("C0 = 0.001", reasonable_mass, 0.001),
         ("reasonable", reasonable_mass, config.reasonable_start_c),
         ("C0 = 1", reasonable_mass, 1.0),
@@ -148,28 +115,23 @@ pub(super) fn run_studies(
             config.bad_start_cell_factor * soft_per_cell,
             config.bad_start_c,
         ),
-    ];
-    let defaults = config.reconstruct_config(field, config.iterations);
-    let truth_layer = LayerSource::Given(std::slice::from_ref(layer_true));
-    let model = LayerSource::Given(std::slice::from_ref(layer_model));
-    // The galaxy-model layer with a prior on C of each width (made here: the jobs borrow them).
-    let held_layers: Vec<Layer> = C_PRIOR_SIGMAS
-        .iter()
-        .map(|&sigma| Layer {
-            prior_sigma: Some(sigma),
-            ..layer_model.clone()
-        })
-        .collect();
-    // The member layer from members.cat (what a user of `wslap reconstruct --members` gets).
-    let (catalog, _) = parse_member_catalog(
-        &simulation.member_catalog_text(),
-        "members.cat",
-        Some(simulation.reference),
-    )
-    .map_err(|e| PaperError::Members(Box::new(e)))?;
+    ]
+}
 
-    // Every run of the studies, in report order; the runs they share with the cases (the
-    // reasonable start is case iii, the default row of each sweep group case ii) are reused.
+/// Every row of the studies, in report order, with the job that computes it; the runs they
+/// share with the cases (the reasonable start is case iii, the default row of each sweep group
+/// case ii) have none and are reused.
+fn plan_studies<'a>(
+    config: &PaperConfig,
+    simulation: &Simulation,
+    inputs: &StudyInputs<'a>,
+    held_layers: &'a [Layer],
+    catalog: &'a MemberCatalog,
+) -> Vec<(Row, Option<Job<'a>>)> {
+    let field = simulation.config.field_arcsec;
+    let starts_spec = start_specs(config, simulation);
+    let defaults = config.reconstruct_config(field, config.iterations);
+    let truth_layer = LayerSource::Given(std::slice::from_ref(inputs.layer_true));
     let mut plan: Vec<(Row, Option<Job>)> = Vec::new();
     for (label, mass, c0) in starts_spec {
         let row = Row::Start { label, mass, c0 };
@@ -193,6 +155,26 @@ pub(super) fn run_studies(
         let row = Row::BestFit { label, mass, c0 };
         plan.push((row, Some(job(truth_layer, rc, "best fit"))));
     }
+    plan_sweep(
+        &mut plan,
+        &defaults,
+        inputs.layer_model,
+        held_layers,
+        catalog,
+    );
+    plan
+}
+
+/// The rows of the sweep of defaults, each on case (ii)'s data: the cell width, the row
+/// weights, the prior on C and the member scale-radius law.
+fn plan_sweep<'a>(
+    plan: &mut Vec<(Row, Option<Job<'a>>)>,
+    defaults: &ReconstructConfig,
+    layer_model: &'a Layer,
+    held_layers: &'a [Layer],
+    catalog: &'a MemberCatalog,
+) {
+    let model = LayerSource::Given(std::slice::from_ref(layer_model));
     let sweep_row = |parameter, value: String, is_default| Row::Sweep {
         parameter,
         value,
@@ -222,7 +204,7 @@ pub(super) fn run_studies(
     }
     // The prior on C: the galaxy-model layer with a prior of each width ("none" is case ii).
     plan.push((sweep_row("c_prior_sigma", "none".to_string(), true), None));
-    for (sigma, held) in C_PRIOR_SIGMAS.iter().zip(&held_layers) {
+    for (sigma, held) in C_PRIOR_SIGMAS.iter().zip(held_layers) {
         let layers = LayerSource::Given(std::slice::from_ref(held));
         let row = sweep_row("c_prior_sigma", format!("{sigma}"), false);
         plan.push((row, Some(job(layers, defaults.clone(), "sweep"))));
@@ -235,32 +217,30 @@ pub(super) fn run_studies(
         let is_default =
             r_s == default_members.r_s_lstar_kpc && exponent == default_members.size_exponent;
         let row = sweep_row("member_r_s_law", label.to_string(), is_default);
-        plan.push((row, Some(job(LayerSource::Members(&catalog), rc, "sweep"))));
+        plan.push((row, Some(job(LayerSource::Members(catalog), rc, "sweep"))));
     }
+}
 
-    // Run what is new (side by side), keeping each run's scores and its f64 chi2.
-    let (rows, jobs): (Vec<Row>, Vec<Option<Job>>) = plan.into_iter().unzip();
-    let ran_rows: Vec<usize> = (0..rows.len()).filter(|&k| jobs[k].is_some()).collect();
-    let ran = run_all(
-        simulation,
-        jobs.into_iter().flatten().collect(),
-        |k, rec| {
-            let name = ran_rows.get(k).map_or("study", |&r| rows[r].job_name());
-            let report = scorer.score(&rec, name)?.report;
-            Ok(Scores::of(&rec, report))
-        },
-    )?;
-    let mut ran = ran.into_iter();
+/// The start study, the best-fit runs and the sweep from the rows in plan order (a row without
+/// a run of its own takes case iii's or case ii's), with one line each to `say`.
+#[allow(clippy::type_complexity)]
+fn collect_studies(
+    config: &PaperConfig,
+    inputs: &StudyInputs<'_>,
+    done: Vec<(Row, Option<Scores>)>,
+    say: &mut dyn FnMut(&str),
+) -> (Vec<StartRun>, Vec<StartRun>, Vec<SweepRow>) {
+    let (case_ii, case_iii) = (inputs.case_ii, inputs.case_iii);
     let mut starts = Vec::new();
     let mut best_runs = Vec::new();
     let mut sweep = Vec::new();
-    for (k, row) in rows.into_iter().enumerate() {
-        let scores = if ran_rows.contains(&k) {
-            ran.next().expect("one result per job")
-        } else if matches!(row, Row::Start { .. }) {
-            Scores::of(&case_iii.reconstruction, case_iii.report.clone())
-        } else {
-            Scores::of(&case_ii.reconstruction, case_ii.report.clone())
+    for (row, scores) in done {
+        let scores = match scores {
+            Some(scores) => scores,
+            None if matches!(row, Row::Start { .. }) => {
+                Scores::of(&case_iii.reconstruction, case_iii.report.clone())
+            }
+            None => Scores::of(&case_ii.reconstruction, case_ii.report.clone()),
         };
         match row {
             Row::Start { label, mass, c0 } => {
@@ -303,9 +283,17 @@ pub(super) fn run_studies(
             }
         }
     }
-    let bad_start = starts.iter().find(|r| r.label == "bad").cloned();
+    (starts, best_runs, sweep)
+}
 
-    // The data's best fit against the simulated lens itself, on case (iii)'s rows.
+/// The data's best fit (`runs`) against the simulated lens itself, on case (iii)'s rows.
+fn best_fit(
+    config: &PaperConfig,
+    simulation: &Simulation,
+    case_iii: &CaseRun,
+    runs: Vec<StartRun>,
+    say: &mut dyn FnMut(&str),
+) -> Result<BestFit, PaperError> {
     let system = &case_iii.reconstruction.system;
     let truth_lens = simulation
         .truth_model()
@@ -316,18 +304,12 @@ pub(super) fn run_studies(
         iterations: config.best_fit_iterations,
         truth_chi2,
         truth_source_rms_arcsec: (truth_chi2 / row_weight_sum(&case_iii.reconstruction)).sqrt(),
-        runs: best_runs,
+        runs,
     };
     say(&format!(
         "best fit: the truth's own chi2 is {truth_chi2:.4e}"
     ));
-    mark_best(&mut sweep);
-    Ok(Studies {
-        starts,
-        bad_start,
-        best_fit: Some(best_fit),
-        sweep,
-    })
+    Ok(best_fit)
 }
 
 /// Sum of the weights of a reconstruction's rows (two per pixel), 1/arcsec^2.
