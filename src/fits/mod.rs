@@ -128,7 +128,12 @@ pub struct FitsImage {
 pub fn write_image(map: &Map, opts: &FitsWriteOptions) -> Result<Vec<u8>, FitsError> {
     let g = &map.geometry;
     let n = g.pixels;
-    let pixel_ok = g.pixel_arcsec().is_finite() && g.pixel_arcsec() > 0.0 && g.center.is_finite();
+    // The pixel in degrees (CDELT) must stay a normal number: a subnormal pixel in arcsec
+    // would write CDELT = 0, a file that does not read.
+    let pixel_ok = g.pixel_arcsec().is_finite()
+        && (g.pixel_arcsec() / 3600.0).is_normal()
+        && g.pixel_arcsec() > 0.0
+        && g.center.is_finite();
     if n == 0 || map.data.len() != n * n || !pixel_ok {
         let (len, pixel_arcsec) = (map.data.len(), g.pixel_arcsec());
         return Err(FitsError::BadMap {
