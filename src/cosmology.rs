@@ -11,12 +11,8 @@ use crate::units::{c2_over_4pi_g_msun_per_mpc, ARCSEC_PER_RAD, C_KM_S, G_SI, MPC
 /// What can be wrong with cosmological parameters or redshifts.
 #[derive(Debug, Error, Clone, PartialEq)]
 pub enum CosmologyError {
-    #[error("cosmology: {name} = {value} is not allowed ({reason})")]
-    BadParameter {
-        name: &'static str,
-        value: f64,
-        reason: &'static str,
-    },
+    #[error(transparent)]
+    BadFieldValue(#[from] crate::error::BadFieldValue),
     #[error(
         "source redshift z_s = {z_source} must be greater than the lens redshift z_l = {z_lens}"
     )]
@@ -66,18 +62,18 @@ impl Cosmology {
     /// Checks `0 < H0 <= 500` and `0 <= Ωm <= 1`.
     pub fn validate(&self) -> Result<(), CosmologyError> {
         if !(self.h0.is_finite() && self.h0 > 0.0 && self.h0 <= 500.0) {
-            return Err(CosmologyError::BadParameter {
-                name: "h0",
-                value: self.h0,
-                reason: "H0 in km/s/Mpc must be in (0, 500]",
-            });
+            return Err(CosmologyError::from(crate::error::BadFieldValue::new(
+                "cosmology.h0",
+                self.h0,
+                "H0 in km/s/Mpc must be in (0, 500]",
+            )));
         }
         if !(self.omega_m.is_finite() && (0.0..=1.0).contains(&self.omega_m)) {
-            return Err(CosmologyError::BadParameter {
-                name: "omega_m",
-                value: self.omega_m,
-                reason: "a flat universe needs 0 <= omega_m <= 1",
-            });
+            return Err(CosmologyError::from(crate::error::BadFieldValue::new(
+                "cosmology.omega_m",
+                self.omega_m,
+                "a flat universe needs 0 <= omega_m <= 1",
+            )));
         }
         Ok(())
     }
@@ -147,11 +143,11 @@ impl LensPlane {
     pub fn new(cosmology: Cosmology, z_lens: f64) -> Result<Self, CosmologyError> {
         cosmology.validate()?;
         if !(z_lens.is_finite() && z_lens > 0.0 && z_lens < 20.0) {
-            return Err(CosmologyError::BadParameter {
-                name: "z_lens",
-                value: z_lens,
-                reason: "the lens redshift must be in (0, 20)",
-            });
+            return Err(CosmologyError::from(crate::error::BadFieldValue::new(
+                "cosmology.z_lens",
+                z_lens,
+                "the lens redshift must be in (0, 20)",
+            )));
         }
         let d_l_mpc = cosmology.angular_diameter_distance_mpc(z_lens);
         let mpc_per_arcsec = d_l_mpc / ARCSEC_PER_RAD;

@@ -62,27 +62,28 @@ impl ImageSearch {
         ];
         for (name, value) in positive {
             if !(value.is_finite() && value > 0.0) {
-                return Err(ImageError::BadSetting {
-                    name,
+                return Err(crate::error::BadFieldValue::new(
+                    format!("image_search.{name}"),
                     value,
-                    reason: "must be finite and positive",
-                });
+                    "must be finite and positive",
+                )
+                .into());
             }
         }
         let m = self.min_abs_magnification;
         if !(m.is_finite() && m >= 0.0) {
-            return Err(ImageError::BadSetting {
-                name: "min_abs_magnification",
-                value: m,
-                reason: "must be finite and not negative",
-            });
+            return Err(ImageError::from(crate::error::BadFieldValue::new(
+                "image_search.min_abs_magnification",
+                m,
+                "must be finite and not negative",
+            )));
         }
         if self.max_newton_iterations == 0 {
-            return Err(ImageError::BadSetting {
-                name: "max_newton_iterations",
-                value: 0.0,
-                reason: "at least one iteration is needed",
-            });
+            return Err(ImageError::from(crate::error::BadFieldValue::new(
+                "image_search.max_newton_iterations",
+                0.0,
+                "at least one iteration is needed",
+            )));
         }
         Ok(())
     }
@@ -91,12 +92,8 @@ impl ImageSearch {
 /// What can be wrong with the input of [`find_images`].
 #[derive(Debug, Error, Clone, PartialEq)]
 pub enum ImageError {
-    #[error("image search: setting {name} = {value} {reason}")]
-    BadSetting {
-        name: &'static str,
-        value: f64,
-        reason: &'static str,
-    },
+    #[error(transparent)]
+    BadFieldValue(#[from] crate::error::BadFieldValue),
     #[error("image search: the distance ratio f = D_ls/D_s = {f} must be finite and positive")]
     BadDistanceRatio { f: f64 },
     #[error("image search: the source position ({x}, {y}) arcsec is not finite")]

@@ -11,6 +11,7 @@ pub mod cosmology;
 pub mod curves;
 pub mod demo;
 pub mod ds9;
+pub mod error;
 pub mod fits;
 pub mod grid;
 pub mod images;

@@ -28,12 +28,8 @@ pub enum ProductsError {
     Model(#[from] ModelError),
     #[error(transparent)]
     Cosmology(#[from] CosmologyError),
-    #[error("{field} = {value} is not allowed ({reason})")]
-    BadOption {
-        field: &'static str,
-        value: f64,
-        reason: &'static str,
-    },
+    #[error(transparent)]
+    BadFieldValue(#[from] crate::error::BadFieldValue),
     #[error(transparent)]
     Maps(#[from] MapsError),
     #[error(transparent)]
@@ -79,25 +75,25 @@ impl ProductOptions {
     pub fn validate(&self) -> Result<(), ProductsError> {
         if !(self.size_arcsec.is_finite() && self.size_arcsec > 0.0 && self.size_arcsec <= 36_000.0)
         {
-            return Err(ProductsError::BadOption {
-                field: "size",
-                value: self.size_arcsec,
-                reason: "the map width in arcsec must be in (0, 36000]",
-            });
+            return Err(ProductsError::from(crate::error::BadFieldValue::new(
+                "products.size",
+                self.size_arcsec,
+                "the map width in arcsec must be in (0, 36000]",
+            )));
         }
         if !(16..=MAX_PIXELS).contains(&self.pixels) {
-            return Err(ProductsError::BadOption {
-                field: "pixels",
-                value: self.pixels as f64,
-                reason: "the map side must be 16 to 8192 pixels",
-            });
+            return Err(ProductsError::from(crate::error::BadFieldValue::new(
+                "products.pixels",
+                self.pixels as f64,
+                "the map side must be 16 to 8192 pixels",
+            )));
         }
         if !self.z_source.is_finite() {
-            return Err(ProductsError::BadOption {
-                field: "z_source",
-                value: self.z_source,
-                reason: "the source redshift must be a number",
-            });
+            return Err(ProductsError::from(crate::error::BadFieldValue::new(
+                "products.z_source",
+                self.z_source,
+                "the source redshift must be a number",
+            )));
         }
         Ok(())
     }

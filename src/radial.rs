@@ -54,12 +54,8 @@ pub struct RadialProfile {
 /// What can be wrong with a radial-profile request.
 #[derive(Debug, Error, Clone, PartialEq)]
 pub enum RadialError {
-    #[error("radial bins: {field} = {value} is not allowed ({reason})")]
-    BadBins {
-        field: &'static str,
-        value: f64,
-        reason: &'static str,
-    },
+    #[error(transparent)]
+    BadFieldValue(#[from] crate::error::BadFieldValue),
     #[error(
         "radial profile: the outer edge {r_max_arcsec} arcsec reaches beyond the map; about this \
          centre the map covers a full circle only out to {limit_arcsec} arcsec"
@@ -79,12 +75,11 @@ pub enum RadialError {
 impl RadialBins {
     /// The validated bin edges in arcsec.
     pub fn edges_arcsec(&self) -> Result<Vec<f64>, RadialError> {
-        let bad = |field, value, reason| {
-            Err(RadialError::BadBins {
-                field,
-                value,
-                reason,
-            })
+        let bad = |field: &str, value, reason| {
+            Err(
+                crate::error::BadFieldValue::new(format!("radial_bins.{field}"), value, reason)
+                    .into(),
+            )
         };
         let edges = match *self {
             RadialBins::Linear {
@@ -154,12 +149,8 @@ impl RadialBins {
 
 /// Checks `r_min` (`> 0` when `log`, else `>= 0`) `< r_max` and `1 <= count <= MAX_RADIAL_BINS`.
 fn check_range(lo: f64, hi: f64, count: usize, log: bool) -> Result<(), RadialError> {
-    let bad = |field, value, reason| {
-        Err(RadialError::BadBins {
-            field,
-            value,
-            reason,
-        })
+    let bad = |field: &str, value, reason| {
+        Err(crate::error::BadFieldValue::new(format!("radial_bins.{field}"), value, reason).into())
     };
     if !(lo.is_finite() && (lo > 0.0 || (!log && lo == 0.0))) {
         return bad(

@@ -31,12 +31,8 @@ use super::arcs::ArcCatalog;
 /// What can be wrong with constraint settings or inputs.
 #[derive(Debug, Error, Clone, PartialEq)]
 pub enum ConstraintError {
-    #[error("constraints: {field} = {value} is not allowed ({reason})")]
-    BadParameter {
-        field: &'static str,
-        value: f64,
-        reason: &'static str,
-    },
+    #[error(transparent)]
+    BadFieldValue(#[from] crate::error::BadFieldValue),
     #[error("constraints: mode \"{mode}\" cannot use {given}")]
     ModeMismatch {
         mode: &'static str,
@@ -160,10 +156,12 @@ impl Default for ConstraintConfig {
 impl ConstraintConfig {
     /// Checks every field against the range in its documentation.
     pub fn validate(&self) -> Result<(), ConstraintError> {
-        let bad = |field, value, reason| ConstraintError::BadParameter {
-            field,
-            value,
-            reason,
+        let bad = |field: &str, value, reason| {
+            ConstraintError::from(crate::error::BadFieldValue::new(
+                format!("constraints.{field}"),
+                value,
+                reason,
+            ))
         };
         if !(self.pixel_arcsec.is_finite() && (1e-3..=10.0).contains(&self.pixel_arcsec)) {
             return Err(bad(

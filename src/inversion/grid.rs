@@ -31,12 +31,8 @@ use crate::profiles::cell_unit_deflection;
 #[derive(Debug, Error, Clone, PartialEq)]
 pub enum GridError {
     /// `grid.<field> = value` is outside its allowed range.
-    #[error("grid: {field} = {value} is not allowed ({reason})")]
-    BadParameter {
-        field: &'static str,
-        value: f64,
-        reason: &'static str,
-    },
+    #[error(transparent)]
+    BadFieldValue(#[from] crate::error::BadFieldValue),
     /// The field must be sized from positions but none were given.
     #[error("grid: no image positions to size the field from (give grid.width_arcsec and grid.center_arcsec)")]
     NoPositions,
@@ -90,11 +86,7 @@ impl Default for GridConfig {
 }
 
 fn bad(field: &'static str, value: f64, reason: &'static str) -> GridError {
-    GridError::BadParameter {
-        field,
-        value,
-        reason,
-    }
+    crate::error::BadFieldValue::new(format!("grid.{field}"), value, reason).into()
 }
 
 fn check_range(

@@ -39,12 +39,8 @@ use crate::profiles::{tnfw_total_mass_unit, Lens, MassComponent, Nfw, ProfileErr
 /// What can be wrong with member settings or a member galaxy.
 #[derive(Debug, Error, Clone, PartialEq)]
 pub enum MembersError {
-    #[error("members: {field} = {value} is not allowed ({reason})")]
-    BadParameter {
-        field: &'static str,
-        value: f64,
-        reason: &'static str,
-    },
+    #[error(transparent)]
+    BadFieldValue(#[from] crate::error::BadFieldValue),
     #[error("members: layers = \"{value}\" is not one of none, single, bcg, brightest:N (N >= 1)")]
     BadLayers { value: String },
     #[error(
@@ -207,11 +203,12 @@ fn check(field: &'static str, v: f64, lo: f64, hi: f64, lo_open: bool) -> Result
     if ok {
         Ok(())
     } else {
-        Err(MembersError::BadParameter {
-            field,
-            value: v,
-            reason: "outside the range given in its documentation",
-        })
+        Err(crate::error::BadFieldValue::new(
+            format!("members.{field}"),
+            v,
+            "outside the range given in its documentation",
+        )
+        .into())
     }
 }
 

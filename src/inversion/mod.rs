@@ -28,8 +28,7 @@ pub use members::{
 pub use npy::{export_system, npy_header, write_f64s, write_npy, NpyError};
 pub use regions::{arcs_from_regions, is_region_file, RegionArcs};
 pub use regularise::{
-    capped_inverse_jacobian, cell_penalty, AutoWord, ObjectiveConfig, ObjectiveError, Regulariser,
-    Strength,
+    capped_inverse_jacobian, cell_penalty, AutoWord, ObjectiveConfig, Regulariser, Strength,
 };
 pub use system::{
     ColumnInfo, LinearSystem, ObjectiveTerms, RowBlock, ScaledLens, SystemConfig, SystemError,

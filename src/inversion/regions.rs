@@ -72,11 +72,12 @@ pub fn arcs_from_regions(
 ) -> Result<RegionArcs, ConstraintError> {
     TooLarge::check_bytes(source_name, InputKind::Arcs, text.len() as u64)?;
     if !(pixel_arcsec.is_finite() && pixel_arcsec > 0.0) {
-        return Err(ConstraintError::BadParameter {
-            field: "pixel_arcsec",
-            value: pixel_arcsec,
-            reason: "must be finite and > 0",
-        });
+        return Err(crate::error::BadFieldValue::new(
+            "constraints.pixel_arcsec",
+            pixel_arcsec,
+            "must be finite and > 0",
+        )
+        .into());
     }
     let at = |line: usize, reason: String| ConstraintError::RegionLine {
         source_name: source_name.to_string(),

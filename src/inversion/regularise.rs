@@ -39,9 +39,9 @@
 //! [`crate::solver::minimise_exact`] finds its minimiser: the answer no longer depends on the
 //! start or on an iteration count.
 
+use crate::error::BadFieldValue;
 use glam::DVec2;
 use serde::{Deserialize, Serialize};
-use thiserror::Error;
 
 use super::grid::CellGrid;
 
@@ -140,25 +140,10 @@ impl ObjectiveConfig {
     }
 }
 
-/// An objective setting out of range.
-#[derive(Debug, Error, Clone, PartialEq)]
-#[error("{field} = {value} is not allowed ({reason})")]
-pub struct ObjectiveError {
-    pub field: &'static str,
-    pub value: f64,
-    pub reason: &'static str,
-}
-
 impl ObjectiveConfig {
     /// Checks every field against the range in its documentation.
-    pub fn validate(&self) -> Result<(), ObjectiveError> {
-        let bad = |field, value, reason| {
-            Err(ObjectiveError {
-                field,
-                value,
-                reason,
-            })
-        };
+    pub fn validate(&self) -> Result<(), BadFieldValue> {
+        let bad = |field, value, reason| Err(BadFieldValue::new(field, value, reason));
         let strength_ok = |v: f64| v.is_finite() && (0.0..=1e6).contains(&v);
         if let Some(v) = self.strength.value() {
             if !strength_ok(v) {

@@ -56,12 +56,8 @@ pub const LAYER_SHARE_WARN: f64 = 1e-3;
 /// What can go wrong building or using the linear system.
 #[derive(Debug, Error, Clone, PartialEq)]
 pub enum SystemError {
-    #[error("system: {field} = {value} is not allowed ({reason})")]
-    BadParameter {
-        field: &'static str,
-        value: f64,
-        reason: &'static str,
-    },
+    #[error(transparent)]
+    BadFieldValue(#[from] crate::error::BadFieldValue),
     #[error("system {system}: {source}")]
     Redshift {
         system: String,
@@ -112,10 +108,12 @@ impl Default for SystemConfig {
 impl SystemConfig {
     /// Checks every field against the range in its documentation.
     pub fn validate(&self) -> Result<(), SystemError> {
-        let bad = |field, value, reason| SystemError::BadParameter {
-            field,
-            value,
-            reason,
+        let bad = |field: &str, value, reason| {
+            SystemError::from(crate::error::BadFieldValue::new(
+                format!("system.{field}"),
+                value,
+                reason,
+            ))
         };
         let m = self.mass_unit_msun;
         if !(m.is_finite() && (1e3..=1e18).contains(&m)) {

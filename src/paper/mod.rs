@@ -89,12 +89,8 @@ pub enum PaperError {
     Products(#[from] ProductsError),
     #[error("radial profile: {0}")]
     Radial(#[from] RadialError),
-    #[error("{field} = {value} is not allowed ({reason})")]
-    BadSetting {
-        field: &'static str,
-        value: f64,
-        reason: &'static str,
-    },
+    #[error(transparent)]
+    BadFieldValue(#[from] crate::error::BadFieldValue),
     #[error("simulated member catalogue: {0}")]
     Members(Box<crate::catalog::CatalogError>),
     #[error("figure {figure}: {message}")]
@@ -228,10 +224,8 @@ pub struct PaperRun {
 
 impl PaperConfig {
     fn validate(&self) -> Result<(), PaperError> {
-        let bad = |field, value: f64, reason| PaperError::BadSetting {
-            field,
-            value,
-            reason,
+        let bad = |field: &'static str, value: f64, reason| {
+            PaperError::from(crate::error::BadFieldValue::new(field, value, reason))
         };
         if self.iterations == 0 || self.long_iterations == 0 || self.best_fit_iterations == 0 {
             return Err(bad(

@@ -3,6 +3,7 @@
 
 use serde::{Deserialize, Serialize};
 
+use crate::error::BadFieldValue;
 use crate::inversion::{
     ConstraintConfig, GridConfig, MemberConfig, ObjectiveConfig, Regulariser, SystemConfig,
 };
@@ -141,13 +142,7 @@ impl ReconstructConfig {
         self.members.validate()?;
         self.constraints.validate()?;
         self.system.validate()?;
-        self.objective
-            .validate()
-            .map_err(|e| ReconstructError::BadSetting {
-                field: e.field,
-                value: e.value,
-                reason: e.reason,
-            })?;
+        self.objective.validate()?;
         self.solver_settings().validate()?;
         if self.solver.method == SolverMethod::Exact {
             let o = &self.objective;
@@ -158,44 +153,44 @@ impl ReconstructConfig {
                 false => o.regulariser == Regulariser::None,
             };
             if none || zero {
-                return Err(ReconstructError::BadSetting {
-                    field: "objective.strength",
-                    value: 0.0,
-                    reason: "the exact solver needs a regulariser with a positive strength: \
+                return Err(ReconstructError::from(BadFieldValue::new(
+                    "objective.strength",
+                    0.0,
+                    "the exact solver needs a regulariser with a positive strength: \
                              without one the data leave the map undetermined (use solver.method \
                              \"qadp\" for the paper's early stop)",
-                });
+                )));
             }
         }
         let s = &self.solver;
         if !(s.start_cell_mass_msun.is_finite() && s.start_cell_mass_msun > 0.0) {
-            return Err(ReconstructError::BadSetting {
-                field: "solver.start_cell_mass_msun",
-                value: s.start_cell_mass_msun,
-                reason: "the start mass must be positive: a cell that starts at 0 stays at 0",
-            });
+            return Err(ReconstructError::from(BadFieldValue::new(
+                "solver.start_cell_mass_msun",
+                s.start_cell_mass_msun,
+                "the start mass must be positive: a cell that starts at 0 stays at 0",
+            )));
         }
         if !(s.start_c.is_finite() && s.start_c > 0.0) {
-            return Err(ReconstructError::BadSetting {
-                field: "solver.start_c",
-                value: s.start_c,
-                reason: "the start C must be positive: a factor that starts at 0 stays at 0",
-            });
+            return Err(ReconstructError::from(BadFieldValue::new(
+                "solver.start_c",
+                s.start_c,
+                "the start C must be positive: a factor that starts at 0 stays at 0",
+            )));
         }
         let p = &self.products;
         if !(p.z_source.is_finite() && p.z_source > 0.0) {
-            return Err(ReconstructError::BadSetting {
-                field: "products.z_source",
-                value: p.z_source,
-                reason: "must be a positive redshift",
-            });
+            return Err(ReconstructError::from(BadFieldValue::new(
+                "products.z_source",
+                p.z_source,
+                "must be a positive redshift",
+            )));
         }
         if !(16..=crate::products::MAX_PIXELS).contains(&p.pixels) {
-            return Err(ReconstructError::BadSetting {
-                field: "products.pixels",
-                value: p.pixels as f64,
-                reason: "the map side must be 16 to 8192 pixels",
-            });
+            return Err(ReconstructError::from(BadFieldValue::new(
+                "products.pixels",
+                p.pixels as f64,
+                "the map side must be 16 to 8192 pixels",
+            )));
         }
         Ok(())
     }

@@ -51,12 +51,8 @@ pub enum ReconstructError {
         source_name: String,
         message: String,
     },
-    #[error("{field} = {value} is not allowed ({reason})")]
-    BadSetting {
-        field: &'static str,
-        value: f64,
-        reason: &'static str,
-    },
+    #[error(transparent)]
+    BadFieldValue(#[from] crate::error::BadFieldValue),
     #[error(transparent)]
     Constraints(#[from] ConstraintError),
     #[error(transparent)]

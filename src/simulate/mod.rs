@@ -48,12 +48,8 @@ pub const SUMMARY_Z_SOURCE: f64 = 3.0;
 /// What can go wrong while simulating or writing the simulation.
 #[derive(Debug, Error)]
 pub enum SimulateError {
-    #[error("simulation setting {field} = {value} is not allowed ({reason})")]
-    BadConfig {
-        field: &'static str,
-        value: f64,
-        reason: &'static str,
-    },
+    #[error(transparent)]
+    BadFieldValue(#[from] crate::error::BadFieldValue),
     #[error(transparent)]
     Cosmology(#[from] CosmologyError),
     #[error("simulated truth model: {0}")]
@@ -128,11 +124,12 @@ impl SimulationConfig {
         ];
         for (field, value, lo, hi) in checks {
             if !(value.is_finite() && (lo..=hi).contains(&value)) {
-                return Err(SimulateError::BadConfig {
-                    field,
+                return Err(crate::error::BadFieldValue::new(
+                    format!("simulation.{field}"),
                     value,
-                    reason: "outside the range given in its documentation",
-                });
+                    "outside the range given in its documentation",
+                )
+                .into());
             }
         }
         Ok(())

@@ -88,12 +88,8 @@ pub enum SolverError {
     },
     #[error("solver: the order of the unknowns is not a permutation of 0..{n}: {reason}")]
     BadOrder { n: usize, reason: String },
-    #[error("solver: setting {name} = {value} is not allowed ({reason})")]
-    BadSetting {
-        name: &'static str,
-        value: usize,
-        reason: &'static str,
-    },
+    #[error(transparent)]
+    BadFieldValue(#[from] crate::error::BadFieldValue),
     #[error("solver: the exact solver handles at most {max} unknowns, got {n}")]
     TooLarge { n: usize, max: usize },
     #[error("solver: the exact solver met a singular subproblem when freeing unknown {index} (pivot {pivot:e}); A must be positive definite on the free set")]

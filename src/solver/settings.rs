@@ -1,6 +1,7 @@
 //! The settings every solver run takes: how far to go, how often to report, how many threads.
 
 use super::SolverError;
+use crate::error::BadFieldValue;
 
 /// Settings of an iterative run, shared by every method (QADP, the accelerated gradient, the
 /// exact solver's exchanges); `wslap reconstruct`'s `solver` block takes its defaults from here.
@@ -32,11 +33,9 @@ impl QadpSettings {
     /// Checks `report_every >= 1`.
     pub fn validate(&self) -> Result<(), SolverError> {
         if self.report_every == 0 {
-            return Err(SolverError::BadSetting {
-                name: "report_every",
-                value: 0,
-                reason: "must be at least 1",
-            });
+            return Err(
+                BadFieldValue::new("solver.report_every", 0.0, "must be at least 1").into(),
+            );
         }
         Ok(())
     }

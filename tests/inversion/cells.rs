@@ -82,7 +82,7 @@ fn grid_refinement_splits_the_densest_cells() {
     ));
     assert!(matches!(
         g.refine(&masses, 0.0),
-        Err(GridError::BadParameter { .. })
+        Err(GridError::BadFieldValue(_))
     ));
 }
 

@@ -13,8 +13,8 @@ use wslap::inversion::{
 #[cfg_attr(target_arch = "wasm32", wasm_bindgen_test::wasm_bindgen_test)]
 fn bad_settings_give_their_errors() {
     let field_of = |e: &GridError| match e {
-        GridError::BadParameter { field, .. } => *field,
-        _ => "",
+        GridError::BadFieldValue(e) => e.field.strip_prefix("grid.").unwrap_or("").to_string(),
+        _ => String::new(),
     };
     for (config, field) in [
         (

@@ -603,10 +603,7 @@ fn bad_inputs_are_named() {
     };
     assert!(matches!(
         problem.run(&[1.0, 1.0], &no_reports, &mut go),
-        Err(SolverError::BadSetting {
-            name: "report_every",
-            ..
-        })
+        Err(SolverError::BadFieldValue(ref e)) if e.field == "solver.report_every"
     ));
 
     let big = NNQP_EXACT_MAX_UNKNOWNS + 1;

@@ -492,8 +492,10 @@ fn bad_input_is_an_error() {
     ];
     for (field, opts) in settings {
         match run(g, 0.5, DVec2::ONE, &opts) {
-            Err(ImageError::BadSetting { name, .. }) => assert_eq!(name, field),
-            other => panic!("{field}: expected BadSetting, got {other:?}"),
+            Err(ImageError::BadFieldValue(e)) => {
+                assert_eq!(e.field, format!("image_search.{field}"))
+            }
+            other => panic!("{field}: expected BadFieldValue, got {other:?}"),
         }
     }
     let mut maps = LensMaps::from_lens(&lens, MapGeometry::centered(40.0, 8));

@@ -128,8 +128,8 @@ fn lens_plane_rejects_bad_redshifts() {
     );
     for z_l in [0.0, -0.5, f64::NAN] {
         match LensPlane::new(Cosmology::default(), z_l) {
-            Err(CosmologyError::BadParameter { name, .. }) => assert_eq!(name, "z_lens"),
-            other => panic!("z_l = {z_l}: expected BadParameter, got {other:?}"),
+            Err(CosmologyError::BadFieldValue(e)) => assert_eq!(e.field, "cosmology.z_lens"),
+            other => panic!("z_l = {z_l}: expected BadFieldValue, got {other:?}"),
         }
     }
 }

@@ -535,15 +535,12 @@ fn radial_profile_rejects_bad_requests() {
     };
     assert!(matches!(
         log0.edges_arcsec(),
-        Err(RadialError::BadBins {
-            field: "r_min_arcsec",
-            ..
-        })
+        Err(RadialError::BadFieldValue(ref e)) if e.field == "radial_bins.r_min_arcsec"
     ));
     let unsorted = RadialBins::Edges(vec![0.0, 2.0, 1.0]);
     assert!(matches!(
         unsorted.edges_arcsec(),
-        Err(RadialError::BadBins { field: "edges", .. })
+        Err(RadialError::BadFieldValue(ref e)) if e.field == "radial_bins.edges"
     ));
     let mut holed = sheet.clone();
     holed.data[64 * 128 + 64] = f64::INFINITY;
