@@ -4,42 +4,23 @@
 
 use serde::Serialize;
 
-use crate::reconstruct::{image_regions, Solved};
+use crate::reconstruct::image_regions;
 
-use super::run::ReconstructionResult;
 use super::{AppError, SessionResult};
-
-impl ReconstructionResult {
-    /// The solved system, for `summary.json` and the quantities it reports.
-    pub fn solved(&self) -> Solved<'_> {
-        Solved {
-            config: &self.config,
-            system: &self.system,
-            x: &self.x,
-            iterations: self.iterations,
-            sources: &self.sources,
-            warnings: &self.warnings,
-            timings: self.timings,
-            strength_choice: self.strength_choice.as_ref(),
-        }
-    }
-}
 
 impl SessionResult {
     /// `summary.json`: the CLI's reconstruction summary, or the map summary of a forward model
     /// or look-up (what `wslap maps` writes).
     pub fn summary_json(&self) -> Result<String, AppError> {
-        let maps = self.products.summary();
-        let Some(r) = &self.reconstruction else {
-            return pretty(&maps);
-        };
-        let summary = r.solved().summary(r.status.clone(), maps);
-        pretty(&summary)
+        match self.reconstruction() {
+            Some(r) => pretty(&r.summary()),
+            None => pretty(&self.products().summary()),
+        }
     }
 
     /// `sources.json` (empty list without a reconstruction).
     pub fn sources_json(&self) -> Result<String, AppError> {
-        match &self.reconstruction {
+        match self.reconstruction() {
             Some(r) => pretty(&r.sources),
             None => Ok("[]".to_string()),
         }
@@ -48,15 +29,15 @@ impl SessionResult {
     /// `images.reg`: DS9 circles at the observed and predicted images (see
     /// [`crate::reconstruct::image_regions`]); an error without a reconstruction.
     pub fn images_regions(&self) -> Result<String, AppError> {
-        let r = self.reconstruction.as_ref().ok_or_else(|| {
+        let r = self.reconstruction().ok_or_else(|| {
             AppError::Missing("images.reg needs a reconstruction: press Reconstruct".to_string())
         })?;
-        Ok(image_regions(&r.sources, &self.products))
+        Ok(image_regions(&r.sources, &r.products))
     }
 
     /// `convergence.json` (empty list without a reconstruction).
     pub fn convergence_json(&self) -> Result<String, AppError> {
-        match &self.reconstruction {
+        match self.reconstruction() {
             Some(r) => pretty(&r.convergence),
             None => Ok("[]".to_string()),
         }

@@ -141,7 +141,7 @@ impl Session {
     /// ([`profile_relative_differences`]).
     pub fn radial_view(&self) -> Result<ViewPng, AppError> {
         let result = self.result()?;
-        let (kappa, mass) = profile_points(&result.products.profile);
+        let (kappa, mass) = profile_points(&result.products().profile);
         let (mut kappa_series, mut mass_series) = match result.kind {
             RunKind::Reconstruct => (
                 vec![Series::line("reconstruction", kappa, PALETTE[0])],
@@ -163,7 +163,7 @@ impl Session {
             mass_series.push(dashed(mass));
             // How far the reconstruction is from the model, radius by radius: the paper's
             // profile error.
-            let (kappa, mass) = profile_relative_differences(&result.products.profile, &model);
+            let (kappa, mass) = profile_relative_differences(&result.products().profile, &model);
             let mut plot = panel(
                 &format!("reconstruction / loaded model - 1 ({name})"),
                 Axis::linear("r [arcsec]"),
@@ -207,8 +207,8 @@ impl Session {
     /// The model's map has at most `MODEL_MAPS_MAX_PIXELS` per side.
     pub fn model_profile(&self, result: &SessionResult) -> Result<Option<NamedProfile>, AppError> {
         self.with_model_maps(result, |m| {
-            let bins = RadialBins::Edges(result.products.profile.r_edges_arcsec.clone());
-            let profile = radial_profile(&m.maps.kappa, m.origin, &bins, &result.products.plane)
+            let bins = RadialBins::Edges(result.products().profile.r_edges_arcsec.clone());
+            let profile = radial_profile(&m.maps.kappa, m.origin, &bins, &result.products().plane)
                 .map_err(|e| AppError::Run(format!("{}: {e}", m.name)))?;
             Ok((m.name.clone(), profile))
         })
@@ -220,10 +220,10 @@ impl Session {
     /// per side), once per source redshift.
     pub fn model_curves(&self, result: &SessionResult) -> Result<Option<ModelCurves>, AppError> {
         self.with_model_maps(result, |m| {
-            let f = result.products.distance_ratio;
+            let f = result.products().distance_ratio;
             let mut cached = m.curves.borrow_mut();
             if !matches!(&*cached, Some((g, _)) if *g == f) {
-                let z_s = result.products.curves.z_source;
+                let z_s = result.products().curves.z_source;
                 let curves = critical_curves(&m.maps, f, z_s, None);
                 let shift = |lines: Vec<Polyline>| -> Vec<Polyline> {
                     let moved = lines
@@ -316,8 +316,7 @@ impl Session {
     pub fn convergence_view(&self) -> Result<ViewPng, AppError> {
         let r = self.result()?;
         let records = r
-            .reconstruction
-            .as_ref()
+            .reconstruction()
             .map(|x| x.convergence.as_slice())
             .unwrap_or(&[]);
         if records.is_empty() {
@@ -410,7 +409,7 @@ fn objective_decrease(x: &[f64], levels: &[usize], objectives: &[f64]) -> Vec<(f
 /// the reconstruction's map (see [`Session::model_profile`]); when the model's lens plane is not
 /// the reconstruction's (its kappa would not compare), why, in words.
 fn model_frame(result: &SessionResult, model: &ModelLens) -> Result<(DVec2, MapGeometry), String> {
-    let (theirs, ours) = (model.plane, result.products.plane);
+    let (theirs, ours) = (model.plane, result.products().plane);
     if theirs.z_lens != ours.z_lens {
         return Err(format!(
             "its z_lens = {} is not the reconstruction's {} (set z_lens to compare)",
@@ -420,11 +419,11 @@ fn model_frame(result: &SessionResult, model: &ModelLens) -> Result<(DVec2, MapG
     if theirs.cosmology != ours.cosmology {
         return Err("its cosmology is not the reconstruction's".to_string());
     }
-    let origin = match (result.products.reference, model.reference) {
+    let origin = match (result.products().reference, model.reference) {
         (Some(ours), Some(theirs)) => theirs.to_offset_arcsec(ours.ra_deg, ours.dec_deg),
         _ => DVec2::ZERO,
     };
-    let g = result.products.maps.geometry();
+    let g = result.products().maps.geometry();
     let geometry = MapGeometry {
         center: origin + g.center,
         pixels: g.pixels.min(MODEL_MAPS_MAX_PIXELS),

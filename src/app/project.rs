@@ -123,16 +123,14 @@ impl Session {
                 kind: r.kind,
                 summary: serde_json::from_str(&r.summary_json()?)
                     .map_err(|e| AppError::Run(e.to_string()))?,
-                x: r.reconstruction.as_ref().map(|x| x.x.clone()),
-                iterations: r.reconstruction.as_ref().map_or(0, |x| x.iterations),
+                x: r.reconstruction().map(|x| x.x.clone()),
+                iterations: r.reconstruction().map_or(0, |x| x.iterations),
                 sources: r
-                    .reconstruction
-                    .as_ref()
+                    .reconstruction()
                     .map(|x| x.sources.clone())
                     .unwrap_or_default(),
                 convergence: r
-                    .reconstruction
-                    .as_ref()
+                    .reconstruction()
                     .map(|x| x.convergence.clone())
                     .unwrap_or_default(),
             }),

@@ -8,12 +8,12 @@ use crate::curves::critical_curves;
 use crate::inversion::Regulariser;
 use crate::inversion::{build_constraints, build_member_layers, CellGrid, Layer, LinearSystem};
 use crate::products::{own_map_side, ProductOptions, Products};
-use crate::profiles::Lens;
 use crate::reconstruct::{
     cross_validate, fitted_system_ids, map_geometry, product_options, reconstruct,
     reconstruct_with_choice, strength_candidates, strength_folds, ConvergenceRecord,
     CrossValidation, Dataset, DatasetError, Inputs, ReconstructConfig, ReconstructError,
-    SourceReport, StageTimings, StrengthCandidate, StrengthChoice, DEFAULT_FOLDS,
+    Reconstruction, RunStatus, SourceReport, StageTimings, StrengthCandidate, StrengthChoice,
+    DEFAULT_FOLDS,
 };
 use crate::solver::Control;
 
@@ -35,42 +35,52 @@ pub enum RunKind {
     Lookup,
 }
 
-/// What a reconstruction adds to the maps.
+/// What a run made: maps (a forward model or a look-up) or a reconstruction with its maps.
 #[derive(Debug)]
-pub struct ReconstructionResult {
-    pub config: ReconstructConfig,
-    pub system: LinearSystem,
-    /// The solution vector `X` (see [`crate::reconstruct::Reconstruction::x`]).
-    pub x: Vec<f64>,
-    /// "Completed", "Cancelled", "Diverged" or "Restored" (rebuilt from a stored `X`).
-    pub status: String,
-    pub iterations: usize,
-    pub convergence: Vec<ConvergenceRecord>,
-    pub sources: Vec<SourceReport>,
-    pub warnings: Vec<String>,
-    pub timings: StageTimings,
-    pub lens: Lens,
-    /// How an "auto" regulariser strength was chosen (not kept in a project file).
-    pub strength_choice: Option<StrengthChoice>,
+pub enum Outcome {
+    Maps(Box<Products>),
+    Reconstruction(Box<Reconstruction>),
 }
 
 /// The last result of a session.
 #[derive(Debug)]
 pub struct SessionResult {
     pub kind: RunKind,
-    pub products: Products,
+    pub outcome: Outcome,
     /// What the views draw of the data the result was made from.
     pub marks: DataMarks,
-    pub reconstruction: Option<ReconstructionResult>,
     /// Wall-clock time of the run in ms.
     pub elapsed_ms: f64,
 }
 
 impl SessionResult {
+    /// The maps, curves and profile of the result.
+    pub fn products(&self) -> &Products {
+        match &self.outcome {
+            Outcome::Maps(p) => p,
+            Outcome::Reconstruction(r) => &r.products,
+        }
+    }
+
+    fn products_mut(&mut self) -> &mut Products {
+        match &mut self.outcome {
+            Outcome::Maps(p) => p,
+            Outcome::Reconstruction(r) => &mut r.products,
+        }
+    }
+
+    /// The reconstruction, when the result is one.
+    pub fn reconstruction(&self) -> Option<&Reconstruction> {
+        match &self.outcome {
+            Outcome::Maps(_) => None,
+            Outcome::Reconstruction(r) => Some(r),
+        }
+    }
+
     /// Critical curves, caustics and magnification at `z_source` from the stored maps
     /// (`f = D_ls/D_s(z_source)`), without solving again.
     pub fn redraw(&mut self, z_source: f64) -> Result<(), AppError> {
-        let p = &mut self.products;
+        let p = self.products_mut();
         let f = p
             .plane
             .distance_ratio(z_source)
@@ -87,7 +97,10 @@ impl SessionResult {
     /// [`crate::reconstruct::SHOWN_MIN_MAGNIFICATION`], the ones the map draws
     /// ([`crate::reconstruct::PredictedImage::is_shown`]).
     pub fn predicted(&self) -> Vec<DVec2> {
-        let sources = self.reconstruction.iter().flat_map(|r| r.sources.iter());
+        let sources = self
+            .reconstruction()
+            .into_iter()
+            .flat_map(|r| r.sources.iter());
         sources
             .flat_map(|s| s.predicted.iter())
             .filter(|p| p.is_shown())
@@ -111,26 +124,14 @@ fn run_error(e: ReconstructError) -> AppError {
 }
 
 /// The session's result of reconstruction `r` of `parsed` (its warnings after the data's).
-fn reconstruction_result(r: crate::reconstruct::Reconstruction, parsed: &Dataset) -> SessionResult {
+fn reconstruction_result(mut r: Reconstruction, parsed: &Dataset) -> SessionResult {
     let mut warnings = parsed.warnings.clone();
-    warnings.extend(r.warnings);
+    warnings.append(&mut r.warnings);
+    r.warnings = warnings;
     SessionResult {
         kind: RunKind::Reconstruct,
-        products: r.products,
+        outcome: Outcome::Reconstruction(Box::new(r)),
         marks: parsed.marks(),
-        reconstruction: Some(ReconstructionResult {
-            config: r.config,
-            system: r.system,
-            x: r.x,
-            status: format!("{:?}", r.status),
-            iterations: r.iterations,
-            convergence: r.convergence,
-            sources: r.sources,
-            warnings,
-            timings: r.timings,
-            lens: r.lens,
-            strength_choice: r.strength_choice,
-        }),
         elapsed_ms: 0.0,
     }
 }
@@ -283,7 +284,7 @@ impl Session {
         let curves = self
             .result()
             .ok()
-            .map(|r| &r.products)
+            .map(|r| r.products())
             .filter(|p| p.maps.geometry() == kappa.spread.geometry)
             .map(|p| &p.curves);
         let (reference, z_lens) =
@@ -342,21 +343,21 @@ impl Session {
             Products::from_lens(&lens, plane, parsed.reference(), &opts).map_err(|e| run(&e))?;
         self.result = Some(SessionResult {
             kind: RunKind::Reconstruct,
-            products,
-            marks: parsed.marks(),
-            reconstruction: Some(ReconstructionResult {
+            outcome: Outcome::Reconstruction(Box::new(Reconstruction {
                 config,
                 system,
                 x,
-                status: "Restored".to_string(),
+                status: RunStatus::Restored,
                 iterations,
                 convergence,
+                lens,
+                products,
                 sources,
                 warnings,
                 timings: StageTimings::default(),
-                lens,
                 strength_choice: None,
-            }),
+            })),
+            marks: parsed.marks(),
             elapsed_ms: t.ms(),
         });
         Ok(())
@@ -379,9 +380,8 @@ impl Session {
         let parsed = self.parsed().unwrap_or_default();
         Ok(SessionResult {
             kind: RunKind::Forward,
-            products,
+            outcome: Outcome::Maps(Box::new(products)),
             marks: parsed.marks(),
-            reconstruction: None,
             elapsed_ms: 0.0,
         })
     }
@@ -403,9 +403,8 @@ impl Session {
         .map_err(|e| AppError::Run(format!("{} / {}: {e}", ax.name, ay.name)))?;
         Ok(SessionResult {
             kind: RunKind::Lookup,
-            products,
+            outcome: Outcome::Maps(Box::new(products)),
             marks: DataMarks::default(),
-            reconstruction: None,
             elapsed_ms: 0.0,
         })
     }

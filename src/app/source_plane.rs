@@ -105,8 +105,11 @@ impl Session {
     /// circle).
     pub fn source_view(&self, opts: &ViewOptions) -> Result<ViewPng, AppError> {
         let r = self.result()?;
-        let p = &r.products;
-        let sources = r.reconstruction.iter().flat_map(|x| x.sources.iter());
+        let p = &r.products();
+        let sources = r
+            .reconstruction()
+            .into_iter()
+            .flat_map(|x| x.sources.iter());
         let betas: Vec<DVec2> = sources.clone().map(|s| s.beta_arcsec).collect();
         // With arcs, each system's images mapped back in its colour (as its arc pixels).
         let mut back: Vec<OverlayPoints> = Vec::new();

@@ -150,7 +150,8 @@ impl Session {
             map_pixels_on_screen: opts.map_pixels_on_screen,
             title: Some(format!(
                 "kappa (z_l = {}), critical curves at z_s = {}",
-                r.products.plane.z_lens, r.products.curves.z_source
+                r.products().plane.z_lens,
+                r.products().curves.z_source
             )),
             legend: opts.legend,
             ..KappaPlotOptions::default()
@@ -164,7 +165,7 @@ impl Session {
         let r = self.result()?;
         let mut overlay = Overlay {
             lines: Vec::new(),
-            curves: Some(&r.products.curves),
+            curves: Some(&r.products().curves),
             points: Vec::new(),
         };
         if opts.show_model_curves {
@@ -229,8 +230,12 @@ impl Session {
     pub fn kappa_view(&self, opts: &ViewOptions) -> Result<ViewPng, AppError> {
         let r = self.result()?;
         let overlay = self.kappa_overlay(opts)?;
-        let png = render_kappa_png(&r.products.maps.kappa, &overlay, &self.kappa_options(opts)?)
-            .map_err(render)?;
+        let png = render_kappa_png(
+            &r.products().maps.kappa,
+            &overlay,
+            &self.kappa_options(opts)?,
+        )
+        .map_err(render)?;
         Ok(ViewPng {
             name: "kappa.png".to_string(),
             png,
@@ -239,7 +244,7 @@ impl Session {
 
     /// Where the map lies in the kappa view drawn with `opts` (PNG pixels).
     pub fn kappa_frame(&self, opts: &ViewOptions) -> Result<FigureFrame, AppError> {
-        let kappa = &self.result()?.products.maps.kappa;
+        let kappa = &self.result()?.products().maps.kappa;
         let overlay = self.kappa_overlay(opts)?;
         kappa_figure_frame_for(kappa, &overlay, &self.kappa_options(opts)?).map_err(render)
     }
@@ -263,7 +268,7 @@ impl Session {
     /// the predicted images of a reconstruction. Any result will do (a reconstruction, a
     /// forward model, deflection maps): where else a candidate arc should appear.
     pub fn counter_images(&self, p: DVec2) -> Result<CounterImages, AppError> {
-        let products = &self.result()?.products;
+        let products = &self.result()?.products();
         let f = products.distance_ratio;
         let beta = self.source_behind(p)?;
         let mut images =
@@ -281,7 +286,7 @@ impl Session {
     /// The source position (arcsec) behind the point `p` of the result's maps at the curves'
     /// source redshift; an error when `p` is not on the maps.
     pub(super) fn source_behind(&self, p: DVec2) -> Result<DVec2, AppError> {
-        let products = &self.result()?.products;
+        let products = &self.result()?.products();
         let g = products.maps.geometry();
         let on_maps = (p - g.center).abs().max_element() <= 0.5 * g.size_arcsec;
         if !(p.is_finite() && on_maps) {
@@ -299,7 +304,7 @@ impl Session {
     /// fk5 with the result's sky reference, else pixels of its maps.
     pub fn counter_image_regions(&self, p: DVec2) -> Result<String, AppError> {
         let c = self.counter_images(p)?;
-        let products = &self.result()?.products;
+        let products = &self.result()?.products();
         let clicked = Mark {
             position_arcsec: p,
             label: "clicked point".to_string(),
@@ -338,7 +343,7 @@ impl Session {
         py: f32,
     ) -> Result<Option<HoverReadout>, AppError> {
         let r = self.result()?;
-        let kappa = &r.products.maps.kappa;
+        let kappa = &r.products().maps.kappa;
         let Some(p) = self.kappa_point(opts, px, py)? else {
             return Ok(None);
         };
@@ -346,8 +351,8 @@ impl Session {
             x_arcsec: p.x,
             y_arcsec: p.y,
             kappa: kappa.sample(p),
-            magnification: r.products.magnification.sample(p),
-            z_source: r.products.curves.z_source,
+            magnification: r.products().magnification.sample(p),
+            z_source: r.products().curves.z_source,
         }))
     }
 }

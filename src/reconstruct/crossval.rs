@@ -329,7 +329,7 @@ pub fn cross_validate(
         runs.push(FoldRun {
             fold,
             held_out: group.clone(),
-            status: format!("{:?}", r.status),
+            status: r.status.name().to_string(),
             iterations: r.iterations,
             c: r.layer_factors(),
             grid_mass_msun: r.grid_mass_msun(),

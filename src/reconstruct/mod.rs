@@ -145,6 +145,39 @@ pub struct StageTimings {
     pub sources_ms: f64,
 }
 
+/// How a reconstruction's solution came about.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum RunStatus {
+    /// Solved now; the solver's status says how its run ended.
+    Solved(SolveStatus),
+    /// Rebuilt from a stored solution `X` (a project file), not solved again.
+    Restored,
+}
+
+impl RunStatus {
+    /// The status as `summary.json` and the app write it: the solver's ("Completed",
+    /// "Converged", "Cancelled", "Diverged") or "Restored".
+    pub fn name(self) -> &'static str {
+        match self {
+            Self::Solved(s) => s.name(),
+            Self::Restored => "Restored",
+        }
+    }
+}
+
+impl std::fmt::Display for RunStatus {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+/// A solved run compares equal to the solver's status it ended with.
+impl PartialEq<SolveStatus> for RunStatus {
+    fn eq(&self, other: &SolveStatus) -> bool {
+        *self == Self::Solved(*other)
+    }
+}
+
 /// The result of a reconstruction.
 #[derive(Debug)]
 pub struct Reconstruction {
@@ -152,7 +185,7 @@ pub struct Reconstruction {
     pub system: LinearSystem,
     /// The solution `X` (cell masses in `system.mass_unit_msun`, C per layer, shifted betas).
     pub x: Vec<f64>,
-    pub status: SolveStatus,
+    pub status: RunStatus,
     pub iterations: usize,
     pub convergence: Vec<ConvergenceRecord>,
     pub lens: Lens,
@@ -232,7 +265,7 @@ impl Reconstruction {
     /// `summary.json` (what `wslap reconstruct` writes).
     pub fn summary(&self) -> ReconstructSummary<'_> {
         self.solved()
-            .summary(format!("{:?}", self.status), self.products.summary())
+            .summary(self.status.name().to_string(), self.products.summary())
     }
 }
 
@@ -549,7 +582,7 @@ fn reconstruct_limited(
         config: config.clone(),
         system,
         x,
-        status,
+        status: RunStatus::Solved(status),
         iterations,
         convergence,
         lens,

@@ -35,6 +35,18 @@ pub enum SolveStatus {
     Diverged,
 }
 
+impl SolveStatus {
+    /// The status as `summary.json` and the app write it.
+    pub fn name(self) -> &'static str {
+        match self {
+            Self::Completed => "Completed",
+            Self::Converged => "Converged",
+            Self::Cancelled => "Cancelled",
+            Self::Diverged => "Diverged",
+        }
+    }
+}
+
 /// The result of a run.
 #[derive(Debug, Clone, PartialEq)]
 pub struct SolveOutcome {

@@ -271,11 +271,11 @@ impl AppSession {
         let r = self.inner.result().map_err(err)?;
         let summary: serde_json::Value =
             serde_json::from_str(&r.summary_json().map_err(err)?).map_err(err)?;
-        let rec = r.reconstruction.as_ref();
+        let rec = r.reconstruction();
         to_js(&serde_json::json!({
             "kind": r.kind,
             "elapsed_ms": r.elapsed_ms,
-            "status": rec.map(|x| x.status.clone()),
+            "status": rec.map(|x| x.status.name()),
             "iterations": rec.map(|x| x.iterations),
             "summary": summary,
             "model_note": self.inner.model_not_compared(r),
@@ -336,7 +336,7 @@ impl AppSession {
     /// arc pixels in the views (`null` for catalogue systems, drawn as markers).
     pub fn sources(&self) -> Result<JsValue, JsError> {
         let r = self.inner.result().map_err(err)?;
-        let Some(x) = &r.reconstruction else {
+        let Some(x) = r.reconstruction() else {
             return Ok(js_sys::Array::new().into());
         };
         let mut rows = serde_json::to_value(&x.sources).map_err(err)?;
@@ -364,8 +364,8 @@ impl AppSession {
             "summary.json" => r.summary_json().map_err(err),
             "sources.json" => r.sources_json().map_err(err),
             "convergence.json" => r.convergence_json().map_err(err),
-            "critical-curves.json" => Ok(r.products.curves_json()),
-            "critical-curves.reg" => Ok(r.products.regions()),
+            "critical-curves.json" => Ok(r.products().curves_json()),
+            "critical-curves.reg" => Ok(r.products().regions()),
             "images.reg" => r.images_regions().map_err(err),
             other => Err(JsError::new(&format!("unknown file '{other}'"))),
         }
@@ -374,7 +374,7 @@ impl AppSession {
     /// The HFF-style FITS maps: an array of `{name, bytes}`.
     pub fn fits_files(&self) -> Result<JsValue, JsError> {
         let r = self.inner.result().map_err(err)?;
-        let files = r.products.fits_files().map_err(err)?;
+        let files = r.products().fits_files().map_err(err)?;
         files_js(files.iter().map(|(n, b)| (*n, b.as_slice())))
     }
 

@@ -46,7 +46,7 @@ pub fn forward_session() -> (Session, Vec<u8>, Vec<u8>) {
         s.set_field(path, value).unwrap();
     }
     s.run(RunKind::Forward, &mut |_| Control::Continue).unwrap();
-    let fits = s.result().unwrap().products.fits_files().unwrap();
+    let fits = s.result().unwrap().products().fits_files().unwrap();
     let file = |name: &str| fits.iter().find(|(n, _)| *n == name).unwrap().1.clone();
     let (x, y) = (file("x-arcsec-deflect.fits"), file("y-arcsec-deflect.fits"));
     (s, x, y)

@@ -175,7 +175,7 @@ fn ds9_regions_load_as_arcs_with_the_catalogue_redshifts() {
     s.run(RunKind::Reconstruct, &mut |_| Control::Continue)
         .unwrap();
     let r = s.result().unwrap();
-    let rec = r.reconstruction.as_ref().unwrap();
+    let rec = r.reconstruction().unwrap();
     let pixels = rec.config.constraints.pixel_arcsec;
     assert_eq!(
         rec.config.constraints.mode,

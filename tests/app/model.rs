@@ -47,11 +47,11 @@ fn the_profile_view_compares_a_reconstruction_with_the_loaded_model() {
     let r = s.result().unwrap();
     let (name, profile) = s.model_profile(r).unwrap().expect("the model's profile");
     assert_eq!(name, "model.json");
-    assert_eq!(profile.r_edges_arcsec, r.products.profile.r_edges_arcsec);
+    assert_eq!(profile.r_edges_arcsec, r.products().profile.r_edges_arcsec);
     let model = wslap::model::ModelFile::from_json_str(TEACHING_MODEL_JSON, "model.json").unwrap();
     let lens = model.build_lens().unwrap();
-    let sigma_cr = r.products.plane.sigma_cr_ref_msun_per_arcsec2;
-    let pixel = r.products.maps.geometry().pixel_arcsec();
+    let sigma_cr = r.products().plane.sigma_cr_ref_msun_per_arcsec2;
+    let pixel = r.products().maps.geometry().pixel_arcsec();
     let mut checked = 0;
     for (&radius, &mass) in profile
         .r_edges_arcsec
@@ -100,14 +100,14 @@ fn the_profile_view_compares_a_reconstruction_with_the_loaded_model() {
         count_near(&lower, wslap::render::PALETTE[2])
     );
     // Its values: the reconstruction against the model, bin by bin.
-    let (kappa, mass) = profile_relative_differences(&r.products.profile, &profile);
+    let (kappa, mass) = profile_relative_differences(&r.products().profile, &profile);
     assert_eq!(kappa.len(), profile.kappa.len());
     for ((rk, dk), (&r0, (&ours, &theirs))) in kappa.iter().zip(
-        r.products
+        r.products()
             .profile
             .r_arcsec
             .iter()
-            .zip(r.products.profile.kappa.iter().zip(&profile.kappa)),
+            .zip(r.products().profile.kappa.iter().zip(&profile.kappa)),
     ) {
         assert_eq!(*rk, r0);
         assert!((dk - (ours / theirs - 1.0)).abs() < 1e-12);
@@ -174,17 +174,17 @@ fn the_kappa_view_draws_the_loaded_model_curves() {
     forward
         .set_field(
             "reconstruct.products.z_source",
-            json!(r.products.curves.z_source),
+            json!(r.products().curves.z_source),
         )
         .unwrap();
     forward
         .run(RunKind::Forward, &mut |_| Control::Continue)
         .unwrap();
-    let truth = &forward.result().unwrap().products;
+    let truth = &forward.result().unwrap().products();
     // The teaching model has no sky reference: its frame is the reconstruction's (no shift;
     // the shift is checked with the profile below).
     assert_eq!(truth.reference, None);
-    let model_pixel = r.products.maps.geometry().size_arcsec / 64.0;
+    let model_pixel = r.products().maps.geometry().size_arcsec / 64.0;
     let nearest = |p: DVec2, lines: &[Vec<DVec2>]| {
         lines
             .iter()
@@ -248,7 +248,7 @@ fn the_model_maps_are_kept_for_the_next_run_of_the_same_field() {
         .unwrap();
     assert_eq!(run(&mut s), first);
     assert_eq!(s.model_maps_computed(), 1);
-    let width = s.result().unwrap().products.maps.geometry().size_arcsec;
+    let width = s.result().unwrap().products().maps.geometry().size_arcsec;
     s.set_field("reconstruct.products.size_arcsec", json!(width + 10.0))
         .unwrap();
     assert_ne!(run(&mut s), first);
@@ -357,7 +357,7 @@ fn a_lenstool_par_is_a_model_file_with_the_member_catalogue_as_its_potfile() {
         s.set_field(path, value).unwrap();
     }
     s.run(RunKind::Forward, &mut |_| Control::Continue).unwrap();
-    let ours = s.result().unwrap().products.curves.einstein_radius_arcsec;
+    let ours = s.result().unwrap().products().curves.einstein_radius_arcsec;
     let model = load_lenstool_model(&dir.join(par), &[&dir.join(members)]).unwrap();
     let opts = ProductOptions {
         z_source: 2.0,

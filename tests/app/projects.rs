@@ -4,6 +4,7 @@
 use crate::fixtures::{forward_session, solved};
 use serde_json::json;
 use wslap::app::{RunKind, Session, MAX_STORED_FITS_BYTES};
+use wslap::reconstruct::RunStatus;
 use wslap::solver::Control;
 
 #[cfg_attr(not(target_arch = "wasm32"), test)]
@@ -18,15 +19,24 @@ fn a_project_reopens_with_the_maps_rebuilt_from_x() {
     // serde_json's float parsing may differ from the written value in the last bit.
     const KAPPA_RTOL: f64 = 1e-9;
     let worst = a
-        .products
+        .products()
         .maps
         .kappa
         .data
         .iter()
-        .zip(&b.products.maps.kappa.data)
+        .zip(&b.products().maps.kappa.data)
         .map(|(p, q)| (p - q).abs() / p.abs().max(1e-12))
         .fold(0.0, f64::max);
     assert!(worst <= KAPPA_RTOL, "kappa differs by {worst:e} (relative)");
+    // One result type: the reopened reconstruction says it was restored, not solved.
+    let solved_status = a.reconstruction().unwrap().status;
+    assert!(
+        matches!(solved_status, RunStatus::Solved(_)),
+        "{solved_status}"
+    );
+    assert_eq!(b.reconstruction().unwrap().status, RunStatus::Restored);
+    let summary: serde_json::Value = serde_json::from_str(&b.summary_json().unwrap()).unwrap();
+    assert_eq!(summary["status"], "Restored");
     assert_eq!(t.settings, s.settings);
     assert_eq!(t.data.images, s.data.images);
     // A broken project changes nothing.
@@ -72,10 +82,10 @@ fn a_lookup_project_keeps_its_deflection_maps() {
     }
     let (a, b) = (s.result().unwrap(), t.result().unwrap());
     assert_eq!(b.kind, RunKind::Lookup);
-    assert_eq!(b.products.curves.z_source, 3.0);
+    assert_eq!(b.products().curves.z_source, 3.0);
     assert_eq!(
-        a.products.curves.einstein_radius_arcsec,
-        b.products.curves.einstein_radius_arcsec
+        a.products().curves.einstein_radius_arcsec,
+        b.products().curves.einstein_radius_arcsec
     );
     // The reopened session writes the same data (the summary's timings differ).
     let again: serde_json::Value = serde_json::from_str(&t.project_json().unwrap()).unwrap();

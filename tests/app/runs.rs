@@ -18,7 +18,7 @@ const PNG_MAGIC: &[u8] = b"\x89PNG\r\n\x1a\n";
 #[cfg_attr(target_arch = "wasm32", wasm_bindgen_test::wasm_bindgen_test)]
 fn the_solver_setting_chooses_the_method() {
     let chi2 = |s: &Session| {
-        let r = s.result().unwrap().reconstruction.as_ref().unwrap();
+        let r = s.result().unwrap().reconstruction().unwrap();
         2.0 * wslap::solver::objective(&r.system.a, &r.system.b, &r.x) + r.system.theta_w_theta
     };
     // The same objective, minimised by QADP and by the accelerated gradient in 400 iterations.
@@ -57,7 +57,7 @@ fn reconstruction_gives_curves_views_hover_and_the_cli_files() {
     assert!(reports >= 4, "{reports} progress reports");
     let r = s.result().unwrap();
     assert!(
-        !r.products.curves.tangential.is_empty(),
+        !r.products().curves.tangential.is_empty(),
         "no tangential curve"
     );
     let summary: serde_json::Value = serde_json::from_str(&r.summary_json().unwrap()).unwrap();
@@ -112,7 +112,7 @@ fn reconstruction_gives_curves_views_hover_and_the_cli_files() {
     let inside = s.hover(&opts, cx, cy).unwrap().expect("inside the map");
     assert!(inside.kappa.is_finite() && inside.magnification.is_finite());
     assert!(s.hover(&opts, 1.0, 1.0).unwrap().is_none());
-    let fits = r.products.fits_files().unwrap();
+    let fits = r.products().fits_files().unwrap();
     assert_eq!(fits.len(), 6);
     let header = String::from_utf8_lossy(&fits[0].1[..2880]).to_string();
     assert!(
@@ -125,17 +125,10 @@ fn reconstruction_gives_curves_views_hover_and_the_cli_files() {
 #[cfg_attr(target_arch = "wasm32", wasm_bindgen_test::wasm_bindgen_test)]
 fn a_higher_source_redshift_redraws_a_larger_einstein_radius_without_solving() {
     let mut s = solved();
-    let x = s
-        .result()
-        .unwrap()
-        .reconstruction
-        .as_ref()
-        .unwrap()
-        .x
-        .clone();
-    let r2 = s.result().unwrap().products.curves.einstein_radius_arcsec;
+    let x = s.result().unwrap().reconstruction().unwrap().x.clone();
+    let r2 = s.result().unwrap().products().curves.einstein_radius_arcsec;
     s.set_z_source(6.0).unwrap();
-    let p = &s.result().unwrap().products;
+    let p = &s.result().unwrap().products();
     let r6 = p.curves.einstein_radius_arcsec;
     // The redraw has only the stored maps: the radius is measured on them, or is a lower bound.
     assert_eq!(
@@ -146,7 +139,7 @@ fn a_higher_source_redshift_redraws_a_larger_einstein_radius_without_solving() {
         r6 > r2 && r2 > 0.0,
         "Einstein radius {r2} at z_s = 2, {r6} at z_s = 6"
     );
-    assert_eq!(s.result().unwrap().reconstruction.as_ref().unwrap().x, x);
+    assert_eq!(s.result().unwrap().reconstruction().unwrap().x, x);
     assert!(
         s.set_z_source(0.1).is_err(),
         "a source in front of the lens"
@@ -169,8 +162,8 @@ fn forward_and_lookup_modes_agree_on_the_einstein_radius() {
     s.set_field("reconstruct.products.pixels", json!(64))
         .unwrap();
     s.run(RunKind::Forward, &mut |_| Control::Continue).unwrap();
-    let forward = s.result().unwrap().products.curves.einstein_radius_arcsec;
-    let fits = s.result().unwrap().products.fits_files().unwrap();
+    let forward = s.result().unwrap().products().curves.einstein_radius_arcsec;
+    let fits = s.result().unwrap().products().fits_files().unwrap();
     let file = |name: &str| fits.iter().find(|(n, _)| *n == name).unwrap().1.clone();
     s.load_fits(0, "x.fits", &file("x-arcsec-deflect.fits"))
         .unwrap();
@@ -178,7 +171,7 @@ fn forward_and_lookup_modes_agree_on_the_einstein_radius() {
         .unwrap();
     assert!(s.load_fits(1, "bad.fits", b"SIMPLE = nonsense").is_err());
     s.run(RunKind::Lookup, &mut |_| Control::Continue).unwrap();
-    let lookup = s.result().unwrap().products.curves.einstein_radius_arcsec;
+    let lookup = s.result().unwrap().products().curves.einstein_radius_arcsec;
     common::assert_abs("Einstein radius", lookup, forward, RADIUS_ATOL_ARCSEC);
 }
 
@@ -212,7 +205,7 @@ fn held_out_systems_are_predicted_and_survive_a_project() {
     assert_eq!(report.result, "restored", "{}", report.message);
     assert_eq!(t.settings.holdout, ["2"]);
     let (a, b) = (r, t.result().unwrap());
-    let (ka, kb) = (&a.products.maps.kappa.data, &b.products.maps.kappa.data);
+    let (ka, kb) = (&a.products().maps.kappa.data, &b.products().maps.kappa.data);
     let worst = ka
         .iter()
         .zip(kb)
@@ -254,7 +247,7 @@ fn cross_validation_predicts_each_system_and_keeps_the_result() {
     assert_eq!(cv.systems.len(), 4);
     // The folds' convergence is on the result's maps (the same settings make the same maps),
     // and its files are the CLI's, the figure with the result's curves.
-    let products = &s.result().unwrap().products;
+    let products = &s.result().unwrap().products();
     let kappa = cv.kappa.as_ref().expect("the folds' kappa maps");
     assert_eq!(kappa.spread.geometry, products.maps.geometry());
     let files = s.crossval_files(&cv).unwrap();
@@ -281,8 +274,7 @@ fn cross_validation_predicts_each_system_and_keeps_the_result() {
             .unwrap();
         let r = t.result().unwrap();
         let alone: Vec<_> = r
-            .reconstruction
-            .as_ref()
+            .reconstruction()
             .unwrap()
             .sources
             .iter()
@@ -328,8 +320,7 @@ fn a_refined_grid_runs_and_its_project_asks_for_a_new_solve() {
         summary["grid_cells"]
     );
     let levels: Vec<usize> = r
-        .reconstruction
-        .as_ref()
+        .reconstruction()
         .unwrap()
         .convergence
         .iter()

@@ -33,7 +33,7 @@ fn the_map_leaves_out_the_demagnified_predicted_images() {
         .unwrap();
     let r = s.result().unwrap();
     let all: Vec<_> = r
-        .reconstruction
+        .reconstruction()
         .iter()
         .flat_map(|rec| rec.sources.iter())
         .flat_map(|src| src.predicted.iter())
@@ -270,13 +270,13 @@ fn a_clicked_point_shows_the_images_of_its_source() {
     let text = s.counter_image_regions(rows[0].1).unwrap();
     let regions = wslap::ds9::read_regions(&text, "counter-images.reg").unwrap();
     let r = s.result().unwrap();
-    let geometry = r.products.maps.geometry();
+    let geometry = r.products().maps.geometry();
     let centres: Vec<DVec2> = regions
         .iter()
         .map(|g| {
             assert_eq!(g.color.as_deref(), Some("yellow"));
             match g
-                .to_frame_arcsec(r.products.reference, Some(&geometry))
+                .to_frame_arcsec(r.products().reference, Some(&geometry))
                 .unwrap()
             {
                 wslap::ds9::Shape::Circle { center, .. } => center,
