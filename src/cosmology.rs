@@ -1,7 +1,9 @@
-//! Flat ΛCDM distances and the lens-plane quantities derived from them (METHOD.md section 1).
+//! Flat ΛCDM distances and the lens-plane quantities derived from them ([method §1]).
 //!
 //! Distances are angular-diameter distances in Mpc from numerical integration of `1/E(z)`,
 //! radiation neglected (astropy's `FlatLambdaCDM(H0, Om0, Tcmb0=0)`).
+//!
+//! [method §1]: crate::method#1-frames-and-units
 
 use serde::{Deserialize, Serialize};
 use thiserror::Error;

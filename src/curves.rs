@@ -1,4 +1,4 @@
-//! Critical curves and caustics (METHOD.md section 6).
+//! Critical curves and caustics ([method §6]).
 //!
 //! Critical curves are the zero contours of the Jacobian eigenvalues `lambda_t`, `lambda_r`
 //! ([`LensMaps::eigen_maps`]), traced by marching squares between pixel centres with linear
@@ -9,6 +9,8 @@
 //! polyline that starts and ends on the map's border; every other curve is a closed loop.
 //! Saddle cells (diagonal corners of equal sign) are resolved by the value at the cell centre
 //! (mean of the four corners): the corners on the centre's side are joined through the cell.
+//!
+//! [method §6]: crate::method#6-products
 
 use glam::DVec2;
 use serde::{Deserialize, Serialize};

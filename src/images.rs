@@ -1,5 +1,5 @@
-//! The lens equation solved forward: every image `theta` of a source at `beta` (METHOD.md
-//! sections 1 and 6), `beta = theta - f alpha_ref(theta)` with `f = D_ls/D_s`.
+//! The lens equation solved forward: every image `theta` of a source at `beta` ([method §1] and [§6]),
+//! `beta = theta - f alpha_ref(theta)` with `f = D_ls/D_s`.
 //!
 //! Method (triangle mapping, Schneider, Ehlers & Falco 1992 section 11; Keeton's gravlens):
 //! the pixel centres of a square grid are mapped to the source plane, each grid cell is split
@@ -20,6 +20,9 @@
 //! `tolerance_arcsec` outside a caustic may give one "image" at the nearly merged pair. Images
 //! with `|mu| < min_abs_magnification` are dropped: they are unobservable, and they include the
 //! artefact images inside the 1e-8 arcsec cores that keep the SIS and point-mass fields finite.
+//!
+//! [method §1]: crate::method#1-frames-and-units
+//! [§6]: crate::method#6-products
 
 use glam::DVec2;
 use thiserror::Error;
@@ -160,7 +163,9 @@ pub struct FoundImage {
     pub residual_arcsec: f64,
 }
 
-/// `beta = theta - f alpha_ref(theta)` in arcsec (the lens equation, METHOD.md section 1).
+/// `beta = theta - f alpha_ref(theta)` in arcsec (the lens equation, [method §1]).
+///
+/// [method §1]: crate::method#1-frames-and-units
 pub fn source_position(lens: &dyn MassComponent, f: f64, theta: DVec2) -> DVec2 {
     theta - f * lens.deflection(theta)
 }
@@ -168,7 +173,9 @@ pub fn source_position(lens: &dyn MassComponent, f: f64, theta: DVec2) -> DVec2 
 /// The source position of a set of images and how well they agree on it.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct SourceScatter {
-    /// Mean of `theta_i - f alpha(theta_i)` in arcsec (the best common source, METHOD.md 5).
+    /// Mean of `theta_i - f alpha(theta_i)` in arcsec (the best common source, [method §5]).
+    ///
+    /// [method §5]: crate::method#5-the-solver-qadp
     pub beta: DVec2,
     /// Root mean square of `|beta_i - beta|` in arcsec.
     pub rms_arcsec: f64,

@@ -1,9 +1,11 @@
 //! WSLAP+ free-form strong-lensing mass reconstruction (Sendra, Diego, Broadhurst & Lazkoz).
 //!
 //! The modules follow the pipeline: cosmology → mass components → maps and critical curves →
-//! rendering and file formats. Angles are arcsec in the tangent-plane frame of METHOD.md
+//! rendering and file formats. Angles are arcsec in the tangent-plane frame of [method §1]
 //! (+x West, +y North); every stored deflection, convergence and shear is for `D_ls/D_s = 1`.
 //! The wasm boundary (`wasm.rs`) and the CLI (`main.rs`) are thin shells around this library.
+//!
+//! [method §1]: crate::method#1-frames-and-units
 
 pub mod app;
 pub mod catalog;
@@ -19,6 +21,7 @@ pub mod inversion;
 pub mod lenstool_par;
 pub mod limits;
 pub mod maps;
+pub mod method;
 pub mod model;
 pub mod paper;
 pub mod products;

@@ -1,7 +1,9 @@
-//! Convergence, shear, deflection and magnification maps of a lens (METHOD.md section 6).
+//! Convergence, shear, deflection and magnification maps of a lens ([method §6]).
 //!
 //! All stored maps use the reference normalisation `D_ls/D_s = 1`; the source-dependent
 //! products (magnification, eigenvalues) take `f = D_ls/D_s` of the source.
+//!
+//! [method §6]: crate::method#6-products
 
 use thiserror::Error;
 

@@ -11,12 +11,14 @@
 //!    {"type": "gaussian", "x": 0.0, "y": 0.0, "mass": 1.0e13, "sigma": 5.0}]}
 //! ```
 //!
-//! Positions `x`, `y`, widths `sigma` and `r_trunc` are arcsec in the frame of METHOD.md
-//! section 1; masses are Msun (`m200` with respect to 200 `rho_crit(z_lens)`); `sigma_v` is
+//! Positions `x`, `y`, widths `sigma` and `r_trunc` are arcsec in the frame of [method §1];
+//! masses are Msun (`m200` with respect to 200 `rho_crit(z_lens)`); `sigma_v` is
 //! km/s; `q` (axis ratio, `0 < q <= 1`, default 1) and `pa` (degrees counter-clockwise from +x,
 //! default 0) are optional on `nfw`. `cosmology` defaults to H0 = 70, Ωm = 0.3; `reference`
 //! (the sky position of the frame origin, degrees) is optional. Unknown fields are errors.
 //! Components are numbered from 0 in error messages, as in the JSON array.
+//!
+//! [method §1]: crate::method#1-frames-and-units
 
 use glam::DVec2;
 use serde::{Deserialize, Serialize};

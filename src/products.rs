@@ -1,6 +1,8 @@
-//! The map product set of METHOD.md section 6 for one lens, as `wslap maps` writes it and the
+//! The map product set of [method §6] for one lens, as `wslap maps` writes it and the
 //! app shows it: reference-normalised maps, magnification, critical curves and caustics at one
 //! source redshift, the radial profile, and the files (FITS, DS9, PNG, JSON).
+//!
+//! [method §6]: crate::method#6-products
 
 use glam::DVec2;
 use serde::{Deserialize, Serialize};

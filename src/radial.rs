@@ -1,9 +1,11 @@
 //! Azimuthally averaged convergence and enclosed projected mass about a centre
-//! (METHOD.md section 6, "Radial profile").
+//! ([method §6], "Radial profile").
 //!
 //! Each pixel is a square of constant `kappa` (its centre value). Its weight in an annulus is
 //! the exact area of the square inside the annulus (disc-rectangle intersection in closed form),
 //! so thin bins and bins smaller than a pixel are averaged correctly.
+//!
+//! [method §6]: crate::method#6-products
 
 use glam::DVec2;
 use serde::{Deserialize, Serialize};

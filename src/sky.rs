@@ -1,10 +1,12 @@
-//! The sky reference of the arcsec frame (METHOD.md section 1).
+//! The sky reference of the arcsec frame ([method §1]).
 //!
 //! Offsets from the reference `(RA0, Dec0)` are Lenstool's relative coordinates:
 //! `x = -(RA - RA0) cos(Dec0) * 3600` (+x West), `y = (Dec - Dec0) * 3600` (+y North).
 //! This linear relation differs from the exact gnomonic (TAN) projection of a FITS WCS by about
 //! `|x| |y| tan(Dec0) / 206265` arcsec, i.e. 0.01 arcsec at 100 arcsec from the reference at
 //! `|Dec0| = 10 deg`: far below a map pixel.
+//!
+//! [method §1]: crate::method#1-frames-and-units
 
 use glam::DVec2;
 use serde::{Deserialize, Serialize};

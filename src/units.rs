@@ -13,13 +13,15 @@ pub const MSUN_KG: f64 = 1.988_409_870_698_051e30;
 /// One megaparsec in metres.
 pub const MPC_M: f64 = 3.085_677_581_491_367e22;
 
-/// `c^2 / (4 pi G)` in Msun/Mpc (METHOD.md section 1 quotes 1.66292e18).
+/// `c^2 / (4 pi G)` in Msun/Mpc ([method §1] quotes 1.66292e18).
+///
+/// [method §1]: crate::method#1-frames-and-units
 pub fn c2_over_4pi_g_msun_per_mpc() -> f64 {
     C_M_S * C_M_S / (4.0 * std::f64::consts::PI * G_SI) * MPC_M / MSUN_KG
 }
 
 /// `4 G Msun / (c^2 * 1 Mpc)` in arcsec^2: a point mass `m` (Msun) at `D_l` (Mpc) deflects by
-/// `K * m / D_l / r` arcsec for `D_ls/D_s = 1` (METHOD.md section 1: 8.14385e-9).
+/// `K * m / D_l / r` arcsec for `D_ls/D_s = 1` ([method §1]: 8.14385e-9).
 pub fn point_mass_deflection_arcsec2() -> f64 {
     4.0 * G_SI * MSUN_KG / (C_M_S * C_M_S * MPC_M) * ARCSEC_PER_RAD * ARCSEC_PER_RAD
 }

@@ -7,7 +7,7 @@
 //!   the catalogue does not carry, so it is rejected;
 //! - `3`: positions in arcsec relative to `(ra0, dec0)` in degrees.
 //!
-//! Relative positions follow METHOD.md section 1: `x = -(RA - RA0) cos(Dec0) 3600`,
+//! Relative positions follow [method §1]: `x = -(RA - RA0) cos(Dec0) 3600`,
 //! `y = (Dec - Dec0) 3600` (see [`SkyReference::to_offset_arcsec`]).
 
 use glam::DVec2;

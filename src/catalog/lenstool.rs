@@ -1,7 +1,9 @@
-//! Parsers for Lenstool multiple-image and member (potfile) catalogues (METHOD.md section 7),
+//! Parsers for Lenstool multiple-image and member (potfile) catalogues ([method §7]),
 //! as people have them: any whitespace (tabs, runs of spaces, trailing spaces, CRLF), `#`
 //! comment lines anywhere (also indented), an optional `#REFERENCE` header before the rows
 //! (see [`super::frame`]), and no header meaning absolute degrees.
+//!
+//! [method §7]: crate::method#7-file-formats
 
 use std::collections::HashMap;
 

@@ -1,9 +1,11 @@
-//! Lenstool catalogues: multiple images and cluster members (METHOD.md section 7).
+//! Lenstool catalogues: multiple images and cluster members ([method §7]).
 //!
 //! Positions are brought into the arcsec frame of one sky reference (+x West, +y North).
 //! [`parse_image_catalog`] and [`parse_member_catalog`] read Lenstool's text formats; the
 //! caller passes the frame it wants (e.g. the members' reference) so that every catalogue of a
 //! run shares one frame.
+//!
+//! [method §7]: crate::method#7-file-formats
 
 use glam::DVec2;
 use serde::{Deserialize, Serialize};

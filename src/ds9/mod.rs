@@ -1,4 +1,4 @@
-//! SAOImage DS9 region files (METHOD.md section 7): critical curves and caustics out, regions
+//! SAOImage DS9 region files ([method §7]): critical curves and caustics out, regions
 //! (e.g. arcs marked by users) in.
 //!
 //! Written files start with `# Region file format: DS9 version 4.1` and a `global` line, then
@@ -9,6 +9,8 @@
 //! `line` takes two points only). Colours: tangential critical curves red, radial critical
 //! curves cyan, caustics yellow (the radial caustic dashed); each region carries a
 //! `tag={...}` and the first of each kind a `text={...}` label.
+//!
+//! [method §7]: crate::method#7-file-formats
 
 use std::fmt::Write;
 
@@ -59,8 +61,10 @@ pub enum Ds9Frame {
 }
 
 /// A region's geometry. Units depend on where it is used: see [`Ds9Frame`] for a parsed
-/// [`Region`]; [`Region::to_frame_arcsec`] gives arcsec in the frame of METHOD.md section 1.
+/// [`Region`]; [`Region::to_frame_arcsec`] gives arcsec in the frame of [method §1].
 /// Angles are degrees counter-clockwise from the +x axis (DS9's convention).
+///
+/// [method §1]: crate::method#1-frames-and-units
 #[derive(Debug, Clone, PartialEq)]
 pub enum Shape {
     Polygon(Vec<DVec2>),
@@ -99,7 +103,7 @@ pub struct Region {
 }
 
 impl Region {
-    /// The shape in arcsec in the frame of METHOD.md section 1: fk5 positions through
+    /// The shape in arcsec in the frame of [method §1]: fk5 positions through
     /// [`SkyReference::to_offset_arcsec`] (needs `reference`), image positions through
     /// `geometry.pixel_to_arcsec(x - 1, y - 1)` and lengths times the pixel size (needs
     /// `geometry`). Angles are unchanged: +x is West in both cases for HFF maps.
@@ -300,7 +304,9 @@ pub fn write_regions(
 /// One position marked by a circle in [`write_marks`].
 #[derive(Debug, Clone, PartialEq)]
 pub struct Mark {
-    /// Arcsec in the frame of METHOD.md section 1.
+    /// Arcsec in the frame of [method §1].
+    ///
+    /// [method §1]: crate::method#1-frames-and-units
     pub position_arcsec: DVec2,
     /// The `text={...}` label (no braces).
     pub label: String,

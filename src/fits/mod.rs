@@ -1,4 +1,4 @@
-//! FITS images in the HFF lens-model convention (METHOD.md sections 1 and 7), written by hand.
+//! FITS images in the HFF lens-model convention ([method §1] and [§7]), written by hand.
 //!
 //! Written files: one float32 (`BITPIX = -32`, big-endian) 2-D primary image in 2880-byte
 //! blocks of 80-character cards, WCS `RA---TAN` / `DEC--TAN` in degrees,
@@ -10,6 +10,9 @@
 //!
 //! Read files: a 2-D image in the primary HDU, or in the first `IMAGE` extension when the
 //! primary HDU is empty; `BITPIX` -32, -64, 16 or 32 with `BSCALE` / `BZERO` / `BLANK`.
+//!
+//! [method §1]: crate::method#1-frames-and-units
+//! [§7]: crate::method#7-file-formats
 
 use glam::DVec2;
 use thiserror::Error;
@@ -122,9 +125,12 @@ pub struct FitsImage {
     pub header: Vec<Card>,
 }
 
-/// Writes `map` as a float32 HFF-style FITS file (module docs; METHOD.md section 7). The map's
+/// Writes `map` as a float32 HFF-style FITS file (module docs; [method §7]). The map's
 /// centre sits at `CRPIX = n/2 + 0.5`, `CRVAL = reference + centre offset` with the
-/// tangent-plane relation of METHOD.md section 1 ([`SkyReference::offset_to_radec`]).
+/// tangent-plane relation of [method §1] ([`SkyReference::offset_to_radec`]).
+///
+/// [method §7]: crate::method#7-file-formats
+/// [method §1]: crate::method#1-frames-and-units
 pub fn write_image(map: &Map, opts: &FitsWriteOptions) -> Result<Vec<u8>, FitsError> {
     let g = &map.geometry;
     let n = g.pixels;

@@ -85,11 +85,13 @@ struct ArcsJson<'a> {
 ///   {"id": "2", "z": null, "images": [[[x, y], ...], [[x, y], ...]]}]}
 /// ```
 ///
-/// Positions in arcsec in the frame of METHOD.md section 1. Each system has either `pixels`
+/// Positions in arcsec in the frame of [method §1]. Each system has either `pixels`
 /// (all its pixels, counted as one image) or `images` (one pixel list per image); `z` null,
 /// 0 or absent means unknown, otherwise `0 < z < 20`. Ids must be unique, pixel lists
 /// non-empty and finite; at most [`MAX_ARC_PIXELS`] pixels in all and
 /// [`crate::limits::MAX_ARCS_BYTES`] of text.
+///
+/// [method §1]: crate::method#1-frames-and-units
 pub fn parse_arcs(text: &str, source_name: &str) -> Result<ArcCatalog, ConstraintError> {
     TooLarge::check_bytes(source_name, InputKind::Arcs, text.len() as u64)?;
     // `part` is the text serde_json parsed, which starts at `at` in the file.

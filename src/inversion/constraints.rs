@@ -1,5 +1,4 @@
-//! Constraint pixels: the positions `theta_i` of the rows of the linear system (METHOD.md
-//! section 3).
+//! Constraint pixels: the positions `theta_i` of the rows of the linear system ([method §3]).
 //!
 //! Each image of a multiple-image system becomes pixels in one of three modes:
 //! - `point`: its catalogue position;
@@ -19,6 +18,8 @@
 //! Systems without a redshift are left out unless `default_z` is given; systems with a single
 //! image and held-out systems are left out too; each is listed in
 //! [`ConstraintSet::excluded`].
+//!
+//! [method §3]: crate::method#3-the-linear-system
 
 use glam::DVec2;
 use serde::{Deserialize, Serialize};

@@ -1,4 +1,4 @@
-//! The cell grid: the free-form basis of WSLAP (METHOD.md sections 2 and 3).
+//! The cell grid: the free-form basis of WSLAP ([method §2] and [§3]).
 //!
 //! `N x N` square cells cover a square field; cell `j` carries a circular Gaussian of mass
 //! `m_j` centred on the cell with width `s = cell_sigma_factor * cell_size`. Cells are numbered
@@ -7,7 +7,7 @@
 //!
 //! Default width: `s = 0.75` cell. Equal masses on a square lattice of spacing `h` give a
 //! peak-to-peak ripple of about `8 exp(-2 pi^2 s^2 / h^2)` in the convergence: measured 5.9%
-//! at `s = 0.5 h` (METHOD.md: ~6%), 1.2e-4 at `s = 0.75 h` and 2e-8 at `s = h`
+//! at `s = 0.5 h` ([method §2]: ~6%), 1.2e-4 at `s = 0.75 h` and 2e-8 at `s = h`
 //! (tests/inversion.rs checks that the default is smooth and 0.5 is not). 0.75 is the
 //! narrowest width that is smooth, so it keeps the most resolution.
 //!
@@ -17,6 +17,9 @@
 //! and 2.27" at 2.0 cells, so `wslap paper` and the app's example of that cluster use 1.25. On
 //! the synthetic lens of tests/reconstruct.rs (16 x 16 cells) 1.25 doubles the image-plane rms
 //! (1.26" to 2.40"), so the general default stays at the smooth minimum.
+//!
+//! [method §2]: crate::method#2-mass-components
+//! [§3]: crate::method#3-the-linear-system
 
 use glam::DVec2;
 use serde::{Deserialize, Serialize};

@@ -1,4 +1,4 @@
-//! Member galaxies: the WSLAP+ prior (METHOD.md section 4, paper section 3).
+//! Member galaxies: the WSLAP+ prior ([method §4], paper section 3).
 //!
 //! Each member gets a luminosity `L/L* = 10^(-0.4 (mag - mag*))` and a halo mass
 //! `M = Upsilon L = Upsilon L* (L/L*)`. Defaults: `Upsilon = 20 Msun/Lsun` (the paper's
@@ -22,6 +22,8 @@
 //!
 //! Members are grouped into layers, each one column `C_l` of the linear system whose fiducial
 //! deflection is the sum of its galaxies' (`C_l = 1`: the catalogue masses are right).
+//!
+//! [method §4]: crate::method#4-member-galaxies
 
 use std::fmt;
 use std::str::FromStr;
@@ -409,10 +411,12 @@ fn member_halo(
     }
 }
 
-/// Halos (METHOD.md section 4) and layers of the members of `catalog` that lie inside the
+/// Halos ([method §4]) and layers of the members of `catalog` that lie inside the
 /// field of `grid` grown by `outside_margin_fraction` of its width; the others are left out
 /// with a warning each. Layers are split by brightness (lowest magnitude first, ties by
 /// catalogue order); empty layers are not made.
+///
+/// [method §4]: crate::method#4-member-galaxies
 pub fn build_member_layers(
     catalog: &MemberCatalog,
     config: &MemberConfig,

@@ -1,6 +1,9 @@
-//! The WSLAP+ inversion between the catalogues and the solver (METHOD.md sections 3 and 4):
+//! The WSLAP+ inversion between the catalogues and the solver ([method §3] and [§4]):
 //! the cell grid, the member-galaxy layers, the constraint pixels and the linear system
 //! `Theta = Gamma X` with its normal equations.
+//!
+//! [method §3]: crate::method#3-the-linear-system
+//! [§4]: crate::method#4-member-galaxies
 
 mod arcs;
 mod constraints;

@@ -1,4 +1,4 @@
-//! The linear system `Theta = Gamma X` of WSLAP+ (METHOD.md section 3, paper eqs. 4-7) and
+//! The linear system `Theta = Gamma X` of WSLAP+ ([method §3], paper eqs. 4-7) and
 //! its normal equations `A = Gamma^T W Gamma`, `b = -Gamma^T W Theta` (section 5).
 //!
 //! Unknowns `X = (m_1..m_Nc, C_1..C_L, beta_x,1..beta_x,Ns, beta_y,1..beta_y,Ns)`. Pixel `i`
@@ -22,12 +22,15 @@
 //!   update is not invariant under a shift of the unknowns, and so the early-stopped answer.
 //!   Measured on `wslap paper` (8000 iterations; median deflection error in the arc region of
 //!   case (ii)): S = 120" gives 2.09", the default (~240") 0.98", S = 500" 1.97". Eliminating
-//!   the betas (each at its best value for the current masses, METHOD.md section 5's other
+//!   the betas (each at its best value for the current masses, [method §5]'s other
 //!   option) lets QADP reach the over-fitted "point-source solution" within the 8000
 //!   iterations (8.8", grid mass +33% in case (iii)), so the betas stay unknowns here.
 //!
 //! `Gamma` is never held whole: rows are made in blocks of at most `block_mbytes` and fed to
 //! the normal-equation accumulator; cell columns are filled by all threads natively.
+//!
+//! [method §3]: crate::method#3-the-linear-system
+//! [method §5]: crate::method#5-the-solver-qadp
 
 use std::ops::Range;
 use std::sync::Arc;
@@ -227,8 +230,10 @@ where
 }
 
 impl LinearSystem {
-    /// Builds the system of METHOD.md section 3 for `grid`, `layers` and `constraints` on
+    /// Builds the system of [method §3] for `grid`, `layers` and `constraints` on
     /// `plane` and accumulates its normal equations block by block.
+    ///
+    /// [method §3]: crate::method#3-the-linear-system
     pub fn build(
         grid: &CellGrid,
         layers: &[Layer],

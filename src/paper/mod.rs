@@ -1,4 +1,4 @@
-//! The paper's test (Sendra et al., sections 4 and 5; METHOD.md section 8): the simulated
+//! The paper's test (Sendra et al., sections 4 and 5; [method §8]): the simulated
 //! A1689-like cluster reconstructed on a 32 x 32 grid with QADP in three cases — (i) no galaxies,
 //! (ii) the perturbed "galaxy-model" layer, (iii) the "galaxy-true" layer — and the convergence
 //! study (grid mass, C and the source-position error vs iteration from a reasonable start, a
@@ -26,6 +26,8 @@
 //! return it from every start; C ~ 1 and the soft mass can only come from where QADP is
 //! stopped. The grid mass is compared with the truth inside the arc region, where the data
 //! constrain it.
+//!
+//! [method §8]: crate::method#8-the-papers-test
 
 mod figures;
 mod markdown;

@@ -7,7 +7,7 @@
 //! - **Best fit**: the minimiser of the same objective, approached with the accelerated
 //!   projected gradient from the reasonable and the bad start, next to the chi2 of the
 //!   simulated lens itself on the same rows: whether the data's best fit is the truth.
-//! - **Sweep**: the defaults METHOD.md leaves open — the cell width (Gaussian sigma over the
+//! - **Sweep**: the defaults [`crate::method`] leaves open — the cell width (Gaussian sigma over the
 //!   cell size), the row weights, and the member scale-radius law of a layer built from the
 //!   member catalogue — and the optional prior on C (`members.c_prior_sigma`, off by default),
 //!   scored by case (ii)'s median deflection error in the arc region (the realistic case:

@@ -20,7 +20,7 @@
 //!   isodensity contours (axes `A`, `B`); the formulas use `eps = (1 - sqrt(1 - e^2))/e`
 //!   (= `(A - B)/(A + B)`; Lenstool calls it `epot`). The isodensity axis ratio is
 //!   `(1-eps)/(1+eps)`.
-//! - `angle_pos` is degrees counter-clockwise from +x, as in the frame of METHOD.md.
+//! - `angle_pos` is degrees counter-clockwise from +x, as in the frame of [method §1].
 //!
 //! `N/D` is 0/0 at `(x', y') = (0, 2 sqrt(eps) w)`; as `N conj'(N) = D conj'(D)` with
 //! `conj'(N) = A - iB`, `conj'(D) = C - iE` (`A^2 + B^2 = C^2 + E^2` exactly), the ratio equals
@@ -29,6 +29,8 @@
 //! Below [`CIRCULAR_EPSILON`] the circular formulas are used (Elíasdóttir 2007 eq. A23):
 //! `alpha = b0 s/(s-a) R [1/(sqrt(R^2+a^2)+a) - 1/(sqrt(R^2+s^2)+s)]`; every field is finite
 //! at the centre (`kappa(0) = b0/(2a)`).
+//!
+//! [method §1]: crate::method#1-frames-and-units
 
 use glam::DVec2;
 

@@ -1,10 +1,12 @@
-//! Circular Gaussian of mass: the WSLAP grid cell (METHOD.md section 2).
+//! Circular Gaussian of mass: the WSLAP grid cell ([method §2]).
 //!
 //! With `b^2 = K m / D_l` (arcsec^2, `K` = [`point_mass_deflection_arcsec2`]), width `s` (arcsec),
 //! `d = theta - theta_0`, `r = |d|` and `u = r^2 / (2 s^2)`:
 //! `kappa = m / (2 pi s^2 Sigma_cr_ref) e^-u = b^2 / (2 s^2) e^-u`,
 //! `alpha = b^2 (1 - e^-u) d / r^2`, which tends to `b^2 d / (2 s^2)` at `r = 0`.
 //! The plain `gaussian_unit_*` functions are for `b^2 = 1` and are what a grid solver calls.
+//!
+//! [method §2]: crate::method#2-mass-components
 
 use glam::DVec2;
 
@@ -121,7 +123,9 @@ pub fn gaussian_unit_kappa(dx: f64, dy: f64, sigma_arcsec: f64) -> f64 {
 
 /// Deflection of a unit Gaussian (`b^2 = 1` arcsec^2) at offset `(dx, dy)` arcsec:
 /// `(1 - e^-u) (dx, dy) / r^2` in 1/arcsec, equal to `(dx, dy) / (2 s^2)` at `r = 0`.
-/// Multiply by `K m / D_l` for a mass `m` (METHOD.md section 2).
+/// Multiply by `K m / D_l` for a mass `m` ([method §2]).
+///
+/// [method §2]: crate::method#2-mass-components
 pub fn gaussian_unit_deflection(dx: f64, dy: f64, sigma_arcsec: f64) -> (f64, f64) {
     let (r, u) = radius_and_u(dx, dy, sigma_arcsec);
     if u < SERIES_MAX_U {
@@ -140,9 +144,11 @@ const CELL_POINT_LIKE_U: f64 = 40.0;
 
 /// Deflection of a unit Gaussian cell (`K m / D_l = 1` arcsec^2) at offset `(dx, dy)` arcsec,
 /// given `inv_2s2 = 1 / (2 s^2)` in 1/arcsec^2: `(1 - e^-u) (dx, dy) / r^2`, `u = r^2 inv_2s2`,
-/// equal to `(dx, dy) inv_2s2` at `r = 0` (METHOD.md section 2). The same function as
+/// equal to `(dx, dy) inv_2s2` at `r = 0` ([method §2]). The same function as
 /// [`gaussian_unit_deflection`] (to ~1e-15 relative), written for the inner loops of the
 /// linear system and the grid's maps: one `exp_m1` near the cell, none far from it.
+///
+/// [method §2]: crate::method#2-mass-components
 #[inline]
 pub fn cell_unit_deflection(dx: f64, dy: f64, inv_2s2: f64) -> (f64, f64) {
     let r2 = dx * dx + dy * dy;

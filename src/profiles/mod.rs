@@ -1,7 +1,9 @@
 //! Mass components: one file per profile, all implementing [`MassComponent`].
 //!
-//! Positions are arcsec in the frame of METHOD.md section 1. Every quantity is for the
+//! Positions are arcsec in the frame of [method §1]. Every quantity is for the
 //! reference normalisation `D_ls/D_s = 1`: multiply by `f(z_s)` for a source at `z_s`.
+//!
+//! [method §1]: crate::method#1-frames-and-units
 
 use glam::DVec2;
 

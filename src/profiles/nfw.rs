@@ -1,5 +1,5 @@
-//! Spherical NFW halo (Navarro, Frenk & White 1997; lensing: Bartelmann 1996), METHOD.md
-//! section 2, normalised by M200 and c200 as lenstronomy's `LensCosmo.nfw_physical2angle`.
+//! Spherical NFW halo (Navarro, Frenk & White 1997; lensing: Bartelmann 1996), [method §2],
+//! normalised by M200 and c200 as lenstronomy's `LensCosmo.nfw_physical2angle`.
 //!
 //! With `x = R / r_s` and `kappa_s = rho_s r_s / Sigma_cr_ref` (`D_ls/D_s = 1`):
 //! `kappa = 2 kappa_s G(x)`, mean convergence inside `R` `= 4 kappa_s h(x) / x^2`,
@@ -7,6 +7,8 @@
 //! (`G`, `h` in [`nfw_terms`]). The Hessian uses `gamma_t = mean kappa - kappa`.
 //! The convergence diverges like `ln(1/x)` at the centre: inside `x <` [`X_FLOOR`] it is held
 //! at its value there; the deflection goes to zero and the shear tends to `kappa_s`.
+//!
+//! [method §2]: crate::method#2-mass-components
 
 use glam::DVec2;
 

@@ -1,4 +1,4 @@
-//! Elliptical NFW halo with the ellipticity in the convergence (METHOD.md section 2;
+//! Elliptical NFW halo with the ellipticity in the convergence ([method §2];
 //! lenstronomy's `NFW_ELLIPSE_CSE`): `kappa(x', y') = kappa_NFW(R)`, `R^2 = q x'^2 + y'^2 / q`,
 //! `x'` along the major axis at position angle `pa` (degrees counter-clockwise from +x), so the
 //! area inside each iso-density ellipse, and hence the enclosed mass, is that of the sphere.
@@ -19,6 +19,8 @@
 //! convergence falls as `R^-3` instead of `R^-2`. The convergence returned by
 //! [`MassComponent::kappa`] is the CSE sum, so that it equals half the trace of the Hessian;
 //! [`NfwEllipse::kappa_exact`] gives the exact elliptical NFW convergence.
+//!
+//! [method §2]: crate::method#2-mass-components
 
 use glam::DVec2;
 

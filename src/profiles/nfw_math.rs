@@ -1,4 +1,4 @@
-//! Shared maths of the NFW family (METHOD.md section 2): the dimensionless functions of
+//! Shared maths of the NFW family ([method §2]): the dimensionless functions of
 //! `x = R / r_s`, the M200/c200 normalisation, and the axially symmetric field assembly.
 //!
 //! With `u = 1 - x^2`:
@@ -8,6 +8,8 @@
 //! Near `x = 1` both `F = sum_n u^n/(2n+1)` and `G = sum_n u^n/(2n+3)` are summed as series;
 //! for small `x` `h` is evaluated in a cancellation-free form. Below [`X_FLOOR`] every function
 //! is evaluated at `X_FLOOR` (the convergence diverges like `ln(1/x)` at the centre).
+//!
+//! [method §2]: crate::method#2-mass-components
 
 use glam::DVec2;
 

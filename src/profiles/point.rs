@@ -1,4 +1,4 @@
-//! Point mass (METHOD.md sections 1 and 2).
+//! Point mass ([method §1] and [§2]).
 //!
 //! With `b^2 = K m / D_l` (`K` = [`point_mass_deflection_arcsec2`], the squared Einstein radius
 //! for `D_ls/D_s = 1`) and `d = theta - theta_0`, `r = |d|`:
@@ -7,6 +7,9 @@
 //! Inside the tiny radius [`POINT_CORE_ARCSEC`] the mass is spread uniformly over the disk:
 //! `kappa = b^2 / r_c^2`, `alpha = b^2 d / r_c^2`, so every field is finite (deflection 0 at
 //! `r = 0`) and the deflection outside the core is exact.
+//!
+//! [method §1]: crate::method#1-frames-and-units
+//! [§2]: crate::method#2-mass-components
 
 use glam::DVec2;
 
@@ -28,7 +31,9 @@ pub struct PointMass {
 }
 
 impl PointMass {
-    /// A point of `mass_msun` (Msun) on `plane`: `theta_E,ref^2 = K m / D_l` (METHOD.md section 1).
+    /// A point of `mass_msun` (Msun) on `plane`: `theta_E,ref^2 = K m / D_l` ([method §1]).
+    ///
+    /// [method §1]: crate::method#1-frames-and-units
     pub fn new(center: DVec2, mass_msun: f64, plane: &LensPlane) -> Result<Self, ProfileError> {
         let mass_msun = require_positive("point", "mass", mass_msun)?;
         let theta_e2 = point_mass_deflection_arcsec2() * mass_msun / plane.d_l_mpc;

@@ -1,4 +1,4 @@
-//! Singular isothermal sphere (METHOD.md section 2).
+//! Singular isothermal sphere ([method §2]).
 //!
 //! With `theta_E = 4 pi (sigma_v / c)^2` (radians, `D_ls/D_s = 1`) and `r = |theta - theta_0|`:
 //! `psi = theta_E r`, `kappa = theta_E / (2 r)`, `alpha = theta_E (theta - theta_0) / r`.
@@ -8,6 +8,8 @@
 //! `kappa = theta_E / r_c`, `alpha = theta_E (theta - theta_0) / r_c`, so every field is finite
 //! (deflection 0 at `r = 0`, a large finite kappa) and the enclosed mass is unchanged for
 //! `r >= r_c`.
+//!
+//! [method §2]: crate::method#2-mass-components
 
 use glam::DVec2;
 

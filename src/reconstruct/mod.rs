@@ -2,7 +2,10 @@
 //! member-galaxy layers, the linear system, QADP, and the products of the solution (maps,
 //! curves, per-system source positions, predicted images and their offsets, hold-out tests).
 //!
-//! The pipeline of the paper (Sendra et al., section 2) and METHOD.md sections 3 to 6.
+//! The pipeline of the paper (Sendra et al., section 2) and [method §3] to [§6].
+//!
+//! [method §3]: crate::method#3-the-linear-system
+//! [§6]: crate::method#6-products
 
 mod config;
 mod crossval;

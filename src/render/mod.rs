@@ -1,9 +1,11 @@
 //! Figures of maps with tiny-skia: the convergence map colour-mapped, with axes in arcsec, a
-//! colour bar, critical curves, point overlays and a legend (METHOD.md section 6).
+//! colour bar, critical curves, point overlays and a legend ([method §6]).
 //!
 //! Orientation: pixel `i` of the map (+x, West for HFF maps with `CDELT1 < 0`) grows to the
 //! right and row `j` (+y, North) grows upward, as DS9 shows the FITS file; so East is to the
 //! left, as on the sky. Rendering is deterministic (no system fonts; a built-in bitmap font).
+//!
+//! [method §6]: crate::method#6-products
 
 use glam::DVec2;
 use serde::{Deserialize, Serialize};
@@ -110,8 +112,10 @@ pub enum LegendPlace {
     Below,
 }
 
-/// A labelled set of positions (arcsec, frame of METHOD.md section 1), e.g. observed images.
+/// A labelled set of positions (arcsec, frame of [method §1]), e.g. observed images.
 /// A set with an empty `label` is drawn but has no legend entry.
+///
+/// [method §1]: crate::method#1-frames-and-units
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct OverlayPoints {
     pub label: String,
@@ -121,8 +125,10 @@ pub struct OverlayPoints {
     pub marker: Marker,
 }
 
-/// Labelled polylines (arcsec, frame of METHOD.md section 1) drawn over the map, e.g. the
+/// Labelled polylines (arcsec, frame of [method §1]) drawn over the map, e.g. the
 /// critical curves of another lens. A set with an empty `label` has no legend entry.
+///
+/// [method §1]: crate::method#1-frames-and-units
 #[derive(Debug, Clone, PartialEq)]
 pub struct OverlayLines {
     pub label: String,

@@ -1,4 +1,4 @@
-//! The simulated A1689-like cluster (paper section 4, METHOD.md section 8): 94 elliptical NFW
+//! The simulated A1689-like cluster (paper section 4, [method §8]): 94 elliptical NFW
 //! galaxy halos ("galaxy-true"), a smooth cluster halo ("soft") of three elliptical NFW
 //! components, and the perturbed galaxies ("galaxy-model").
 //!
@@ -28,6 +28,8 @@
 //!
 //! Galaxy-model: the same positions, `M200` and `r_s` each multiplied by `exp(sigma g)`
 //! with independent standard normal `g` (`sigma = model_scatter`, default 0.2: ~20%).
+//!
+//! [method §8]: crate::method#8-the-papers-test
 
 use glam::DVec2;
 

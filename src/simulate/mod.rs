@@ -1,4 +1,4 @@
-//! The simulated A1689-like cluster of the WSLAP+ paper (section 4; METHOD.md section 8): the
+//! The simulated A1689-like cluster of the WSLAP+ paper (section 4; [method §8]): the
 //! data set on which the three reconstruction cases are run, and the app's built-in example.
 //!
 //! A cluster at `z_l = 0.185` made of 94 elliptical NFW galaxy halos ("galaxy-true") and a
@@ -9,6 +9,8 @@
 //! pixel above 1% of its source's peak brightness being one constraint (`raytrace`,
 //! `sources`). Everything is deterministic for a seed (own SplitMix64 generator) and runs
 //! without threads or files, so the same simulation is made in the browser.
+//!
+//! [method §8]: crate::method#8-the-papers-test
 
 use glam::DVec2;
 use serde::{Deserialize, Serialize};

@@ -1,5 +1,5 @@
 //! Ray shooting through the truth lens: every pixel centre `theta` of the field is mapped to
-//! `beta = theta - f alpha_ref(theta)` (METHOD.md section 1), the source's surface brightness is
+//! `beta = theta - f alpha_ref(theta)` ([method §1]), the source's surface brightness is
 //! read there, and the pixels above a threshold are grouped into images.
 //!
 //! Sources are elliptical Sérsic profiles normalised to their peak,
@@ -8,6 +8,8 @@
 //! (Ciotti & Bertin 1999), so `R_e` is the half-light radius. A pixel belongs to a system when
 //! its brightness is at least [`THRESHOLD_FRACTION`] of the source's peak, i.e. when
 //! `R <= R_thr = R_e (ln(1/THRESHOLD_FRACTION) / b_n)^n` (2.74 `R_e` for n = 1).
+//!
+//! [method §1]: crate::method#1-frames-and-units
 
 use glam::DVec2;
 

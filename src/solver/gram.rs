@@ -1,5 +1,5 @@
 //! The normal equations of the weighted least-squares system `Gamma X = Theta`:
-//! `A = Gamma^T W Gamma` and `b = -Gamma^T W Theta` (METHOD.md section 5), accumulated from
+//! `A = Gamma^T W Gamma` and `b = -Gamma^T W Theta` ([method §5]), accumulated from
 //! blocks of rows so that `Gamma` never has to exist whole.
 //!
 //! `A += G^T W G` for a block `G` of rows is a symmetric rank-k update. Only the upper triangle
@@ -9,6 +9,8 @@
 //! accumulates `sum_r g_ri (w_r g_rj)`. Natively the rows of `A` are shared between threads in
 //! bands of equal work; on x86-64 with AVX2 and FMA (checked at run time) the tile loop is
 //! compiled for those instructions.
+//!
+//! [method §5]: crate::method#5-the-solver-qadp
 
 use super::{check_finite, check_len, SolverError};
 

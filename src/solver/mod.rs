@@ -1,4 +1,4 @@
-//! Non-negative quadratic programming for the WSLAP+ linear system (METHOD.md section 5).
+//! Non-negative quadratic programming for the WSLAP+ linear system ([method §5]).
 //!
 //! The inversion minimises `phi(X) = 1/2 X^T A X + b^T X` subject to `X >= 0`, with
 //! `A = Gamma^T W Gamma` (symmetric positive semi-definite, dense) and `b = -Gamma^T W Theta`.
@@ -19,6 +19,8 @@
 //!   reproduce: whether the data measure them at all.
 //!
 //! All matrices are dense, row-major `&[f64]` of `n * n` values.
+//!
+//! [method §5]: crate::method#5-the-solver-qadp
 
 mod accelerated;
 mod gram;

@@ -1,6 +1,6 @@
 //! QADP: the multiplicative update of Sha, Saul & Lee (2002, "Multiplicative updates for
 //! nonnegative quadratic programming in support vector machines", NIPS 15) for
-//! `min phi(X) = 1/2 X^T A X + b^T X` subject to `X >= 0` (METHOD.md section 5):
+//! `min phi(X) = 1/2 X^T A X + b^T X` subject to `X >= 0` ([method §5]):
 //!
 //! ```text
 //! a = A+ X,  c = A- X,  X_i <- X_i * (-b_i + sqrt(b_i^2 + 4 a_i c_i)) / (2 a_i)
@@ -22,6 +22,8 @@
 //!   entries have one sign cost half, and [`QadpProblem::with_order`] stores neighbouring grid
 //!   cells next to each other to make them long. Natively the rows are split into bands, one
 //!   per thread, with two barriers per iteration.
+//!
+//! [method §5]: crate::method#5-the-solver-qadp
 
 use super::sweep::{run_chunks, ScaledProblem};
 use super::{

@@ -1,6 +1,8 @@
-//! Lenstool catalogues (METHOD.md section 7): the real AS1063 and MACS1931 inputs in
+//! Lenstool catalogues ([method §7]): the real AS1063 and MACS1931 inputs in
 //! ../shared/data (native only), the formats' variants and frame changes, and one test per bad
 //! input, each expecting its specific error text.
+//!
+//! [method §7]: wslap::method#7-file-formats
 
 use crate::common;
 
@@ -27,7 +29,9 @@ fn as1063_reference() -> SkyReference {
     SkyReference::new(AS1063_RA0, AS1063_DEC0).unwrap()
 }
 
-/// `x = -(RA - RA0) cos(Dec0) 3600`, `y = (Dec - Dec0) 3600` (METHOD.md section 1).
+/// `x = -(RA - RA0) cos(Dec0) 3600`, `y = (Dec - Dec0) 3600` ([method §1]).
+///
+/// [method §1]: wslap::method#1-frames-and-units
 fn lenstool_offset(ra: f64, dec: f64, ra0: f64, dec0: f64) -> DVec2 {
     DVec2::new(
         -(ra - ra0) * dec0.to_radians().cos() * 3600.0,

@@ -22,8 +22,10 @@ const GOLDEN_LOG: &[u8] = include_bytes!("../data/golden/kappa_log_magma.png");
 
 /// float32 storage: relative precision 2^-24 ~ 6e-8; values here are O(1).
 const F32_ATOL: f64 = 1e-6;
-/// Our linear tangent-plane frame (METHOD.md sec. 1) vs astropy's exact TAN projection: for
+/// Our linear tangent-plane frame ([method §1]) vs astropy's exact TAN projection: for
 /// offsets of a few arcsec the second-order difference is < 1e-4 arcsec; 1e-3 arcsec in degrees.
+///
+/// [method §1]: wslap::method#1-frames-and-units
 const WCS_ATOL_DEG: f64 = 1e-3 / 3600.0;
 /// Region coordinates written with 8 decimals in degrees.
 const REGION_ATOL_DEG: f64 = 1e-7;

@@ -1,10 +1,12 @@
-//! The simulated A1689-like cluster (`wslap::simulate`, METHOD.md section 8): masses measured
+//! The simulated A1689-like cluster (`wslap::simulate`, [method §8]): masses measured
 //! independently from kappa maps, arcs traced back through the truth lens, radial arcs,
 //! catalogues read back with the project's parsers, determinism, and the CLI.
 //!
 //! Most tests share one simulation at 1 arcsec pixels (a quarter of the default's ray-tracing
 //! cost) so the file stays fast in a debug build; the cluster itself does not depend on the
 //! pixel size.
+//!
+//! [method §8]: wslap::method#8-the-papers-test
 
 use crate::common;
 

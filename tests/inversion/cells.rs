@@ -1,5 +1,7 @@
-//! The cell grid (METHOD.md section 3): its geometry and automatic field, refinement of the
+//! The cell grid ([method §3]): its geometry and automatic field, refinement of the
 //! densest cells, the smoothness of the default cell width, and the fast cell kernel.
+//!
+//! [method §3]: wslap::method#3-the-linear-system
 
 use crate::common::{assert_abs, assert_rel};
 use glam::DVec2;

@@ -1,5 +1,7 @@
-//! Constraint pixels and weights (METHOD.md section 4): ellipse pixels, the three weightings,
+//! Constraint pixels and weights ([method §4]): ellipse pixels, the three weightings,
 //! systems left out (redshift, single image, hold-out), and arcs files.
+//!
+//! [method §4]: wslap::method#4-member-galaxies
 
 use crate::common::assert_rel;
 use crate::fixtures::{image, system, three_systems};

@@ -1,5 +1,7 @@
-//! Member galaxies (METHOD.md section 3): masses from magnitudes, truncated-NFW halos, layer
+//! Member galaxies ([method §3]): masses from magnitudes, truncated-NFW halos, layer
 //! splits, and members outside the field.
+//!
+//! [method §3]: wslap::method#3-the-linear-system
 
 use crate::common::{assert_abs, assert_rel};
 use crate::fixtures::{member, members, plane};

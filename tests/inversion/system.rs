@@ -1,6 +1,8 @@
-//! The linear system (METHOD.md section 4): `Gamma X` is the lens equation of the
+//! The linear system ([method §4]): `Gamma X` is the lens equation of the
 //! reconstructed lens, normal equations from blocks, the frame shift, the prior on C, and
 //! the NumPy export.
+//!
+//! [method §4]: wslap::method#4-member-galaxies
 
 use crate::common::{assert_abs, assert_rel};
 use crate::fixtures::{members, plane, three_systems};

@@ -1,6 +1,8 @@
-//! The NFW family (METHOD.md section 2): spherical NFW, elliptical NFW (CSE decomposition) and
+//! The NFW family ([method §2]): spherical NFW, elliptical NFW (CSE decomposition) and
 //! truncated NFW, against lenstronomy and mpmath (tests/data/nfw_reference.py), analytic
 //! identities, consistency loops, finiteness everywhere, and bad parameters.
+//!
+//! [method §2]: wslap::method#2-mass-components
 
 use crate::common;
 
@@ -15,7 +17,7 @@ use wslap::{Cosmology, LensPlane, MassComponent};
 use std::f64::consts::PI;
 
 /// Scales vs astropy: constants are identical and our distances match astropy's to ~1e-13
-/// here (measured 3e-14; METHOD.md asks 1e-6 in general).
+/// here (measured 3e-14; [`wslap::method`] asks 1e-6 in general).
 const SCALES_RTOL: f64 = 1e-9;
 /// lenstronomy's `nfw_physical2angle` uses older G and M_sun (alpha_Rs off by 2.8e-4).
 const LENSCOSMO_RTOL: f64 = 5e-4;

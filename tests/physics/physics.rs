@@ -13,7 +13,9 @@ use wslap::profiles::{
 };
 use wslap::{Cosmology, CosmologyError, LensPlane, MassComponent};
 
-/// Distances, densities and ratios vs astropy (METHOD.md section 1 asks for 1e-6).
+/// Distances, densities and ratios vs astropy ([method §1] asks for 1e-6).
+///
+/// [method §1]: wslap::method#1-frames-and-units
 const COSMOLOGY_RTOL: f64 = 1e-6;
 /// Fields vs lenstronomy: the same formulae with the same constants (errors reached ~3e-14);
 /// 1e-9 leaves room for distance differences far below COSMOLOGY_RTOL, and is tighter than the
@@ -221,7 +223,7 @@ fn point_mass_einstein_radius() {
     let lp = plane(0.3);
     let m = 1.0e12;
     let pm = PointMass::new(DVec2::ZERO, m, &lp).expect("valid point mass");
-    let expected = (8.14385e-9 * m / lp.d_l_mpc).sqrt(); // METHOD.md section 1
+    let expected = (8.14385e-9 * m / lp.d_l_mpc).sqrt(); // wslap::method §1
     assert_rel("point theta_E", pm.theta_e_ref_arcsec(), expected, 1e-5);
     let p = DVec2::new(0.0, pm.theta_e_ref_arcsec());
     assert_rel(

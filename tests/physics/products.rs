@@ -1,5 +1,7 @@
-//! Map products (METHOD.md section 6): lens maps, magnification, critical curves, caustics,
+//! Map products ([method §6]): lens maps, magnification, critical curves, caustics,
 //! Einstein radius and radial profiles, checked on analytic lenses.
+//!
+//! [method §6]: wslap::method#6-products
 
 use crate::common;
 
