@@ -94,10 +94,6 @@ pub enum SolverError {
     BadFieldValue(#[from] crate::error::BadFieldValue),
     #[error("solver: the exact solver handles at most {max} unknowns, got {n}")]
     TooLarge { n: usize, max: usize },
-    #[error("solver: the exact solver met a singular subproblem when freeing unknown {index} (pivot {pivot:e}); A must be positive definite on the free set")]
-    Singular { index: usize, pivot: f64 },
-    #[error("solver: the exact solver did not converge in {iterations} active-set changes")]
-    NotConverged { iterations: usize },
 }
 
 /// Relative tolerance of the symmetry check: `|A_ij - A_ji| <= SYMMETRY_RTOL * sqrt(A_ii A_jj)`.

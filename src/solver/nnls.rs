@@ -9,7 +9,7 @@
 //! feasible region the step is cut at the first boundary and those unknowns leave `P`. It
 //! stops when the gradient is `>= -tol` on every fixed unknown (the KKT conditions).
 
-use super::{validate_system, SolverError};
+use super::{objective, validate_system, SolveOutcome, SolveStatus, SolverError};
 
 /// Largest problem [`nnqp_exact`] accepts: each active-set change refactorises `A_PP`
 /// (`|P|^3 / 3` operations), which is meant for test problems.
@@ -24,8 +24,11 @@ const PIVOT_RTOL: f64 = 1e-13;
 
 /// The exact minimiser of `1/2 x^T A x + b^T x` over `x >= 0` for `A` row-major `n * n`
 /// (symmetric positive definite on the free sets visited, e.g. `A = G^T G` with `G` of full
-/// column rank) and `n <= NNQP_EXACT_MAX_UNKNOWNS`.
-pub fn nnqp_exact(a: &[f64], b: &[f64], n: usize) -> Result<Vec<f64>, SolverError> {
+/// column rank) and `n <= NNQP_EXACT_MAX_UNKNOWNS`. The status says how it ended:
+/// [`SolveStatus::Converged`] (every optimality condition holds), [`SolveStatus::Completed`]
+/// (the limit of `10 n + 100` active-set changes was reached first) or
+/// [`SolveStatus::Singular`] (`A` is singular on a free set); `iterations` counts the changes.
+pub fn nnqp_exact(a: &[f64], b: &[f64], n: usize) -> Result<SolveOutcome, SolverError> {
     validate_system(a, b, n)?;
     if n > NNQP_EXACT_MAX_UNKNOWNS {
         return Err(SolverError::TooLarge {
@@ -46,19 +49,19 @@ pub fn nnqp_exact(a: &[f64], b: &[f64], n: usize) -> Result<Vec<f64>, SolverErro
             .filter(|&j| !free[j] && !skipped[j] && gradient[j] < -tol)
             .min_by(|&i, &j| gradient[i].total_cmp(&gradient[j]));
         let Some(j) = entering else {
-            return Ok(x);
+            return Ok(outcome(a, b, x, changes, SolveStatus::Converged));
         };
-        changes += 1;
-        if changes > max_changes {
-            return Err(SolverError::NotConverged {
-                iterations: max_changes,
-            });
+        if changes == max_changes {
+            return Ok(outcome(a, b, x, changes, SolveStatus::Completed));
         }
+        changes += 1;
         free[j] = true;
         let mut first = true;
         loop {
             let set: Vec<usize> = (0..n).filter(|&i| free[i]).collect();
-            let s = solve_free(a, b, n, &set, j)?;
+            let Some(s) = solve_free(a, b, n, &set) else {
+                return Ok(outcome(a, b, x, changes, SolveStatus::Singular));
+            };
             if s.iter().all(|&v| v > 0.0) {
                 for (&i, &v) in set.iter().zip(&s) {
                     x[i] = v;
@@ -92,6 +95,15 @@ pub fn nnqp_exact(a: &[f64], b: &[f64], n: usize) -> Result<Vec<f64>, SolverErro
     }
 }
 
+fn outcome(a: &[f64], b: &[f64], x: Vec<f64>, changes: usize, status: SolveStatus) -> SolveOutcome {
+    SolveOutcome {
+        objective: objective(a, b, &x),
+        x,
+        iterations: changes,
+        status,
+    }
+}
+
 /// The gradient `A x + b` and `max_i (|b_i| + sum_j |A_ij| x_j)`.
 fn gradient_and_scale(a: &[f64], b: &[f64], x: &[f64], n: usize) -> (Vec<f64>, f64) {
     let mut scale = 0.0f64;
@@ -111,15 +123,9 @@ fn gradient_and_scale(a: &[f64], b: &[f64], x: &[f64], n: usize) -> (Vec<f64>, f
     (gradient, scale)
 }
 
-/// `x_P = -A_PP^{-1} b_P` by Cholesky, for the free set `set`; `entering` names the unknown in
-/// the error if a pivot is too small.
-fn solve_free(
-    a: &[f64],
-    b: &[f64],
-    n: usize,
-    set: &[usize],
-    entering: usize,
-) -> Result<Vec<f64>, SolverError> {
+/// `x_P = -A_PP^{-1} b_P` by Cholesky, for the free set `set`; `None` when a pivot is too small
+/// (`A_PP` numerically singular).
+fn solve_free(a: &[f64], b: &[f64], n: usize, set: &[usize]) -> Option<Vec<f64>> {
     let m = set.len();
     let max_diag = set.iter().map(|&i| a[i * n + i]).fold(0.0, f64::max);
     let mut l = vec![0.0; m * m];
@@ -129,10 +135,7 @@ fn solve_free(
             let v = a[set[r] * n + set[c]] - dot;
             if r == c {
                 if v <= PIVOT_RTOL * max_diag {
-                    return Err(SolverError::Singular {
-                        index: entering,
-                        pivot: v,
-                    });
+                    return None;
                 }
                 l[r * m + r] = v.sqrt();
             } else {
@@ -150,5 +153,5 @@ fn solve_free(
         let dot: f64 = ((r + 1)..m).map(|k| l[k * m + r] * y[k]).sum();
         y[r] = (y[r] - dot) / l[r * m + r];
     }
-    Ok(y)
+    Some(y)
 }

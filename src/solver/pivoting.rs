@@ -237,7 +237,7 @@ mod tests {
         for seed in 1..6 {
             let n = 40;
             let (a, b) = system(n, seed);
-            let exact = nnqp_exact(&a, &b, n).unwrap();
+            let exact = nnqp_exact(&a, &b, n).unwrap().x;
             let out = minimise_exact(&a, &b, n, 500, &mut never).unwrap();
             assert_eq!(out.status, SolveStatus::Converged);
             let zeros = exact.iter().filter(|&&v| v == 0.0).count();

@@ -33,6 +33,9 @@ pub enum SolveStatus {
     /// The objective stopped being finite (only possible when `A` is not positive
     /// semi-definite or the objective is unbounded); the outcome is the last finite state.
     Diverged,
+    /// The exact reference solver ([`super::nnqp_exact`]) met a free set on which `A` is
+    /// numerically singular and cannot go on; the outcome is the last feasible state.
+    Singular,
 }
 
 impl SolveStatus {
@@ -43,6 +46,7 @@ impl SolveStatus {
             Self::Converged => "Converged",
             Self::Cancelled => "Cancelled",
             Self::Diverged => "Diverged",
+            Self::Singular => "Singular",
         }
     }
 }

@@ -36,6 +36,13 @@ const GRAM_RTOL: f64 = 1e-12;
 
 use common::rng::Rng;
 
+/// The reference minimiser: [`nnqp_exact`]'s answer, which must have converged.
+fn exact_minimiser(a: &[f64], b: &[f64], n: usize) -> Vec<f64> {
+    let outcome = nnqp_exact(a, b, n).expect("exact solver");
+    assert_eq!(outcome.status, SolveStatus::Converged, "{outcome:?}");
+    outcome.x
+}
+
 /// `A = G^T G`, `b = -G^T y` with `G` (2n x n) Gaussian and `y = G x_true + noise`, where
 /// about a third of `x_true` is negative, so that the optimum has components at 0.
 fn random_problem(rng: &mut Rng, n: usize) -> (Vec<f64>, Vec<f64>) {
@@ -81,7 +88,7 @@ fn qadp_matches_exact_on_random_problems() {
     for case in 0..20 {
         let n = 5 + case * 55 / 19;
         let (a, b) = random_problem(&mut rng, n);
-        let exact = nnqp_exact(&a, &b, n).expect("exact solver");
+        let exact = exact_minimiser(&a, &b, n);
         let phi_star = objective(&a, &b, &exact);
         assert!(exact.contains(&0.0), "case {case}: some optimal x_i = 0");
         let problem = QadpProblem::new(&a, &b, n).expect("valid problem");
@@ -129,7 +136,7 @@ fn diagonal_problem_has_closed_form_optimum() {
         a[i * n + i] = d[i];
     }
     let expected: Vec<f64> = (0..n).map(|i| (-b[i] / d[i]).max(0.0)).collect();
-    let exact = nnqp_exact(&a, &b, n).expect("exact solver");
+    let exact = exact_minimiser(&a, &b, n);
     let problem = QadpProblem::new(&a, &b, n).expect("valid problem");
     let settings = QadpSettings {
         iterations: 50,
@@ -151,7 +158,7 @@ fn two_by_two_with_active_bound() {
     // constrained one is (1/2, 0) with phi = -1/4 (gradient of x_2 there: 1/2 + 1 > 0).
     let a = [2.0, 1.0, 1.0, 2.0];
     let b = [-1.0, 1.0];
-    let exact = nnqp_exact(&a, &b, 2).expect("exact solver");
+    let exact = exact_minimiser(&a, &b, 2);
     common::assert_abs("exact x_1", exact[0], 0.5, EXACT_RTOL);
     common::assert_abs("exact x_2", exact[1], 0.0, EXACT_RTOL);
     let problem = QadpProblem::new(&a, &b, 2).expect("valid problem");
@@ -227,7 +234,7 @@ fn reports_at_start_every_k_and_at_the_end() {
 fn zero_start_component_stays_zero() {
     let n = 20;
     let (a, b) = random_problem(&mut Rng(9), n);
-    let exact = nnqp_exact(&a, &b, n).expect("exact solver");
+    let exact = exact_minimiser(&a, &b, n);
     let k = exact
         .iter()
         .position(|&v| v > 0.1)
@@ -644,7 +651,7 @@ fn accelerated_gradient_matches_exact_on_random_problems() {
     for case in 0..20 {
         let n = 5 + case * 55 / 19;
         let (a, b) = random_problem(&mut rng, n);
-        let exact = nnqp_exact(&a, &b, n).expect("exact solver");
+        let exact = exact_minimiser(&a, &b, n);
         let phi_star = objective(&a, &b, &exact);
         let settings = QadpSettings {
             iterations: 3000,
@@ -683,7 +690,7 @@ fn accelerated_gradient_matches_exact_on_random_problems() {
 fn accelerated_gradient_goes_further_than_qadp_per_iteration() {
     let n = 60;
     let (a, b) = random_problem(&mut Rng(31), n);
-    let phi_star = objective(&a, &b, &nnqp_exact(&a, &b, n).expect("exact solver"));
+    let phi_star = objective(&a, &b, &exact_minimiser(&a, &b, n));
     let settings = QadpSettings {
         iterations: 300,
         report_every: 300,
