@@ -33,7 +33,7 @@ impl SkyReference {
             && dec_deg.abs() < 90.0
             && ra_deg.abs() <= 360.0;
         ok.then(|| Self {
-            ra_deg: ra_deg.rem_euclid(360.0),
+            ra_deg: wrap_ra(ra_deg),
             dec_deg,
         })
     }
@@ -53,7 +53,18 @@ impl SkyReference {
     /// [`Self::to_offset_arcsec`], RA wrapped to `[0, 360)`.
     pub fn offset_to_radec(&self, p: DVec2) -> (f64, f64) {
         let ra = self.ra_deg - p.x / 3600.0 / self.dec_deg.to_radians().cos();
-        (ra.rem_euclid(360.0), self.dec_deg + p.y / 3600.0)
+        (wrap_ra(ra), self.dec_deg + p.y / 3600.0)
+    }
+}
+
+/// RA in `[0, 360)` degrees: `rem_euclid` alone gives 360.0 for a tiny negative angle (found
+/// by fuzzing, fuzz/regressions/fits_roundtrip/).
+fn wrap_ra(ra_deg: f64) -> f64 {
+    let ra = ra_deg.rem_euclid(360.0);
+    if ra < 360.0 {
+        ra
+    } else {
+        0.0
     }
 }
 
@@ -76,5 +87,14 @@ mod tests {
         assert!(SkyReference::new(10.0, 90.0).is_none());
         assert!(SkyReference::new(f64::NAN, 0.0).is_none());
         assert_eq!(SkyReference::new(-10.0, 5.0).unwrap().ra_deg, 350.0);
+    }
+
+    #[test]
+    fn tiny_negative_ra_wraps_below_360() {
+        for ra in [-1e-17, -9.8e-310] {
+            assert_eq!(SkyReference::new(ra, 5.0).unwrap().ra_deg, 0.0, "{ra}");
+        }
+        let r = SkyReference::new(0.0, 0.0).unwrap();
+        assert!(r.offset_to_radec(DVec2::new(1e-15, 0.0)).0 < 360.0);
     }
 }
