@@ -89,7 +89,7 @@ put("ds9_regions", "arcs.reg",
     '-circle(197.8700,-1.3401,0.3")\nbox(13:11:29.1,-01:20:24.5,1\',3",20) # text="3.1" color=red\n'
     "icrs; circle point 197.87 -1.34 # text={3.2}\n")
 
-# Lenstool .par: the CATS-like file of tests/dpie.rs.
+# Lenstool .par: the CATS-like file of tests/physics/dpie.rs.
 def test_source_with(marker):
     for d, _, files in os.walk(os.path.join(ROOT, "tests")):
         for name in sorted(files):

@@ -14,7 +14,7 @@ use wslap::catalog::{parse_image_catalog, parse_member_catalog, ImageCatalog, Me
 use wslap::ds9::{read_regions, Ds9Frame, Region, Shape};
 use wslap::fits::{read_image, write_image, FitsWriteOptions};
 use wslap::grid::{Map, MapGeometry};
-use wslap::inversion::{arcs_from_regions, parse_arcs, ArcCatalog};
+use wslap::arcs::{arcs_from_regions, parse_arcs, ArcCatalog};
 use wslap::lenstool_par::parse_par;
 use wslap::model::ModelFile;
 use wslap::profiles::MassComponent;

@@ -8,6 +8,7 @@
 //! [method §1]: crate::method#1-frames-and-units
 
 pub mod app;
+pub mod arcs;
 pub mod catalog;
 pub mod cosmology;
 pub mod curves;

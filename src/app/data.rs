@@ -4,11 +4,11 @@
 use glam::DVec2;
 use serde::{Deserialize, Serialize};
 
+use crate::arcs::{is_region_file, ArcCatalog};
 use crate::catalog::{parse_image_catalog, parse_member_catalog, ImageCatalog};
 use crate::cosmology::LensPlane;
 use crate::fits::read_image;
 use crate::grid::Map;
-use crate::inversion::{is_region_file, ArcCatalog};
 use crate::lenstool_par::parse_par;
 use crate::model::ModelFile;
 use crate::profiles::Lens;
@@ -25,7 +25,7 @@ pub enum DataRole {
     Images,
     /// Lenstool member catalogue (`id x y a b theta mag lum`).
     Members,
-    /// Arc pixels, JSON or DS9 regions (see [`crate::inversion::parse_arcs`]).
+    /// Arc pixels, JSON or DS9 regions (see [`crate::arcs::parse_arcs`]).
     Arcs,
     /// Parametric model file (forward mode).
     Model,

@@ -27,7 +27,7 @@ use thiserror::Error;
 
 use crate::catalog::ImageCatalog;
 
-use super::arcs::ArcCatalog;
+use crate::arcs::ArcCatalog;
 
 /// What can be wrong with constraint settings or inputs.
 #[derive(Debug, Error, Clone, PartialEq)]
@@ -39,36 +39,6 @@ pub enum ConstraintError {
         mode: &'static str,
         given: &'static str,
     },
-    #[error("{source_name}: line {line}, column {column}: {message}")]
-    ArcsSyntax {
-        source_name: String,
-        line: usize,
-        column: usize,
-        message: String,
-    },
-    /// One system of an arcs file; `line` is where the system's object starts.
-    #[error("{source_name}: line {line}: system {system}: {reason}")]
-    ArcsSystem {
-        source_name: String,
-        line: usize,
-        system: String,
-        reason: String,
-    },
-    #[error(transparent)]
-    TooLarge(#[from] crate::limits::TooLarge),
-    /// A DS9 region file that does not parse (the message names the file and line).
-    #[error(transparent)]
-    Regions(crate::ds9::Ds9Error),
-    /// One region of a DS9 region file used as arcs.
-    #[error("{source_name}: line {line}: {reason}")]
-    RegionLine {
-        source_name: String,
-        line: usize,
-        reason: String,
-    },
-    /// A DS9 region file as a whole.
-    #[error("{source_name}: {reason}")]
-    RegionFile { source_name: String, reason: String },
     #[error("{source_name}: line {line}: image {id}: {field} = {value} is not allowed ({reason})")]
     BadImage {
         source_name: String,

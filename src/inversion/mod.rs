@@ -5,18 +5,15 @@
 //! [method §3]: crate::method#3-the-linear-system
 //! [§4]: crate::method#4-member-galaxies
 
-mod arcs;
 mod constraints;
 mod grid;
 mod grid_fft;
 mod members;
 mod npy;
-mod regions;
 mod regularise;
 mod system;
 
 pub use crate::profiles::cell_unit_deflection;
-pub use arcs::{parse_arcs, ArcCatalog, ArcSystem};
 pub use constraints::{
     build_constraints, ellipse_pixels, ConstraintConfig, ConstraintError, ConstraintMode,
     ConstraintPixel, ConstraintSet, ConstraintSource, ConstraintSystem, ExcludedSystem, Exclusion,
@@ -29,7 +26,6 @@ pub use members::{
     MembersError,
 };
 pub use npy::{export_system, npy_header, write_f64s, write_npy, NpyError};
-pub use regions::{arcs_from_regions, is_region_file, RegionArcs};
 pub use regularise::{
     capped_inverse_jacobian, cell_penalty, AutoWord, ObjectiveConfig, Regulariser, Strength,
 };

@@ -16,14 +16,14 @@
 use thiserror::Error;
 
 use super::{Inputs, LayerSource, ReconstructConfig};
+use crate::arcs::{
+    arcs_from_regions, is_region_file, parse_arcs, ArcCatalog, ArcsError, RegionArcs,
+};
 use crate::catalog::{
     parse_image_catalog, parse_member_catalog, CatalogError, ImageCatalog, MemberCatalog,
 };
 use crate::cosmology::LensPlane;
-use crate::inversion::{
-    arcs_from_regions, is_region_file, parse_arcs, ArcCatalog, ConstraintError, ConstraintMode,
-    ConstraintSource, RegionArcs,
-};
+use crate::inversion::{ConstraintMode, ConstraintSource};
 use crate::sky::SkyReference;
 
 /// One input file: the name used in messages and its text.
@@ -51,7 +51,7 @@ pub enum DatasetError {
     #[error(transparent)]
     Catalog(#[from] CatalogError),
     #[error(transparent)]
-    Arcs(#[from] ConstraintError),
+    Arcs(#[from] ArcsError),
     #[error("give an image catalogue or an arcs file to reconstruct")]
     NoConstraints,
 }
@@ -170,7 +170,7 @@ fn region_arcs(
     reference: Option<SkyReference>,
     pixel_arcsec: f64,
     images: Option<&ImageCatalog>,
-) -> Result<RegionArcs, ConstraintError> {
+) -> Result<RegionArcs, ArcsError> {
     let catalog_z = |id: &str| {
         let systems = images.into_iter().flat_map(|c| c.systems.iter());
         systems.filter(|s| s.id == id).find_map(|s| s.z)

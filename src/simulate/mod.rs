@@ -31,10 +31,11 @@ pub use sources::{
 #[cfg(not(target_arch = "wasm32"))]
 pub use write::write_simulation;
 
+use crate::arcs::{ArcCatalog, ArcSystem};
 use crate::cosmology::{Cosmology, CosmologyError, LensPlane};
 use crate::curves::critical_curves;
 use crate::grid::{Map, MapGeometry};
-use crate::inversion::{ArcCatalog, ArcSystem, Layer};
+use crate::inversion::Layer;
 use crate::maps::LensMaps;
 use crate::model::{ComponentSpec, ModelError, ModelFile};
 use crate::products::ProductsError;

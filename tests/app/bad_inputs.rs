@@ -2,8 +2,8 @@
 //! names the file, says line and column once, and the size limits refuse a huge input before
 //! it is parsed. Catalogue cases are in tests/files/catalog.rs, command-line ones in tests/cli.rs.
 
+use wslap::arcs::{parse_arcs, ArcsError};
 use wslap::fits::{read_image, FitsError};
-use wslap::inversion::{parse_arcs, ConstraintError};
 use wslap::limits::{MAX_ARC_PIXELS, MAX_FITS_PIXELS};
 use wslap::model::ModelFile;
 use wslap::reconstruct::ReconstructConfig;
@@ -131,7 +131,7 @@ fn arcs_pixel_limit() {
          [{pixels}]}}]}}"
     );
     let err = parse_arcs(&text, "arcs.json").unwrap_err();
-    assert!(matches!(err, ConstraintError::TooLarge(_)), "{err}");
+    assert!(matches!(err, ArcsError::TooLarge(_)), "{err}");
     assert_eq!(
         err.to_string(),
         format!(

@@ -15,8 +15,9 @@ use std::sync::OnceLock;
 
 use common::assert_rel;
 use glam::DVec2;
+use wslap::arcs::parse_arcs;
 use wslap::catalog::{parse_image_catalog, parse_member_catalog};
-use wslap::inversion::{parse_arcs, MemberConfig};
+use wslap::inversion::MemberConfig;
 use wslap::model::ComponentSpec;
 use wslap::simulate::{
     GalaxySet, SimulatedSource, Simulation, SimulationConfig, RADIAL_ZONE_ARCSEC,

@@ -6,9 +6,10 @@
 use crate::common::assert_rel;
 use crate::fixtures::{image, system, three_systems};
 use glam::DVec2;
+use wslap::arcs::parse_arcs;
 use wslap::inversion::{
-    build_constraints, ellipse_pixels, parse_arcs, ConstraintConfig, ConstraintError,
-    ConstraintMode, ConstraintSet, ConstraintSource, Exclusion, Weighting,
+    build_constraints, ellipse_pixels, ConstraintConfig, ConstraintError, ConstraintMode,
+    ConstraintSet, ConstraintSource, Exclusion, Weighting,
 };
 
 /// Ellipse pixel count vs `pi a b / pixel^2` (lattice-point count error ~ perimeter / pixel).

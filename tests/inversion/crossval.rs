@@ -4,8 +4,9 @@
 
 use glam::DVec2;
 use wslap::app::examples::teaching_image_catalog;
+use wslap::arcs::{ArcCatalog, ArcSystem};
 use wslap::catalog::{parse_image_catalog, ImageCatalog};
-use wslap::inversion::{ArcCatalog, ArcSystem, ConstraintMode, ConstraintSource, Layer};
+use wslap::inversion::{ConstraintMode, ConstraintSource, Layer};
 use wslap::profiles::{MassComponent, TruncatedNfw};
 use wslap::reconstruct::{
     cross_validate, fold_groups, reconstruct, ConvergenceRecord, Inputs, LayerSource,

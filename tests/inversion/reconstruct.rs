@@ -4,9 +4,10 @@
 use crate::common;
 
 use glam::DVec2;
+use wslap::arcs::{ArcCatalog, ArcSystem};
 use wslap::catalog::ImageCatalog;
 use wslap::images::source_position;
-use wslap::inversion::{ArcCatalog, ArcSystem, ConstraintMode, ConstraintSource, Layer};
+use wslap::inversion::{ConstraintMode, ConstraintSource, Layer};
 use wslap::profiles::{Lens, MassComponent, Nfw, TruncatedNfw};
 use wslap::reconstruct::{reconstruct, Inputs, LayerSource, ReconstructConfig};
 use wslap::solver::Control;

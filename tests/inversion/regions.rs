@@ -41,8 +41,7 @@ fn region_files_become_arc_pixels() {
         pt = at(7.3, -2.1),
     );
     let pixel = 0.1;
-    let r = wslap::inversion::arcs_from_regions(&text, "arcs.reg", Some(sky), pixel, &|_| None)
-        .unwrap();
+    let r = wslap::arcs::arcs_from_regions(&text, "arcs.reg", Some(sky), pixel, &|_| None).unwrap();
     assert!(!r.reference_from_regions);
     let a = &r.arcs;
     assert_eq!(a.systems.len(), 2);
@@ -96,8 +95,7 @@ fn region_files_become_arc_pixels() {
     }
 
     // Without a reference the frame is the regions' mean position.
-    let r2 =
-        wslap::inversion::arcs_from_regions(&text, "arcs.reg", None, pixel, &|_| None).unwrap();
+    let r2 = wslap::arcs::arcs_from_regions(&text, "arcs.reg", None, pixel, &|_| None).unwrap();
     assert!(r2.reference_from_regions);
     let shift = sky.to_offset_arcsec(r2.reference.ra_deg, r2.reference.dec_deg);
     let centres = [
@@ -119,7 +117,7 @@ fn region_files_become_arc_pixels() {
     );
     // A polygon across RA = 0 is averaged there, not at RA 180.
     let across = "fk5\npolygon(359.999,0,0.001,0,0.001,0.001,359.999,0.001) # text={1.1 z=2}\n";
-    let r3 = wslap::inversion::arcs_from_regions(across, "a.reg", None, pixel, &|_| None).unwrap();
+    let r3 = wslap::arcs::arcs_from_regions(across, "a.reg", None, pixel, &|_| None).unwrap();
     let (ra, dec) = (r3.reference.ra_deg, r3.reference.dec_deg);
     assert!(
         ra.min(360.0 - ra) < 1e-9 && (dec - 0.0005).abs() < 1e-9,
@@ -135,13 +133,9 @@ fn region_files_report_their_errors_by_line() {
     let sky = SkyReference::new(150.0, 2.2).unwrap();
     let c = |x: f64| fk5(sky, DVec2::new(x, 0.0));
     let read = |body: &str| {
-        wslap::inversion::arcs_from_regions(
-            &format!("fk5\n{body}"),
-            "arcs.reg",
-            Some(sky),
-            0.2,
-            &|id| (id == "7").then_some(3.3),
-        )
+        wslap::arcs::arcs_from_regions(&format!("fk5\n{body}"), "arcs.reg", Some(sky), 0.2, &|id| {
+            (id == "7").then_some(3.3)
+        })
     };
     let ok = read(&format!(
         "circle({},1\") # text={{7.1}}\ncircle({},1\") # text={{7.2}}\ncircle({},1\") # text={{8.1}}",

@@ -37,8 +37,7 @@ use std::collections::{HashMap, HashSet};
 
 use glam::DVec2;
 
-use super::arcs::{ArcCatalog, ArcSystem, MAX_Z};
-use super::constraints::ConstraintError;
+use super::{ArcCatalog, ArcSystem, ArcsError, MAX_Z};
 use crate::catalog::redshifts_agree;
 use crate::ds9::{read_regions, Ds9Frame, Region, Shape};
 use crate::limits::{InputKind, TooLarge, MAX_ARC_PIXELS};
@@ -69,7 +68,7 @@ pub fn arcs_from_regions(
     reference: Option<SkyReference>,
     pixel_arcsec: f64,
     catalog_z: &dyn Fn(&str) -> Option<f64>,
-) -> Result<RegionArcs, ConstraintError> {
+) -> Result<RegionArcs, ArcsError> {
     TooLarge::check_bytes(source_name, InputKind::Arcs, text.len() as u64)?;
     if !(pixel_arcsec.is_finite() && pixel_arcsec > 0.0) {
         return Err(crate::error::BadFieldValue::new(
@@ -79,12 +78,12 @@ pub fn arcs_from_regions(
         )
         .into());
     }
-    let at = |line: usize, reason: String| ConstraintError::RegionLine {
+    let at = |line: usize, reason: String| ArcsError::RegionLine {
         source_name: source_name.to_string(),
         line,
         reason,
     };
-    let regions = read_regions(text, source_name).map_err(ConstraintError::Regions)?;
+    let regions = read_regions(text, source_name).map_err(ArcsError::Regions)?;
     if let Some(r) = regions.iter().find(|r| r.frame == Ds9Frame::Image) {
         return Err(at(
             r.line,
@@ -94,7 +93,7 @@ pub fn arcs_from_regions(
         ));
     }
     if !regions.iter().any(|r| r.include) {
-        return Err(ConstraintError::RegionFile {
+        return Err(ArcsError::RegionFile {
             source_name: source_name.to_string(),
             reason: "holds no region to use as an arc (polygon, circle, ellipse, box or point)"
                 .into(),

@@ -1,4 +1,5 @@
-//! Arc files: constraint pixels given explicitly, per system and image (JSON, arcsec).
+//! Arc files: constraint pixels given explicitly, per system and image, as JSON (arcsec) or
+//! as DS9 regions ([`arcs_from_regions`]).
 //!
 //! Errors name the file and the line where the faulty system's object starts (a syntax error:
 //! its own line and column), and the file's size and pixel count are limited
@@ -8,8 +9,51 @@ use glam::DVec2;
 use serde::Deserialize;
 use serde_json::value::RawValue;
 
-use super::constraints::ConstraintError;
+use thiserror::Error;
+
 use crate::limits::{json_error_parts, InputKind, TooLarge, MAX_ARC_PIXELS};
+
+mod regions;
+
+pub use regions::{arcs_from_regions, is_region_file, RegionArcs};
+
+/// What is wrong with an arcs file (JSON or DS9 regions); every message names the file and,
+/// where there is one, the line.
+#[derive(Debug, Error, Clone, PartialEq)]
+pub enum ArcsError {
+    #[error("{source_name}: line {line}, column {column}: {message}")]
+    Syntax {
+        source_name: String,
+        line: usize,
+        column: usize,
+        message: String,
+    },
+    /// One system of an arcs file; `line` is where the system's object starts.
+    #[error("{source_name}: line {line}: system {system}: {reason}")]
+    System {
+        source_name: String,
+        line: usize,
+        system: String,
+        reason: String,
+    },
+    #[error(transparent)]
+    TooLarge(#[from] crate::limits::TooLarge),
+    /// A DS9 region file that does not parse (the message names the file and line).
+    #[error(transparent)]
+    Regions(#[from] crate::ds9::Ds9Error),
+    /// One region of a DS9 region file used as arcs.
+    #[error("{source_name}: line {line}: {reason}")]
+    RegionLine {
+        source_name: String,
+        line: usize,
+        reason: String,
+    },
+    /// A DS9 region file as a whole.
+    #[error("{source_name}: {reason}")]
+    RegionFile { source_name: String, reason: String },
+    #[error(transparent)]
+    BadFieldValue(#[from] crate::error::BadFieldValue),
+}
 
 /// Explicit arc pixels, from [`parse_arcs`].
 #[derive(Debug, Clone, PartialEq)]
@@ -92,7 +136,7 @@ struct ArcsJson<'a> {
 /// [`crate::limits::MAX_ARCS_BYTES`] of text.
 ///
 /// [method §1]: crate::method#1-frames-and-units
-pub fn parse_arcs(text: &str, source_name: &str) -> Result<ArcCatalog, ConstraintError> {
+pub fn parse_arcs(text: &str, source_name: &str) -> Result<ArcCatalog, ArcsError> {
     TooLarge::check_bytes(source_name, InputKind::Arcs, text.len() as u64)?;
     // `part` is the text serde_json parsed, which starts at `at` in the file.
     let syntax = |e: serde_json::Error, part: &str, at: (usize, usize)| {
@@ -103,7 +147,7 @@ pub fn parse_arcs(text: &str, source_name: &str) -> Result<ArcCatalog, Constrain
             (1, (l, c)) => (l, c + column - 1),
             (n, (l, _)) => (l + n - 1, column),
         };
-        ConstraintError::ArcsSyntax {
+        ArcsError::Syntax {
             source_name: source_name.to_string(),
             line,
             column,
@@ -121,7 +165,7 @@ pub fn parse_arcs(text: &str, source_name: &str) -> Result<ArcCatalog, Constrain
             IdJson::Text(t) => t,
             IdJson::Number(n) => n.to_string(),
         };
-        let fail = |reason: String| ConstraintError::ArcsSystem {
+        let fail = |reason: String| ArcsError::System {
             source_name: source_name.to_string(),
             line,
             system: id.clone(),
