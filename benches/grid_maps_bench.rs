@@ -12,9 +12,9 @@
 use std::time::Instant;
 
 use glam::DVec2;
-use wslap::inversion::{CellGrid, GridMass};
-use wslap::maps::LensMaps;
+use wslap::LensMaps;
 use wslap::MapGeometry;
+use wslap::{CellGrid, GridMass};
 
 // Shared with the tests; this bench uses `uniform` only.
 #[allow(dead_code)]

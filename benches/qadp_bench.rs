@@ -12,7 +12,7 @@
 
 use std::time::Instant;
 
-use wslap::solver::{gram_weighted, locality_order, Control, QadpProblem, QadpSettings};
+use wslap::{gram_weighted, locality_order, Control, QadpProblem, QadpSettings};
 
 #[path = "../tests/common/rng.rs"]
 mod rng;
@@ -71,7 +71,7 @@ fn main() {
     let arg = |k: usize, default: usize| args.get(k).copied().unwrap_or(default);
     let (n_grid, n_pix, iterations, threads) = (arg(0, 32), arg(1, 4000), arg(2, 8000), arg(3, 0));
     // THREADS holds for every stage, the normal matrix included.
-    wslap::threads::with_limit(threads, || run(n_grid, n_pix, iterations, threads));
+    wslap::with_thread_limit(threads, || run(n_grid, n_pix, iterations, threads));
 }
 
 fn run(n_grid: usize, n_pix: usize, iterations: usize, threads: usize) {
@@ -100,7 +100,7 @@ fn run(n_grid: usize, n_pix: usize, iterations: usize, threads: usize) {
         .run(&vec![1e-3; n], &settings, &mut |_| Control::Continue)
         .expect("valid start");
     let t3 = Instant::now();
-    let exact = wslap::solver::objective(&a, &b, &outcome.x);
+    let exact = wslap::quadratic_objective(&a, &b, &outcome.x);
     println!(
         "unknowns={n} rows={} load_or_build={:.3}s normal_matrix={:.3}s (gram {:.3}s) \
          qadp_{iterations}={:.3}s per_iteration={:.1}us objective={:.9e} (f64 recomputed {:.9e}) \

@@ -10,16 +10,16 @@ use std::fmt::Write as _;
 
 use glam::DVec2;
 
-use wslap::catalog::{parse_image_catalog, parse_member_catalog, ImageCatalog, MemberCatalog};
-use wslap::ds9::{read_regions, Ds9Frame, Region, Shape};
-use wslap::fits::{read_image, write_image, FitsWriteOptions};
-use wslap::grid::{Map, MapGeometry};
-use wslap::arcs::{arcs_from_regions, parse_arcs, ArcCatalog};
-use wslap::lenstool_par::parse_par;
-use wslap::model::ModelFile;
-use wslap::profiles::MassComponent;
-use wslap::reconstruct::ReconstructConfig;
-use wslap::sky::SkyReference;
+use wslap::parse_par;
+use wslap::MassComponent;
+use wslap::ModelFile;
+use wslap::ReconstructConfig;
+use wslap::SkyReference;
+use wslap::{arcs_from_regions, parse_arcs, ArcCatalog};
+use wslap::{parse_image_catalog, parse_member_catalog, ImageCatalog, MemberCatalog};
+use wslap::{read_image, write_image, FitsWriteOptions};
+use wslap::{read_regions, Ds9Frame, Region, Shape};
+use wslap::{Map, MapGeometry};
 
 /// A target's body.
 pub type Target = fn(&[u8]);

@@ -16,8 +16,8 @@ use glam::DVec2;
 use serde::{Deserialize, Serialize};
 
 use crate::cosmology::{CosmologyError, LensPlane};
-use crate::grid::{Map, MapGeometry};
-use crate::maps::LensMaps;
+use crate::map::LensMaps;
+use crate::map::{Map, MapGeometry};
 use crate::profiles::MassComponent;
 
 /// A polyline in arcsec; closed curves repeat no point (the last joins the first).

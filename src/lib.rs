@@ -1,45 +1,160 @@
 //! WSLAP+ free-form strong-lensing mass reconstruction (Sendra, Diego, Broadhurst & Lazkoz).
 //!
-//! The modules follow the pipeline: cosmology → mass components → maps and critical curves →
-//! rendering and file formats. Angles are arcsec in the tangent-plane frame of [method §1]
-//! (+x West, +y North); every stored deflection, convergence and shear is for `D_ls/D_s = 1`.
-//! The wasm boundary (`wasm.rs`) and the CLI (`main.rs`) are thin shells around this library.
+//! A cluster's mass is a grid of Gaussian cells plus its member galaxies (luminosity-scaled
+//! halos rescaled by free factors `C`), constrained by multiply-lensed images: the lens
+//! equation becomes a linear system, solved with non-negative quadratic programming. The
+//! equations, frames, units and file conventions are in [`method`]. Angles are arcsec in the
+//! tangent-plane frame of [method §1] (+x West, +y North); every stored deflection,
+//! convergence and shear is for `D_ls/D_s = 1`.
+//!
+//! Everything a user of the library needs is here at the root, in the order of the pipeline:
+//!
+//! - cosmology and the sky frame: [`Cosmology`], [`LensPlane`], [`SkyReference`];
+//! - mass components and their maps: [`MassComponent`], [`Lens`], [`LensMaps`],
+//!   [`CriticalCurves`], [`Products`], [`find_images`];
+//! - the inputs: [`parse_image_catalog`], [`parse_member_catalog`], [`parse_arcs`],
+//!   [`arcs_from_regions`], [`parse_par`], [`read_image`], and [`Dataset`], which reads them
+//!   into one frame the way the command line and the app both do;
+//! - a reconstruction: [`reconstruct`] of [`Inputs`] with a [`ReconstructConfig`], giving a
+//!   [`Reconstruction`]; [`cross_validate`] for held-out systems;
+//! - the pieces under it: the cell grid ([`CellGrid`]), members ([`build_member_layers`]), the
+//!   constraints ([`build_constraints`]), the [`LinearSystem`] and the solvers
+//!   ([`minimise_exact`], [`QadpProblem`], [`accelerated_gradient`]);
+//! - figures ([`render_kappa_png`], [`LinePlot`]) and simulated clusters ([`Simulation`]).
+//!
+//! Every out-of-range setting is reported as a [`BadFieldValue`] inside the error of the step
+//! that checked it. Two shells sit on this library: the `wslap` command line (`main.rs`) and the
+//! browser app, whose core is [`app`] (called from a web worker through the wasm boundary);
+//! [`paper`] reproduces the paper's test.
 //!
 //! [method §1]: crate::method#1-frames-and-units
 
 pub mod app;
-pub mod arcs;
-pub mod catalog;
-pub mod cosmology;
-pub mod curves;
-pub mod demo;
-pub mod ds9;
-pub mod error;
-pub mod fits;
-pub mod grid;
-pub mod images;
-pub mod inversion;
-pub mod lenstool_par;
-pub mod limits;
-pub mod maps;
 pub mod method;
-pub mod model;
 pub mod paper;
-pub mod products;
-pub mod profiles;
-pub mod radial;
-pub mod reconstruct;
-pub mod render;
-pub mod simulate;
-pub mod sky;
-pub mod solver;
-pub mod threads;
-pub mod units;
+
+mod arcs;
+mod catalog;
+mod cosmology;
+mod curves;
+mod demo;
+mod ds9;
+mod error;
+mod fits;
+mod image_search;
+mod inversion;
+mod lenstool_par;
+mod limits;
+mod map;
+mod model;
+mod products;
+mod profiles;
+mod radial;
+mod reconstruct;
+mod render;
+mod simulate;
+mod sky;
+mod solver;
+mod threads;
+mod units;
 
 #[cfg(target_arch = "wasm32")]
 mod wasm;
 
+// Cosmology, the sky frame and units.
 pub use cosmology::{Cosmology, CosmologyError, LensPlane};
-pub use curves::CriticalCurves;
-pub use grid::{Map, MapGeometry};
-pub use profiles::{Lens, MassComponent};
+pub use sky::SkyReference;
+
+// Mass components and the maps of a lens.
+pub use curves::{
+    critical_curves, einstein_radius_for, zero_contours, Caustics, CriticalCurves, Polyline,
+    OPEN_AREA_SHARE, TANGENTIAL_BORDER_SHARE,
+};
+pub use demo::{CLUSTER_MODEL_JSON, TEACHING_MODEL_JSON};
+pub use image_search::{
+    find_images, source_position, source_scatter, FoundImage, ImageError, ImageKind, ImageSearch,
+    Parity, SearchGrid,
+};
+pub use map::{LensMaps, Map, MapGeometry, MapsError, MAGNIFICATION_CLAMP};
+pub use model::{ComponentSpec, ModelError, ModelFile};
+pub use products::{ProductOptions, Products, ProductsError, EINSTEIN_MAP_WIDENING};
+pub use profiles::{
+    add_pixelwise, cell_unit_deflection, dpie_b0_arcsec, gaussian_unit_deflection,
+    gaussian_unit_hessian, kk_epsilon, nfw_deflection, nfw_hessian, nfw_mass_cylinder_msun,
+    nfw_terms, sis_theta_e_arcsec, tnfw_far_field_coefficients, tnfw_mass_and_kappa_unit, Dpie,
+    ExternalShear, Gaussian, Lens, MassComponent, Nfw, NfwEllipse, NfwTerms, PointMass,
+    ProfileError, Sis, TruncatedNfw, CSE_TERMS, DPIE_CIRCULAR_EPSILON, NFW_X_FLOOR,
+};
+pub use radial::{radial_profile, rect_disc_area, RadialBins, RadialError, RadialProfile};
+
+// The inputs: catalogues, arcs, regions, Lenstool models, FITS.
+pub use arcs::{arcs_from_regions, parse_arcs, ArcCatalog, ArcSystem, ArcsError};
+pub use catalog::{
+    parse_image_catalog, parse_member_catalog, CatalogError, Image, ImageCatalog, ImageSystem,
+    Member, MemberCatalog, DEGREE_LOOKALIKE, FIELD_ERROR_DEG, FIELD_WARN_DEG, Z_AGREEMENT_TOL,
+};
+pub use ds9::{
+    polyline_is_open, read_regions, write_marks, write_regions, Ds9Error, Ds9Frame, Mark, Region,
+    Shape,
+};
+pub use fits::{read_image, write_image, Card, CardValue, FitsError, FitsWriteOptions};
+#[cfg(not(target_arch = "wasm32"))]
+pub use lenstool_par::load_lenstool_model;
+pub use lenstool_par::{parse_par, LenstoolModel, ParComponent, ParError, Radius};
+pub use limits::{
+    InputKind, TooLarge, MAX_ARCS_BYTES, MAX_ARC_PIXELS, MAX_CATALOG_BYTES, MAX_CATALOG_ROWS,
+    MAX_FITS_BYTES, MAX_FITS_PIXELS, MAX_JSON_BYTES,
+};
+
+// The WSLAP+ inversion: cells, members, constraints, the linear system.
+pub use inversion::{
+    build_constraints, build_member_layers, capped_inverse_jacobian, cell_penalty, ellipse_pixels,
+    export_system, npy_header, write_f64s, write_npy, AutoWord, Cell, CellGrid, ColumnInfo,
+    ConstraintConfig, ConstraintError, ConstraintMode, ConstraintPixel, ConstraintSet,
+    ConstraintSource, ConstraintSystem, ExcludedSystem, Exclusion, GridConfig, GridError, GridMass,
+    HaloProfile, Layer, LayerSplit, LinearSystem, MapPlan, MemberConfig, MemberHalo, MemberModel,
+    MembersError, NpyError, ObjectiveConfig, ObjectiveTerms, Regulariser, RowBlock, ScaledLens,
+    Strength, SystemConfig, SystemError, Weighting, LAYER_SHARE_WARN,
+};
+
+// Non-negative quadratic programming.
+pub use solver::{
+    accelerated_gradient, column_independence, gram_weighted, locality_order, minimise_exact,
+    nnqp_exact, objective as quadratic_objective, Control, NormalEquations, Progress, QadpProblem,
+    QadpSettings, SolveOutcome, SolveStatus, SolverError, INDEPENDENCE_MAX_UNKNOWNS,
+    NNQP_EXACT_MAX_UNKNOWNS,
+};
+
+// A reconstruction: inputs, settings, the run, cross-validation.
+pub use reconstruct::{
+    cross_validate, fitted_system_ids, fold_groups, image_regions, product_options, reconstruct,
+    reconstruct_with_choice, strength_candidates, strength_folds, strength_trial,
+    ConvergenceRecord, CrossValidation, Dataset, DatasetError, FoldRun, ImageReport, InputText,
+    InputTexts, Inputs, KappaSpread, LayerSource, PredictedImage, PredictedSystem, ProductConfig,
+    ReconstructConfig, ReconstructError, ReconstructSummary, Reconstruction, RunStatus, Solved,
+    SolverConfig, SolverMethod, SourceReport, StrengthCandidate, StrengthChoice, CHOICE_MAP_PIXELS,
+    DEFAULT_FOLDS, SHOWN_MIN_MAGNIFICATION,
+};
+
+// Figures.
+pub use render::{
+    color_limits, compose_grid, compose_png_grid, grid_offsets, kappa_figure_frame,
+    kappa_figure_frame_for, render_colormap_rgba, render_kappa_png, value_rgb, Axis, AxisScale,
+    ColorScale, Colormap, FigureFrame, GridLayout, KappaPlotOptions, LegendPlace, LinePlot,
+    LineStyle, Marker, Overlay, OverlayPoints, PlotFrame, Reference, RenderError, Series,
+    CAUSTIC_RGB, LOG_RANGE, MAX_COMPOSED_PIXELS, MAX_COMPOSED_SIDE_PX, MAX_LINE_WIDTH_PX,
+    MIN_PIXEL_SIDE_PX, NO_DATA_RGB, PALETTE, PIXEL_ALPHA, PLOT_SIDE_PX, RADIAL_RGB, TANGENTIAL_RGB,
+};
+
+// Simulated clusters.
+#[cfg(not(target_arch = "wasm32"))]
+pub use simulate::write_simulation;
+pub use simulate::{
+    GalaxySet, SimulatedSource, Simulation, SimulationConfig, MAX_SYSTEM_AREA_ARCSEC2,
+    MIN_SYSTEM_AREA_ARCSEC2, N_GALAXIES, RADIAL_ZONE_ARCSEC, SOFT_TO_GALAXY, SYSTEM_GAP_PIXELS,
+    TOTAL_FIELD_MASS_MSUN,
+};
+
+// Errors shared by every settings check, and the run's threads.
+pub use error::BadFieldValue;
+pub use threads::{available as available_threads, with_limit as with_thread_limit};

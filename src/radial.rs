@@ -12,7 +12,7 @@ use serde::{Deserialize, Serialize};
 use thiserror::Error;
 
 use crate::cosmology::LensPlane;
-use crate::grid::Map;
+use crate::map::Map;
 
 /// Most bins a profile may have (guards against absurd allocations from user input).
 pub const MAX_RADIAL_BINS: usize = 100_000;

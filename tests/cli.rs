@@ -5,9 +5,9 @@ use std::fs;
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
-use wslap::curves::CriticalCurves;
-use wslap::demo::CLUSTER_MODEL_JSON;
-use wslap::fits::read_image;
+use wslap::read_image;
+use wslap::CriticalCurves;
+use wslap::CLUSTER_MODEL_JSON;
 
 const PRODUCT_FILES: [&str; 10] = [
     "kappa.fits",
@@ -321,7 +321,7 @@ fn reconstruct_writes_every_product_and_marks_held_out_systems() {
     assert_eq!(held, ["2", "7"]);
     // images.reg: a green circle on each catalogue image, at its RA and Dec (the catalogue is
     // in absolute degrees), and a dashed magenta one on each predicted image.
-    let regions = wslap::ds9::read_regions(
+    let regions = wslap::read_regions(
         &fs::read_to_string(out_dir.join("images.reg")).unwrap(),
         "images.reg",
     )
@@ -346,7 +346,7 @@ fn reconstruct_writes_every_product_and_marks_held_out_systems() {
             id.starts_with("2.") || id.starts_with("7.")
         );
         let row = rows.iter().find(|f| f[0] == id).expect(label);
-        let wslap::ds9::Shape::Circle { center, radius } = r.shape else {
+        let wslap::Shape::Circle { center, radius } = r.shape else {
             panic!("{r:?}")
         };
         let (ra, dec): (f64, f64) = (row[1].parse().unwrap(), row[2].parse().unwrap());
@@ -472,7 +472,7 @@ fn reconstruct_from_arc_pixels() {
         ]}"#,
     )
     .unwrap();
-    // A fixed strength: "auto" would run its candidates (tested in tests/objective.rs).
+    // A fixed strength: "auto" would run its candidates (tested in tests/inversion/objective.rs).
     let config = dir.join("fixed.json");
     fs::write(
         &config,
@@ -527,7 +527,7 @@ fn reconstruct_from_arc_pixels() {
 }
 
 /// `--folds K` also writes crossval.json: K hold-out runs, every fitted system predicted once
-/// (library: tests/crossval.rs). A number of folds that cannot work is refused before the first
+/// (library: tests/inversion/crossval.rs). A number of folds that cannot work is refused before the first
 /// run, naming the count of systems.
 #[test]
 fn reconstruct_folds_writes_crossval_json() {
@@ -681,13 +681,13 @@ fn huge_files_are_refused_before_reading() {
         format!(
             "error: {}: 2147483648 bytes is more than the limit of {} bytes for a catalogue\n",
             cat.display(),
-            wslap::limits::MAX_CATALOG_BYTES
+            wslap::MAX_CATALOG_BYTES
         )
     );
     let fits = dir.join("huge.fits");
     fs::File::create(&fits)
         .unwrap()
-        .set_len(wslap::limits::MAX_FITS_BYTES + 1)
+        .set_len(wslap::MAX_FITS_BYTES + 1)
         .expect("sparse file");
     let err = refused(
         &dir,
@@ -798,7 +798,7 @@ fn catalogue_units_nan_and_empty_systems_name_file_and_line() {
 
 #[test]
 fn config_prints_every_setting_and_reads_back_as_the_defaults() {
-    use wslap::reconstruct::ReconstructConfig;
+    use wslap::ReconstructConfig;
     let out = wslap(&["config"]);
     assert!(
         out.status.success(),
@@ -825,7 +825,7 @@ fn config_prints_every_setting_and_reads_back_as_the_defaults() {
 fn reconstruct_from_a_ds9_region_file() {
     let dir = temp_dir("regions");
     let cat = wslap::app::examples::teaching_image_catalog().unwrap();
-    let (catalog, _) = wslap::catalog::parse_image_catalog(&cat, "images.cat", None).unwrap();
+    let (catalog, _) = wslap::parse_image_catalog(&cat, "images.cat", None).unwrap();
     let sky = catalog.reference.unwrap();
     let mut reg = String::from("# Region file format: DS9 version 4.1\nfk5\n");
     for s in &catalog.systems {
@@ -908,8 +908,8 @@ fn reconstruct_from_a_ds9_region_file() {
 /// same map, maps in the .par's sky frame, and a clear error when a potfile is not found.
 #[test]
 fn maps_of_a_lenstool_model_match_the_library_and_name_a_missing_potfile() {
-    use wslap::lenstool_par::load_lenstool_model;
-    use wslap::products::{ProductOptions, Products};
+    use wslap::load_lenstool_model;
+    use wslap::{ProductOptions, Products};
     let par = shared("AS1063/lenstool_cats/cats_gold_bestopt.par");
     let potfile = shared("AS1063/lenstool_cats/cats_gold_ref_potential_w_clumpNE.cat");
     let dir = temp_dir("lenstool");
@@ -947,7 +947,7 @@ fn maps_of_a_lenstool_model_match_the_library_and_name_a_missing_potfile() {
         "{theta_e} vs {}",
         library.curves.einstein_radius_arcsec
     );
-    // The published model's radius at z_s = 2 (tests/reconstruct.rs checks it against the
+    // The published model's radius at z_s = 2 (tests/inversion/reconstruct.rs checks it against the
     // reconstruction): about 30 arcsec.
     assert!((25.0..35.0).contains(&theta_e), "{theta_e}");
     let fits = read_image(&fs::read(dir.join("kappa.fits")).unwrap(), "kappa.fits").unwrap();

@@ -8,11 +8,11 @@
 
 #![cfg(not(target_arch = "wasm32"))]
 
-use wslap::inversion::LAYER_SHARE_WARN;
 use wslap::paper::metrics::lens_equation_chi2;
-use wslap::paper::{run_paper, Case, PaperConfig};
-use wslap::profiles::MassComponent;
-use wslap::solver::objective;
+use wslap::quadratic_objective as objective;
+use wslap::MassComponent;
+use wslap::LAYER_SHARE_WARN;
+use wslap::{paper::run_paper, paper::Case, paper::PaperConfig};
 
 /// Iterations of the reduced run: enough for the galaxy layer to matter (the paper's solutions
 /// are good after a few thousand).

@@ -7,8 +7,8 @@ use std::fmt::Write;
 use glam::DVec2;
 
 use crate::demo::TEACHING_MODEL_JSON;
-use crate::grid::MapGeometry;
-use crate::images::{find_images, ImageSearch, SearchGrid};
+use crate::image_search::{find_images, ImageSearch, SearchGrid};
+use crate::map::MapGeometry;
 use crate::model::ModelFile;
 
 use super::AppError;

@@ -7,8 +7,8 @@ use std::hash::{DefaultHasher, Hash, Hasher};
 use glam::DVec2;
 
 use crate::curves::{critical_curves, Polyline};
-use crate::grid::MapGeometry;
-use crate::maps::LensMaps;
+use crate::map::LensMaps;
+use crate::map::MapGeometry;
 use crate::radial::{radial_profile, RadialBins, RadialProfile};
 use crate::render::{
     compose_grid, Axis, LinePlot, LineStyle, Reference, RenderError, Series, PALETTE,

@@ -3,8 +3,8 @@
 
 use glam::DVec2;
 
-use crate::grid::{Map, MapGeometry};
-use crate::maps::LensMaps;
+use crate::map::LensMaps;
+use crate::map::{Map, MapGeometry};
 use crate::render::OverlayPoints;
 use crate::render::{render_kappa_png, ColorScale, Colormap, KappaPlotOptions, Marker, Overlay};
 use crate::CriticalCurves;

@@ -5,7 +5,7 @@ use std::fs::File;
 use std::io::Read;
 use std::path::Path;
 
-use wslap::limits::{InputKind, TooLarge};
+use wslap::{InputKind, TooLarge};
 
 /// The bytes of `path`, refused when over the limit of `kind` (checked on the metadata first,
 /// then while reading, for files that grow or report no size).

@@ -7,13 +7,13 @@ use std::path::{Path, PathBuf};
 use super::input::{read_bytes, read_text};
 
 use clap::Args;
-use wslap::fits::read_image;
-use wslap::lenstool_par::parse_par;
-use wslap::limits::InputKind;
-use wslap::model::ModelFile;
-use wslap::products::{ProductOptions, Products};
-use wslap::render::ColorScale;
+use wslap::parse_par;
+use wslap::read_image;
+use wslap::ColorScale;
+use wslap::InputKind;
+use wslap::ModelFile;
 use wslap::{Cosmology, LensPlane};
+use wslap::{ProductOptions, Products};
 
 /// Maps, critical curves, caustics and figures of a lens.
 ///
@@ -145,7 +145,7 @@ fn lenstool_products(
     Products::from_lens(&model.lens, model.plane, model.reference, opts).map_err(|e| e.to_string())
 }
 
-fn read_map(path: &Path) -> Result<(wslap::Map, Option<wslap::sky::SkyReference>), String> {
+fn read_map(path: &Path) -> Result<(wslap::Map, Option<wslap::SkyReference>), String> {
     let bytes = read_bytes(path, InputKind::Fits)?;
     let image = read_image(&bytes, &path.display().to_string()).map_err(|e| e.to_string())?;
     let (_, reference) = image.geometry().map_err(|e| e.to_string())?;

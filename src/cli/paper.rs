@@ -5,8 +5,8 @@ use std::fs;
 use std::path::{Path, PathBuf};
 
 use clap::Args;
-use wslap::paper::{render_figures, report_markdown, run_paper, PaperConfig};
-use wslap::simulate::write_simulation;
+use wslap::write_simulation;
+use wslap::{paper::render_figures, paper::report_markdown, paper::run_paper, paper::PaperConfig};
 
 use super::reconstruct::write_reconstruction;
 

@@ -5,14 +5,14 @@ use std::path::{Path, PathBuf};
 
 use clap::Args;
 use serde::Serialize;
-use wslap::inversion::export_system;
-use wslap::limits::InputKind;
-use wslap::reconstruct::{
+use wslap::export_system;
+use wslap::ColorScale;
+use wslap::Control;
+use wslap::InputKind;
+use wslap::{
     cross_validate, fold_groups, image_regions, reconstruct, ConvergenceRecord, CrossValidation,
     Dataset, InputText, InputTexts, ReconstructConfig, Reconstruction, SolverMethod,
 };
-use wslap::render::ColorScale;
-use wslap::solver::Control;
 use wslap::{Cosmology, LensPlane};
 
 use super::input::read_text;

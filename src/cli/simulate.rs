@@ -3,7 +3,7 @@
 use std::path::PathBuf;
 
 use clap::Args;
-use wslap::simulate::{write_simulation, Simulation, SimulationConfig};
+use wslap::{write_simulation, Simulation, SimulationConfig};
 
 /// Simulate the paper's A1689-like cluster (94 elliptical NFW galaxies plus a smooth halo with
 /// 3x their mass, 2.58e14 Msun/h in a 3.3 arcmin field) and the arcs of 30 background sources.

@@ -18,7 +18,7 @@ use glam::DVec2;
 use thiserror::Error;
 
 use crate::curves::{CriticalCurves, Polyline};
-use crate::grid::MapGeometry;
+use crate::map::MapGeometry;
 use crate::sky::SkyReference;
 
 mod parse;

@@ -17,7 +17,7 @@
 use glam::DVec2;
 use thiserror::Error;
 
-use crate::grid::{Map, MapGeometry};
+use crate::map::{Map, MapGeometry};
 use crate::sky::SkyReference;
 
 mod card;

@@ -244,7 +244,7 @@ impl Hdu<'_> {
 mod tests {
     use super::*;
     use crate::fits::{write_image, FitsWriteOptions};
-    use crate::grid::{Map, MapGeometry};
+    use crate::map::{Map, MapGeometry};
 
     /// Found by fuzzing (fuzz/regressions/fits_roundtrip/): `BZERO + BSCALE * v` turned a
     /// written -0.0 into +0.0.

@@ -33,7 +33,7 @@ use glam::DVec2;
 use serde::{Deserialize, Serialize};
 use thiserror::Error;
 
-use super::grid::CellGrid;
+use super::cells::CellGrid;
 use crate::catalog::MemberCatalog;
 use crate::cosmology::LensPlane;
 use crate::profiles::{tnfw_total_mass_unit, Lens, MassComponent, Nfw, ProfileError, TruncatedNfw};

@@ -5,22 +5,21 @@
 //! [method §3]: crate::method#3-the-linear-system
 //! [§4]: crate::method#4-member-galaxies
 
+mod cells;
+mod cells_fft;
 mod constraints;
-mod grid;
-mod grid_fft;
 mod members;
 mod npy;
 mod regularise;
 mod system;
 
-pub use crate::profiles::cell_unit_deflection;
+pub use cells::{Cell, CellGrid, GridConfig, GridError, GridMass};
+pub use cells_fft::MapPlan;
 pub use constraints::{
     build_constraints, ellipse_pixels, ConstraintConfig, ConstraintError, ConstraintMode,
     ConstraintPixel, ConstraintSet, ConstraintSource, ConstraintSystem, ExcludedSystem, Exclusion,
     Weighting,
 };
-pub use grid::{Cell, CellGrid, GridConfig, GridError, GridMass};
-pub use grid_fft::MapPlan;
 pub use members::{
     build_member_layers, HaloProfile, Layer, LayerSplit, MemberConfig, MemberHalo, MemberModel,
     MembersError,

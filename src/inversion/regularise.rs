@@ -43,7 +43,7 @@ use crate::error::BadFieldValue;
 use glam::DVec2;
 use serde::{Deserialize, Serialize};
 
-use super::grid::CellGrid;
+use super::cells::CellGrid;
 
 /// Which derivative of the grid's surface density the regulariser penalises.
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Serialize, Deserialize)]
@@ -292,14 +292,14 @@ mod tests {
         let area = step * step;
         let grid = CellGrid {
             cells: vec![
-                super::super::grid::Cell {
+                super::super::cells::Cell {
                     center: c1,
                     size_arcsec: 1.0,
                     sigma_arcsec: s1,
                     level: 0,
                     parent: 0,
                 },
-                super::super::grid::Cell {
+                super::super::cells::Cell {
                     center: c2,
                     size_arcsec: 1.0,
                     sigma_arcsec: s2,

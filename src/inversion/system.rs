@@ -39,8 +39,8 @@ use glam::DVec2;
 use serde::{Deserialize, Serialize};
 use thiserror::Error;
 
+use super::cells::{CellGrid, GridError, GridMass};
 use super::constraints::ConstraintSet;
-use super::grid::{CellGrid, GridError, GridMass};
 use super::members::Layer;
 use super::regularise::{cell_penalty, Regulariser};
 use crate::cosmology::{CosmologyError, LensPlane};

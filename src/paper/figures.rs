@@ -3,7 +3,7 @@
 //! the soft (dark) component recovered vs true; grid mass, galaxy mass and C vs iteration; the
 //! source-position error vs iteration; the deflection-error map.
 
-use crate::grid::Map;
+use crate::map::Map;
 use crate::render::{
     compose_png_grid, render_kappa_png, Axis, AxisScale, ColorScale, KappaPlotOptions, LinePlot,
     LineStyle, Marker, Overlay, OverlayLines, OverlayPoints, Reference, Series, PALETTE,

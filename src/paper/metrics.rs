@@ -8,9 +8,9 @@ use glam::DVec2;
 use serde::{Deserialize, Serialize};
 
 use crate::curves::CriticalCurves;
-use crate::grid::{Map, MapGeometry};
 use crate::inversion::ConstraintSet;
-use crate::maps::LensMaps;
+use crate::map::LensMaps;
+use crate::map::{Map, MapGeometry};
 use crate::profiles::MassComponent;
 
 /// The region that holds arcs: the disc around the field centre out to the outermost constraint

@@ -49,7 +49,7 @@ pub use report::{
 };
 
 use crate::inversion::{ConstraintMode, ConstraintSource, Layer, Weighting};
-use crate::maps::LensMaps;
+use crate::map::LensMaps;
 use crate::model::ModelError;
 use crate::products::{Clock, ProductOptions, Products, ProductsError};
 use crate::radial::{radial_profile, RadialBins, RadialError, RadialProfile};
@@ -204,7 +204,7 @@ pub struct CaseRun {
     pub reconstruction: Reconstruction,
     pub profile: RadialProfile,
     /// Kappa of the grid cells alone (the recovered soft component), `D_ls/D_s = 1`.
-    pub soft_kappa: crate::grid::Map,
+    pub soft_kappa: crate::map::Map,
     pub deflection_error: metrics::DeflectionError,
     pub report: CaseReport,
 }
@@ -218,7 +218,7 @@ pub struct PaperRun {
     pub truth: Products,
     pub truth_profile: RadialProfile,
     /// Kappa of the true soft component alone.
-    pub truth_soft_kappa: crate::grid::Map,
+    pub truth_soft_kappa: crate::map::Map,
     pub region: ArcRegion,
     pub cases: Vec<CaseRun>,
     pub report: PaperReport,
@@ -359,7 +359,7 @@ struct Setup {
     /// Truth products at z_s = 3 on the common map.
     truth: Products,
     /// Kappa of the true soft component alone.
-    truth_soft_kappa: crate::grid::Map,
+    truth_soft_kappa: crate::map::Map,
     region: ArcRegion,
     bins: RadialBins,
     truth_profile: RadialProfile,
@@ -721,7 +721,7 @@ struct Scorer<'a> {
 struct Scored {
     report: CaseReport,
     profile: RadialProfile,
-    soft_kappa: crate::grid::Map,
+    soft_kappa: crate::map::Map,
     deflection_error: metrics::DeflectionError,
 }
 

@@ -241,7 +241,7 @@ impl RegionMasses {
     /// From the truth's kappa and the soft component's kappa on the same map.
     pub(super) fn of_truth(
         truth: &Products,
-        soft_kappa: &crate::grid::Map,
+        soft_kappa: &crate::map::Map,
         region: &ArcRegion,
         plane: &crate::cosmology::LensPlane,
     ) -> Self {

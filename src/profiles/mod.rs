@@ -7,11 +7,12 @@
 
 use glam::DVec2;
 
-use crate::maps::LensMaps;
+use crate::map::LensMaps;
 
 mod dpie;
 mod error;
 mod gaussian;
+mod maps;
 mod nfw;
 mod nfw_ellipse;
 mod nfw_math;
@@ -27,6 +28,7 @@ pub use gaussian::{
     cell_unit_deflection, gaussian_unit_deflection, gaussian_unit_hessian, gaussian_unit_kappa,
     Gaussian,
 };
+pub use maps::add_pixelwise;
 pub use nfw::{nfw_deflection, nfw_hessian, nfw_kappa, nfw_mass_cylinder_msun, Nfw};
 pub use nfw_ellipse::{NfwEllipse, CSE_TERMS};
 pub use nfw_math::{nfw_terms, NfwTerms, X_FLOOR as NFW_X_FLOOR};
@@ -55,11 +57,16 @@ pub trait MassComponent: Send + Sync + std::fmt::Debug {
     /// Adds this component's `kappa`, `gamma1`, `gamma2` and `alpha` (arcsec), all at
     /// `D_ls/D_s = 1`, to every pixel of `maps` by a faster whole-map method and returns true,
     /// or returns false and leaves `maps` untouched: the caller then evaluates
-    /// [`Self::deflection_hessian`] pixel by pixel ([`crate::maps::LensMaps::from_lens`]).
+    /// [`Self::deflection_hessian`] pixel by pixel ([`LensMaps::from_lens`]).
     /// The default declines; a grid of Gaussian cells convolves by FFT.
     fn add_to_maps(&self, maps: &mut LensMaps) -> bool {
         let _ = maps;
         false
+    }
+    /// The components a composite lens ([`Lens`]) is made of, which map making evaluates each
+    /// on its own (so that each can use its whole-map method); empty for a single component.
+    fn parts(&self) -> &[Box<dyn MassComponent>] {
+        &[]
     }
 }
 
@@ -96,21 +103,7 @@ impl MassComponent for Lens {
                 (a + da, [h[0] + dh[0], h[1] + dh[1], h[2] + dh[2]])
             })
     }
-    /// Lets every component add its maps; the components that decline are then summed pixel by
-    /// pixel together. Declines when all of them do (so the caller's path is unchanged).
-    fn add_to_maps(&self, maps: &mut LensMaps) -> bool {
-        let declined: Vec<&dyn MassComponent> = self
-            .components
-            .iter()
-            .filter(|c| !c.add_to_maps(maps))
-            .map(|c| c.as_ref())
-            .collect();
-        if declined.len() == self.components.len() {
-            return false;
-        }
-        if !declined.is_empty() {
-            crate::maps::add_pixelwise(&declined, maps);
-        }
-        true
+    fn parts(&self) -> &[Box<dyn MassComponent>] {
+        &self.components
     }
 }

@@ -13,7 +13,7 @@
 //! The product-averaged radius is reached by scaling the coordinates by `sqrt(q)`
 //! (`X = sqrt(q) x' / r_s`): the Hessian is unchanged and the deflection gains `1/sqrt(q)`.
 //!
-//! Accuracy of the fit (measured at q = 1 against the exact NFW, see tests/nfw.rs), for
+//! Accuracy of the fit (measured at q = 1 against the exact NFW, see tests/physics/nfw.rs), for
 //! `1e-4 < R / r_s < 1e3`: convergence 4e-5 relative, deflection 5e-6, Hessian 2e-5 (of its
 //! largest element). Beyond `~1e3 r_s` the CSE
 //! convergence falls as `R^-3` instead of `R^-2`. The convergence returned by

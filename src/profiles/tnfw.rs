@@ -19,7 +19,7 @@
 //! `m = m_tot + T sum_{k=2..K} c_k x^-k` (derived from the closed form; `c_2 = -1/3`,
 //! `c_3 = pi/8`, ... see [`far_field_coefficients`]) replaces all transcendental functions
 //! by one polynomial; truncated at `K = FAR_FIELD_TERMS` it matches the closed form to
-//! about 1e-13 relative in `m` and 1e-11 in `kappa` (tests/nfw.rs). A point mass of the total
+//! about 1e-13 relative in `m` and 1e-11 in `kappa` (tests/physics/nfw.rs). A point mass of the total
 //! mass would need `x > 500 tau` for 1e-6, since the mass outside `R` falls only as `T/(3 x^2)`.
 //!
 //! Near field: from `x = 2^-8` out to the far-field radius, `m/x^2` and `m'(x)/x` come from a
@@ -323,7 +323,7 @@ mod tests {
         assert_eq!(Q_MIN, 2f64.powi(-16));
         // The closed form itself loses digits where kappa is tiny against its terms (tau =
         // 1e-3, x >> tau: kappa ~ 1e-9 of its central value; the table is the smoother of the
-        // two there), so that case is held to 1e-10. tests/nfw.rs checks the fields against
+        // two there), so that case is held to 1e-10. tests/physics/nfw.rs checks the fields against
         // 50-digit values.
         for (tau, rtol) in [
             (1e-3, 1e-10),

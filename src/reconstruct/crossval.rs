@@ -23,9 +23,9 @@ use super::{
 };
 use crate::curves::CriticalCurves;
 use crate::fits::{write_image, Card, FitsWriteOptions};
-use crate::grid::{Map, MapGeometry};
 use crate::inversion::build_constraints;
-use crate::maps::LensMaps;
+use crate::map::LensMaps;
+use crate::map::{Map, MapGeometry};
 use crate::products::ProductsError;
 use crate::profiles::MassComponent;
 use crate::render::{render_kappa_png, ColorScale, KappaPlotOptions, Overlay};

@@ -31,13 +31,13 @@ pub use summary::{ReconstructSummary, Solved};
 
 use crate::catalog::{ImageCatalog, MemberCatalog};
 use crate::cosmology::LensPlane;
-use crate::grid::MapGeometry;
-use crate::images::ImageError;
+use crate::image_search::ImageError;
 use crate::inversion::{
     build_constraints, build_member_layers, capped_inverse_jacobian, CellGrid, ConstraintError,
     ConstraintSet, ConstraintSource, GridError, GridMass, Layer, LinearSystem, MembersError,
     ObjectiveTerms, Regulariser, Strength, SystemError,
 };
+use crate::map::MapGeometry;
 use crate::products::{ProductOptions, Products, ProductsError};
 use crate::profiles::{Lens, MassComponent};
 use crate::sky::SkyReference;

@@ -6,11 +6,11 @@ use glam::DVec2;
 use serde::{Deserialize, Serialize};
 
 use crate::ds9::{write_marks, Mark};
-use crate::images::{
+use crate::image_search::{
     find_images, magnification_at, source_position, ImageError, ImageSearch, SearchGrid,
 };
 use crate::inversion::{ConstraintSource, LinearSystem};
-use crate::maps::LensMaps;
+use crate::map::LensMaps;
 use crate::products::Products;
 use crate::profiles::{Lens, MassComponent};
 

@@ -4,7 +4,7 @@ use serde::{Deserialize, Serialize};
 
 use super::colormap_tables::{MAGMA, VIRIDIS};
 use super::RenderError;
-use crate::grid::Map;
+use crate::map::Map;
 
 /// A 256-entry perceptually uniform colour map (matplotlib's tables).
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Serialize, Deserialize)]

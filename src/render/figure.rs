@@ -11,7 +11,7 @@ use super::overlay::{below_height, draw_legend, draw_overlay, legend_entries, Ke
 use super::paint::{color, frame, paint};
 use super::{check_map, KappaPlotOptions, Overlay, RenderError};
 use super::{ColorScale, LegendPlace};
-use crate::grid::{Map, MapGeometry};
+use crate::map::{Map, MapGeometry};
 
 /// Where the map lies in a figure of [`render_kappa_png`] (screen pixels, origin top-left),
 /// e.g. to turn a click on the PNG into arcsec.
@@ -130,7 +130,7 @@ pub fn kappa_figure_frame_for(
     })
 }
 
-/// A PNG figure of `kappa` (module docs of [`super`]): colour-mapped map with +x right, +y up,
+/// A PNG figure of `kappa` (options: [`super::KappaPlotOptions`]): colour-mapped map with +x right, +y up,
 /// axes in arcsec, colour bar ("kappa" or "log10 kappa"), critical curves, points, a legend
 /// (in the map's corner or under it, [`KappaPlotOptions::legend`]) and an optional title. The map occupies `opts.map_pixels_on_screen` pixels a side; colour
 /// limits as in [`super::color_limits`].

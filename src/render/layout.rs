@@ -4,7 +4,7 @@
 use glam::DVec2;
 
 use super::font::CAP;
-use crate::grid::MapGeometry;
+use crate::map::MapGeometry;
 
 /// Pixel positions of the parts of the figure.
 pub(super) struct Layout {

@@ -12,7 +12,7 @@ use serde::{Deserialize, Serialize};
 use thiserror::Error;
 
 use crate::curves::CriticalCurves;
-use crate::grid::Map;
+use crate::map::Map;
 
 mod axes;
 mod colormap;

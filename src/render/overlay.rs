@@ -11,7 +11,7 @@ use super::layout::Layout;
 use super::paint::{color, frame, paint};
 use super::{LegendPlace, Marker, Overlay, MIN_PIXEL_SIDE_PX, PIXEL_ALPHA};
 use crate::ds9::polyline_is_open;
-use crate::grid::MapGeometry;
+use crate::map::MapGeometry;
 
 /// Tangential critical curves.
 pub const TANGENTIAL_RGB: [u8; 3] = [230, 30, 30];

@@ -13,8 +13,8 @@
 
 use glam::DVec2;
 
-use crate::grid::MapGeometry;
-use crate::maps::LensMaps;
+use crate::map::LensMaps;
+use crate::map::MapGeometry;
 
 /// Fraction of a source's peak surface brightness above which a lensed pixel is a constraint.
 pub const THRESHOLD_FRACTION: f64 = 0.01;

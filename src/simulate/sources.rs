@@ -22,7 +22,7 @@ use super::rng::Rng;
 use super::{SimulateError, SimulatedSource};
 use crate::cosmology::LensPlane;
 use crate::curves::{critical_curves, signed_area_arcsec2};
-use crate::maps::LensMaps;
+use crate::map::LensMaps;
 use crate::units::ARCSEC_PER_RAD;
 
 /// Source redshifts, resembling the spectroscopic and photometric redshifts of the ~30

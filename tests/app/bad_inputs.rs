@@ -2,11 +2,11 @@
 //! names the file, says line and column once, and the size limits refuse a huge input before
 //! it is parsed. Catalogue cases are in tests/files/catalog.rs, command-line ones in tests/cli.rs.
 
-use wslap::arcs::{parse_arcs, ArcsError};
-use wslap::fits::{read_image, FitsError};
-use wslap::limits::{MAX_ARC_PIXELS, MAX_FITS_PIXELS};
-use wslap::model::ModelFile;
-use wslap::reconstruct::ReconstructConfig;
+use wslap::ModelFile;
+use wslap::ReconstructConfig;
+use wslap::{parse_arcs, ArcsError};
+use wslap::{read_image, FitsError};
+use wslap::{MAX_ARC_PIXELS, MAX_FITS_PIXELS};
 
 fn config_err(text: &str) -> String {
     ReconstructConfig::from_json_str(text, "config.json")
@@ -145,7 +145,7 @@ fn arcs_pixel_limit() {
 #[cfg(not(target_arch = "wasm32"))]
 #[test]
 fn json_size_limit() {
-    use wslap::limits::MAX_JSON_BYTES;
+    use wslap::MAX_JSON_BYTES;
     let text = " ".repeat(MAX_JSON_BYTES as usize + 1);
     let err = ModelFile::from_json_str(&text, "model.json")
         .unwrap_err()

@@ -3,9 +3,9 @@
 
 use serde_json::json;
 use wslap::app::examples::teaching_image_catalog;
-use wslap::app::{DataRole, RunKind, Session};
-use wslap::demo::TEACHING_MODEL_JSON;
-use wslap::solver::Control;
+use wslap::Control;
+use wslap::TEACHING_MODEL_JSON;
+use wslap::{app::DataRole, app::RunKind, app::Session};
 
 /// A quick reconstruction: 16 x 16 cells, 400 iterations, 64-pixel maps.
 pub fn teaching_session() -> Session {

@@ -3,9 +3,9 @@
 
 use crate::fixtures::teaching_session;
 use serde_json::json;
-use wslap::app::examples::{teaching_image_catalog, TEACHING_SOURCES};
-use wslap::app::{DataRole, RunKind, Session};
-use wslap::solver::Control;
+use wslap::Control;
+use wslap::{app::examples::teaching_image_catalog, app::examples::TEACHING_SOURCES};
+use wslap::{app::DataRole, app::RunKind, app::Session};
 
 #[cfg_attr(not(target_arch = "wasm32"), test)]
 #[cfg_attr(target_arch = "wasm32", wasm_bindgen_test::wasm_bindgen_test)]
@@ -146,7 +146,7 @@ fn a_bad_setting_is_refused_and_the_old_value_kept() {
 fn ds9_regions_load_as_arcs_with_the_catalogue_redshifts() {
     let mut s = teaching_session();
     let cat = teaching_image_catalog().unwrap();
-    let (catalog, _) = wslap::catalog::parse_image_catalog(&cat, "images.cat", None).unwrap();
+    let (catalog, _) = wslap::parse_image_catalog(&cat, "images.cat", None).unwrap();
     let sky = catalog.reference.unwrap();
     let mut reg = String::from("# Region file format: DS9 version 4.1\nfk5\n");
     for im in catalog.images() {
@@ -177,10 +177,7 @@ fn ds9_regions_load_as_arcs_with_the_catalogue_redshifts() {
     let r = s.result().unwrap();
     let rec = r.reconstruction().unwrap();
     let pixels = rec.config.constraints.pixel_arcsec;
-    assert_eq!(
-        rec.config.constraints.mode,
-        wslap::inversion::ConstraintMode::Arcs
-    );
+    assert_eq!(rec.config.constraints.mode, wslap::ConstraintMode::Arcs);
     assert_eq!(rec.sources.len(), TEACHING_SOURCES.len());
     for (src, system) in rec.sources.iter().zip(&catalog.systems) {
         assert_eq!(src.z, system.z.unwrap(), "system {}", src.id);

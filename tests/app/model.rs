@@ -5,11 +5,12 @@
 use crate::fixtures::{count_near, solved, teaching_session};
 use glam::DVec2;
 use serde_json::json;
-use wslap::app::{
-    profile_relative_differences, DataRole, RunKind, Session, ViewOptions, MODEL_CURVE_RGB,
+use wslap::Control;
+use wslap::TEACHING_MODEL_JSON;
+use wslap::{
+    app::profile_relative_differences, app::DataRole, app::RunKind, app::Session, app::ViewOptions,
+    app::MODEL_CURVE_RGB,
 };
-use wslap::demo::TEACHING_MODEL_JSON;
-use wslap::solver::Control;
 
 #[cfg(not(target_arch = "wasm32"))]
 #[test]
@@ -33,7 +34,7 @@ fn the_profile_view_compares_a_reconstruction_with_the_loaded_model() {
     let mut s = teaching_session();
     s.run(RunKind::Reconstruct, &mut |_| Control::Continue)
         .unwrap();
-    let palette_1 = wslap::render::PALETTE[1];
+    let palette_1 = wslap::PALETTE[1];
     let without = s.radial_view().unwrap();
     let without = tiny_skia::Pixmap::decode_png(&without.png).unwrap();
     assert_eq!(
@@ -48,7 +49,7 @@ fn the_profile_view_compares_a_reconstruction_with_the_loaded_model() {
     let (name, profile) = s.model_profile(r).unwrap().expect("the model's profile");
     assert_eq!(name, "model.json");
     assert_eq!(profile.r_edges_arcsec, r.products().profile.r_edges_arcsec);
-    let model = wslap::model::ModelFile::from_json_str(TEACHING_MODEL_JSON, "model.json").unwrap();
+    let model = wslap::ModelFile::from_json_str(TEACHING_MODEL_JSON, "model.json").unwrap();
     let lens = model.build_lens().unwrap();
     let sigma_cr = r.products().plane.sigma_cr_ref_msun_per_arcsec2;
     let pixel = r.products().maps.geometry().pixel_arcsec();
@@ -95,9 +96,9 @@ fn the_profile_view_compares_a_reconstruction_with_the_loaded_model() {
         )
         .unwrap();
     assert!(
-        count_near(&lower, wslap::render::PALETTE[2]) > 200,
+        count_near(&lower, wslap::PALETTE[2]) > 200,
         "the enclosed mass's relative difference: {} pixels",
-        count_near(&lower, wslap::render::PALETTE[2])
+        count_near(&lower, wslap::PALETTE[2])
     );
     // Its values: the reconstruction against the model, bin by bin.
     let (kappa, mass) = profile_relative_differences(&r.products().profile, &profile);
@@ -124,13 +125,13 @@ fn the_profile_view_compares_a_reconstruction_with_the_loaded_model() {
 #[cfg_attr(not(target_arch = "wasm32"), test)]
 #[cfg_attr(target_arch = "wasm32", wasm_bindgen_test::wasm_bindgen_test)]
 fn relative_differences_of_profiles() {
-    let model = wslap::radial::RadialProfile {
+    let model = wslap::RadialProfile {
         r_arcsec: vec![1.0, 3.0, 5.0],
         kappa: vec![2.0, 0.0, 0.5],
         r_edges_arcsec: vec![0.0, 2.0, 4.0, 6.0],
         enclosed_mass_msun: vec![0.0, 1e12, 1e12, 2e12],
     };
-    let ours = wslap::radial::RadialProfile {
+    let ours = wslap::RadialProfile {
         kappa: model.kappa.iter().map(|k| 1.1 * k).collect(),
         enclosed_mass_msun: model.enclosed_mass_msun.iter().map(|m| 1.1 * m).collect(),
         ..model.clone()
@@ -318,8 +319,8 @@ fn the_model_profile_follows_the_sky_frame_and_the_lens_plane() {
 #[cfg(not(target_arch = "wasm32"))]
 #[test]
 fn a_lenstool_par_is_a_model_file_with_the_member_catalogue_as_its_potfile() {
-    use wslap::lenstool_par::load_lenstool_model;
-    use wslap::products::{ProductOptions, Products};
+    use wslap::load_lenstool_model;
+    use wslap::{ProductOptions, Products};
     let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
         .join("../shared/data/AS1063/lenstool_cats");
     let read = |name: &str| std::fs::read_to_string(dir.join(name)).unwrap();

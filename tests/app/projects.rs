@@ -3,9 +3,9 @@
 
 use crate::fixtures::{forward_session, solved};
 use serde_json::json;
-use wslap::app::{RunKind, Session, MAX_STORED_FITS_BYTES};
-use wslap::reconstruct::RunStatus;
-use wslap::solver::Control;
+use wslap::Control;
+use wslap::RunStatus;
+use wslap::{app::RunKind, app::Session, app::MAX_STORED_FITS_BYTES};
 
 #[cfg_attr(not(target_arch = "wasm32"), test)]
 #[cfg_attr(target_arch = "wasm32", wasm_bindgen_test::wasm_bindgen_test)]

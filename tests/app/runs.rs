@@ -6,9 +6,9 @@ use crate::common;
 use crate::fixtures::{solved, teaching_session};
 use serde_json::json;
 use wslap::app::examples::TEACHING_SOURCES;
-use wslap::app::{DataRole, RunKind, Session, ViewOptions};
-use wslap::demo::TEACHING_MODEL_JSON;
-use wslap::solver::Control;
+use wslap::Control;
+use wslap::TEACHING_MODEL_JSON;
+use wslap::{app::DataRole, app::RunKind, app::Session, app::ViewOptions};
 
 const PNG_MAGIC: &[u8] = b"\x89PNG\r\n\x1a\n";
 
@@ -19,7 +19,7 @@ const PNG_MAGIC: &[u8] = b"\x89PNG\r\n\x1a\n";
 fn the_solver_setting_chooses_the_method() {
     let chi2 = |s: &Session| {
         let r = s.result().unwrap().reconstruction().unwrap();
-        2.0 * wslap::solver::objective(&r.system.a, &r.system.b, &r.x) + r.system.theta_w_theta
+        2.0 * wslap::quadratic_objective(&r.system.a, &r.system.b, &r.x) + r.system.theta_w_theta
     };
     // The same objective, minimised by QADP and by the accelerated gradient in 400 iterations.
     let mut qadp = teaching_session();
@@ -261,10 +261,7 @@ fn cross_validation_predicts_each_system_and_keeps_the_result() {
         ]
     );
     let (fits, png) = (&files[1].1, &files[2].1);
-    let spread = wslap::fits::read_image(fits, "spread")
-        .unwrap()
-        .to_map()
-        .unwrap();
+    let spread = wslap::read_image(fits, "spread").unwrap().to_map().unwrap();
     assert_eq!(spread.data.len(), kappa.spread.data.len());
     assert!(png.starts_with(b"\x89PNG"));
     for run in &cv.runs {
@@ -349,7 +346,7 @@ fn auto_strength_in_pieces_equals_one_auto_run() {
     s.set_field("reconstruct.objective.candidates", json!([0.01, 1.0]))
         .unwrap();
     let (candidates, folds) = s.strength_plan().unwrap().expect("auto has a plan");
-    use wslap::inversion::Regulariser::{Curvature, Gradient};
+    use wslap::{Regulariser::Curvature, Regulariser::Gradient};
     assert_eq!(
         candidates,
         vec![

@@ -4,14 +4,14 @@
 use crate::fixtures::{count_near, forward_session, solved, teaching_session};
 use glam::DVec2;
 use serde_json::json;
-use wslap::app::examples::{teaching_image_catalog, TEACHING_SOURCES};
-use wslap::app::{
-    system_rgb, DataRole, RunKind, Session, ViewOptions, COUNTER_IMAGE_RGB, OBSERVED_RGB,
-    PREDICTED_RGB, SHOWN_MIN_MAGNIFICATION,
+use wslap::Control;
+use wslap::TEACHING_MODEL_JSON;
+use wslap::{app::examples::teaching_image_catalog, app::examples::TEACHING_SOURCES};
+use wslap::{
+    app::system_rgb, app::DataRole, app::RunKind, app::Session, app::ViewOptions,
+    app::COUNTER_IMAGE_RGB, app::OBSERVED_RGB, app::PREDICTED_RGB, app::SHOWN_MIN_MAGNIFICATION,
 };
-use wslap::demo::TEACHING_MODEL_JSON;
-use wslap::render::{LegendPlace, PIXEL_ALPHA};
-use wslap::solver::Control;
+use wslap::{LegendPlace, PIXEL_ALPHA};
 
 /// The map draws the predicted images down to `|mu|` = [`SHOWN_MIN_MAGNIFICATION`]; the
 /// demagnified central images below it stay in `sources.json`.
@@ -268,7 +268,7 @@ fn a_clicked_point_shows_the_images_of_its_source() {
     assert_eq!(bright.count(), 2, "{:?}", c.images);
     // As DS9 regions: the clicked point and the two images, yellow, where they are.
     let text = s.counter_image_regions(rows[0].1).unwrap();
-    let regions = wslap::ds9::read_regions(&text, "counter-images.reg").unwrap();
+    let regions = wslap::read_regions(&text, "counter-images.reg").unwrap();
     let r = s.result().unwrap();
     let geometry = r.products().maps.geometry();
     let centres: Vec<DVec2> = regions
@@ -279,7 +279,7 @@ fn a_clicked_point_shows_the_images_of_its_source() {
                 .to_frame_arcsec(r.products().reference, Some(&geometry))
                 .unwrap()
             {
-                wslap::ds9::Shape::Circle { center, .. } => center,
+                wslap::Shape::Circle { center, .. } => center,
                 other => panic!("{other:?}"),
             }
         })

@@ -42,12 +42,12 @@ pub fn assert_abs(what: &str, a: f64, b: f64, atol: f64) {
 /// grid; system `k + 1` is the `k`-th source, and sources with fewer than 2 images are left
 /// out.
 pub fn point_image_catalog(
-    lens: &dyn wslap::profiles::MassComponent,
+    lens: &dyn wslap::MassComponent,
     plane: &wslap::LensPlane,
     sources: impl Iterator<Item = (f64, glam::DVec2)>,
-) -> wslap::catalog::ImageCatalog {
-    use wslap::catalog::{Image, ImageCatalog, ImageSystem};
-    use wslap::images::{find_images, ImageSearch, SearchGrid};
+) -> wslap::ImageCatalog {
+    use wslap::{find_images, ImageSearch, SearchGrid};
+    use wslap::{Image, ImageCatalog, ImageSystem};
     let search = SearchGrid::Lens(wslap::MapGeometry::centered(120.0, 240));
     let mut systems = Vec::new();
     for (k, (z, beta)) in sources.enumerate() {

@@ -8,12 +8,12 @@ use crate::common;
 
 use common::assert_abs;
 use glam::DVec2;
-use wslap::catalog::{
+use wslap::SkyReference;
+use wslap::MAX_CATALOG_ROWS;
+use wslap::{
     parse_image_catalog, parse_member_catalog, CatalogError, ImageCatalog, DEGREE_LOOKALIKE,
     FIELD_ERROR_DEG, Z_AGREEMENT_TOL,
 };
-use wslap::limits::MAX_CATALOG_ROWS;
-use wslap::sky::SkyReference;
 
 /// Positions computed by the same formula in another order: rounding of `RA - RA0` (~1e-13 deg)
 /// times 3600 arcsec/deg.
@@ -689,7 +689,7 @@ fn too_many_rows() {
 #[test]
 fn too_many_bytes() {
     // Refused on its length alone (a text of blanks would otherwise read as "empty").
-    use wslap::limits::MAX_CATALOG_BYTES;
+    use wslap::MAX_CATALOG_BYTES;
     let text = " ".repeat(MAX_CATALOG_BYTES as usize + 1);
     let err = image_err(&text);
     assert_eq!(

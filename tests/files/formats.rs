@@ -4,9 +4,9 @@
 
 use glam::DVec2;
 use serde_json::Value;
-use wslap::curves::{Caustics, CriticalCurves};
-use wslap::fits::{Card, FitsWriteOptions};
-use wslap::sky::SkyReference;
+use wslap::SkyReference;
+use wslap::{Card, FitsWriteOptions};
+use wslap::{Caustics, CriticalCurves};
 use wslap::{Map, MapGeometry};
 
 const REFERENCE_JSON: &str = include_str!("../data/files.json");

@@ -6,7 +6,7 @@ use crate::common;
 mod examples;
 
 use tiny_skia::Pixmap;
-use wslap::render::{
+use wslap::{
     compose_grid, compose_png_grid, Axis, AxisScale, LinePlot, LineStyle, Reference, RenderError,
     Series, PALETTE,
 };
@@ -398,9 +398,9 @@ fn bad_compositions_are_errors() {
     assert!(compose_grid(&p, 1, 0).is_ok());
     let many = vec![solid(10, 10, RED); 3];
     assert!(compose_grid(&many, 3, u32::MAX).is_err());
-    let layout = wslap::render::grid_offsets(&[(4096, 4096); 4], 2, 0);
+    let layout = wslap::grid_offsets(&[(4096, 4096); 4], 2, 0);
     assert!(layout.is_err(), "8192 x 8192 exceeds the pixel budget");
-    let layout = wslap::render::grid_offsets(&[(4096, 4096); 2], 2, 0).unwrap();
+    let layout = wslap::grid_offsets(&[(4096, 4096); 2], 2, 0).unwrap();
     assert_eq!((layout.width, layout.height), (8192, 4096));
     assert!(
         matches!(compose_png_grid(&[b"not a png".to_vec()], 1, 0), Err(RenderError::Png(m)) if m.contains("panel 0"))

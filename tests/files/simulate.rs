@@ -15,11 +15,11 @@ use std::sync::OnceLock;
 
 use common::assert_rel;
 use glam::DVec2;
-use wslap::arcs::parse_arcs;
-use wslap::catalog::{parse_image_catalog, parse_member_catalog};
-use wslap::inversion::MemberConfig;
-use wslap::model::ComponentSpec;
-use wslap::simulate::{
+use wslap::parse_arcs;
+use wslap::ComponentSpec;
+use wslap::MemberConfig;
+use wslap::{parse_image_catalog, parse_member_catalog};
+use wslap::{
     GalaxySet, SimulatedSource, Simulation, SimulationConfig, RADIAL_ZONE_ARCSEC,
     TOTAL_FIELD_MASS_MSUN,
 };
@@ -437,7 +437,7 @@ fn cli_writes_every_file() {
         assert!(stdout.contains(name), "{name} not listed in {stdout}");
     }
     let model = std::fs::read_to_string(dir.join("truth/model.json")).unwrap();
-    let model = wslap::model::ModelFile::from_json_str(&model, "model.json").unwrap();
+    let model = wslap::ModelFile::from_json_str(&model, "model.json").unwrap();
     assert_eq!(model.components.len(), 3 + 94);
     let summary: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(dir.join("simulation.json")).unwrap())

@@ -5,8 +5,8 @@
 
 use crate::common::{assert_abs, assert_rel};
 use glam::DVec2;
-use wslap::inversion::{cell_unit_deflection, CellGrid, GridConfig, GridError, GridMass};
-use wslap::profiles::{gaussian_unit_deflection, MassComponent};
+use wslap::{cell_unit_deflection, CellGrid, GridConfig, GridError, GridMass};
+use wslap::{gaussian_unit_deflection, MassComponent};
 
 /// The fast cell kernel vs the reference Gaussian deflection (both accurate to a few ulp).
 const KERNEL_RTOL: f64 = 1e-13;
@@ -71,7 +71,7 @@ fn grid_refinement_splits_the_densest_cells() {
         } else {
             assert_eq!(
                 c,
-                &wslap::inversion::Cell {
+                &wslap::Cell {
                     parent: c.parent,
                     ..*parent
                 }

@@ -6,8 +6,8 @@
 use crate::common::assert_rel;
 use crate::fixtures::{image, system, three_systems};
 use glam::DVec2;
-use wslap::arcs::parse_arcs;
-use wslap::inversion::{
+use wslap::parse_arcs;
+use wslap::{
     build_constraints, ellipse_pixels, ConstraintConfig, ConstraintError, ConstraintMode,
     ConstraintSet, ConstraintSource, Exclusion, Weighting,
 };

@@ -4,17 +4,17 @@
 
 use glam::DVec2;
 use wslap::app::examples::teaching_image_catalog;
-use wslap::arcs::{ArcCatalog, ArcSystem};
-use wslap::catalog::{parse_image_catalog, ImageCatalog};
-use wslap::inversion::{ConstraintMode, ConstraintSource, Layer};
-use wslap::profiles::{MassComponent, TruncatedNfw};
-use wslap::reconstruct::{
+use wslap::Control;
+use wslap::{
     cross_validate, fold_groups, reconstruct, ConvergenceRecord, Inputs, LayerSource,
     ReconstructConfig, ReconstructError,
 };
-use wslap::solver::Control;
+use wslap::{parse_image_catalog, ImageCatalog};
+use wslap::{ArcCatalog, ArcSystem};
+use wslap::{ConstraintMode, ConstraintSource, Layer};
 use wslap::{Cosmology, LensPlane};
 use wslap::{Map, MapGeometry};
+use wslap::{MassComponent, TruncatedNfw};
 
 fn quiet(_: &ConvergenceRecord) -> Control {
     Control::Continue

@@ -2,8 +2,8 @@
 //! of ~20 arcsec and six cluster members.
 
 use glam::DVec2;
-use wslap::catalog::{Image, ImageCatalog, ImageSystem, Member, MemberCatalog};
 use wslap::{Cosmology, LensPlane};
+use wslap::{Image, ImageCatalog, ImageSystem, Member, MemberCatalog};
 
 pub fn plane() -> LensPlane {
     LensPlane::new(Cosmology::default(), 0.3).unwrap()

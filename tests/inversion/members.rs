@@ -6,9 +6,9 @@
 use crate::common::{assert_abs, assert_rel};
 use crate::fixtures::{member, members, plane};
 use glam::DVec2;
-use wslap::catalog::MemberCatalog;
-use wslap::inversion::{build_member_layers, CellGrid, Layer, LayerSplit, MemberConfig};
-use wslap::profiles::{MassComponent, TruncatedNfw};
+use wslap::MemberCatalog;
+use wslap::{build_member_layers, CellGrid, Layer, LayerSplit, MemberConfig};
+use wslap::{MassComponent, TruncatedNfw};
 
 /// Member halo rebuilt from its M200, c200 (the concentration is found by bisection to
 /// double precision; the TNFW total-mass formula rounds at ~1e-13).
@@ -129,7 +129,7 @@ fn member_masses_follow_magnitudes() {
     assert_abs("layer y", model.layers[0].deflection(p).y, sum.y, 1e-14);
 
     let nfw_config = MemberConfig {
-        profile: wslap::inversion::HaloProfile::Nfw,
+        profile: wslap::HaloProfile::Nfw,
         ..config
     };
     let model = build_member_layers(&cat, &nfw_config, &plane, &grid).unwrap();

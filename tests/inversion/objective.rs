@@ -6,17 +6,15 @@
 use crate::common;
 
 use glam::DVec2;
-use wslap::catalog::ImageCatalog;
-use wslap::images::{find_images, ImageSearch, SearchGrid};
-use wslap::inversion::{capped_inverse_jacobian, ConstraintSource, Layer, Regulariser, Strength};
-use wslap::profiles::{Lens, MassComponent, Nfw, TruncatedNfw};
-use wslap::reconstruct::{
-    cross_validate, reconstruct, Inputs, LayerSource, ReconstructConfig, SolverMethod,
-};
-use wslap::solver::{Control, SolveStatus};
+use wslap::ImageCatalog;
+use wslap::{capped_inverse_jacobian, ConstraintSource, Layer, Regulariser, Strength};
+use wslap::{cross_validate, reconstruct, Inputs, LayerSource, ReconstructConfig, SolverMethod};
+use wslap::{find_images, ImageSearch, SearchGrid};
+use wslap::{Control, SolveStatus};
 use wslap::{Cosmology, LensPlane, MapGeometry};
+use wslap::{Lens, MassComponent, Nfw, TruncatedNfw};
 
-fn quiet(_: &wslap::reconstruct::ConvergenceRecord) -> Control {
+fn quiet(_: &wslap::ConvergenceRecord) -> Control {
     Control::Continue
 }
 
@@ -101,7 +99,7 @@ fn point_inputs<'a>(
 fn small_config() -> ReconstructConfig {
     let mut c = ReconstructConfig::default();
     c.grid.cells = 12;
-    c.constraints.mode = wslap::inversion::ConstraintMode::Point;
+    c.constraints.mode = wslap::ConstraintMode::Point;
     c.products.pixels = 96;
     c
 }

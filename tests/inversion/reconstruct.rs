@@ -4,14 +4,14 @@
 use crate::common;
 
 use glam::DVec2;
-use wslap::arcs::{ArcCatalog, ArcSystem};
-use wslap::catalog::ImageCatalog;
-use wslap::images::source_position;
-use wslap::inversion::{ConstraintMode, ConstraintSource, Layer};
-use wslap::profiles::{Lens, MassComponent, Nfw, TruncatedNfw};
-use wslap::reconstruct::{reconstruct, Inputs, LayerSource, ReconstructConfig};
-use wslap::solver::Control;
+use wslap::source_position;
+use wslap::Control;
+use wslap::ImageCatalog;
+use wslap::{reconstruct, Inputs, LayerSource, ReconstructConfig};
+use wslap::{ArcCatalog, ArcSystem};
+use wslap::{ConstraintMode, ConstraintSource, Layer};
 use wslap::{Cosmology, LensPlane};
+use wslap::{Lens, MassComponent, Nfw, TruncatedNfw};
 
 /// Median deflection error (arcsec, at D_ls/D_s = 1) at the observed images.
 /// A constant deflection is absorbed by the betas, so it is removed before comparing.
@@ -136,7 +136,7 @@ impl Truth {
     }
 }
 
-fn quiet(_: &wslap::reconstruct::ConvergenceRecord) -> Control {
+fn quiet(_: &wslap::ConvergenceRecord) -> Control {
     Control::Continue
 }
 
@@ -146,7 +146,7 @@ fn reconstruct_synthetic(
     truth: &Truth,
     catalog: &ImageCatalog,
     layers: &[Layer],
-) -> (wslap::reconstruct::Reconstruction, f64) {
+) -> (wslap::Reconstruction, f64) {
     // The paper's method (QADP stopped early on the source-plane chi^2).
     let mut config = ReconstructConfig::paper();
     config.constraints.mode = ConstraintMode::Arcs;
@@ -289,7 +289,7 @@ fn a_system_with_fewer_rows_than_unknowns_is_flagged() {
         };
         reconstruct(&inputs, config, &mut quiet).unwrap()
     };
-    let flagged = |r: &wslap::reconstruct::Reconstruction| {
+    let flagged = |r: &wslap::Reconstruction| {
         r.warnings
             .iter()
             .any(|w| w.contains("constraint rows") && w.contains("C are not measured"))
@@ -299,7 +299,7 @@ fn a_system_with_fewer_rows_than_unknowns_is_flagged() {
     assert!(points.system.n_rows < points.system.n_columns());
     assert!(flagged(&points), "{:?}", points.warnings);
     // About the ridge of the computation (1e-10): none.
-    let share = |r: &wslap::reconstruct::Reconstruction| r.system.layer_independence()[0].unwrap();
+    let share = |r: &wslap::Reconstruction| r.system.layer_independence()[0].unwrap();
     assert!(share(&points) < 1e-8, "{}", share(&points));
     config.constraints.mode = ConstraintMode::Arcs;
     let pixels = run(&config, ConstraintSource::Arcs(&arcs));
@@ -313,14 +313,14 @@ fn a_system_with_fewer_rows_than_unknowns_is_flagged() {
 }
 
 /// `system.threads` holds for the whole run: every parallel section (rows, normal equations,
-/// QADP passes, maps, image search) takes its thread count from `wslap::threads::available()`
+/// QADP passes, maps, image search) takes its thread count from `wslap::available_threads()`
 /// on the run's thread, which is also where the progress callback runs.
 #[cfg(not(target_arch = "wasm32"))]
 #[test]
 fn system_threads_limits_every_parallel_section_of_the_run() {
     let truth = Truth::new();
     let catalog = truth.catalog();
-    let all = wslap::threads::available();
+    let all = wslap::available_threads();
     for threads in [1, 3] {
         let mut config = ReconstructConfig::default();
         config.grid.cells = 8;
@@ -338,7 +338,7 @@ fn system_threads_limits_every_parallel_section_of_the_run() {
         };
         let mut seen = Vec::new();
         reconstruct(&inputs, &config, &mut |_| {
-            seen.push(wslap::threads::available());
+            seen.push(wslap::available_threads());
             Control::Continue
         })
         .unwrap();
@@ -348,7 +348,7 @@ fn system_threads_limits_every_parallel_section_of_the_run() {
         );
     }
     assert_eq!(
-        wslap::threads::available(),
+        wslap::available_threads(),
         all,
         "the limit ends with the run"
     );
@@ -398,12 +398,12 @@ fn the_accelerated_gradient_goes_further_than_qadp() {
         holdout: &[],
         catalog: Some(&catalog),
     };
-    let chi2 = |r: &wslap::reconstruct::Reconstruction| {
-        2.0 * wslap::solver::objective(&r.system.a, &r.system.b, &r.x) + r.system.theta_w_theta
+    let chi2 = |r: &wslap::Reconstruction| {
+        2.0 * wslap::quadratic_objective(&r.system.a, &r.system.b, &r.x) + r.system.theta_w_theta
     };
     let fast = reconstruct(&inputs, &config, &mut quiet).unwrap();
     let mut qadp_config = config.clone();
-    qadp_config.solver.method = wslap::reconstruct::SolverMethod::Qadp;
+    qadp_config.solver.method = wslap::SolverMethod::Qadp;
     let qadp = reconstruct(&inputs, &qadp_config, &mut quiet).unwrap();
     println!(
         "chi2 {} vs QADP {}; grid mass {:e} vs {:e}",
@@ -424,10 +424,10 @@ pub(crate) mod real {
     use std::path::{Path, PathBuf};
 
     use super::*;
-    use wslap::catalog::{parse_image_catalog, parse_member_catalog, MemberCatalog};
-    use wslap::curves::einstein_radius_for;
-    use wslap::lenstool_par::load_lenstool_model;
-    use wslap::reconstruct::Reconstruction;
+    use wslap::einstein_radius_for;
+    use wslap::load_lenstool_model;
+    use wslap::Reconstruction;
+    use wslap::{parse_image_catalog, parse_member_catalog, MemberCatalog};
 
     /// How far the free-form Einstein radius at z_s = 2 may lie from the published parametric
     /// model's (the issue asks for 25%), with a prior on the member factor C of width
@@ -582,7 +582,7 @@ pub(crate) mod real {
     #[test]
     fn as1063_gold_with_members_and_the_stated_objective() {
         let mut config = quick_config();
-        config.objective.strength = wslap::inversion::Strength::Value(0.1);
+        config.objective.strength = wslap::Strength::Value(0.1);
         let r = check_as1063(&config, 0.10);
         let c = r.layer_factors()[0];
         assert!((c - 1.0).abs() < 0.2, "C = {c}");

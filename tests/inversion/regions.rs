@@ -3,7 +3,7 @@
 
 use crate::common::assert_rel;
 use glam::DVec2;
-use wslap::sky::SkyReference;
+use wslap::SkyReference;
 
 /// RA, Dec (degrees, 9 decimals: 4 microarcsec) of the offset `p` (arcsec) from `sky`.
 fn fk5(sky: SkyReference, p: DVec2) -> String {
@@ -41,7 +41,7 @@ fn region_files_become_arc_pixels() {
         pt = at(7.3, -2.1),
     );
     let pixel = 0.1;
-    let r = wslap::arcs::arcs_from_regions(&text, "arcs.reg", Some(sky), pixel, &|_| None).unwrap();
+    let r = wslap::arcs_from_regions(&text, "arcs.reg", Some(sky), pixel, &|_| None).unwrap();
     assert!(!r.reference_from_regions);
     let a = &r.arcs;
     assert_eq!(a.systems.len(), 2);
@@ -95,7 +95,7 @@ fn region_files_become_arc_pixels() {
     }
 
     // Without a reference the frame is the regions' mean position.
-    let r2 = wslap::arcs::arcs_from_regions(&text, "arcs.reg", None, pixel, &|_| None).unwrap();
+    let r2 = wslap::arcs_from_regions(&text, "arcs.reg", None, pixel, &|_| None).unwrap();
     assert!(r2.reference_from_regions);
     let shift = sky.to_offset_arcsec(r2.reference.ra_deg, r2.reference.dec_deg);
     let centres = [
@@ -117,7 +117,7 @@ fn region_files_become_arc_pixels() {
     );
     // A polygon across RA = 0 is averaged there, not at RA 180.
     let across = "fk5\npolygon(359.999,0,0.001,0,0.001,0.001,359.999,0.001) # text={1.1 z=2}\n";
-    let r3 = wslap::arcs::arcs_from_regions(across, "a.reg", None, pixel, &|_| None).unwrap();
+    let r3 = wslap::arcs_from_regions(across, "a.reg", None, pixel, &|_| None).unwrap();
     let (ra, dec) = (r3.reference.ra_deg, r3.reference.dec_deg);
     assert!(
         ra.min(360.0 - ra) < 1e-9 && (dec - 0.0005).abs() < 1e-9,
@@ -133,7 +133,7 @@ fn region_files_report_their_errors_by_line() {
     let sky = SkyReference::new(150.0, 2.2).unwrap();
     let c = |x: f64| fk5(sky, DVec2::new(x, 0.0));
     let read = |body: &str| {
-        wslap::arcs::arcs_from_regions(&format!("fk5\n{body}"), "arcs.reg", Some(sky), 0.2, &|id| {
+        wslap::arcs_from_regions(&format!("fk5\n{body}"), "arcs.reg", Some(sky), 0.2, &|id| {
             (id == "7").then_some(3.3)
         })
     };

@@ -2,8 +2,8 @@
 
 use crate::fixtures::{member, members, plane, three_systems};
 use glam::DVec2;
-use wslap::catalog::MemberCatalog;
-use wslap::inversion::{
+use wslap::MemberCatalog;
+use wslap::{
     build_constraints, build_member_layers, CellGrid, ConstraintConfig, ConstraintError,
     ConstraintSource, GridConfig, GridError, LayerSplit, LinearSystem, MemberConfig, MembersError,
     SystemConfig, SystemError,

@@ -5,9 +5,10 @@
 use crate::common;
 
 use common::assert_rel;
-use wslap::solver::{
-    accelerated_gradient, gram_weighted, nnqp_exact, objective, Control, NormalEquations, Progress,
-    QadpProblem, QadpSettings, SolveStatus, SolverError, NNQP_EXACT_MAX_UNKNOWNS,
+use wslap::{
+    accelerated_gradient, gram_weighted, nnqp_exact, quadratic_objective as objective, Control,
+    NormalEquations, Progress, QadpProblem, QadpSettings, SolveStatus, SolverError,
+    NNQP_EXACT_MAX_UNKNOWNS,
 };
 
 /// QADP after enough iterations against the exact optimum: `phi - phi* <= 1e-6 |phi*|` is the
@@ -64,7 +65,7 @@ fn run_recorded(
     problem: &QadpProblem,
     x0: &[f64],
     settings: &QadpSettings,
-) -> (wslap::solver::SolveOutcome, Vec<Report>) {
+) -> (wslap::SolveOutcome, Vec<Report>) {
     let mut reports = Vec::new();
     let outcome = problem
         .run(x0, settings, &mut |p| {
@@ -394,10 +395,7 @@ fn the_storage_order_changes_only_the_rounding() {
     let x_max = reference.x.iter().fold(0.0f64, |m, &v| m.max(v));
     let reversed: Vec<usize> = (0..n).rev().collect();
     for (name, order) in [
-        (
-            "along the Hilbert curve",
-            wslap::solver::locality_order(&centres),
-        ),
+        ("along the Hilbert curve", wslap::locality_order(&centres)),
         ("reversed", reversed),
     ] {
         let problem = QadpProblem::with_order(&a, &b, n, order).expect("valid order");

@@ -7,13 +7,13 @@
 use crate::common::{assert_abs, assert_rel};
 use crate::fixtures::{members, plane, three_systems};
 use glam::DVec2;
-use wslap::inversion::{
+use wslap::gram_weighted;
+use wslap::{
     build_constraints, build_member_layers, npy_header, CellGrid, ColumnInfo, ConstraintConfig,
     ConstraintSource, GridConfig, Layer, LinearSystem, MemberConfig, RowBlock, SystemConfig,
     SystemError,
 };
-use wslap::profiles::{MassComponent, Nfw, TruncatedNfw};
-use wslap::solver::gram_weighted;
+use wslap::{MassComponent, Nfw, TruncatedNfw};
 
 /// Row-by-row `Gamma X` vs the lens equation with the reconstructed lens: the same sums in a
 /// different order (arcsec, for deflections of tens of arcsec).
@@ -306,7 +306,7 @@ fn export_writes_gamma_theta_weights_and_columns() {
         },
     );
     let dir = std::env::temp_dir().join(format!("wslap-export-{}", std::process::id()));
-    wslap::inversion::export_system(&sys, &dir).unwrap();
+    wslap::export_system(&sys, &dir).unwrap();
     let n = sys.n_columns();
     let gamma = std::fs::read(dir.join("gamma.npy")).unwrap();
     let header = npy_header(&[sys.n_rows, n]);
@@ -406,7 +406,7 @@ fn a_prior_on_c_adds_one_row_per_member_layer() {
 fn export_ends_with_the_prior_rows() {
     let sys = small_system_with_prior("single", &SystemConfig::default(), Some(0.5));
     let dir = std::env::temp_dir().join(format!("wslap-export-prior-{}", std::process::id()));
-    wslap::inversion::export_system(&sys, &dir).unwrap();
+    wslap::export_system(&sys, &dir).unwrap();
     let n = sys.n_columns();
     let read = |name: &str| -> Vec<f64> {
         let bytes = std::fs::read(dir.join(name)).unwrap();

@@ -7,8 +7,8 @@ use crate::common;
 use common::{assert_abs, assert_rel};
 use glam::DVec2;
 use serde::Deserialize;
-use wslap::lenstool_par::{parse_par, ParComponent, ParError, Radius};
-use wslap::profiles::{dpie_b0_arcsec, kk_epsilon, Dpie, ExternalShear, ProfileError, Sis};
+use wslap::{dpie_b0_arcsec, kk_epsilon, Dpie, ExternalShear, ProfileError, Sis};
+use wslap::{parse_par, ParComponent, ParError, Radius};
 use wslap::{Cosmology, LensPlane, MassComponent};
 
 /// Circular dPIE vs lenstronomy 'PJAFFE' (measured 2.3e-9: lenstronomy softens r by 1e-4").
@@ -547,12 +547,10 @@ mod published {
     //! The CATS Lenstool models of ../shared/data (not copied into the repository).
     use super::*;
     use std::path::{Path, PathBuf};
-    use wslap::catalog::{parse_image_catalog, ImageCatalog};
-    use wslap::lenstool_par::{load_lenstool_model, LenstoolModel};
-    use wslap::products::{ProductOptions, Products};
-    use wslap::render::{
-        render_kappa_png, ColorScale, KappaPlotOptions, Marker, Overlay, OverlayPoints,
-    };
+    use wslap::{load_lenstool_model, LenstoolModel};
+    use wslap::{parse_image_catalog, ImageCatalog};
+    use wslap::{render_kappa_png, ColorScale, KappaPlotOptions, Marker, Overlay, OverlayPoints};
+    use wslap::{ProductOptions, Products};
 
     fn data(rel: &str) -> PathBuf {
         Path::new(env!("CARGO_MANIFEST_DIR"))

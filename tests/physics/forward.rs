@@ -1,11 +1,11 @@
 //! The forward path the app's worker runs (`Products::from_model` on the built-in examples),
 //! natively and as WebAssembly in a browser worker.
 
-use wslap::demo::{CLUSTER_MODEL_JSON, TEACHING_MODEL_JSON};
-use wslap::model::ModelFile;
-use wslap::products::{ProductOptions, Products, ProductsError};
-use wslap::profiles::sis_theta_e_arcsec;
-use wslap::render::ColorScale;
+use wslap::sis_theta_e_arcsec;
+use wslap::ColorScale;
+use wslap::ModelFile;
+use wslap::{ProductOptions, Products, ProductsError};
+use wslap::{CLUSTER_MODEL_JSON, TEACHING_MODEL_JSON};
 
 /// The teaching example's main halo dominates: its Einstein radius is close to the SIS value
 /// `f theta_E`; the satellite perturbs it by a few percent.

@@ -5,10 +5,10 @@ use crate::common;
 
 use common::rng::Rng;
 use glam::DVec2;
-use wslap::inversion::{CellGrid, GridMass};
-use wslap::maps::LensMaps;
-use wslap::profiles::{Lens, Nfw};
+use wslap::LensMaps;
+use wslap::{CellGrid, GridMass};
 use wslap::{Cosmology, LensPlane, MapGeometry, MassComponent};
+use wslap::{Lens, Nfw};
 
 /// FFT maps against the direct sum, as a fraction of the largest |value| of each field: double
 /// precision FFTs of side ~1000 keep ~1e-14; the brief asks for 1e-9.
@@ -251,7 +251,7 @@ fn lens_of_grid_and_nfw_matches_direct_maps() {
 #[cfg_attr(not(target_arch = "wasm32"), test)]
 #[cfg_attr(target_arch = "wasm32", wasm_bindgen_test::wasm_bindgen_test)]
 fn product_maps_are_widened_or_narrowed_onto_the_cell_lattice() {
-    use wslap::reconstruct::{product_options, ReconstructConfig};
+    use wslap::{product_options, ReconstructConfig};
     let plan = |grid: &CellGrid, size_arcsec: f64, pixels: usize| {
         let mass = GridMass::new(grid, vec![1.0; grid.len()]).expect("grid mass");
         let geometry = MapGeometry {

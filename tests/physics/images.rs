@@ -9,13 +9,13 @@ use crate::common;
 use common::{assert_abs, assert_rel};
 use glam::DVec2;
 use serde::Deserialize;
-use wslap::images::{
+use wslap::{
     find_images, source_position, source_scatter, FoundImage, ImageError, ImageKind, ImageSearch,
     Parity, SearchGrid,
 };
-use wslap::maps::{LensMaps, MAGNIFICATION_CLAMP};
-use wslap::profiles::{NfwEllipse, PointMass, Sis, TruncatedNfw};
 use wslap::{Cosmology, Lens, LensPlane, MapGeometry, MassComponent};
+use wslap::{LensMaps, MAGNIFICATION_CLAMP};
+use wslap::{NfwEllipse, PointMass, Sis, TruncatedNfw};
 
 /// Image positions vs the analytic solutions, arcsec: Newton settles at |r| <= 1e-11 arcsec
 /// in the source plane, and `|det A| >= 0.1` here, so positions are good to ~1e-10 arcsec.

@@ -4,9 +4,9 @@ use crate::common;
 
 use common::assert_rel;
 use glam::DVec2;
-use wslap::model::{ComponentSpec, ModelError, ModelFile};
-use wslap::profiles::{Gaussian, Sis};
+use wslap::{ComponentSpec, ModelError, ModelFile};
 use wslap::{Cosmology, LensPlane, MassComponent};
+use wslap::{Gaussian, Sis};
 
 fn plane(z_lens: f64) -> LensPlane {
     LensPlane::new(Cosmology::default(), z_lens).expect("valid lens plane")
@@ -95,8 +95,8 @@ fn model_nfw_axis_ratio_selects_the_elliptical_profile() {
 #[cfg_attr(target_arch = "wasm32", wasm_bindgen_test::wasm_bindgen_test)]
 fn demo_models_parse() {
     for (name, text) in [
-        ("cluster", wslap::demo::CLUSTER_MODEL_JSON),
-        ("teaching", wslap::demo::TEACHING_MODEL_JSON),
+        ("cluster", wslap::CLUSTER_MODEL_JSON),
+        ("teaching", wslap::TEACHING_MODEL_JSON),
     ] {
         let model = ModelFile::from_json_str(text, name).expect("demo model is valid");
         assert!(

@@ -9,7 +9,7 @@ use crate::common;
 use common::{assert_abs, assert_rel};
 use glam::DVec2;
 use serde::Deserialize;
-use wslap::profiles::{
+use wslap::{
     nfw_terms, tnfw_mass_and_kappa_unit, Nfw, NfwEllipse, ProfileError, TruncatedNfw, NFW_X_FLOOR,
 };
 use wslap::{Cosmology, LensPlane, MassComponent};

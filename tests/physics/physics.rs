@@ -6,8 +6,8 @@ use crate::common;
 use common::{assert_abs, assert_rel};
 use glam::DVec2;
 use serde::Deserialize;
-use wslap::model::ComponentSpec;
-use wslap::profiles::{
+use wslap::ComponentSpec;
+use wslap::{
     gaussian_unit_deflection, gaussian_unit_hessian, sis_theta_e_arcsec, Gaussian, PointMass,
     ProfileError, Sis,
 };

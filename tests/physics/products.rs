@@ -7,11 +7,11 @@ use crate::common;
 
 use common::{assert_abs, assert_rel};
 use glam::DVec2;
-use wslap::curves::{critical_curves, einstein_radius_for, zero_contours, Polyline};
-use wslap::maps::{LensMaps, MapsError, MAGNIFICATION_CLAMP};
-use wslap::profiles::Sis;
-use wslap::radial::{radial_profile, rect_disc_area, RadialBins, RadialError};
+use wslap::Sis;
+use wslap::{critical_curves, einstein_radius_for, zero_contours, Polyline};
+use wslap::{radial_profile, rect_disc_area, RadialBins, RadialError};
 use wslap::{Cosmology, LensPlane, Map, MapGeometry, MassComponent};
+use wslap::{LensMaps, MapsError, MAGNIFICATION_CLAMP};
 
 /// Test lens: softened isothermal with an elliptical potential,
 /// `psi = b sqrt(s^2 + (1 - e) x^2 + (1 + e) y^2)` about `center`; `kappa(centre) = b / s`.
@@ -564,7 +564,7 @@ fn radial_profile_rejects_bad_requests() {
 #[cfg_attr(not(target_arch = "wasm32"), test)]
 #[cfg_attr(target_arch = "wasm32", wasm_bindgen_test::wasm_bindgen_test)]
 fn an_einstein_curve_larger_than_the_map_is_measured_on_a_wider_one() {
-    use wslap::products::{ProductOptions, Products, EINSTEIN_MAP_WIDENING};
+    use wslap::{ProductOptions, Products, EINSTEIN_MAP_WIDENING};
     let plane = LensPlane::new(Cosmology::default(), 0.3).expect("plane");
     let f = plane.distance_ratio(2.0).expect("f");
     let r_true = f * THETA_E_ARCSEC;
@@ -618,7 +618,7 @@ fn an_einstein_curve_larger_than_the_map_is_measured_on_a_wider_one() {
     // not make the main curve "leave" the map.
     let size = 3.0 * r_true;
     let small = Sis::from_theta_e(DVec2::new(0.5 * size, 0.0), 1.0).expect("small SIS");
-    let lens = wslap::profiles::Lens::new(vec![Box::new(sis()), Box::new(small)]);
+    let lens = wslap::Lens::new(vec![Box::new(sis()), Box::new(small)]);
     let with_small = products_of(&lens, size);
     assert!(!with_small.curves.tangential_leaves_map);
     assert_eq!(with_small.einstein_radius_map_arcsec, Some(size));

@@ -2,7 +2,7 @@
 
 use super::*;
 use crate::common::assert_abs;
-use wslap::ds9::{
+use wslap::{
     polyline_is_open, read_regions, write_marks, write_regions, Ds9Error, Ds9Frame, Mark, Shape,
 };
 
@@ -181,7 +181,7 @@ fn regions_package_reads_our_files_like_we_do() {
     let ours_fk5 = read_regions(OURS_FK5_REG, "fk5.reg").unwrap();
     let ours_img = read_regions(OURS_IMAGE_REG, "image.reg").unwrap();
     // `regions` skips DS9 `segment` (open curves): it only sees the polygons.
-    let polygons = |r: &[wslap::ds9::Region]| -> Vec<Vec<DVec2>> {
+    let polygons = |r: &[wslap::Region]| -> Vec<Vec<DVec2>> {
         r.iter()
             .filter(|r| matches!(r.shape, Shape::Polygon(_)))
             .map(|r| vertices(&r.shape).to_vec())

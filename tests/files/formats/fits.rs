@@ -2,7 +2,7 @@
 
 use super::*;
 use crate::common::assert_abs;
-use wslap::fits::{read_image, write_image, CardValue, FitsError};
+use wslap::{read_image, write_image, CardValue, FitsError};
 
 /// Header cards of a FITS file up to and including END.
 fn header_cards(bytes: &[u8]) -> Vec<String> {

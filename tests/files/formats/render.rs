@@ -2,7 +2,7 @@
 
 use super::*;
 use tiny_skia::Pixmap;
-use wslap::render::{
+use wslap::{
     kappa_figure_frame, render_colormap_rgba, render_kappa_png, value_rgb, ColorScale, Colormap,
     KappaPlotOptions, Marker, Overlay, OverlayPoints, RenderError,
 };
@@ -218,7 +218,7 @@ fn raw_rgba_has_north_in_the_first_row() {
     let n = map.geometry.pixels;
     let rgba = render_colormap_rgba(&map, ColorScale::Log, None, None, Colormap::Magma).unwrap();
     assert_eq!(rgba.len(), n * n * 4);
-    let limits = wslap::render::color_limits(&map, ColorScale::Log, None, None).unwrap();
+    let limits = wslap::color_limits(&map, ColorScale::Log, None, None).unwrap();
     for (i, j) in [(0, n - 1), (n - 1, n - 1), (5, 0), (20, 27)] {
         let row = n - 1 - j;
         let k = (row * n + i) * 4;

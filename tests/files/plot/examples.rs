@@ -3,7 +3,7 @@
 //! a small log-log plot and a large one with big numbers.
 
 use tiny_skia::Pixmap;
-use wslap::render::{compose_png_grid, Axis, LinePlot, LineStyle, Reference, Series, PALETTE};
+use wslap::{compose_png_grid, Axis, LinePlot, LineStyle, Reference, Series, PALETTE};
 
 /// Convergence- and profile-style examples written to the temp dir for a look by eye.
 #[test]

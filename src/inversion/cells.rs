@@ -3,19 +3,19 @@
 //! `N x N` square cells cover a square field; cell `j` carries a circular Gaussian of mass
 //! `m_j` centred on the cell with width `s = cell_sigma_factor * cell_size`. Cells are numbered
 //! row by row from the bottom-left corner, `j = row * N + column` (column along +x, row along
-//! +y), as the maps of `crate::grid` are.
+//! +y), as the maps of `crate::map` are.
 //!
 //! Default width: `s = 0.75` cell. Equal masses on a square lattice of spacing `h` give a
 //! peak-to-peak ripple of about `8 exp(-2 pi^2 s^2 / h^2)` in the convergence: measured 5.9%
 //! at `s = 0.5 h` ([method §2]: ~6%), 1.2e-4 at `s = 0.75 h` and 2e-8 at `s = h`
-//! (tests/inversion.rs checks that the default is smooth and 0.5 is not). 0.75 is the
+//! (tests/inversion/ checks that the default is smooth and 0.5 is not). 0.75 is the
 //! narrowest width that is smooth, so it keeps the most resolution.
 //!
 //! The best width depends on the data. On the paper's simulated cluster (`wslap paper`, the
 //! sweep in its report.md; 32 x 32 cells over 198") wider cells fit better: case (ii)'s median
 //! deflection error is 2.70" at 0.5, 2.42" at 0.75, 1.73" at 1.0, 0.98" at 1.25, 1.13" at 1.5
 //! and 2.27" at 2.0 cells, so `wslap paper` and the app's example of that cluster use 1.25. On
-//! the synthetic lens of tests/reconstruct.rs (16 x 16 cells) 1.25 doubles the image-plane rms
+//! the synthetic lens of tests/inversion/reconstruct.rs (16 x 16 cells) 1.25 doubles the image-plane rms
 //! (1.26" to 2.40"), so the general default stays at the smooth minimum.
 //!
 //! [method §2]: crate::method#2-mass-components
@@ -25,9 +25,9 @@ use glam::DVec2;
 use serde::{Deserialize, Serialize};
 use thiserror::Error;
 
-use super::grid_fft::{self, MapPlan};
-use crate::grid::MapGeometry;
-use crate::maps::LensMaps;
+use super::cells_fft::{self, MapPlan};
+use crate::map::LensMaps;
+use crate::map::MapGeometry;
 use crate::profiles::cell_unit_deflection;
 
 /// What can be wrong with a grid setting or a refinement request.
@@ -369,15 +369,15 @@ impl GridMass {
 
     /// How [`crate::profiles::MassComponent::add_to_maps`] would make the maps of `geometry`:
     /// which cells go to the FFT convolution (groups of equal width on a sub-lattice of the
-    /// pixel lattice, see `grid_fft`) and which to the direct per-pixel sum.
+    /// pixel lattice, see `cells_fft`) and which to the direct per-pixel sum.
     pub fn map_plan(&self, geometry: &MapGeometry) -> MapPlan {
-        let (groups, direct) = grid_fft::plan(
+        let (groups, direct) = cells_fft::plan(
             &self.centers,
             &self.sigmas_arcsec,
             &self.b2_arcsec2,
             geometry,
         );
-        grid_fft::summarize(&groups, &direct)
+        cells_fft::summarize(&groups, &direct)
     }
 
     /// The cells `indices` alone.
@@ -441,7 +441,7 @@ impl crate::profiles::MassComponent for GridMass {
         {
             return false;
         }
-        let (groups, direct) = grid_fft::plan(
+        let (groups, direct) = cells_fft::plan(
             &self.centers,
             &self.sigmas_arcsec,
             &self.b2_arcsec2,
@@ -451,10 +451,10 @@ impl crate::profiles::MassComponent for GridMass {
             return false;
         }
         for group in &groups {
-            grid_fft::add_group(group, maps);
+            cells_fft::add_group(group, maps);
         }
         if !direct.is_empty() {
-            crate::maps::add_pixelwise(&[&self.subset(&direct)], maps);
+            crate::profiles::add_pixelwise(&[&self.subset(&direct)], maps);
         }
         true
     }

@@ -24,8 +24,8 @@ use glam::DVec2;
 use rustfft::num_complex::Complex64;
 use rustfft::{Fft, FftPlanner};
 
-use crate::grid::MapGeometry;
-use crate::maps::LensMaps;
+use crate::map::LensMaps;
+use crate::map::MapGeometry;
 use crate::profiles::{cell_unit_deflection, gaussian_unit_hessian};
 
 /// Largest distance (pixels) of a cell centre from the pixel lattice that still counts as on it:

@@ -27,8 +27,8 @@
 use glam::DVec2;
 use thiserror::Error;
 
-use crate::grid::MapGeometry;
-use crate::maps::{LensMaps, MAGNIFICATION_CLAMP};
+use crate::map::MapGeometry;
+use crate::map::{LensMaps, MAGNIFICATION_CLAMP};
 use crate::profiles::MassComponent;
 
 /// Settings of [`find_images`]; every field has a documented default.
