@@ -83,6 +83,39 @@ pub fn arcs_from_regions(
         line,
         reason,
     };
+    let regions = sky_regions(text, source_name, &at)?;
+    let (reference, reference_from_regions) = match reference {
+        Some(r) => (r, false),
+        None => (
+            mean_position(&regions).map_err(|(line, e)| at(line, e))?,
+            true,
+        ),
+    };
+    let (labelled, excluded) = shapes_in_frame(&regions, reference, &at)?;
+    let lattice = Lattice {
+        pitch: pixel_arcsec,
+    };
+    check_pixel_count(&labelled, &lattice, &at)?;
+    let systems = group_into_systems(&labelled, &excluded, &lattice, &at)?;
+    let mut out = Vec::with_capacity(systems.len());
+    for s in systems {
+        out.push(s.finish(catalog_z, &at)?);
+    }
+    Ok(RegionArcs {
+        arcs: ArcCatalog {
+            source_name: source_name.to_string(),
+            systems: out,
+        },
+        reference,
+        reference_from_regions,
+    })
+}
+
+/// An error on one line of the region file.
+type At<'a> = dyn Fn(usize, String) -> ArcsError + 'a;
+
+/// The file's regions, refused when they are in image pixels or none can be an arc.
+fn sky_regions(text: &str, source_name: &str, at: &At) -> Result<Vec<Region>, ArcsError> {
     let regions = read_regions(text, source_name).map_err(ArcsError::Regions)?;
     if let Some(r) = regions.iter().find(|r| r.frame == Ds9Frame::Image) {
         return Err(at(
@@ -99,16 +132,20 @@ pub fn arcs_from_regions(
                 .into(),
         });
     }
-    let (reference, reference_from_regions) = match reference {
-        Some(r) => (r, false),
-        None => (
-            mean_position(&regions).map_err(|(line, e)| at(line, e))?,
-            true,
-        ),
-    };
-    let mut labelled: Vec<(Label, &Region, Shape)> = Vec::new();
-    let mut excluded: Vec<Shape> = Vec::new();
-    for r in &regions {
+    Ok(regions)
+}
+
+/// The regions as shapes in the frame of `reference`: the included ones with their labels,
+/// and the excluded ones (`-` regions), which cut pixels out.
+#[allow(clippy::type_complexity)]
+fn shapes_in_frame<'r>(
+    regions: &'r [Region],
+    reference: SkyReference,
+    at: &At,
+) -> Result<(Vec<(Label, &'r Region, Shape)>, Vec<Shape>), ArcsError> {
+    let mut labelled = Vec::new();
+    let mut excluded = Vec::new();
+    for r in regions {
         let shape = r
             .to_frame_arcsec(Some(reference), None)
             .map_err(|e| at(r.line, e.to_string()))?;
@@ -125,25 +162,44 @@ pub fn arcs_from_regions(
             excluded.push(shape);
         }
     }
-    let lattice = Lattice {
-        pitch: pixel_arcsec,
-    };
+    Ok((labelled, excluded))
+}
+
+/// Refuses the file, before any pixel is made, when its regions would hold more than
+/// [`MAX_ARC_PIXELS`] pixels (the error is on the line where the count passes it).
+fn check_pixel_count(
+    labelled: &[(Label, &Region, Shape)],
+    lattice: &Lattice,
+    at: &At,
+) -> Result<(), ArcsError> {
     let mut total = 0u64;
-    for (_, r, shape) in &labelled {
+    for (_, r, shape) in labelled {
         total = total.saturating_add(lattice.estimate(shape));
         if total > MAX_ARC_PIXELS as u64 {
             return Err(at(
                 r.line,
                 format!(
-                    "the regions up to here hold up to {total} pixels of {pixel_arcsec} arcsec, \
+                    "the regions up to here hold up to {total} pixels of {} arcsec, \
                      more than the limit of {MAX_ARC_PIXELS} for arcs; use a larger \
-                     constraints.pixel_arcsec or smaller regions"
+                     constraints.pixel_arcsec or smaller regions",
+                    lattice.pitch
                 ),
             ));
         }
     }
+    Ok(())
+}
+
+/// The labelled regions grouped by system and image, with their lattice pixels (less the
+/// excluded shapes) and the redshifts of their labels, which must agree within a system.
+fn group_into_systems(
+    labelled: &[(Label, &Region, Shape)],
+    excluded: &[Shape],
+    lattice: &Lattice,
+    at: &At,
+) -> Result<Vec<SystemBuild>, ArcsError> {
     let mut systems: Vec<SystemBuild> = Vec::new();
-    for (label, r, shape) in &labelled {
+    for (label, r, shape) in labelled {
         let k = match systems.iter().position(|s| s.id == label.system) {
             Some(k) => k,
             None => {
@@ -153,69 +209,12 @@ pub fn arcs_from_regions(
         };
         let s = &mut systems[k];
         if let Some(z) = label.z {
-            if !(z > 0.0 && z < MAX_Z) {
-                return Err(at(r.line, format!("z = {z} must be in (0, {MAX_Z})")));
-            }
-            // Against the lowest and the highest z so far: then every pair agrees.
-            for &(z0, line0) in s.z_range.iter().flat_map(|(lo, hi)| [lo, hi]) {
-                if !redshifts_agree(z, z0) {
-                    return Err(at(
-                        r.line,
-                        format!(
-                            "image {}: z = {z}, but line {line0} gives system {} z = {z0}",
-                            label.image, label.system
-                        ),
-                    ));
-                }
-            }
-            s.z_range = Some(match s.z_range {
-                None => ((z, r.line), (z, r.line)),
-                Some((lo, hi)) => (
-                    if z < lo.0 { (z, r.line) } else { lo },
-                    if z > hi.0 { (z, r.line) } else { hi },
-                ),
-            });
-            s.z_sum += z;
-            s.z_count += 1;
+            s.add_redshift(z, label, r.line, at)?;
         }
-        let pixels = lattice.inside(shape, &excluded);
+        let pixels = lattice.inside(shape, excluded);
         s.add(&label.image, r.line, pixels);
     }
-    let mut out = Vec::with_capacity(systems.len());
-    for s in systems {
-        let mut images = Vec::with_capacity(s.images.len());
-        let mut image_ids = Vec::with_capacity(s.images.len());
-        for (id, line, pixels) in s.images {
-            if pixels.is_empty() {
-                return Err(at(
-                    line,
-                    format!("image {id}: an excluded region covers all of its pixels"),
-                ));
-            }
-            images.push(pixels);
-            image_ids.push(id);
-        }
-        let z = if s.z_count > 0 {
-            Some(s.z_sum / s.z_count as f64)
-        } else {
-            catalog_z(&s.id)
-        };
-        out.push(ArcSystem {
-            id: s.id,
-            z,
-            images,
-            image_ids,
-            line: s.line,
-        });
-    }
-    Ok(RegionArcs {
-        arcs: ArcCatalog {
-            source_name: source_name.to_string(),
-            systems: out,
-        },
-        reference,
-        reference_from_regions,
-    })
+    Ok(systems)
 }
 
 /// A region's label: `system.image` and an optional `z=VALUE`.
@@ -288,6 +287,75 @@ impl SystemBuild {
             images: Vec::new(),
             seen: HashMap::new(),
         }
+    }
+
+    /// Adds the redshift `z` of one label (on `line`): in (0, MAX_Z), and agreeing with the
+    /// system's others (checked against the lowest and the highest so far: then every pair
+    /// agrees).
+    fn add_redshift(
+        &mut self,
+        z: f64,
+        label: &Label,
+        line: usize,
+        at: &At,
+    ) -> Result<(), ArcsError> {
+        if !(z > 0.0 && z < MAX_Z) {
+            return Err(at(line, format!("z = {z} must be in (0, {MAX_Z})")));
+        }
+        for &(z0, line0) in self.z_range.iter().flat_map(|(lo, hi)| [lo, hi]) {
+            if !redshifts_agree(z, z0) {
+                return Err(at(
+                    line,
+                    format!(
+                        "image {}: z = {z}, but line {line0} gives system {} z = {z0}",
+                        label.image, label.system
+                    ),
+                ));
+            }
+        }
+        self.z_range = Some(match self.z_range {
+            None => ((z, line), (z, line)),
+            Some((lo, hi)) => (
+                if z < lo.0 { (z, line) } else { lo },
+                if z > hi.0 { (z, line) } else { hi },
+            ),
+        });
+        self.z_sum += z;
+        self.z_count += 1;
+        Ok(())
+    }
+
+    /// The system with its images in file order and its redshift: the mean of its labels', or
+    /// `catalog_z` of its id. An image that the excluded regions emptied is an error.
+    fn finish(
+        self,
+        catalog_z: &dyn Fn(&str) -> Option<f64>,
+        at: &At,
+    ) -> Result<ArcSystem, ArcsError> {
+        let mut images = Vec::with_capacity(self.images.len());
+        let mut image_ids = Vec::with_capacity(self.images.len());
+        for (id, line, pixels) in self.images {
+            if pixels.is_empty() {
+                return Err(at(
+                    line,
+                    format!("image {id}: an excluded region covers all of its pixels"),
+                ));
+            }
+            images.push(pixels);
+            image_ids.push(id);
+        }
+        let z = if self.z_count > 0 {
+            Some(self.z_sum / self.z_count as f64)
+        } else {
+            catalog_z(&self.id)
+        };
+        Ok(ArcSystem {
+            id: self.id,
+            z,
+            images,
+            image_ids,
+            line: self.line,
+        })
     }
 
     /// Adds the pixels of one region to the image `id` (each pixel once).

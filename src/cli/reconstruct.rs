@@ -5,15 +5,11 @@ use std::path::{Path, PathBuf};
 
 use clap::Args;
 use serde::Serialize;
-use wslap::export_system;
-use wslap::ColorScale;
-use wslap::Control;
-use wslap::InputKind;
 use wslap::{
-    cross_validate, fold_groups, image_regions, reconstruct, ConvergenceRecord, CrossValidation,
-    Dataset, InputText, InputTexts, ReconstructConfig, Reconstruction, SolverMethod,
+    cross_validate, export_system, fold_groups, image_regions, reconstruct, ColorScale, Control,
+    ConvergenceRecord, Cosmology, CrossValidation, Dataset, InputKind, InputText, InputTexts,
+    Inputs, LensPlane, ReconstructConfig, Reconstruction, SolverMethod,
 };
-use wslap::{Cosmology, LensPlane};
 
 use super::input::read_text;
 use super::maps::write_products;
@@ -183,31 +179,45 @@ pub fn run(args: &ReconstructArgs) -> Result<(), String> {
     write_reconstruction(&result, &args.out)?;
     println!("{}", one_line(&result, &args.out));
     if let Some(folds) = args.folds {
-        let mut progress = |fold: usize, r: &ConvergenceRecord| {
-            if r.iteration == total {
-                eprintln!("fold {fold}/{folds}: {total} iterations");
-            }
-            Control::Continue
-        };
-        let geometry = result.products.maps.geometry();
-        let cv = cross_validate(&inputs, &config, folds, Some(geometry), &mut progress)
-            .map_err(|e| e.to_string())?;
-        let write = |file: &str, bytes: &[u8]| -> Result<(), String> {
-            let path = args.out.join(file);
-            fs::write(&path, bytes).map_err(|e| format!("{}: {e}", path.display()))
-        };
-        write("crossval.json", json(&cv)?.as_bytes())?;
-        if let Some(kappa) = &cv.kappa {
-            let p = &result.products;
-            let files = kappa
-                .files(p.reference, p.plane.z_lens, Some(&p.curves), cv.runs.len())
-                .map_err(|e| e.to_string())?;
-            for (file, bytes) in files {
-                write(file, &bytes)?;
-            }
-        }
-        println!("{}", crossval_line(&cv, &args.out.join("crossval.json")));
+        run_crossval(&inputs, &config, folds, &result, &args.out)?;
     }
+    Ok(())
+}
+
+/// `--folds`: the cross-validation of `result`'s inputs and settings over `folds` folds, written
+/// to `out` (crossval.json and the folds' convergence maps) with a line on stdout.
+fn run_crossval(
+    inputs: &Inputs<'_>,
+    config: &ReconstructConfig,
+    folds: usize,
+    result: &Reconstruction,
+    out: &Path,
+) -> Result<(), String> {
+    let total = config.solver.iterations;
+    let mut progress = |fold: usize, r: &ConvergenceRecord| {
+        if r.iteration == total {
+            eprintln!("fold {fold}/{folds}: {total} iterations");
+        }
+        Control::Continue
+    };
+    let geometry = result.products.maps.geometry();
+    let cv = cross_validate(inputs, config, folds, Some(geometry), &mut progress)
+        .map_err(|e| e.to_string())?;
+    let write = |file: &str, bytes: &[u8]| -> Result<(), String> {
+        let path = out.join(file);
+        fs::write(&path, bytes).map_err(|e| format!("{}: {e}", path.display()))
+    };
+    write("crossval.json", json(&cv)?.as_bytes())?;
+    if let Some(kappa) = &cv.kappa {
+        let p = &result.products;
+        let files = kappa
+            .files(p.reference, p.plane.z_lens, Some(&p.curves), cv.runs.len())
+            .map_err(|e| e.to_string())?;
+        for (file, bytes) in files {
+            write(file, &bytes)?;
+        }
+    }
+    println!("{}", crossval_line(&cv, &out.join("crossval.json")));
     Ok(())
 }
 
