@@ -12,7 +12,7 @@
 
 use std::time::Instant;
 
-use wslap::{gram_weighted, locality_order, Control, QadpProblem, QadpSettings};
+use wslap::{gram_weighted, locality_order, Control, QadpProblem, SolverSettings};
 
 #[path = "../tests/common/rng.rs"]
 mod rng;
@@ -91,7 +91,7 @@ fn run(n_grid: usize, n_pix: usize, iterations: usize, threads: usize) {
     }
     .expect("valid problem");
     let t2 = Instant::now();
-    let settings = QadpSettings {
+    let settings = SolverSettings {
         iterations,
         report_every: 100,
         threads,

@@ -121,7 +121,7 @@ pub use inversion::{
 pub use solver::{
     accelerated_gradient, column_independence, gram_weighted, locality_order, minimise_exact,
     nnqp_exact, objective as quadratic_objective, Control, NormalEquations, Progress, QadpProblem,
-    QadpSettings, SolveOutcome, SolveStatus, SolverError, INDEPENDENCE_MAX_UNKNOWNS,
+    SolveOutcome, SolveStatus, SolverError, SolverSettings, INDEPENDENCE_MAX_UNKNOWNS,
     NNQP_EXACT_MAX_UNKNOWNS,
 };
 

@@ -8,7 +8,7 @@ use crate::inversion::{
     ConstraintConfig, GridConfig, MemberConfig, ObjectiveConfig, Regulariser, SystemConfig,
 };
 use crate::limits::{json_error_message, InputKind, TooLarge};
-use crate::solver::QadpSettings;
+use crate::solver::SolverSettings;
 
 use super::ReconstructError;
 
@@ -72,7 +72,7 @@ pub struct SolverConfig {
 
 impl Default for SolverConfig {
     fn default() -> Self {
-        let run = QadpSettings::default();
+        let run = SolverSettings::default();
         Self {
             method: SolverMethod::Exact,
             iterations: run.iterations,
@@ -195,9 +195,9 @@ impl ReconstructConfig {
         Ok(())
     }
 
-    /// The QADP settings of this configuration.
-    pub fn solver_settings(&self) -> QadpSettings {
-        QadpSettings {
+    /// The solver run settings of this configuration.
+    pub fn solver_settings(&self) -> SolverSettings {
+        SolverSettings {
             iterations: self.solver.iterations,
             report_every: self.solver.report_every,
             // One thread count for the whole run (`system.threads`).

@@ -23,7 +23,7 @@
 
 use super::run::drive;
 use super::{check_finite, check_len, validate_system, SolverError};
-use super::{Control, Progress, QadpSettings, SolveOutcome};
+use super::{Control, Progress, SolveOutcome, SolverSettings};
 
 /// Power-iteration steps for the largest eigenvalue of the scaled Hessian.
 const POWER_STEPS: usize = 60;
@@ -40,7 +40,7 @@ pub fn accelerated_gradient(
     b: &[f64],
     n: usize,
     x0: &[f64],
-    settings: &QadpSettings,
+    settings: &SolverSettings,
     callback: &mut dyn FnMut(&Progress) -> Control,
 ) -> Result<SolveOutcome, SolverError> {
     validate_system(a, b, n)?;

@@ -27,8 +27,8 @@
 
 use super::sweep::{run_chunks, ScaledProblem};
 use super::{
-    check_finite, check_len, check_permutation, validate_system, Control, Progress, QadpSettings,
-    SolveOutcome, SolverError,
+    check_finite, check_len, check_permutation, validate_system, Control, Progress, SolveOutcome,
+    SolverError, SolverSettings,
 };
 
 /// A non-negative quadratic program prepared for QADP: build once, run from any start.
@@ -83,7 +83,7 @@ impl QadpProblem {
     pub fn run(
         &self,
         x0: &[f64],
-        settings: &QadpSettings,
+        settings: &SolverSettings,
         callback: &mut dyn FnMut(&Progress) -> Control,
     ) -> Result<SolveOutcome, SolverError> {
         settings.validate()?;

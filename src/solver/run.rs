@@ -1,7 +1,7 @@
 //! The run loop the iterative solvers share: reports to the caller, cancelling, and a stop
 //! when the objective stops being finite.
 
-use super::{Control, Progress, QadpSettings, SolveOutcome, SolveStatus, SolverError};
+use super::{Control, Progress, SolveOutcome, SolveStatus, SolverError, SolverSettings};
 
 /// The run protocol the solvers share: the callback sees `x0` (iteration 0), the state every
 /// `settings.report_every` steps and after the last one, and may cancel;
@@ -11,7 +11,7 @@ use super::{Control, Progress, QadpSettings, SolveOutcome, SolveStatus, SolverEr
 pub(crate) fn drive(
     x0: Vec<f64>,
     objective0: f64,
-    settings: &QadpSettings,
+    settings: &SolverSettings,
     callback: &mut dyn FnMut(&Progress) -> Control,
     advance: &mut dyn FnMut(usize, usize) -> Option<(Vec<f64>, f64)>,
 ) -> Result<SolveOutcome, SolverError> {

@@ -6,7 +6,7 @@ use crate::error::BadFieldValue;
 /// Settings of an iterative run, shared by every method (QADP, the accelerated gradient, the
 /// exact solver's exchanges); `wslap reconstruct`'s `solver` block takes its defaults from here.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub struct QadpSettings {
+pub struct SolverSettings {
     /// Number of multiplicative updates (default 8000, the paper's best; the iteration count is
     /// the regulariser: ~50000 over-fits towards the "point-source solution").
     pub iterations: usize,
@@ -19,7 +19,7 @@ pub struct QadpSettings {
     pub threads: usize,
 }
 
-impl Default for QadpSettings {
+impl Default for SolverSettings {
     fn default() -> Self {
         Self {
             iterations: 8000,
@@ -29,7 +29,7 @@ impl Default for QadpSettings {
     }
 }
 
-impl QadpSettings {
+impl SolverSettings {
     /// Checks `report_every >= 1`.
     pub fn validate(&self) -> Result<(), SolverError> {
         if self.report_every == 0 {

@@ -15,7 +15,7 @@ use std::sync::atomic::{AtomicBool, AtomicU64, AtomicUsize, Ordering};
 use super::kernel::{band_pass, PassSums, UpperTriangle};
 use super::run::drive;
 use super::SolverError;
-use super::{Control, Progress, QadpSettings, SolveOutcome};
+use super::{Control, Progress, SolveOutcome, SolverSettings};
 
 /// Entries of the unit-diagonal matrix below this are stored as 0: they change a sum by less
 /// than `1e-15 sum_j x_j`, far below f32 rounding, and could give subnormal (slow) products.
@@ -159,7 +159,7 @@ fn band_rows(upper: &UpperTriangle, threads: usize) -> Vec<Range<usize>> {
 pub(crate) fn run_chunks(
     p: &ScaledProblem,
     x0: &[f64],
-    settings: &QadpSettings,
+    settings: &SolverSettings,
     callback: &mut dyn FnMut(&Progress) -> Control,
 ) -> Result<SolveOutcome, SolverError> {
     let n = p.n;
@@ -219,7 +219,7 @@ fn lead(
     x0: &[f64],
     shared: &Shared,
     band: &mut Band,
-    settings: &QadpSettings,
+    settings: &SolverSettings,
     callback: &mut dyn FnMut(&Progress) -> Control,
 ) -> Result<SolveOutcome, SolverError> {
     let objective = |shared: &Shared| {
@@ -568,7 +568,7 @@ mod tests {
     fn panics(p: ScaledProblem, threads: usize, panic_in_callback: bool) -> Option<bool> {
         let (done, ended) = std::sync::mpsc::channel();
         std::thread::spawn(move || {
-            let settings = QadpSettings {
+            let settings = SolverSettings {
                 iterations: 400,
                 report_every: 100,
                 threads,

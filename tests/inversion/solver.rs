@@ -7,7 +7,7 @@ use crate::common;
 use common::assert_rel;
 use wslap::{
     accelerated_gradient, gram_weighted, nnqp_exact, quadratic_objective as objective, Control,
-    NormalEquations, Progress, QadpProblem, QadpSettings, SolveStatus, SolverError,
+    NormalEquations, Progress, QadpProblem, SolveStatus, SolverError, SolverSettings,
     NNQP_EXACT_MAX_UNKNOWNS,
 };
 
@@ -64,7 +64,7 @@ fn run_recorded(
     (a, b): (&[f64], &[f64]),
     problem: &QadpProblem,
     x0: &[f64],
-    settings: &QadpSettings,
+    settings: &SolverSettings,
 ) -> (wslap::SolveOutcome, Vec<Report>) {
     let mut reports = Vec::new();
     let outcome = problem
@@ -93,7 +93,7 @@ fn qadp_matches_exact_on_random_problems() {
         let phi_star = objective(&a, &b, &exact);
         assert!(exact.contains(&0.0), "case {case}: some optimal x_i = 0");
         let problem = QadpProblem::new(&a, &b, n).expect("valid problem");
-        let settings = QadpSettings {
+        let settings = SolverSettings {
             iterations: 6000,
             report_every: 200,
             threads: 0,
@@ -139,9 +139,9 @@ fn diagonal_problem_has_closed_form_optimum() {
     let expected: Vec<f64> = (0..n).map(|i| (-b[i] / d[i]).max(0.0)).collect();
     let exact = exact_minimiser(&a, &b, n);
     let problem = QadpProblem::new(&a, &b, n).expect("valid problem");
-    let settings = QadpSettings {
+    let settings = SolverSettings {
         iterations: 50,
-        ..QadpSettings::default()
+        ..SolverSettings::default()
     };
     let outcome = problem
         .run(&[1.0; 5], &settings, &mut |_| Control::Continue)
@@ -164,7 +164,7 @@ fn two_by_two_with_active_bound() {
     common::assert_abs("exact x_2", exact[1], 0.0, EXACT_RTOL);
     let problem = QadpProblem::new(&a, &b, 2).expect("valid problem");
     let outcome = problem
-        .run(&[1.0, 1.0], &QadpSettings::default(), &mut |_| {
+        .run(&[1.0, 1.0], &SolverSettings::default(), &mut |_| {
             Control::Continue
         })
         .expect("valid run");
@@ -180,7 +180,7 @@ fn cancel_stops_at_the_reported_state() {
     let problem = QadpProblem::new(&a, &b, 30).expect("valid problem");
     let mut seen = Vec::new();
     let outcome = problem
-        .run(&[0.1; 30], &QadpSettings::default(), &mut |p| {
+        .run(&[0.1; 30], &SolverSettings::default(), &mut |p| {
             seen.push(p.iteration);
             if p.iteration == 300 {
                 assert_rel(
@@ -212,7 +212,7 @@ fn cancel_stops_at_the_reported_state() {
 fn reports_at_start_every_k_and_at_the_end() {
     let (a, b) = random_problem(&mut Rng(8), 12);
     let problem = QadpProblem::new(&a, &b, 12).expect("valid problem");
-    let settings = QadpSettings {
+    let settings = SolverSettings {
         iterations: 250,
         report_every: 100,
         threads: 0,
@@ -221,7 +221,7 @@ fn reports_at_start_every_k_and_at_the_end() {
     let iterations: Vec<usize> = reports.iter().map(|r| r.0).collect();
     assert_eq!(iterations, vec![0, 100, 200, 250]);
     assert_eq!(outcome.iterations, 250);
-    let none = QadpSettings {
+    let none = SolverSettings {
         iterations: 0,
         ..settings
     };
@@ -244,7 +244,7 @@ fn zero_start_component_stays_zero() {
     x0[k] = 0.0;
     let problem = QadpProblem::new(&a, &b, n).expect("valid problem");
     let outcome = problem
-        .run(&x0, &QadpSettings::default(), &mut |p| {
+        .run(&x0, &SolverSettings::default(), &mut |p| {
             assert_eq!(p.x[k], 0.0, "x_{k} at iteration {}", p.iteration);
             Control::Continue
         })
@@ -272,9 +272,11 @@ fn zero_rows_go_to_zero_or_stay() {
     let (a, b) = zero_row_problem();
     let problem = QadpProblem::new(&a, &b, n).expect("valid problem");
     let outcome = problem
-        .run(&[1.0, 1.0, 1.0, 0.7], &QadpSettings::default(), &mut |_| {
-            Control::Continue
-        })
+        .run(
+            &[1.0, 1.0, 1.0, 0.7],
+            &SolverSettings::default(),
+            &mut |_| Control::Continue,
+        )
         .expect("valid run");
     common::assert_abs("x_0", outcome.x[0], 0.5, 1e-6);
     assert_eq!(outcome.x[1], 0.0);
@@ -287,9 +289,9 @@ fn units_do_not_matter() {
     // phi scaled by s: same minimiser. Extreme s checks that the f32 copy is rescaled.
     let n = 15;
     let (a, b) = random_problem(&mut Rng(10), n);
-    let settings = QadpSettings {
+    let settings = SolverSettings {
         iterations: 500,
-        ..QadpSettings::default()
+        ..SolverSettings::default()
     };
     let base = QadpProblem::new(&a, &b, n)
         .expect("valid problem")
@@ -317,7 +319,7 @@ fn threads_agree_to_rounding() {
     let (a, b) = random_problem(&mut Rng(11), n);
     let problem = QadpProblem::new(&a, &b, n).expect("valid problem");
     let run = |threads| {
-        let settings = QadpSettings {
+        let settings = SolverSettings {
             iterations: 700,
             report_every: 100,
             threads,
@@ -384,7 +386,7 @@ fn lens_problem(rng: &mut Rng) -> (Vec<f64>, Vec<f64>, Vec<[f64; 2]>) {
 fn the_storage_order_changes_only_the_rounding() {
     let (a, b, centres) = lens_problem(&mut Rng(14));
     let n = centres.len();
-    let settings = QadpSettings {
+    let settings = SolverSettings {
         iterations: 1500,
         report_every: 500,
         threads: 1,
@@ -400,7 +402,7 @@ fn the_storage_order_changes_only_the_rounding() {
     ] {
         let problem = QadpProblem::with_order(&a, &b, n, order).expect("valid order");
         for threads in [1, 2] {
-            let settings = QadpSettings {
+            let settings = SolverSettings {
                 threads,
                 ..settings
             };
@@ -443,7 +445,7 @@ fn threaded_runs_report_every_chunk_and_end_on_cancel() {
     let problem = QadpProblem::new(&a, &b, n).expect("valid problem");
     let record = |threads| {
         let mut reports = Vec::new();
-        let settings = QadpSettings {
+        let settings = SolverSettings {
             iterations: 400,
             report_every: 30,
             threads,
@@ -581,7 +583,7 @@ fn bad_inputs_are_named() {
     );
 
     let problem = QadpProblem::new(&a, &b, 2).expect("valid problem");
-    let settings = QadpSettings::default();
+    let settings = SolverSettings::default();
     let mut go = |_: &Progress| Control::Continue;
     assert!(matches!(
         problem.run(&[1.0], &settings, &mut go),
@@ -602,7 +604,7 @@ fn bad_inputs_are_named() {
             value: -0.5
         })
     );
-    let no_reports = QadpSettings {
+    let no_reports = SolverSettings {
         report_every: 0,
         ..settings
     };
@@ -651,7 +653,7 @@ fn accelerated_gradient_matches_exact_on_random_problems() {
         let (a, b) = random_problem(&mut rng, n);
         let exact = exact_minimiser(&a, &b, n);
         let phi_star = objective(&a, &b, &exact);
-        let settings = QadpSettings {
+        let settings = SolverSettings {
             iterations: 3000,
             report_every: 500,
             threads: 0,
@@ -689,7 +691,7 @@ fn accelerated_gradient_goes_further_than_qadp_per_iteration() {
     let n = 60;
     let (a, b) = random_problem(&mut Rng(31), n);
     let phi_star = objective(&a, &b, &exact_minimiser(&a, &b, n));
-    let settings = QadpSettings {
+    let settings = SolverSettings {
         iterations: 300,
         report_every: 300,
         threads: 1,
@@ -715,7 +717,7 @@ fn accelerated_gradient_goes_further_than_qadp_per_iteration() {
 fn accelerated_gradient_cancels_and_handles_zero_rows() {
     let n = 4;
     let (a, b) = zero_row_problem();
-    let settings = QadpSettings::default();
+    let settings = SolverSettings::default();
     let outcome = accelerated_gradient(&a, &b, n, &[1.0, 1.0, 1.0, 0.7], &settings, &mut |_| {
         Control::Continue
     })
