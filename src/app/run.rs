@@ -160,21 +160,16 @@ impl Session {
         &self,
         f: impl FnOnce(&Inputs<'_>, &ReconstructConfig, &Dataset) -> Result<T, AppError>,
     ) -> Result<T, AppError> {
-        let parsed = self.parsed()?;
+        let mut parsed = self.parsed()?;
         let plane = self.settings.lens_plane()?;
         let mut config = self.settings.reconstruct.clone();
-        let (inputs, note) = parsed
+        // The result lists the data's warnings, this one among them.
+        let unfitted = parsed.unfitted_arcs(config.constraints.mode);
+        parsed.warnings.extend(unfitted);
+        let inputs = parsed
             .inputs(plane, &self.settings.holdout, &mut config)
             .map_err(dataset_error)?;
-        match note {
-            // The result lists the data's warnings: add the note to a copy of the data.
-            Some(note) => {
-                let mut noted = parsed.clone();
-                noted.warnings.push(note);
-                f(&inputs, &config, &noted)
-            }
-            None => f(&inputs, &config, &parsed),
-        }
+        f(&inputs, &config, &parsed)
     }
 
     fn run_reconstruction(
@@ -315,7 +310,8 @@ impl Session {
                 "a refined grid cannot be rebuilt from X: solve again".to_string(),
             ));
         }
-        let (source, mode, note) = parsed
+        let unfitted = parsed.unfitted_arcs(config.constraints.mode);
+        let (source, mode) = parsed
             .constraints(config.constraints.mode)
             .map_err(dataset_error)?;
         config.constraints.mode = mode;
@@ -324,7 +320,7 @@ impl Session {
         let positions: Vec<DVec2> = constraints.pixels.iter().map(|p| p.position).collect();
         let grid = CellGrid::from_config(&config.grid, &positions).map_err(|e| run(&e))?;
         let mut warnings = parsed.warnings.clone();
-        warnings.extend(note);
+        warnings.extend(unfitted);
         let layers: Vec<Layer> = match &parsed.members {
             None => Vec::new(),
             Some(m) => {

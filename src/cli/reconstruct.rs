@@ -137,15 +137,13 @@ pub fn run(args: &ReconstructArgs) -> Result<(), String> {
         arcs: text(&arcs),
     };
     let data = Dataset::read(&files, config.constraints.pixel_arcsec).map_err(|e| e.to_string())?;
-    for w in &data.warnings {
+    let unfitted = data.unfitted_arcs(config.constraints.mode);
+    for w in data.warnings.iter().chain(&unfitted) {
         eprintln!("warning: {w}");
     }
-    let (inputs, note) = data
+    let inputs = data
         .inputs(plane, &args.holdout, &mut config)
         .map_err(|e| e.to_string())?;
-    if let Some(note) = note {
-        eprintln!("warning: {note}");
-    }
     if let Some(folds) = args.folds {
         // A number of folds that cannot work is refused before the first run.
         fold_groups(&inputs, &config, folds).map_err(|e| e.to_string())?;

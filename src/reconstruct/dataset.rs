@@ -112,41 +112,45 @@ impl Dataset {
     }
 
     /// The constraints fitted under `mode` and the mode they are fitted with (see the module
-    /// documentation), with a warning when loaded arcs are not fitted.
+    /// documentation).
     pub fn constraints(
         &self,
         mode: ConstraintMode,
-    ) -> Result<(ConstraintSource<'_>, ConstraintMode, Option<String>), DatasetError> {
+    ) -> Result<(ConstraintSource<'_>, ConstraintMode), DatasetError> {
         match (&self.images, &self.arcs) {
             (Some(_), Some(a)) if mode == ConstraintMode::Arcs => {
-                Ok((ConstraintSource::Arcs(a), mode, None))
+                Ok((ConstraintSource::Arcs(a), mode))
             }
-            (Some(c), arcs) => {
-                let note = arcs.as_ref().map(|a| {
-                    format!(
-                        "{}: its arc pixels are not fitted: constraints.mode is \"{}\", so the image catalogue {} is (set the mode to \"arcs\" to fit the arcs)",
-                        a.source_name,
-                        mode.name(),
-                        c.source_name
-                    )
-                });
-                Ok((ConstraintSource::Catalog(c), mode, note))
-            }
-            (None, Some(a)) => Ok((ConstraintSource::Arcs(a), ConstraintMode::Arcs, None)),
+            (Some(c), _) => Ok((ConstraintSource::Catalog(c), mode)),
+            (None, Some(a)) => Ok((ConstraintSource::Arcs(a), ConstraintMode::Arcs)),
             (None, None) => Err(DatasetError::NoConstraints),
+        }
+    }
+
+    /// The warning that loaded arcs are not fitted under `mode` (a catalogue is, see
+    /// [`Self::constraints`]); `None` when they are, or when there are none.
+    pub fn unfitted_arcs(&self, mode: ConstraintMode) -> Option<String> {
+        match (&self.images, &self.arcs) {
+            (Some(c), Some(a)) if mode != ConstraintMode::Arcs => Some(format!(
+                "{}: its arc pixels are not fitted: constraints.mode is \"{}\", so the image catalogue {} is (set the mode to \"arcs\" to fit the arcs)",
+                a.source_name,
+                mode.name(),
+                c.source_name
+            )),
+            _ => None,
         }
     }
 
     /// The reconstruction's inputs from this data, in lens plane `plane` with the systems
     /// `holdout` left out of the fit. Sets `config.constraints.mode` to the mode the constraints
-    /// are fitted with (see [`Self::constraints`]); a warning, if any, is returned beside them.
+    /// are fitted with (see [`Self::constraints`]).
     pub fn inputs<'a>(
         &'a self,
         plane: LensPlane,
         holdout: &'a [String],
         config: &mut ReconstructConfig,
-    ) -> Result<(Inputs<'a>, Option<String>), DatasetError> {
-        let (images, mode, note) = self.constraints(config.constraints.mode)?;
+    ) -> Result<Inputs<'a>, DatasetError> {
+        let (images, mode) = self.constraints(config.constraints.mode)?;
         config.constraints.mode = mode;
         let inputs = Inputs {
             images,
@@ -159,7 +163,7 @@ impl Dataset {
             holdout,
             catalog: self.images.as_ref(),
         };
-        Ok((inputs, note))
+        Ok(inputs)
     }
 }
 
@@ -239,19 +243,22 @@ mod tests {
         let both = Dataset::read(&files(true, true), 0.1).unwrap();
         let mut config = ReconstructConfig::default();
         config.constraints.mode = ConstraintMode::Point;
-        let (inputs, note) = both.inputs(plane(), &[], &mut config).unwrap();
+        let note = both.unfitted_arcs(config.constraints.mode);
+        let inputs = both.inputs(plane(), &[], &mut config).unwrap();
         assert!(matches!(inputs.images, ConstraintSource::Catalog(_)));
         assert!(note
             .unwrap()
             .contains("arcs.reg: its arc pixels are not fitted"));
         config.constraints.mode = ConstraintMode::Arcs;
-        let (inputs, note) = both.inputs(plane(), &[], &mut config).unwrap();
+        let note = both.unfitted_arcs(config.constraints.mode);
+        let inputs = both.inputs(plane(), &[], &mut config).unwrap();
         assert!(matches!(inputs.images, ConstraintSource::Arcs(_)));
         assert_eq!(note, None);
         // Arcs alone are fitted as arcs whatever the mode.
         let arcs = Dataset::read(&files(false, true), 0.1).unwrap();
         config.constraints.mode = ConstraintMode::Ellipse;
-        let (inputs, _) = arcs.inputs(plane(), &[], &mut config).unwrap();
+        assert_eq!(arcs.unfitted_arcs(config.constraints.mode), None);
+        let inputs = arcs.inputs(plane(), &[], &mut config).unwrap();
         assert!(matches!(inputs.images, ConstraintSource::Arcs(_)));
         assert_eq!(config.constraints.mode, ConstraintMode::Arcs);
         let none = Dataset::read(&InputTexts::default(), 0.1).unwrap();
