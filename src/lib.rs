@@ -47,6 +47,7 @@ mod lenstool_par;
 mod limits;
 mod map;
 mod model;
+mod potential;
 mod products;
 mod profiles;
 mod radial;
@@ -63,7 +64,7 @@ mod wasm;
 
 // Cosmology, the sky frame and units.
 pub use cosmology::{Cosmology, CosmologyError, LensPlane};
-pub use sky::SkyReference;
+pub use sky::{parse_sky_angle, SkyReference};
 
 // Mass components and the maps of a lens.
 pub use curves::{
@@ -77,6 +78,9 @@ pub use image_search::{
 };
 pub use map::{LensMaps, Map, MapGeometry, MapsError, MAGNIFICATION_CLAMP};
 pub use model::{ComponentSpec, ModelError, ModelFile};
+pub use potential::{
+    arrival_time_days, potential_at, potential_difference, potential_map, time_delay_distance_mpc,
+};
 pub use products::{ProductOptions, Products, ProductsError, EINSTEIN_MAP_WIDENING};
 pub use profiles::{
     add_pixelwise, cell_unit_deflection, dpie_b0_arcsec, gaussian_unit_deflection,
@@ -128,12 +132,12 @@ pub use solver::{
 // A reconstruction: inputs, settings, the run, cross-validation.
 pub use reconstruct::{
     cross_validate, fitted_system_ids, fold_groups, image_regions, product_options, reconstruct,
-    reconstruct_with_choice, strength_candidates, strength_folds, strength_trial,
+    reconstruct_with_choice, strength_candidates, strength_folds, strength_trial, ArrivalTimes,
     ConvergenceRecord, CrossValidation, Dataset, DatasetError, FoldRun, ImageReport, InputText,
-    InputTexts, Inputs, KappaSpread, LayerSource, PredictedImage, PredictedSystem, ProductConfig,
-    ReconstructConfig, ReconstructError, ReconstructSummary, Reconstruction, RunStatus, Solved,
-    SolverConfig, SolverMethod, SourceReport, StrengthCandidate, StrengthChoice, CHOICE_MAP_PIXELS,
-    DEFAULT_FOLDS, SHOWN_MIN_MAGNIFICATION,
+    InputTexts, Inputs, InterpolatedLens, KappaSpread, LayerSource, PredictedImage,
+    PredictedSystem, ProductConfig, ReconstructConfig, ReconstructError, ReconstructSummary,
+    Reconstruction, RunStatus, Solved, SolverConfig, SolverMethod, SourceReport, StrengthCandidate,
+    StrengthChoice, CHOICE_MAP_PIXELS, DEFAULT_FOLDS, SHOWN_MIN_MAGNIFICATION,
 };
 
 // Figures.

@@ -328,7 +328,7 @@
 //! `x = x_c + (i + 1/2 - n/2) p`, `y = y_c + (j + 1/2 - n/2) p` (pixel size `p`, `i` towards
 //! West, `j` towards North, stored row by row from the bottom as FITS does;
 //! [`crate::MapGeometry`]). The stored maps are `kappa`, `gamma1`, `gamma2`, `alpha_x`,
-//! `alpha_y` at the reference normalisation. For a chosen source redshift (default 2) with
+//! `alpha_y` and the potential `psi` at the reference normalisation. For a chosen source redshift (default 2) with
 //! `f = f(z_s)` and `|gamma|^2 = gamma1^2 + gamma2^2`:
 //!
 //! ```text
@@ -341,6 +341,21 @@
 //! On a critical line, where `|det A| < 1e-6`, the magnification is clamped to `±1e6` with the
 //! sign of `det A`. Maps can also be made from published deflection maps, taking the
 //! derivatives by finite differences.
+//!
+//! **Potential and arrival times** ([`crate::potential_difference`], [`crate::potential_map`]).
+//! The potential `psi` (arcsec^2, reference normalisation) has `alpha = grad psi`; it is fixed
+//! only up to a constant, so it is computed as differences: between two points, the deflection
+//! integrated along the straight segment (adaptive Gauss-Legendre, so every profile and every
+//! reconstruction has it without a formula of its own); as a map (`psi.fits`, zero at the
+//! centre pixel), the deflection maps integrated from the centre along rows and columns (cubic
+//! steps, the two orders averaged). A source at `beta` seen at `theta` arrives at
+//!
+//! ```text
+//! t = D_dt / c * ( |theta - beta|^2 / 2 - f psi(theta) ),   D_dt = (1 + z_l) D_l D_s / D_ls
+//! ```
+//!
+//! (angles in radians); the delay between two images is the difference of their `t`, and the
+//! image that arrives first is a minimum of `t`.
 //!
 //! **Critical curves and caustics** ([`crate::CriticalCurves`]). The tangential critical curves
 //! are the zero contours of `lambda_t`, the radial ones of `lambda_r` (together, the zeros of

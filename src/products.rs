@@ -402,7 +402,8 @@ impl Products {
     }
 
     /// The HFF-style FITS maps: `(file name, bytes)` for kappa, gamma1, gamma2, the two
-    /// deflections (all at `D_ls/D_s = 1`) and the magnification at `z_s` (header `ZSOURCE`).
+    /// deflections, the potential `psi` ([`crate::potential_map`]; all at `D_ls/D_s = 1`) and
+    /// the magnification at `z_s` (header `ZSOURCE`).
     pub fn fits_files(&self) -> Result<Vec<(&'static str, Vec<u8>)>, ProductsError> {
         let z = self.curves.z_source;
         let base = |bunit: &str, what: &str| FitsWriteOptions {
@@ -447,6 +448,16 @@ impl Products {
                 )?,
             ),
             ("magnif.fits", write_image(&self.magnification, &magnif)?),
+            (
+                "psi.fits",
+                write_image(
+                    &crate::potential::potential_map(m),
+                    &base(
+                        "arcsec2",
+                        "Lensing potential, zero at the centre pixel (n/2, n/2)",
+                    ),
+                )?,
+            ),
         ])
     }
 

@@ -57,6 +57,25 @@ impl SkyReference {
     }
 }
 
+/// An RA (`is_ra`) or a Dec typed by a person: decimal degrees (`342.1833`) or sexagesimal,
+/// hours for RA (`22:48:44.0`) and degrees for Dec (`-44:31:51`).
+pub fn parse_sky_angle(text: &str, is_ra: bool) -> Result<f64, String> {
+    let text = text.trim();
+    let value = if text.contains(':') {
+        crate::catalog::sexagesimal(text, if is_ra { 15.0 } else { 1.0 })?
+    } else {
+        text.parse::<f64>()
+            .ok()
+            .filter(|v| v.is_finite())
+            .ok_or_else(|| format!("'{text}' is not an angle in degrees or like 22:48:44.0"))?
+    };
+    let (what, limit) = if is_ra { ("RA", 360.0) } else { ("Dec", 90.0) };
+    if value.abs() > limit {
+        return Err(format!("{what} '{text}' is outside +-{limit} degrees"));
+    }
+    Ok(value)
+}
+
 /// RA in `[0, 360)` degrees: `rem_euclid` alone gives 360.0 for a tiny negative angle (found
 /// by fuzzing, fuzz/regressions/fits_roundtrip/).
 fn wrap_ra(ra_deg: f64) -> f64 {

@@ -9,13 +9,14 @@ use wslap::read_image;
 use wslap::CriticalCurves;
 use wslap::CLUSTER_MODEL_JSON;
 
-const PRODUCT_FILES: [&str; 10] = [
+const PRODUCT_FILES: [&str; 11] = [
     "kappa.fits",
     "gamma1.fits",
     "gamma2.fits",
     "x-arcsec-deflect.fits",
     "y-arcsec-deflect.fits",
     "magnif.fits",
+    "psi.fits",
     "critical-curves.json",
     "critical-curves.reg",
     "kappa.png",
@@ -365,6 +366,29 @@ fn reconstruct_writes_every_product_and_marks_held_out_systems() {
         .count();
     assert!(predicted > 0);
     assert_eq!(regions.len(), observed.len() + predicted);
+    // Every system's delays count from its first predicted image: one is 0, none is negative,
+    // and the observed images have theirs on the same zero.
+    for s in sources.as_array().unwrap() {
+        let delays: Vec<f64> = s["predicted"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|p| {
+                p["delay_days"]
+                    .as_f64()
+                    .expect("a delay per predicted image")
+            })
+            .collect();
+        assert!(
+            delays.contains(&0.0) && delays.iter().all(|&d| d >= 0.0),
+            "{s}"
+        );
+        assert!(s["observed"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .all(|o| o["delay_days"].is_f64()));
+    }
     assert!(regions
         .iter()
         .filter(|r| r.color.as_deref() == Some("magenta"))
@@ -978,4 +1002,155 @@ fn maps_of_a_lenstool_model_match_the_library_and_name_a_missing_potfile() {
     let out = wslap(&["maps", "--model", &par, "--potfile", &potfile, "--out", "x"]);
     assert!(!out.status.success());
     assert!(String::from_utf8_lossy(&out.stderr).contains("cannot be used with"));
+}
+
+/// `wslap images` on the elliptical NFW halo of tests/data/time_delays.json: the images and
+/// delays of lenstronomy (tests/data/time_delays_reference.py), from the model file, from the
+/// source's RA/Dec, and from the deflection maps `wslap maps` writes (with their ZLENS card).
+#[test]
+fn images_match_lenstronomy_from_a_model_and_from_maps() {
+    let reference: serde_json::Value =
+        serde_json::from_str(include_str!("data/time_delays.json")).unwrap();
+    let case = reference["cases"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .find(|c| c["name"] == "nfw_ellipse")
+        .unwrap();
+    let source = &case["sources"][0];
+    let (bx, by) = (
+        source["beta"][0].as_f64().unwrap(),
+        source["beta"][1].as_f64().unwrap(),
+    );
+    let want: Vec<(f64, f64, f64)> = source["images"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|i| {
+            (
+                i["x"].as_f64().unwrap(),
+                i["y"].as_f64().unwrap(),
+                i["arrival_days"].as_f64().unwrap(),
+            )
+        })
+        .collect();
+    let dir = temp_dir("images");
+    let model = dir.join("model.json");
+    fs::write(
+        &model,
+        r#"{"z_lens": 0.3, "reference": {"ra": 342.18, "dec": -44.53}, "components": [
+            {"type": "nfw", "x": 1.0, "y": -2.0, "m200": 1.0e15, "c200": 5.0, "q": 0.7, "pa": 30.0}]}"#,
+    )
+    .unwrap();
+    let run = |args: &[&str]| -> serde_json::Value {
+        let out = wslap(args);
+        assert!(
+            out.status.success(),
+            "{args:?}: {}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        serde_json::from_slice(&out.stdout).expect("JSON on stdout")
+    };
+    // Images in order of arrival, as lenstronomy sorted them: positions and delays.
+    let check = |got: &serde_json::Value, position_atol: f64, delay_rtol: f64| {
+        let images = got["images"].as_array().unwrap();
+        assert_eq!(images.len(), want.len(), "{got}");
+        for (image, &(x, y, t)) in images.iter().zip(&want) {
+            let p = &image["position_arcsec"];
+            let (px, py) = (p[0].as_f64().unwrap(), p[1].as_f64().unwrap());
+            assert!(
+                (px - x).hypot(py - y) < position_atol,
+                "image at ({px}, {py}), lenstronomy ({x}, {y})"
+            );
+            let delay = image["delay_days"].as_f64().unwrap();
+            let expected = t - want[0].2;
+            assert!(
+                (delay - expected).abs() <= delay_rtol * expected.abs().max(1.0),
+                "delay {delay} d at ({x}, {y}), lenstronomy {expected} d"
+            );
+            assert!(image["radec_deg"].is_array());
+        }
+        assert_eq!(images[0]["delay_days"].as_f64(), Some(0.0));
+    };
+    let m = model.to_str().unwrap();
+    let (sx, sy) = (bx.to_string(), by.to_string());
+    let from_model = run(&[
+        "images",
+        "--model",
+        m,
+        "--source",
+        &sx,
+        &sy,
+        "--z-source",
+        "2",
+    ]);
+    // The model itself: Newton to 1e-11 arcsec, delays to the potentials' 1e-10.
+    check(&from_model, 1e-6, 1e-6);
+    let radec = &from_model["source_radec_deg"];
+    let (ra, dec) = (radec[0].to_string(), radec[1].to_string());
+    let from_sky = run(&[
+        "images",
+        "--model",
+        m,
+        "--source-radec",
+        &ra,
+        &dec,
+        "--z-source",
+        "2",
+    ]);
+    check(&from_sky, 1e-6, 1e-6);
+    // Maps of 0.2 arcsec pixels: positions to a few 1e-3 arcsec, delays to 1e-5 (measured:
+    // 6.4e-3 arcsec at the central image, 5e-6 relative on the shortest delay, 51 days).
+    let maps = dir.join("maps");
+    let out = wslap(&[
+        "maps",
+        "--model",
+        m,
+        "--size",
+        "80",
+        "--pixels",
+        "400",
+        "--out",
+        maps.to_str().unwrap(),
+    ]);
+    assert!(out.status.success());
+    assert!(maps.join("psi.fits").exists());
+    let from_maps = run(&[
+        "images",
+        "--maps",
+        maps.to_str().unwrap(),
+        "--source",
+        &sx,
+        &sy,
+        "--z-source",
+        "2",
+    ]);
+    check(&from_maps, 0.01, 1e-5);
+    // Bad input says what is wrong.
+    let out = wslap(&[
+        "images",
+        "--model",
+        m,
+        "--source-radec",
+        "ten",
+        "-44",
+        "--z-source",
+        "2",
+    ]);
+    assert!(!out.status.success());
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(err.contains("'ten' is not an angle"), "{err}");
+    let out = wslap(&[
+        "images",
+        "--model",
+        m,
+        "--source",
+        &sx,
+        &sy,
+        "--z-source",
+        "0.2",
+    ]);
+    assert!(!out.status.success());
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(err.contains("greater than the lens redshift"), "{err}");
 }

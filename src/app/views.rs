@@ -13,7 +13,7 @@ use super::data::{ArcPixels, DataMarks};
 use super::{AppError, Session, SHOWN_MIN_MAGNIFICATION};
 use crate::ds9::{write_marks, Mark};
 use crate::reconstruct::{
-    images_on_maps, source_on_maps, PredictedImage, IMAGE_REGION_RADIUS_ARCSEC,
+    images_on_maps, source_on_maps, ArrivalTimes, PredictedImage, IMAGE_REGION_RADIUS_ARCSEC,
 };
 
 /// The images of a clicked point's source: yellow squares.
@@ -125,7 +125,7 @@ pub struct CounterImages {
     /// Its source position `theta - f alpha(theta)` (arcsec).
     pub beta_arcsec: [f64; 2],
     /// Every image of that source (the point itself among them), with its signed
-    /// magnification, brightest first.
+    /// magnification and its delay in days after the first to arrive, brightest first.
     pub images: Vec<PredictedImage>,
 }
 
@@ -274,6 +274,7 @@ impl Session {
         let mut images =
             images_on_maps(&products.maps, f, beta).map_err(|e| AppError::Run(e.to_string()))?;
         images.sort_by(|a, b| b.magnification.abs().total_cmp(&a.magnification.abs()));
+        ArrivalTimes::new(products).set_delays(products.curves.z_source, beta, &mut images);
         Ok(CounterImages {
             x_arcsec: p.x,
             y_arcsec: p.y,

@@ -238,7 +238,7 @@ fn degrees(text: &str) -> Result<f64, String> {
 
 /// `[+-]a:m:s` to degrees: `scale * sign * (a + m/60 + s/3600)`; `scale` is 15 for hours of RA
 /// and 1 for degrees of Dec. Minutes and seconds must be in `[0, 60)`.
-fn sexagesimal(text: &str, scale: f64) -> Result<f64, String> {
+pub(crate) fn sexagesimal(text: &str, scale: f64) -> Result<f64, String> {
     let err = || format!("'{text}' is not a sexagesimal angle like 22:48:44.0 or -44:31:51");
     let (sign, body) = match text.strip_prefix('-') {
         Some(b) => (-1.0, b),

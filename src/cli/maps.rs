@@ -11,6 +11,7 @@ use wslap::parse_par;
 use wslap::read_image;
 use wslap::ColorScale;
 use wslap::InputKind;
+use wslap::LenstoolModel;
 use wslap::ModelFile;
 use wslap::{Cosmology, LensPlane};
 use wslap::{ProductOptions, Products};
@@ -18,7 +19,7 @@ use wslap::{ProductOptions, Products};
 /// Maps, critical curves, caustics and figures of a lens.
 ///
 /// Writes into DIR: kappa.fits, gamma1.fits, gamma2.fits, x-arcsec-deflect.fits,
-/// y-arcsec-deflect.fits (all for D_ls/D_s = 1), magnif.fits (at --z-source, header ZSOURCE),
+/// y-arcsec-deflect.fits, psi.fits (all for D_ls/D_s = 1), magnif.fits (at --z-source, header ZSOURCE),
 /// critical-curves.json, critical-curves.reg (DS9), kappa.png and summary.json.
 #[derive(Debug, Args)]
 #[command(group(clap::ArgGroup::new("lens").required(true).args(["model", "lenstool", "deflection"])))]
@@ -35,9 +36,9 @@ pub struct MapsArgs {
     #[arg(long, value_name = "MEMBERS.cat", conflicts_with_all = ["model", "deflection"])]
     potfile: Vec<PathBuf>,
     /// Published deflection maps (HFF x- and y-arcsec-deflect FITS, D_ls/D_s = 1).
-    #[arg(long, num_args = 2, value_names = ["X.fits", "Y.fits"], requires = "z_lens")]
+    #[arg(long, num_args = 2, value_names = ["X.fits", "Y.fits"])]
     deflection: Option<Vec<PathBuf>>,
-    /// Lens redshift (with --deflection; a model file has its own).
+    /// Lens redshift (with --deflection, default the maps' ZLENS card; a model file has its own).
     #[arg(long)]
     z_lens: Option<f64>,
     /// H0 in km/s/Mpc (with --deflection).
@@ -96,7 +97,8 @@ pub fn run(args: &MapsArgs) -> Result<(), String> {
     } else {
         let paths = args.deflection.as_deref().unwrap_or_default();
         let (ax, ay) = (read_map(&paths[0])?, read_map(&paths[1])?);
-        let z_lens = args.z_lens.ok_or("--deflection needs --z-lens")?;
+        let z_lens = args.z_lens.or(ax.2);
+        let z_lens = z_lens.ok_or("--deflection needs --z-lens (the maps have no ZLENS card)")?;
         let cosmology = Cosmology::new(args.h0, args.omega_m).map_err(|e| e.to_string())?;
         let plane = LensPlane::new(cosmology, z_lens).map_err(|e| e.to_string())?;
         Products::from_deflection(ax.0, ay.0, plane, ax.1, args.z_source)
@@ -123,6 +125,16 @@ fn lenstool_products(
     potfiles: &[PathBuf],
     opts: &ProductOptions,
 ) -> Result<Products, String> {
+    let model = load_lenstool(par_path, potfiles)?;
+    Products::from_lens(&model.lens, model.plane, model.reference, opts).map_err(|e| e.to_string())
+}
+
+/// The Lenstool model `par_path` with the member catalogues `potfiles` (one per potfile block;
+/// when empty, each block's `filein` next to the .par file); warnings go to stderr.
+pub(super) fn load_lenstool(
+    par_path: &Path,
+    potfiles: &[PathBuf],
+) -> Result<LenstoolModel, String> {
     let name = par_path.display().to_string();
     let par =
         parse_par(&read_text(par_path, InputKind::Model)?, &name).map_err(|e| e.to_string())?;
@@ -142,15 +154,19 @@ fn lenstool_products(
     for w in warnings {
         eprintln!("warning: {w}");
     }
-    Products::from_lens(&model.lens, model.plane, model.reference, opts).map_err(|e| e.to_string())
+    Ok(model)
 }
 
-fn read_map(path: &Path) -> Result<(wslap::Map, Option<wslap::SkyReference>), String> {
+/// A FITS map, its sky reference and its `ZLENS` card (the lens redshift the project writes).
+pub(super) fn read_map(
+    path: &Path,
+) -> Result<(wslap::Map, Option<wslap::SkyReference>, Option<f64>), String> {
     let bytes = read_bytes(path, InputKind::Fits)?;
     let image = read_image(&bytes, &path.display().to_string()).map_err(|e| e.to_string())?;
     let (_, reference) = image.geometry().map_err(|e| e.to_string())?;
     let map = image.to_map().map_err(|e| e.to_string())?;
-    Ok((map, reference))
+    let z_lens = image.card("ZLENS").and_then(|c| c.as_f64());
+    Ok((map, reference, z_lens))
 }
 
 /// Writes every product file into `dir`.

@@ -1,5 +1,6 @@
 //! Command-line parsing and the subcommands (native only).
 
+mod images;
 mod input;
 mod maps;
 mod paper;
@@ -24,6 +25,7 @@ struct Cli {
 #[derive(Debug, Subcommand)]
 enum Command {
     Maps(maps::MapsArgs),
+    Images(images::ImagesArgs),
     Reconstruct(reconstruct::ReconstructArgs),
     Config(reconstruct::ConfigArgs),
     Simulate(simulate::SimulateArgs),
@@ -35,6 +37,7 @@ pub fn run() -> ExitCode {
     let cli = Cli::parse();
     let result = match cli.command {
         Command::Maps(args) => maps::run(&args),
+        Command::Images(args) => images::run(&args),
         Command::Reconstruct(args) => reconstruct::run(&args),
         Command::Config(_) => reconstruct::print_config(),
         Command::Simulate(args) => simulate::run(&args),

@@ -24,8 +24,8 @@ pub use crossval::{
 };
 pub use dataset::{Dataset, DatasetError, InputText, InputTexts};
 pub use sources::{
-    image_regions, images_on_maps, source_on_maps, ImageReport, PredictedImage, SourceReport,
-    IMAGE_REGION_RADIUS_ARCSEC, SHOWN_MIN_MAGNIFICATION,
+    image_regions, images_on_maps, source_on_maps, ArrivalTimes, ImageReport, InterpolatedLens,
+    PredictedImage, SourceReport, IMAGE_REGION_RADIUS_ARCSEC, SHOWN_MIN_MAGNIFICATION,
 };
 pub use summary::{ReconstructSummary, Solved};
 

@@ -10,7 +10,8 @@ use crate::image_search::{
     find_images, magnification_at, source_position, ImageError, ImageSearch, SearchGrid,
 };
 use crate::inversion::{ConstraintSource, LinearSystem};
-use crate::map::LensMaps;
+use crate::map::{LensMaps, Map};
+use crate::potential::{arrival_time_days, potential_at, potential_map};
 use crate::products::Products;
 use crate::profiles::{Lens, MassComponent};
 
@@ -20,10 +21,10 @@ use super::{Inputs, ReconstructError};
 /// the maps themselves are good to a fraction of their pixel.
 const MAP_IMAGE_TOLERANCE_ARCSEC: f64 = 1e-3;
 
-/// The lens as its product maps, bilinearly interpolated (deflection from the alpha maps, the
-/// Hessian from kappa and gamma).
+/// A lens given as its maps (`D_ls/D_s = 1`), bilinearly interpolated: the deflection from the
+/// alpha maps, the Hessian from kappa and gamma.
 #[derive(Debug)]
-struct InterpolatedLens<'a>(&'a LensMaps);
+pub struct InterpolatedLens<'a>(pub &'a LensMaps);
 
 impl MassComponent for InterpolatedLens<'_> {
     fn kappa(&self, p: DVec2) -> f64 {
@@ -66,6 +67,7 @@ pub fn images_on_maps(
         .map(|i| PredictedImage {
             position_arcsec: i.position,
             magnification: i.magnification,
+            delay_days: None,
         })
         .collect())
 }
@@ -98,6 +100,11 @@ pub struct ImageReport {
     /// it was added.)
     #[serde(default)]
     pub magnification: Option<f64>,
+    /// The model's arrival time at the observed position from the system's source, in days
+    /// after the system's first predicted image (negative: earlier). Absent when the lens's
+    /// maps do not reach the image, and in results saved before it was added.
+    #[serde(default)]
+    pub delay_days: Option<f64>,
 }
 
 /// One predicted image.
@@ -106,6 +113,10 @@ pub struct PredictedImage {
     pub position_arcsec: DVec2,
     /// Signed magnification at the system's redshift.
     pub magnification: f64,
+    /// Arrival time in days after the system's first predicted image (0 for that one; see
+    /// [`crate::arrival_time_days`]). Absent in results saved before it was added.
+    #[serde(default)]
+    pub delay_days: Option<f64>,
 }
 
 impl PredictedImage {
@@ -211,6 +222,11 @@ pub(super) fn report(
     default_z: Option<f64>,
 ) -> Result<Vec<SourceReport>, ReconstructError> {
     let betas = system.betas_arcsec(x)?;
+    let times = ArrivalTimes::new(products);
+    let arrival = |z: f64, beta: DVec2| {
+        let times = &times;
+        move |theta: DVec2| times.days(z, beta, theta)
+    };
     let mut reports = Vec::new();
     for (s, sys) in system.constraints.systems.iter().enumerate() {
         let f = system.distance_ratios[s];
@@ -257,6 +273,7 @@ pub(super) fn report(
             predicted,
             lens,
             f,
+            &arrival(sys.z, beta),
         ));
     }
     for id in inputs.holdout {
@@ -286,9 +303,45 @@ pub(super) fn report(
             predicted,
             lens,
             f,
+            &arrival(z, beta),
         ));
     }
     Ok(reports)
+}
+
+/// Arrival times on a lens's product maps: its potential map, made once.
+pub struct ArrivalTimes<'a> {
+    psi: Map,
+    products: &'a Products,
+}
+
+impl<'a> ArrivalTimes<'a> {
+    /// The potential of `products`' maps ([`potential_map`]).
+    pub fn new(products: &'a Products) -> Self {
+        Self {
+            psi: potential_map(&products.maps),
+            products,
+        }
+    }
+
+    /// The arrival time in days at `theta` (arcsec) from a source at `beta` and `z`, from a
+    /// fixed origin (compare images of one source only); `None` off the maps.
+    pub fn days(&self, z: f64, beta: DVec2, theta: DVec2) -> Option<f64> {
+        let psi = potential_at(&self.psi, &self.products.maps, theta)?;
+        arrival_time_days(&self.products.plane, z, theta, beta, psi).ok()
+    }
+
+    /// Sets each image's `delay_days` from the first of them to arrive.
+    pub fn set_delays(&self, z: f64, beta: DVec2, images: &mut [PredictedImage]) {
+        let times: Vec<Option<f64>> = images
+            .iter()
+            .map(|i| self.days(z, beta, i.position_arcsec))
+            .collect();
+        let zero = times.iter().flatten().copied().reduce(f64::min);
+        for (i, t) in images.iter_mut().zip(times) {
+            i.delay_days = t.zip(zero).map(|(t, z)| t - z);
+        }
+    }
 }
 
 /// Observed images by id and position (arcsec).
@@ -352,13 +405,28 @@ fn finish(
     beta: DVec2,
     scatter: f64,
     observed: Vec<(String, DVec2)>,
-    predicted: Vec<PredictedImage>,
+    mut predicted: Vec<PredictedImage>,
     lens: &Lens,
     f: f64,
+    arrival_days: &dyn Fn(DVec2) -> Option<f64>,
 ) -> SourceReport {
+    // Delays count from the first predicted image (from the first observed one when none was
+    // predicted), so that both lists share one zero.
+    let times: Vec<Option<f64>> = predicted
+        .iter()
+        .map(|p| arrival_days(p.position_arcsec))
+        .collect();
+    let observed_times: Vec<Option<f64>> = observed.iter().map(|(_, p)| arrival_days(*p)).collect();
+    let first = |t: &[Option<f64>]| t.iter().flatten().copied().reduce(f64::min);
+    let zero = first(&times).or_else(|| first(&observed_times));
+    let since = |t: Option<f64>| Some(t? - zero?);
+    for (p, t) in predicted.iter_mut().zip(&times) {
+        p.delay_days = since(*t);
+    }
     let observed: Vec<ImageReport> = observed
         .into_iter()
-        .map(|(id, position)| {
+        .zip(observed_times)
+        .map(|((id, position), t)| {
             let nearest = predicted.iter().map(|p| p.position_arcsec).min_by(|a, b| {
                 a.distance_squared(position)
                     .total_cmp(&b.distance_squared(position))
@@ -370,6 +438,7 @@ fn finish(
                 predicted_arcsec: nearest,
                 offset_arcsec: nearest.map(|p| p.distance(position)),
                 magnification: Some(magnification_at(lens, f, position)),
+                delay_days: since(t),
             }
         })
         .collect();

@@ -196,7 +196,7 @@ fn nfw_mass(spec: &ComponentSpec) -> Option<f64> {
 /// Writes the simulation into `dir` (created if missing) and returns the paths written:
 /// `truth/model.json` (soft + galaxy-true), `truth/soft.json`, `truth/galaxies-true.json`,
 /// `truth/galaxies-model.json`, the truth products at `z_s = 3` on the simulation's pixel grid
-/// (`truth/kappa.fits`, `gamma1/2.fits`, `x/y-arcsec-deflect.fits`, `magnif.fits`,
+/// (`truth/kappa.fits`, `gamma1/2.fits`, `x/y-arcsec-deflect.fits`, `psi.fits`, `magnif.fits`,
 /// `critical-curves.json`, `critical-curves.reg`, `kappa.png`, `summary.json`), `arcs.json`,
 /// `arcs.png`, `images.cat`, `members.cat` and `simulation.json`.
 #[cfg(not(target_arch = "wasm32"))]

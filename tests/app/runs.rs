@@ -113,7 +113,7 @@ fn reconstruction_gives_curves_views_hover_and_the_cli_files() {
     assert!(inside.kappa.is_finite() && inside.magnification.is_finite());
     assert!(s.hover(&opts, 1.0, 1.0).unwrap().is_none());
     let fits = r.products().fits_files().unwrap();
-    assert_eq!(fits.len(), 6);
+    assert_eq!(fits.len(), 7);
     let header = String::from_utf8_lossy(&fits[0].1[..2880]).to_string();
     assert!(
         header.contains("NAXIS1  =                   64"),

@@ -111,6 +111,8 @@ test('the built-in example reconstructs and shows a map with critical curves', a
     const [download] = await Promise.all([page.waitForEvent('download'), page.click('#dl-kappa-fits')]);
     const bytes = await readFile(await download.path());
     assert.deepEqual(fitsAxes(bytes), [256, 256]);
+    const [psi] = await Promise.all([page.waitForEvent('download'), page.click('#dl-psi-fits')]);
+    assert.deepEqual(fitsAxes(await readFile(await psi.path())), [256, 256]);
     const [dl2] = await Promise.all([page.waitForEvent('download'), page.click('#dl-summary-json')]);
     const summary = JSON.parse(await readFile(await dl2.path(), 'utf8'));
     assert.equal(summary.settings.solver.iterations, QUICK_ITERATIONS);
@@ -183,6 +185,13 @@ test('the teaching example loads from the menu and reconstructs', async () => {
     const images = [...listed.matchAll(/\((-?[\d.]+), (-?[\d.]+)\) μ/g)].map((g) => [Number(g[1]), Number(g[2])]);
     assert.equal(images.length, Number(m[3]), listed);
     assert.ok(images.some(([x, y]) => Math.hypot(x - Number(m[1]), y - Number(m[2])) < 0.02), listed);
+    // Each image with its parity and, when there are several, the first to arrive and the
+    // delays of the others.
+    assert.equal([...listed.matchAll(/\(parity [+−]\)/g)].length, images.length, listed);
+    if (images.length > 1) {
+      assert.equal([...listed.matchAll(/arrives first/g)].length, 1, listed);
+      assert.equal([...listed.matchAll(/Δt [\d,]+ d/g)].length, images.length - 1, listed);
+    }
     assert.ok(await yellow() > plain + 20, 'the images are drawn');
     // The same as DS9 regions: the clicked point and each image with |μ| >= 0.1.
     const bright = [...listed.matchAll(/μ (-?[\d.]+)/g)].filter((g) => Math.abs(Number(g[1])) >= 0.1).length;

@@ -49,7 +49,7 @@ fn cluster_example_has_curves_and_a_figure() {
     assert_eq!(&png[1..4], b"PNG");
     assert!(png.len() > 10_000, "figure of {} bytes", png.len());
     let fits = p.fits_files().unwrap();
-    assert_eq!(fits.len(), 6);
+    assert_eq!(fits.len(), 7);
     assert!(fits.iter().all(|(_, bytes)| bytes.len() % 2880 == 0));
     assert!(p.regions().contains("fk5"));
 }

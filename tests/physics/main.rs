@@ -14,3 +14,4 @@ mod model_file;
 mod nfw;
 mod physics;
 mod products;
+mod time_delays;

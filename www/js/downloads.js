@@ -10,7 +10,7 @@ const TEXT_FILES = [
   ['critical-curves.reg', 'text/plain'],
 ];
 const FITS = ['kappa.fits', 'gamma1.fits', 'gamma2.fits', 'x-arcsec-deflect.fits',
-  'y-arcsec-deflect.fits', 'magnif.fits'];
+  'y-arcsec-deflect.fits', 'psi.fits', 'magnif.fits'];
 const VIEWS = [['kappa', 'kappa.png'], ['source', 'source-plane.png'],
   ['radial', 'radial-profile.png'], ['convergence', 'convergence.png']];
 

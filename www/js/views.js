@@ -33,6 +33,14 @@ async function readOut() {
   if (queued) { queued = false; await readOut(); }
 }
 
+/** A delay in days as the list shows it: "first" for the first image, days and years after it. */
+function delayText(days) {
+  if (days == null) return '';
+  if (days === 0) return ', arrives first';
+  const d = `${Math.round(days).toLocaleString('en')} d`;
+  return `, Δt ${Math.abs(days) >= 365.25 ? `${d} (${(days / 365.25).toFixed(1)} yr)` : d}`;
+}
+
 /** Lists the images of the pinned point's source (or hides the list). */
 async function listCounterImages() {
   const box = document.getElementById('counter-images');
@@ -44,10 +52,11 @@ async function listCounterImages() {
   let text;
   try {
     const c = await app.counterImages(pin);
-    const images = c.images.map((i) => `(${fmt(i.position_arcsec[0])}, ${fmt(i.position_arcsec[1])}) μ ${fmt(i.magnification, 1)}`);
+    const images = c.images.map((i) => `(${fmt(i.position_arcsec[0])}, ${fmt(i.position_arcsec[1])}) ` +
+      `μ ${fmt(i.magnification, 1)} (parity ${i.magnification < 0 ? '−' : '+'})${delayText(i.delay_days)}`);
     text = `The source behind (${fmt(c.x_arcsec)}″, ${fmt(c.y_arcsec)}″) lies at β = (${fmt(c.beta_arcsec[0])}″, ` +
       `${fmt(c.beta_arcsec[1])}″); at z_s = ${c.z_source} it has ${images.length} image${images.length === 1 ? '' : 's'} ` +
-      `(yellow squares where |μ| ≥ 0.1): ${images.join('; ')}.`;
+      `(yellow squares where |μ| ≥ 0.1; Δt: arrival after the first image): ${images.join('; ')}.`;
   } catch (err) {
     text = `The clicked point: ${err.message}.`;
   }
