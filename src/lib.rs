@@ -76,7 +76,7 @@ pub use image_search::{
     find_images, source_position, source_scatter, FoundImage, ImageError, ImageKind, ImageSearch,
     Parity, SearchGrid,
 };
-pub use map::{LensMaps, Map, MapGeometry, MapsError, MAGNIFICATION_CLAMP};
+pub use map::{magnification_at_point, LensMaps, Map, MapGeometry, MapsError, MAGNIFICATION_CLAMP};
 pub use model::{ComponentSpec, ModelError, ModelFile};
 pub use potential::{
     arrival_time_days, potential_at, potential_difference, potential_map, time_delay_distance_mpc,
@@ -131,13 +131,15 @@ pub use solver::{
 
 // A reconstruction: inputs, settings, the run, cross-validation.
 pub use reconstruct::{
-    cross_validate, fitted_system_ids, fold_groups, image_regions, product_options, reconstruct,
-    reconstruct_with_choice, strength_candidates, strength_folds, strength_trial, ArrivalTimes,
-    ConvergenceRecord, CrossValidation, Dataset, DatasetError, FoldRun, ImageReport, InputText,
+    check_ensemble_size, cross_validate, fitted_system_ids, fold_groups, image_regions,
+    product_options, reconstruct, reconstruct_with_choice, run_ensemble, strength_candidates,
+    strength_folds, strength_trial, ArrivalTimes, ConvergenceRecord, CrossValidation, Dataset,
+    DatasetError, Ensemble, EnsembleMaps, EnsembleMember, FoldRun, ImageReport, InputText,
     InputTexts, Inputs, InterpolatedLens, KappaSpread, LayerSource, PredictedImage,
     PredictedSystem, ProductConfig, ReconstructConfig, ReconstructError, ReconstructSummary,
     Reconstruction, RunStatus, Solved, SolverConfig, SolverMethod, SourceReport, StrengthCandidate,
-    StrengthChoice, CHOICE_MAP_PIXELS, DEFAULT_FOLDS, SHOWN_MIN_MAGNIFICATION,
+    StrengthChoice, CHOICE_MAP_PIXELS, DEFAULT_FOLDS, MAX_ENSEMBLE_MEMBERS,
+    SHOWN_MIN_MAGNIFICATION,
 };
 
 // Figures.

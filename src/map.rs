@@ -173,6 +173,19 @@ mod tests {
 /// (`|det A| < 1 / MAGNIFICATION_CLAMP`) the magnification is this value with the sign of `det A`.
 pub const MAGNIFICATION_CLAMP: f64 = 1.0e6;
 
+/// The magnification `1/det A` of one point with `kappa`, `gamma1`, `gamma2` for `f =
+/// D_ls/D_s`, clamped as [`LensMaps::magnification`] says.
+pub fn magnification_at_point(f: f64, kappa: f64, gamma1: f64, gamma2: f64) -> f64 {
+    let det = (1.0 - f * kappa).powi(2) - f * f * (gamma1 * gamma1 + gamma2 * gamma2);
+    if det.abs() >= 1.0 / MAGNIFICATION_CLAMP {
+        1.0 / det
+    } else if det < 0.0 {
+        -MAGNIFICATION_CLAMP
+    } else {
+        MAGNIFICATION_CLAMP
+    }
+}
+
 /// What can be wrong with maps handed to [`LensMaps::from_deflection`].
 #[derive(Debug, Error, Clone, PartialEq)]
 pub enum MapsError {
@@ -289,16 +302,7 @@ impl LensMaps {
     /// critical line) the result is `±MAGNIFICATION_CLAMP` with the sign of `det A` (`+` for an
     /// exact zero or a non-finite input), so the map is finite everywhere.
     pub fn magnification(&self, f: f64) -> Map {
-        self.pointwise(|k, g1, g2| {
-            let det = (1.0 - f * k).powi(2) - f * f * (g1 * g1 + g2 * g2);
-            if det.abs() >= 1.0 / MAGNIFICATION_CLAMP {
-                1.0 / det
-            } else if det < 0.0 {
-                -MAGNIFICATION_CLAMP
-            } else {
-                MAGNIFICATION_CLAMP
-            }
-        })
+        self.pointwise(|k, g1, g2| magnification_at_point(f, k, g1, g2))
     }
 
     /// The eigenvalues of the lensing Jacobian for `f = D_ls/D_s`, `(lambda_t, lambda_r)` with

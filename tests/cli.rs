@@ -1154,3 +1154,106 @@ fn images_match_lenstronomy_from_a_model_and_from_maps() {
     let err = String::from_utf8_lossy(&out.stderr);
     assert!(err.contains("greater than the lens redshift"), "{err}");
 }
+
+/// `--ensemble`: the members' maps in range/, and the summary maps are their statistics:
+/// kappa-mean and kappa-std the mean and standard deviation of range/NNN-kappa.fits per pixel,
+/// magnif-p50 between p16 and p84; the Einstein-radius range in summary.json brackets the
+/// members'; the same seed gives the same ensemble; a size out of range is refused up front.
+#[test]
+fn reconstruct_ensemble_writes_its_statistics() {
+    let dir = temp_dir("ensemble");
+    let images = dir.join("images.cat");
+    fs::write(
+        &images,
+        wslap::app::examples::teaching_image_catalog().unwrap(),
+    )
+    .unwrap();
+    let config = dir.join("config.json");
+    fs::write(
+        &config,
+        r#"{"grid": {"cells": 12}, "products": {"pixels": 48, "size_arcsec": 60},
+            "objective": {"strength": 0.1}}"#,
+    )
+    .unwrap();
+    let run = |out: &Path, members: &str| {
+        wslap(&[
+            "reconstruct",
+            "--images",
+            images.to_str().unwrap(),
+            "--z-lens",
+            "0.3",
+            "--config",
+            config.to_str().unwrap(),
+            "--ensemble",
+            members,
+            "--seed",
+            "7",
+            "--out",
+            out.to_str().unwrap(),
+        ])
+    };
+    let out_dir = dir.join("out");
+    let out = run(&out_dir, "4");
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let read = |path: PathBuf| {
+        let bytes = fs::read(&path).unwrap();
+        read_image(&bytes, &path.display().to_string())
+            .unwrap()
+            .to_map()
+            .unwrap()
+            .data
+    };
+    let members: Vec<Vec<f64>> = (1..=4)
+        .map(|k| read(out_dir.join(format!("range/{k:03}-kappa.fits"))))
+        .collect();
+    let mean = read(out_dir.join("kappa-mean.fits"));
+    let std = read(out_dir.join("kappa-std.fits"));
+    // FITS stores float32: compare to its precision.
+    for i in 0..mean.len() {
+        let m = members.iter().map(|k| k[i]).sum::<f64>() / 4.0;
+        let s = (members.iter().map(|k| (k[i] - m).powi(2)).sum::<f64>() / 4.0).sqrt();
+        assert!((mean[i] - m).abs() <= 1e-6 * m.abs().max(1.0), "pixel {i}");
+        assert!((std[i] - s).abs() <= 1e-6 * m.abs().max(1.0), "pixel {i}");
+    }
+    assert!(std.iter().any(|&s| s > 0.0), "the members differ");
+    let (p16, p50, p84) = (
+        read(out_dir.join("magnif-p16.fits")),
+        read(out_dir.join("magnif-p50.fits")),
+        read(out_dir.join("magnif-p84.fits")),
+    );
+    assert!((0..p50.len()).all(|i| p16[i] <= p50[i] && p50[i] <= p84[i]));
+    let ensemble: serde_json::Value =
+        serde_json::from_str(&fs::read_to_string(out_dir.join("ensemble.json")).unwrap()).unwrap();
+    let radii: Vec<f64> = ensemble["members"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|m| m["einstein_radius_arcsec"].as_f64().unwrap())
+        .collect();
+    assert_eq!(radii.len(), 4);
+    let s = summary(&out_dir);
+    let range = &s["einstein_radius_interval_arcsec"];
+    let (lo, hi) = (range[0].as_f64().unwrap(), range[1].as_f64().unwrap());
+    let (min, max) = radii
+        .iter()
+        .fold((f64::MAX, f64::MIN), |(a, b), &r| (a.min(r), b.max(r)));
+    assert!(min <= lo && lo <= hi && hi <= max, "{lo} {hi} of {radii:?}");
+    assert_eq!(s["mass_within_interval_msun"].as_array().unwrap().len(), 3);
+    // The same seed, the same members.
+    let again = dir.join("again");
+    assert!(run(&again, "4").status.success());
+    assert_eq!(read(again.join("kappa-std.fits")), std);
+    // Refused before any work.
+    let out = run(&dir.join("bad"), "1");
+    assert!(!out.status.success());
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        err.contains("--ensemble") && err.contains("2 to 200"),
+        "{err}"
+    );
+    assert!(!dir.join("bad").join("summary.json").exists());
+}

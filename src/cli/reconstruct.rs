@@ -6,9 +6,10 @@ use std::path::{Path, PathBuf};
 use clap::Args;
 use serde::Serialize;
 use wslap::{
-    cross_validate, export_system, fold_groups, image_regions, reconstruct, ColorScale, Control,
-    ConvergenceRecord, Cosmology, CrossValidation, Dataset, InputKind, InputText, InputTexts,
-    Inputs, LensPlane, ReconstructConfig, Reconstruction, SolverMethod,
+    check_ensemble_size, cross_validate, export_system, fold_groups, image_regions, reconstruct,
+    run_ensemble, ColorScale, Control, ConvergenceRecord, Cosmology, CrossValidation, Dataset,
+    InputKind, InputText, InputTexts, Inputs, LensPlane, ReconstructConfig, Reconstruction,
+    SolverMethod,
 };
 
 use super::input::read_text;
@@ -75,6 +76,16 @@ pub struct ReconstructArgs {
     /// PNG): where the mass map depends on which systems are fitted.
     #[arg(long, value_name = "K", num_args = 0..=1, default_missing_value = "5")]
     folds: Option<usize>,
+    /// Also run an ensemble of N more reconstructions (2 to 200) that differ in the systems
+    /// fitted (bootstrap over systems) and the grid's placement (up to half a cell), with this
+    /// run's settings: writes kappa-mean.fits, kappa-std.fits, magnif-p16/p50/p84.fits, each
+    /// member's maps in range/, ensemble.json, kappa-std.png, and the 16th - 84th percentile
+    /// ranges of the Einstein radius and enclosed masses in summary.json.
+    #[arg(long, value_name = "N")]
+    ensemble: Option<usize>,
+    /// Seed of the ensemble's draws (the same seed gives the same members).
+    #[arg(long, default_value_t = 1, requires = "ensemble")]
+    seed: u64,
     /// Also write the linear system (gamma.npy, theta.npy, weights.npy, columns.json) here.
     #[arg(long, value_name = "DIR")]
     export_system: Option<PathBuf>,
@@ -148,6 +159,9 @@ pub fn run(args: &ReconstructArgs) -> Result<(), String> {
         // A number of folds that cannot work is refused before the first run.
         fold_groups(&inputs, &config, folds).map_err(|e| e.to_string())?;
     }
+    if let Some(n) = args.ensemble {
+        check_ensemble_size(n).map_err(|e| format!("--ensemble: {e}"))?;
+    }
     let total = config.solver.iterations;
     let exact = config.solver.method == SolverMethod::Exact;
     let mut progress = |r: &ConvergenceRecord| {
@@ -179,6 +193,74 @@ pub fn run(args: &ReconstructArgs) -> Result<(), String> {
     if let Some(folds) = args.folds {
         run_crossval(&inputs, &config, folds, &result, &args.out)?;
     }
+    if let Some(n) = args.ensemble {
+        write_ensemble(&inputs, &config, n, args.seed, &result, &args.out)?;
+    }
+    Ok(())
+}
+
+/// `--ensemble`: `members` more reconstructions ([`run_ensemble`]), their files written to
+/// `out` and their ranges added to its summary.json, with a line on stdout.
+fn write_ensemble(
+    inputs: &Inputs<'_>,
+    config: &ReconstructConfig,
+    members: usize,
+    seed: u64,
+    result: &Reconstruction,
+    out: &Path,
+) -> Result<(), String> {
+    let mut last = 0;
+    let mut progress = |member: usize, _: &ConvergenceRecord| {
+        if member != last {
+            eprintln!("ensemble member {member}/{members}");
+            last = member;
+        }
+        Control::Continue
+    };
+    let ensemble = run_ensemble(inputs, config, result, members, seed, &mut progress)
+        .map_err(|e| e.to_string())?;
+    let p = &result.products;
+    let files = ensemble
+        .files(p.reference, p.plane.z_lens, Some(&p.curves))
+        .map_err(|e| e.to_string())?;
+    let range = out.join("range");
+    fs::create_dir_all(&range).map_err(|e| format!("{}: {e}", range.display()))?;
+    let write = |file: &str, bytes: &[u8]| -> Result<(), String> {
+        let path = out.join(file);
+        fs::write(&path, bytes).map_err(|e| format!("{}: {e}", path.display()))
+    };
+    for (file, bytes) in &files {
+        write(file, bytes)?;
+    }
+    write("ensemble.json", json(&ensemble)?.as_bytes())?;
+    // The ranges join the main run's summary.json.
+    let mut summary = serde_json::to_value(result.summary()).map_err(|e| e.to_string())?;
+    if let Some(s) = summary.as_object_mut() {
+        s.insert(
+            "einstein_radius_interval_arcsec".to_string(),
+            serde_json::json!(ensemble.einstein_radius_interval_arcsec),
+        );
+        s.insert(
+            "mass_within_interval_msun".to_string(),
+            serde_json::json!(ensemble.mass_within_interval_msun),
+        );
+        s.insert(
+            "ensemble_members".to_string(),
+            serde_json::json!(ensemble.members.len()),
+        );
+    }
+    write("summary.json", json(&summary)?.as_bytes())?;
+    let radius = ensemble
+        .einstein_radius_interval_arcsec
+        .map_or("n/a".to_string(), |[a, b]| {
+            format!("{a:.2} - {b:.2} arcsec")
+        });
+    println!(
+        "wrote {} ({} members: Einstein radius (16th - 84th percentile) {radius}; \
+         kappa-mean.fits, kappa-std.fits, magnif-p16/p50/p84.fits, range/)",
+        out.join("ensemble.json").display(),
+        ensemble.members.len()
+    );
     Ok(())
 }
 

@@ -10,6 +10,7 @@
 mod config;
 mod crossval;
 mod dataset;
+mod ensemble;
 mod sources;
 mod summary;
 
@@ -23,6 +24,9 @@ pub use crossval::{
     PredictedSystem, DEFAULT_FOLDS,
 };
 pub use dataset::{Dataset, DatasetError, InputText, InputTexts};
+pub use ensemble::{
+    check_ensemble_size, run_ensemble, Ensemble, EnsembleMaps, EnsembleMember, MAX_ENSEMBLE_MEMBERS,
+};
 pub use sources::{
     image_regions, images_on_maps, source_on_maps, ArrivalTimes, ImageReport, InterpolatedLens,
     PredictedImage, SourceReport, IMAGE_REGION_RADIUS_ARCSEC, SHOWN_MIN_MAGNIFICATION,

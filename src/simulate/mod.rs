@@ -18,7 +18,7 @@ use thiserror::Error;
 
 mod cluster;
 mod raytrace;
-mod rng;
+pub(crate) mod rng;
 mod sources;
 mod write;
 

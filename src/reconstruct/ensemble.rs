@@ -1,0 +1,440 @@
+//! Ensembles: how sure the map is.
+//!
+//! One reconstruction is one answer; an ensemble is many, each as good as the first, that
+//! differ in what the data leave open. Member `k` is a full reconstruction with the main run's
+//! settings (its regulariser and strength: an "auto" choice is made once, by the main run)
+//! and with
+//!
+//! - **the systems fitted drawn at random** (bootstrap over systems): as many draws with
+//!   replacement as there are fitted systems; the systems drawn at least once are fitted
+//!   (a system drawn twice counts once), the others (about a third) are left out;
+//! - **the grid moved** by up to half a cell in x and y (uniform), so that where the cells fall
+//!   is not mistaken for structure.
+//!
+//! The start is not varied: the default objective has one minimiser, which the exact solver
+//! finds from any start ([method §9]). Redshifts are not drawn: catalogue redshifts carry no
+//! uncertainty, and systems without one use the configured default.
+//!
+//! Every member's maps are sampled on the main run's map. Per pixel, the ensemble gives the
+//! mean and standard deviation of kappa and the 16th, 50th and 84th percentiles of the
+//! magnification (HFF `kappa-mean`, `kappa-std`, `magnif-p16/p50/p84`), and over the members
+//! the 16th - 84th percentile range of the Einstein radius and of the masses inside 10, 20 and
+//! 50 arcsec. The spread says how much the answer depends on which systems are fitted and on
+//! the grid; it does not include errors common to every member (the members' mass-to-light
+//! law, the cosmology, a wrong redshift, mass outside the grid that no image constrains).
+//!
+//! [method §9]: crate::method#9-the-default-objective
+
+use glam::DVec2;
+use serde::{Deserialize, Serialize};
+
+use super::{
+    fitted_system_ids, reconstruct, reconstruct_with_choice, ConvergenceRecord, Inputs,
+    ReconstructConfig, ReconstructError, Reconstruction, StrengthChoice,
+};
+use crate::curves::CriticalCurves;
+use crate::error::BadFieldValue;
+use crate::fits::{write_image, Card, FitsWriteOptions};
+use crate::map::{magnification_at_point, Map, MapGeometry};
+use crate::products::ProductsError;
+use crate::render::{render_kappa_png, ColorScale, KappaPlotOptions, Overlay};
+use crate::simulate::rng::Rng;
+use crate::sky::SkyReference;
+use crate::solver::{Control, SolveStatus};
+
+/// Most members of an ensemble: each is a full reconstruction.
+pub const MAX_ENSEMBLE_MEMBERS: usize = 200;
+
+/// One member of an ensemble.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct EnsembleMember {
+    /// 1-based member number.
+    pub member: usize,
+    /// The systems it fitted (the bootstrap draw).
+    pub fitted: Vec<String>,
+    /// How far its grid was moved from the main run's (arcsec).
+    pub grid_shift_arcsec: DVec2,
+    pub status: String,
+    /// `C_l` per layer.
+    pub c: Vec<f64>,
+    /// Its Einstein radius at the products' z_s (arcsec).
+    pub einstein_radius_arcsec: f64,
+    /// Its projected mass (Msun) inside 10, 20 and 50 arcsec of (0, 0).
+    pub mass_within_arcsec: Vec<(f64, Option<f64>)>,
+    /// Median offset of the images it did not fit from their predictions (arcsec).
+    pub left_out_image_offset_median_arcsec: Option<f64>,
+    pub elapsed_ms: f64,
+}
+
+/// The result of [`run_ensemble`] (`ensemble.json`, and the maps as FITS).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Ensemble {
+    /// "Completed", or "Cancelled" (the members before it are kept).
+    pub status: String,
+    pub seed: u64,
+    pub z_source: f64,
+    pub members: Vec<EnsembleMember>,
+    /// 16th and 84th percentiles over the members (arcsec).
+    pub einstein_radius_interval_arcsec: Option<[f64; 2]>,
+    /// Per radius of `summary.json` (10, 20, 50 arcsec): the 16th and 84th percentiles of the
+    /// enclosed mass over the members (Msun; `null` where a member's circle left its map).
+    pub mass_within_interval_msun: Vec<(f64, Option<[f64; 2]>)>,
+    /// What the spread includes and what it does not.
+    pub note: String,
+    #[serde(skip)]
+    pub maps: Option<EnsembleMaps>,
+}
+
+/// Per-pixel statistics of the members, on the main run's map, and each member's own maps.
+#[derive(Debug, Clone, PartialEq)]
+pub struct EnsembleMaps {
+    pub kappa_mean: Map,
+    pub kappa_std: Map,
+    /// Magnification at the products' z_s: 16th, 50th and 84th percentiles.
+    pub magnif_p16: Map,
+    pub magnif_p50: Map,
+    pub magnif_p84: Map,
+    /// Each member's kappa and magnification (for `range/`).
+    pub member_kappa: Vec<Map>,
+    pub member_magnif: Vec<Map>,
+}
+
+const NOTE: &str = "Members differ in the systems fitted (bootstrap over systems) and in the \
+     grid's placement (up to half a cell); the strength of the regulariser is the main run's. \
+     Not included: the members' mass-to-light law, the cosmology, redshift errors, and mass \
+     that no image constrains.";
+
+impl Ensemble {
+    /// The files of `wslap reconstruct --ensemble`: `kappa-mean.fits`, `kappa-std.fits`,
+    /// `magnif-p16.fits`, `magnif-p50.fits`, `magnif-p84.fits` (HFF-style like `kappa.fits`:
+    /// sky `reference`, `ZLENS`, the members in `NMEMBERS`, `ZSOURCE` on the magnifications),
+    /// `range/NNN-kappa.fits` and `range/NNN-magnif.fits` per member, and `kappa-std.png`, the
+    /// spread with the critical `curves` of the main run on top. Empty without maps.
+    pub fn files(
+        &self,
+        reference: Option<SkyReference>,
+        z_lens: f64,
+        curves: Option<&CriticalCurves>,
+    ) -> Result<Vec<(String, Vec<u8>)>, ProductsError> {
+        let Some(maps) = &self.maps else {
+            return Ok(Vec::new());
+        };
+        let n = self.members.len();
+        let opts = |what: &str, magnification: bool| {
+            let mut extra_cards = vec![
+                Card::real("ZLENS", z_lens, "lens redshift"),
+                Card::integer("NMEMBERS", n as i64, "members of the ensemble"),
+            ];
+            if magnification {
+                extra_cards.push(Card::real("ZSOURCE", self.z_source, "source redshift"));
+            }
+            FitsWriteOptions {
+                bunit: String::new(),
+                comments: vec![
+                    format!("{what}, written by wslap {}", env!("CARGO_PKG_VERSION")),
+                    if magnification {
+                        "Magnification at the source redshift ZSOURCE.".to_string()
+                    } else {
+                        "Normalised to D_ls/D_s = 1 (HFF convention).".to_string()
+                    },
+                ],
+                reference,
+                extra_cards,
+            }
+        };
+        let mut files = vec![
+            (
+                "kappa-mean.fits".to_string(),
+                write_image(
+                    &maps.kappa_mean,
+                    &opts("Mean convergence of the ensemble", false),
+                )?,
+            ),
+            (
+                "kappa-std.fits".to_string(),
+                write_image(
+                    &maps.kappa_std,
+                    &opts(
+                        "Standard deviation of the convergence over the ensemble",
+                        false,
+                    ),
+                )?,
+            ),
+        ];
+        for (name, map, q) in [
+            ("magnif-p16.fits", &maps.magnif_p16, 16),
+            ("magnif-p50.fits", &maps.magnif_p50, 50),
+            ("magnif-p84.fits", &maps.magnif_p84, 84),
+        ] {
+            let what = format!("{q}th percentile of the magnification over the ensemble");
+            files.push((name.to_string(), write_image(map, &opts(&what, true))?));
+        }
+        for (k, (kappa, magnif)) in maps
+            .member_kappa
+            .iter()
+            .zip(&maps.member_magnif)
+            .enumerate()
+        {
+            let what = format!("Member {} of the ensemble", k + 1);
+            files.push((
+                format!("range/{:03}-kappa.fits", k + 1),
+                write_image(kappa, &opts(&what, false))?,
+            ));
+            files.push((
+                format!("range/{:03}-magnif.fits", k + 1),
+                write_image(magnif, &opts(&what, true))?,
+            ));
+        }
+        let title = match curves {
+            Some(c) => format!(
+                "Spread of kappa over {n} members; critical curves at z_s = {}",
+                c.z_source
+            ),
+            None => format!("Spread of kappa over {n} members"),
+        };
+        let plot = KappaPlotOptions {
+            scale: ColorScale::Linear,
+            vmin: Some(0.0),
+            title: Some(title),
+            colorbar_label: Some("kappa std".to_string()),
+            ..KappaPlotOptions::default()
+        };
+        let overlay = Overlay {
+            curves,
+            ..Overlay::default()
+        };
+        files.push((
+            "kappa-std.png".to_string(),
+            render_kappa_png(&maps.kappa_std, &overlay, &plot)?,
+        ));
+        Ok(files)
+    }
+}
+
+/// The value at quantile `q` of `sorted` (linear between order statistics).
+fn quantile(sorted: &[f64], q: f64) -> f64 {
+    let n = sorted.len();
+    if n == 1 {
+        return sorted[0];
+    }
+    let t = q * (n - 1) as f64;
+    let (i, frac) = (t.floor() as usize, t - t.floor());
+    let j = (i + 1).min(n - 1);
+    sorted[i] + frac * (sorted[j] - sorted[i])
+}
+
+fn interval(mut values: Vec<f64>) -> Option<[f64; 2]> {
+    values.retain(|v| v.is_finite());
+    if values.is_empty() {
+        return None;
+    }
+    values.sort_by(f64::total_cmp);
+    Some([quantile(&values, 0.16), quantile(&values, 0.84)])
+}
+
+/// Checks the number of members.
+pub fn check_ensemble_size(members: usize) -> Result<(), ReconstructError> {
+    if !(2..=MAX_ENSEMBLE_MEMBERS).contains(&members) {
+        return Err(BadFieldValue::new(
+            "ensemble",
+            members as f64,
+            "an ensemble needs 2 to 200 members",
+        )
+        .into());
+    }
+    Ok(())
+}
+
+/// `members` reconstructions of `inputs` that differ as the module says, with `main`'s
+/// settings, sampled on `main`'s maps. `progress` sees the member number (1-based) and every
+/// solver report, and may cancel.
+pub fn run_ensemble(
+    inputs: &Inputs<'_>,
+    config: &ReconstructConfig,
+    main: &Reconstruction,
+    members: usize,
+    seed: u64,
+    progress: &mut dyn FnMut(usize, &ConvergenceRecord) -> Control,
+) -> Result<Ensemble, ReconstructError> {
+    check_ensemble_size(members)?;
+    let ids = fitted_system_ids(inputs, config)?;
+    if ids.len() < 2 {
+        return Err(ReconstructError::Folds {
+            folds: 2,
+            systems: ids.len(),
+        });
+    }
+    // The main run's settings, its strength fixed, its grid and map held.
+    let choice: Option<&StrengthChoice> = main.strength_choice.as_ref();
+    let grid = &main.system.grid;
+    let cell = grid.width_arcsec / grid.cells_per_side.max(1) as f64;
+    let geometry = main.products.maps.geometry();
+    let z_source = main.products.curves.z_source;
+    let mut member_config = config.clone();
+    member_config.grid.width_arcsec = Some(grid.width_arcsec);
+    member_config.products.size_arcsec = Some(geometry.size_arcsec);
+    member_config.products.pixels = geometry.pixels;
+    let mut rng = Rng::stream(seed, 0xE25E);
+    let mut runs = Vec::new();
+    let mut kappas = Vec::new();
+    let mut magnifs = Vec::new();
+    let mut status = "Completed";
+    for k in 0..members {
+        let member = k + 1;
+        let clock = crate::products::Clock::start();
+        // Bootstrap over systems, redrawn until at least two distinct systems are fitted.
+        let drawn = loop {
+            let mut drawn = vec![false; ids.len()];
+            for _ in 0..ids.len() {
+                drawn[rng.index(ids.len())] = true;
+            }
+            if drawn.iter().filter(|&&d| d).count() >= 2 {
+                break drawn;
+            }
+        };
+        let left_out: Vec<String> = inputs
+            .holdout
+            .iter()
+            .cloned()
+            .chain(
+                ids.iter()
+                    .zip(&drawn)
+                    .filter(|(_, &d)| !d)
+                    .map(|(id, _)| id.clone()),
+            )
+            .collect();
+        let shift = DVec2::new(rng.range(-0.5, 0.5), rng.range(-0.5, 0.5)) * cell;
+        member_config.grid.center_arcsec = Some(grid.center + shift);
+        let member_inputs = Inputs {
+            holdout: &left_out,
+            ..*inputs
+        };
+        let mut report = |rec: &ConvergenceRecord| progress(member, rec);
+        let r = match choice {
+            Some(c) => {
+                reconstruct_with_choice(&member_inputs, &member_config, c.clone(), &mut report)?
+            }
+            None => reconstruct(&member_inputs, &member_config, &mut report)?,
+        };
+        if r.status == SolveStatus::Cancelled {
+            status = "Cancelled";
+            break;
+        }
+        let (kappa, magnif) = sampled_maps(&r, geometry);
+        kappas.push(kappa);
+        magnifs.push(magnif);
+        let summary = r.products.summary();
+        runs.push(EnsembleMember {
+            member,
+            fitted: ids
+                .iter()
+                .zip(&drawn)
+                .filter(|(_, &d)| d)
+                .map(|(id, _)| id.clone())
+                .collect(),
+            grid_shift_arcsec: shift,
+            status: r.status.name().to_string(),
+            c: r.layer_factors(),
+            einstein_radius_arcsec: summary.einstein_radius_arcsec,
+            mass_within_arcsec: summary.mass_within_arcsec,
+            left_out_image_offset_median_arcsec: r.image_offset_median_arcsec(true),
+            elapsed_ms: clock.ms(),
+        });
+    }
+    let radii: Vec<f64> = main
+        .products
+        .summary()
+        .mass_within_arcsec
+        .iter()
+        .map(|(r, _)| *r)
+        .collect();
+    let mass_within_interval_msun = radii
+        .iter()
+        .enumerate()
+        .map(|(i, &r)| {
+            let values: Option<Vec<f64>> = runs
+                .iter()
+                .map(|m| m.mass_within_arcsec.get(i).and_then(|(_, v)| *v))
+                .collect();
+            (r, values.and_then(interval))
+        })
+        .collect();
+    Ok(Ensemble {
+        status: status.to_string(),
+        seed,
+        z_source,
+        einstein_radius_interval_arcsec: interval(
+            runs.iter().map(|m| m.einstein_radius_arcsec).collect(),
+        ),
+        mass_within_interval_msun,
+        members: runs,
+        note: NOTE.to_string(),
+        maps: (!kappas.is_empty()).then(|| statistics(geometry, kappas, magnifs)),
+    })
+}
+
+/// A member's kappa (`D_ls/D_s = 1`) and magnification at the products' z_s on the pixels of
+/// `geometry` (its own maps have that geometry, or are sampled onto it).
+fn sampled_maps(r: &Reconstruction, geometry: MapGeometry) -> (Map, Map) {
+    let maps = &r.products.maps;
+    if maps.geometry() == geometry {
+        return (maps.kappa.clone(), r.products.magnification.clone());
+    }
+    let f = r.products.distance_ratio;
+    let kappa = Map::from_fn(geometry, |p| maps.kappa.sample(p));
+    let magnif = Map::from_fn(geometry, |p| {
+        let (k, g1, g2) = (
+            maps.kappa.sample(p),
+            maps.gamma1.sample(p),
+            maps.gamma2.sample(p),
+        );
+        magnification_at_point(f, k, g1, g2)
+    });
+    (kappa, magnif)
+}
+
+fn statistics(geometry: MapGeometry, kappas: Vec<Map>, magnifs: Vec<Map>) -> EnsembleMaps {
+    let n = geometry.pixels * geometry.pixels;
+    let count = kappas.len() as f64;
+    let mut mean = vec![0.0; n];
+    let mut std = vec![0.0; n];
+    let mut p = [vec![0.0; n], vec![0.0; n], vec![0.0; n]];
+    let mut column = Vec::with_capacity(magnifs.len());
+    for i in 0..n {
+        let m = kappas.iter().map(|k| k.data[i]).sum::<f64>() / count;
+        let var = kappas.iter().map(|k| (k.data[i] - m).powi(2)).sum::<f64>() / count;
+        mean[i] = m;
+        std[i] = var.sqrt();
+        column.clear();
+        column.extend(magnifs.iter().map(|mu| mu.data[i]));
+        column.sort_by(f64::total_cmp);
+        for (out, q) in p.iter_mut().zip([0.16, 0.5, 0.84]) {
+            out[i] = quantile(&column, q);
+        }
+    }
+    let map = |data| Map { geometry, data };
+    let [p16, p50, p84] = p;
+    EnsembleMaps {
+        kappa_mean: map(mean),
+        kappa_std: map(std),
+        magnif_p16: map(p16),
+        magnif_p50: map(p50),
+        magnif_p84: map(p84),
+        member_kappa: kappas,
+        member_magnif: magnifs,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn quantiles_interpolate_between_order_statistics() {
+        let v = [1.0, 2.0, 3.0, 4.0, 5.0];
+        assert_eq!(quantile(&v, 0.5), 3.0);
+        assert!((quantile(&v, 0.16) - 1.64).abs() < 1e-12);
+        assert!((quantile(&v, 0.84) - 4.36).abs() < 1e-12);
+        assert_eq!(interval(vec![f64::NAN]), None);
+    }
+}
