@@ -30,6 +30,13 @@
 //! `alpha = b0 s/(s-a) R [1/(sqrt(R^2+a^2)+a) - 1/(sqrt(R^2+s^2)+s)]`; every field is finite
 //! at the centre (`kappa(0) = b0/(2a)`).
 //!
+//! A singular core (`a = 0`, Lenstool's `core_radius 0`) is allowed: the formulas above stay
+//! finite for `a -> 0` except at the centre itself (`kappa ~ b0/(2 rho)`, `|alpha| -> b0` for
+//! a circular dPIE), so they are evaluated with the core [`DPIE_SINGULAR_CORE_ARCSEC`]
+//! (lenstronomy's `PJAFFE` floors its core at the same 1e-8 arcsec): the fields differ from
+//! the singular ones by about `1e-8 arcsec / r` relative, far below any pixel, and stay finite
+//! at the centre, as the SIS's do inside the same radius.
+//!
 //! [method §1]: crate::method#1-frames-and-units
 
 use glam::DVec2;
@@ -43,6 +50,10 @@ use crate::units::{ARCSEC_PER_RAD, C_KM_S};
 /// ones lose about `1e-16/eps` relative precision and differ from the circle by `~eps`, so the
 /// switch is continuous to about 1e-8 (Lenstool switches at 2e-4).
 pub const CIRCULAR_EPSILON: f64 = 1.0e-8;
+
+/// Core radius in arcsec with which a singular dPIE (`r_core = 0`) is evaluated: far below any
+/// pixel, large enough that `1/a^3` stays finite (the floor of lenstronomy's `PJAFFE` core).
+pub const DPIE_SINGULAR_CORE_ARCSEC: f64 = 1.0e-8;
 
 /// `b0 = 6 pi (sigma/c)^2` in arcsec (`D_ls/D_s = 1`): the Lenstool dPIE strength for the
 /// "dPIE" velocity dispersion `sigma_v_km_s` [km/s] (Elíasdóttir 2007 `E_0`).
@@ -64,6 +75,8 @@ pub struct Dpie {
     b0_arcsec: f64,
     r_core_arcsec: f64,
     r_cut_arcsec: f64,
+    /// The core the formulas use: `r_core_arcsec`, or [`DPIE_SINGULAR_CORE_ARCSEC`] for 0.
+    core_eval_arcsec: f64,
     ellipticity: f64,
     epsilon: f64,
     pa_deg: f64,
@@ -73,7 +86,8 @@ pub struct Dpie {
 
 impl Dpie {
     /// A dPIE with Lenstool's parameters: `v_disp` = `sigma_v_km_s` [km/s] (`b0 = 6 pi
-    /// (sigma/c)^2`), core and cut radii in arcsec (`0 < r_core < r_cut`, finite), mass
+    /// (sigma/c)^2`), core and cut radii in arcsec (`0 <= r_core < r_cut`, finite; a singular
+    /// core `r_core = 0` is evaluated as in the module documentation), mass
     /// ellipticity `e = (A^2-B^2)/(A^2+B^2)` in `[0, 1)`, position angle `pa_deg` [degrees
     /// counter-clockwise from +x].
     pub fn new(
@@ -85,19 +99,31 @@ impl Dpie {
         pa_deg: f64,
     ) -> Result<Self, ProfileError> {
         let sigma_v_km_s = require_positive("dpie", "sigma_v", sigma_v_km_s)?;
-        let r_core = require_positive("dpie", "r_core", r_core_arcsec)?;
-        let r_cut = require_positive("dpie", "r_cut", r_cut_arcsec)?;
         let bad = |field, value, reason| ProfileError::BadParameter {
             component: "dpie",
             field,
             value,
             reason,
         };
-        if r_cut <= r_core {
+        if !(r_core_arcsec.is_finite() && r_core_arcsec >= 0.0) {
+            return Err(bad(
+                "r_core",
+                r_core_arcsec,
+                "must be finite and >= 0 (0 is a singular core)",
+            ));
+        }
+        let r_core = r_core_arcsec;
+        let core_eval = if r_core > 0.0 {
+            r_core
+        } else {
+            DPIE_SINGULAR_CORE_ARCSEC
+        };
+        let r_cut = require_positive("dpie", "r_cut", r_cut_arcsec)?;
+        if r_cut <= core_eval {
             return Err(bad(
                 "r_cut",
                 r_cut,
-                "the cut radius must exceed the core radius",
+                "the cut radius must exceed the core radius (and 1e-8 arcsec)",
             ));
         }
         if !(ellipticity.is_finite() && (0.0..1.0).contains(&ellipticity)) {
@@ -112,6 +138,7 @@ impl Dpie {
             b0_arcsec: dpie_b0_arcsec(sigma_v_km_s),
             r_core_arcsec: r_core,
             r_cut_arcsec: r_cut,
+            core_eval_arcsec: core_eval,
             ellipticity,
             epsilon: kk_epsilon(ellipticity),
             pa_deg,
@@ -143,7 +170,7 @@ impl Dpie {
     pub fn b0_arcsec(&self) -> f64 {
         self.b0_arcsec
     }
-    /// Core and cut radii in arcsec.
+    /// Core and cut radii in arcsec, as given (a singular core is 0).
     pub fn radii_arcsec(&self) -> (f64, f64) {
         (self.r_core_arcsec, self.r_cut_arcsec)
     }
@@ -169,7 +196,7 @@ impl Dpie {
 
     /// `b0 s/(s-a)`, the factor of the core-minus-cut difference.
     fn strength(&self) -> f64 {
-        self.b0_arcsec * self.r_cut_arcsec / (self.r_cut_arcsec - self.r_core_arcsec)
+        self.b0_arcsec * self.r_cut_arcsec / (self.r_cut_arcsec - self.core_eval_arcsec)
     }
 
     /// Offset from the centre rotated into the profile frame (`x'` along the major axis).
@@ -184,7 +211,7 @@ impl Dpie {
     /// Deflection (arcsec) and Hessian in the sky frame.
     fn fields(&self, p: DVec2) -> (DVec2, [f64; 3]) {
         let q = self.frame_offset(p);
-        let (a, s, k) = (self.r_core_arcsec, self.r_cut_arcsec, self.strength());
+        let (a, s, k) = (self.core_eval_arcsec, self.r_cut_arcsec, self.strength());
         let (g, h) = if self.epsilon < CIRCULAR_EPSILON {
             let (ga, gpa) = circular_unit(q, a);
             let (gs, gps) = circular_unit(q, s);
@@ -306,7 +333,7 @@ impl MassComponent for Dpie {
         let q = self.frame_offset(p);
         let (ep, em) = (1.0 + self.epsilon, 1.0 - self.epsilon);
         let rho2 = q.x * q.x / (ep * ep) + q.y * q.y / (em * em);
-        let (a, s) = (self.r_core_arcsec, self.r_cut_arcsec);
+        let (a, s) = (self.core_eval_arcsec, self.r_cut_arcsec);
         let (ua, us) = ((a * a + rho2).sqrt(), (s * s + rho2).sqrt());
         0.5 * self.b0_arcsec * s * (s + a) / (ua * us * (ua + us))
     }

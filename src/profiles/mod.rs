@@ -22,7 +22,10 @@ mod sis;
 mod tnfw;
 mod tnfw_near;
 
-pub use dpie::{dpie_b0_arcsec, kk_epsilon, Dpie, CIRCULAR_EPSILON as DPIE_CIRCULAR_EPSILON};
+pub use dpie::{
+    dpie_b0_arcsec, kk_epsilon, Dpie, CIRCULAR_EPSILON as DPIE_CIRCULAR_EPSILON,
+    DPIE_SINGULAR_CORE_ARCSEC,
+};
 pub use error::ProfileError;
 pub use gaussian::{
     cell_unit_deflection, gaussian_unit_deflection, gaussian_unit_hessian, gaussian_unit_kappa,

@@ -19,6 +19,10 @@ rho^2 = x'^2/(1+eps)^2 + y'^2/(1-eps)^2, eps = (1 - sqrt(1-e^2))/e.
   K_n = int_0^1 u kappa'(xi(u)^2) / (1-(1-q^2)u)^(n+1/2) du,
   xi(u)^2 = u (x'^2 + y'^2/(1-(1-q^2)u)), computed with scipy.integrate.quad (epsrel 1e-12)
   and rotated to the sky frame by the position angle.
+* Singular core (r_core = 0, Lenstool's `core_radius 0.000000`): the circular case against
+  lenstronomy 'PJAFFE' with Ra = 0 (which lenstronomy floors at 1e-8 arcsec, as the crate
+  does) and sigma0 Ra = b0/2; the elliptical case with the Keeton integrals above at a = 0
+  exactly (kappa ~ 1/sqrt(u) near u = 0 is integrable; quad copes).
 """
 
 import json
@@ -42,13 +46,15 @@ def kk_eps(e):
     return e / (1.0 + math.sqrt(1.0 - e * e))
 
 
-def circular_case():
-    sigma, a, s = 350.0, 1.5, 40.0
+def circular_case(sigma=350.0, a=1.5, s=40.0, pts=None):
     b0 = b0_arcsec(sigma)
     lm = LensModel(["PJAFFE"])
-    kw = [{"sigma0": b0 / (2.0 * a), "Ra": a, "Rs": s, "center_x": 0.3, "center_y": -0.2}]
-    pts = [(0.3, -0.2), (0.31, -0.2), (1.0, 0.5), (-2.0, 3.0), (10.0, -7.0), (35.0, 20.0),
-           (-80.0, 60.0), (200.0, 5.0)]
+    # lenstronomy replaces Ra < 1e-8 by 1e-8: sigma0 Ra = b0/2 with that Ra.
+    kw = [{"sigma0": b0 / (2.0 * max(a, 1e-8)), "Ra": a, "Rs": s, "center_x": 0.3,
+           "center_y": -0.2}]
+    if pts is None:
+        pts = [(0.3, -0.2), (0.31, -0.2), (1.0, 0.5), (-2.0, 3.0), (10.0, -7.0), (35.0, 20.0),
+               (-80.0, 60.0), (200.0, 5.0)]
     rows = []
     for x, y in pts:
         k = float(lm.kappa(x, y, kw))
@@ -67,10 +73,14 @@ def elliptical_case(sigma, a, s, e, pa_deg, center, pts):
 
     def kappa_xi2(xi2):
         rho2 = xi2 / (1.0 + eps) ** 2
+        if a * a + rho2 == 0.0:
+            return math.inf
         return k0 * (1.0 / math.sqrt(a * a + rho2) - 1.0 / math.sqrt(s * s + rho2))
 
     def dkappa_dxi2(xi2):
         rho2 = xi2 / (1.0 + eps) ** 2
+        if a * a + rho2 == 0.0:
+            return -math.inf
         d = -0.5 * ((a * a + rho2) ** -1.5 - (s * s + rho2) ** -1.5)
         return k0 * d / (1.0 + eps) ** 2
 
@@ -123,6 +133,15 @@ def main():
         "elliptical_member": elliptical_case(
             180.0, 0.05, 8.0, 0.3, 50.0, (2.0, -1.0),
             [(2.0, -1.0), (2.02, -0.99), (2.5, -0.6), (0.0, 0.0), (-5.0, 6.0), (30.0, 20.0)]),
+        # Singular cores (away from the centre, where the fields are infinite or undefined).
+        "circular_singular": circular_case(
+            1100.0, 0.0, 250.0,
+            [(0.8, -0.2), (0.3, 1.0), (-2.0, 3.0), (10.0, -7.0), (35.0, 20.0), (-80.0, 60.0),
+             (400.0, 5.0)]),
+        "elliptical_singular": elliptical_case(
+            1100.0, 0.0, 250.0, 0.35, 20.0, (1.0, -2.0),
+            [(1.5, -2.0), (1.0, -1.0), (-3.0, 4.0), (25.0, -10.0), (-60.0, 45.0),
+             (300.0, 200.0)]),
     }
     path = os.path.join(os.path.dirname(os.path.abspath(__file__)), "dpie.json")
     with open(path, "w") as f:
