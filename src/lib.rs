@@ -96,7 +96,8 @@ pub use radial::{radial_profile, rect_disc_area, RadialBins, RadialError, Radial
 pub use arcs::{arcs_from_regions, parse_arcs, ArcCatalog, ArcSystem, ArcsError};
 pub use catalog::{
     parse_image_catalog, parse_member_catalog, CatalogError, Image, ImageCatalog, ImageSystem,
-    Member, MemberCatalog, DEGREE_LOOKALIKE, FIELD_ERROR_DEG, FIELD_WARN_DEG, Z_AGREEMENT_TOL,
+    Member, MemberCatalog, DEGREE_LOOKALIKE, FIELD_ERROR_DEG, FIELD_WARN_DEG, MAG_NO_MEASUREMENT,
+    Z_AGREEMENT_TOL,
 };
 pub use ds9::{
     polyline_is_open, read_regions, write_marks, write_regions, Ds9Error, Ds9Frame, Mark, Region,
@@ -105,7 +106,10 @@ pub use ds9::{
 pub use fits::{read_image, write_image, Card, CardValue, FitsError, FitsWriteOptions};
 #[cfg(not(target_arch = "wasm32"))]
 pub use lenstool_par::load_lenstool_model;
-pub use lenstool_par::{parse_par, LenstoolModel, ParComponent, ParError, Radius};
+pub use lenstool_par::{
+    parse_par, parse_par_with, LenstoolModel, ParComponent, ParError, ParOptions, ParWarning,
+    Radius,
+};
 pub use limits::{
     InputKind, TooLarge, MAX_ARCS_BYTES, MAX_ARC_PIXELS, MAX_CATALOG_BYTES, MAX_CATALOG_ROWS,
     MAX_FITS_BYTES, MAX_FITS_PIXELS, MAX_JSON_BYTES,

@@ -401,6 +401,20 @@
 //! 5 degrees from the field centre, or "offsets" that are really the reference's degrees) are
 //! refused, beyond 1 degree warned about.
 //!
+//! A member whose magnitude says "no measurement" (`|mag| >= 90`, e.g. `99` or `-99`, or `nan`)
+//! is skipped with a warning.
+//!
+//! **Lenstool parameter files** (`.par`, e.g. a published `bestopt.par`) are read as Lenstool
+//! reads them: blocks from a header line to `end`, `#` comments anywhere, lines between blocks
+//! that open no Lenstool block (a stray `end`) skipped, `fini` (or `finish`) at the end. The
+//! model is the `potentiel` blocks of profile 81 (dPIE, singular core `core_radius 0`
+//! included) and 14 (shear) and the `potfile` members; keywords Lenstool does not read are
+//! ignored with a warning, other profiles and keywords that would change the model are refused
+//! by name and line. A model with potentials at several redshifts (multi-plane) is refused,
+//! or on request evaluated in the single-plane approximation: every potential on the first
+//! one's plane with its angular sizes and velocity dispersion, each moved block named in a
+//! warning.
+//!
 //! **HFF-style lens-model FITS maps.** One 2-D image per quantity, at the reference
 //! normalisation except the magnification: the HFF names are `<model>_kappa.fits`,
 //! `_gamma1`, `_gamma2`, `_x-arcsec-deflect`, `_y-arcsec-deflect` and magnifications such as

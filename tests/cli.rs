@@ -1257,3 +1257,50 @@ fn reconstruct_ensemble_writes_its_statistics() {
     );
     assert!(!dir.join("bad").join("summary.json").exists());
 }
+
+/// A Lenstool model with a background group (tests/data/lenstool/multiplane.par, after A370's
+/// CATS bestopt.par): refused with the option to use, then evaluated in the single-plane
+/// approximation with a warning naming the block moved; members with magnitude 99 are skipped
+/// with a warning.
+#[test]
+fn maps_of_a_multi_plane_lenstool_model_need_single_plane() {
+    let data = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/lenstool");
+    let par = data.join("multiplane.par").display().to_string();
+    let dir = temp_dir("multiplane");
+    let out_dir = dir.join("out").display().to_string();
+    let base = [
+        "maps",
+        "--lenstool",
+        &par,
+        "--out",
+        &out_dir,
+        "--pixels",
+        "64",
+        "--size",
+        "100",
+    ];
+    let out = wslap(&base);
+    assert!(!out.status.success());
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        err.contains("multiplane.par:42")
+            && err.contains("`potfile1`")
+            && err.contains("--single-plane"),
+        "{err}"
+    );
+    let out = wslap(&[&base[..], &["--single-plane"]].concat());
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "{err}");
+    assert!(
+        err.contains("warning: ") && err.contains("single-plane approximation: block `potfile1`"),
+        "{err}"
+    );
+    assert!(
+        err.contains("members.cat: line 4") && err.contains("no measurement"),
+        "{err}"
+    );
+    assert!(Path::new(&out_dir).join("kappa.fits").exists());
+    // --single-plane belongs to --lenstool.
+    let out = wslap(&["maps", "--model", &par, "--single-plane", "--out", "x"]);
+    assert!(!out.status.success());
+}

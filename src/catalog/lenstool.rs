@@ -22,6 +22,11 @@ use crate::sky::SkyReference;
 /// lines or spectra of one galaxy (e.g. 1.1781 and 1.1783 for system 32 of MACS J1931).
 pub const Z_AGREEMENT_TOL: f64 = 1e-3;
 
+/// A member magnitude this far from zero or beyond (99, -99, 99.99, 999, ...) is a
+/// catalogue's "no measurement" value, not a magnitude: the member is skipped with a warning.
+/// Real apparent magnitudes of cluster members lie between about 10 and 35.
+pub const MAG_NO_MEASUREMENT: f64 = 90.0;
+
 const IMAGE_LAYOUT: &str = "id x y a b theta z [mag]";
 const MEMBER_LAYOUT: &str = "id x y a b theta mag [lum]";
 
@@ -105,7 +110,9 @@ pub fn parse_image_catalog(
 ///
 /// Same `#REFERENCE` rules and frame as [`parse_image_catalog`]; `a`, `b` arcsec (>= 0),
 /// `theta` degrees, `mag` required, `lum` 0 when missing (kept as written, not interpreted).
-/// Ids are free text; a repeated id is only a warning.
+/// Ids are free text; a repeated id is only a warning. A row whose magnitude says "no
+/// measurement" (`|mag| >=` [`MAG_NO_MEASUREMENT`], e.g. 99 or -99, or `nan`) is skipped with a
+/// warning: Lenstool would give it a meaningless mass.
 pub fn parse_member_catalog(
     text: &str,
     source_name: &str,
@@ -137,6 +144,22 @@ pub fn parse_member_catalog(
         }
         seen.insert(id, row.line);
         let shape = f.shape(table.coords)?;
+        let mag_text = row.fields[6];
+        let mag = if mag_text.eq_ignore_ascii_case("nan") {
+            f64::NAN
+        } else {
+            f.number(6)?
+        };
+        if mag.is_nan() || mag.abs() >= MAG_NO_MEASUREMENT {
+            warnings.push(CatalogWarning {
+                source_name: source_name.into(),
+                line: row.line,
+                message: format!(
+                    "member '{id}': magnitude {mag_text} means no measurement: member skipped"
+                ),
+            });
+            continue;
+        }
         positions.push(RowPosition::of(row, shape.raw));
         members.push(Member {
             id: id.into(),
@@ -144,7 +167,7 @@ pub fn parse_member_catalog(
             a_arcsec: shape.a,
             b_arcsec: shape.b,
             theta_deg: shape.theta,
-            mag: f.number(6)?,
+            mag,
             lum: f.optional(7)?,
             line: row.line,
         });

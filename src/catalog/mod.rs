@@ -20,7 +20,9 @@ mod units;
 
 pub use error::{CatalogError, CatalogWarning};
 pub(crate) use frame::{mean_position, sexagesimal};
-pub use lenstool::{parse_image_catalog, parse_member_catalog, redshifts_agree, Z_AGREEMENT_TOL};
+pub use lenstool::{
+    parse_image_catalog, parse_member_catalog, redshifts_agree, MAG_NO_MEASUREMENT, Z_AGREEMENT_TOL,
+};
 pub use units::{DEGREE_LOOKALIKE, FIELD_ERROR_DEG, FIELD_WARN_DEG};
 
 /// One observed image of a multiply-lensed source.

@@ -9,7 +9,7 @@ use serde::Serialize;
 use wslap::{
     arrival_time_days, find_images, parse_sky_angle, potential_at, potential_difference,
     potential_map, Cosmology, ImageKind, ImageSearch, InputKind, InterpolatedLens, LensMaps,
-    LensPlane, MapGeometry, MassComponent, ModelFile, Parity, SearchGrid, SkyReference,
+    LensPlane, MapGeometry, MassComponent, ModelFile, ParOptions, Parity, SearchGrid, SkyReference,
 };
 
 use super::input::read_text;
@@ -33,6 +33,10 @@ pub struct ImagesArgs {
     /// Member catalogue of the --lenstool model's potfile blocks (repeat the option).
     #[arg(long, value_name = "MEMBERS.cat", requires = "lenstool")]
     potfile: Vec<PathBuf>,
+    /// Evaluate a --lenstool model with potentials at other redshifts in the single-plane
+    /// approximation (as `wslap maps --single-plane`).
+    #[arg(long, requires = "lenstool")]
+    single_plane: bool,
     /// A folder of HFF-style maps: x-arcsec-deflect.fits and y-arcsec-deflect.fits
     /// (D_ls/D_s = 1), e.g. a `wslap reconstruct` or `wslap maps` output, or a published model.
     #[arg(long, value_name = "DIR")]
@@ -256,7 +260,10 @@ fn load(args: &ImagesArgs) -> Result<Source, String> {
         });
     }
     if let Some(path) = &args.lenstool {
-        let model = load_lenstool(path, &args.potfile)?;
+        let options = ParOptions {
+            single_plane: args.single_plane,
+        };
+        let model = load_lenstool(path, &args.potfile, &options)?;
         return Ok(Source::Lens {
             lens: Box::new(model.lens),
             plane: model.plane,

@@ -7,12 +7,12 @@ use std::path::{Path, PathBuf};
 use super::input::{read_bytes, read_text};
 
 use clap::Args;
-use wslap::parse_par;
 use wslap::read_image;
 use wslap::ColorScale;
 use wslap::InputKind;
 use wslap::LenstoolModel;
 use wslap::ModelFile;
+use wslap::{parse_par_with, ParOptions};
 use wslap::{Cosmology, LensPlane};
 use wslap::{ProductOptions, Products};
 
@@ -35,6 +35,12 @@ pub struct MapsArgs {
     /// (repeat the option); without it, each block's `filein`, next to the .par file.
     #[arg(long, value_name = "MEMBERS.cat", conflicts_with_all = ["model", "deflection"])]
     potfile: Vec<PathBuf>,
+    /// Evaluate a --lenstool model with potentials at several redshifts (a foreground or
+    /// background group) in the single-plane approximation: every potential at the first
+    /// one's z_lens, keeping its angular sizes and velocity dispersion (a warning names each
+    /// block moved). Without it such a model is refused.
+    #[arg(long, requires = "lenstool")]
+    single_plane: bool,
     /// Published deflection maps (HFF x- and y-arcsec-deflect FITS, D_ls/D_s = 1).
     #[arg(long, num_args = 2, value_names = ["X.fits", "Y.fits"])]
     deflection: Option<Vec<PathBuf>>,
@@ -93,7 +99,10 @@ pub fn run(args: &MapsArgs) -> Result<(), String> {
             .map_err(|e| e.to_string())?;
         Products::from_model(&model, &opts).map_err(|e| e.to_string())?
     } else if let Some(path) = &args.lenstool {
-        lenstool_products(path, &args.potfile, &opts)?
+        let par_options = ParOptions {
+            single_plane: args.single_plane,
+        };
+        lenstool_products(path, &args.potfile, &par_options, &opts)?
     } else {
         let paths = args.deflection.as_deref().unwrap_or_default();
         let (ax, ay) = (read_map(&paths[0])?, read_map(&paths[1])?);
@@ -117,27 +126,32 @@ pub fn run(args: &MapsArgs) -> Result<(), String> {
     Ok(())
 }
 
-/// The products of the Lenstool model `par_path` with the member catalogues `potfiles` (one per
-/// potfile block; when empty, each block's `filein` next to the .par file), on the map of `opts`
-/// centred on the model's reference point.
+/// The products of the Lenstool model of [`load_lenstool`] on the map of `opts` centred on the
+/// model's reference point.
 fn lenstool_products(
     par_path: &Path,
     potfiles: &[PathBuf],
+    par_options: &ParOptions,
     opts: &ProductOptions,
 ) -> Result<Products, String> {
-    let model = load_lenstool(par_path, potfiles)?;
+    let model = load_lenstool(par_path, potfiles, par_options)?;
     Products::from_lens(&model.lens, model.plane, model.reference, opts).map_err(|e| e.to_string())
 }
 
 /// The Lenstool model `par_path` with the member catalogues `potfiles` (one per potfile block;
-/// when empty, each block's `filein` next to the .par file); warnings go to stderr.
+/// when empty, each block's `filein` next to the .par file), read with `par_options`;
+/// warnings go to stderr.
 pub(super) fn load_lenstool(
     par_path: &Path,
     potfiles: &[PathBuf],
+    par_options: &ParOptions,
 ) -> Result<LenstoolModel, String> {
     let name = par_path.display().to_string();
-    let par =
-        parse_par(&read_text(par_path, InputKind::Model)?, &name).map_err(|e| e.to_string())?;
+    let text = read_text(par_path, InputKind::Model)?;
+    let par = parse_par_with(&text, &name, par_options).map_err(|e| e.to_string())?;
+    for w in &par.warnings {
+        eprintln!("warning: {w}");
+    }
     let paths: Vec<PathBuf> = if potfiles.is_empty() {
         par.potfile_paths(par_path)
     } else {

@@ -5,6 +5,15 @@
 //! `image`, `grille`, `cline`, ...) is skipped: a model is evaluated with the values written in
 //! its `potentiel` blocks, which in a `bestopt.par` are the fitted ones.
 //!
+//! The file is read as Lenstool reads it ([`parse_par_with`]): `#` comments anywhere, any
+//! whitespace, CR line ends; lines between blocks that do not open a Lenstool block (the stray
+//! `end` of many `bestopt.par` files, unknown words such as Lenstool-HPC's `frame`) are skipped;
+//! a keyword Lenstool does not read in a `potentiel` or `potfile` block (e.g. `identity`) is
+//! ignored with a [`ParWarning`], while one it reads but this reader does not implement is
+//! refused; `fini` (or `finish`) ends the file. A dPIE without a core radius, or with
+//! `core_radius 0`, has Lenstool's singular core. Potentials at several redshifts are refused
+//! unless [`ParOptions::single_plane`] asks for the single-plane approximation.
+//!
 //! Conventions, from Lenstool's source (github.com/cerschae/Lenstool-HPC,
 //! ChiBenchmark/lenstoolchi/src: `r_potentiel.c`, `set_potfile.c`, `o_print_res.c`,
 //! `o_set_lens_bayes.c`):
@@ -33,7 +42,7 @@ use crate::sky::SkyReference;
 
 mod read;
 
-pub use read::parse_par;
+pub use read::{parse_par, parse_par_with};
 
 /// Redshifts of the potentials that differ by more than this make a multi-plane model.
 pub(crate) const Z_MATCH_TOL: f64 = 1.0e-6;
@@ -97,6 +106,34 @@ pub enum ParError {
         id: String,
         reason: String,
     },
+}
+
+/// How a `.par` file is read.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct ParOptions {
+    /// The single-plane approximation of a multi-plane model (default `false`: such a model is
+    /// refused). Every `potentiel` / `potfile` block whose `z_lens` differs from the first
+    /// block's is evaluated on the first block's plane, keeping its angular sizes (kpc radii
+    /// converted on its own plane) and velocity dispersion, so its deflection scales with that
+    /// plane's `D_ls/D_s`; the lensing of one plane by another is ignored. Each moved block is
+    /// named in a [`ParWarning`].
+    pub single_plane: bool,
+}
+
+/// Something in a `.par` file that Lenstool accepts and the model is built without, or an
+/// approximation asked for, worth telling the user.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct ParWarning {
+    pub file: String,
+    /// 1-based line.
+    pub line: usize,
+    pub message: String,
+}
+
+impl std::fmt::Display for ParWarning {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "{}:{}: {}", self.file, self.line, self.message)
+    }
 }
 
 /// A radius as the file gives it.
@@ -207,6 +244,9 @@ pub struct LenstoolPar {
     pub z_lens: f64,
     pub potentials: Vec<ParPotential>,
     pub potfiles: Vec<ParPotfile>,
+    /// What was skipped or approximated while reading (unknown blocks and keywords, blocks
+    /// moved by the single-plane approximation).
+    pub warnings: Vec<ParWarning>,
 }
 
 /// A model ready to evaluate: the lens (reference normalisation) and its plane.

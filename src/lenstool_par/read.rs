@@ -1,12 +1,16 @@
 //! The text layer of a `.par` file: blocks, keywords and values, and their interpretation
 //! into [`LenstoolPar`] (see the parent module for the conventions).
 
+use std::cell::RefCell;
 use std::collections::HashMap;
 
 use glam::DVec2;
 
-use super::{LenstoolPar, ParComponent, ParError, ParPotential, ParPotfile, Radius, Z_MATCH_TOL};
-use crate::cosmology::Cosmology;
+use super::{
+    LenstoolPar, ParComponent, ParError, ParOptions, ParPotential, ParPotfile, ParWarning, Radius,
+    Z_MATCH_TOL,
+};
+use crate::cosmology::{Cosmology, LensPlane};
 use crate::sky::SkyReference;
 
 /// One `keyword values...` line of a block.
@@ -24,14 +28,30 @@ struct Block {
     entries: HashMap<String, Entry>,
 }
 
-/// Parses the text of a `.par` file (`source_name` is used in messages). Comments start at
-/// `#`; blocks run from a header line to `end`; `fini` ends the file.
+/// Parses the text of a `.par` file (`source_name` is used in messages) with the default
+/// [`ParOptions`]: a model with potentials at several redshifts is refused.
 pub fn parse_par(text: &str, source_name: &str) -> Result<LenstoolPar, ParError> {
-    let blocks = read_blocks(text, source_name)?;
+    parse_par_with(text, source_name, &ParOptions::default())
+}
+
+/// Parses the text of a `.par` file as Lenstool reads it (`init_grille.c`, `flire`): `#`
+/// starts a comment anywhere on a line; a line whose first word names a Lenstool block opens
+/// it and the block runs to its `end`; any other line between blocks (a stray `end`, a word
+/// Lenstool does not know) is skipped, with a warning for unknown words; `fini` (or
+/// Lenstool-HPC's `finish`) ends the file. With `options.single_plane`, potentials at another
+/// redshift than the first one are moved to its plane (see [`ParOptions`]).
+pub fn parse_par_with(
+    text: &str,
+    source_name: &str,
+    options: &ParOptions,
+) -> Result<LenstoolPar, ParError> {
+    let mut warnings = Vec::new();
+    let blocks = read_blocks(text, source_name, &mut warnings)?;
     let name = |b: &Block| b.header.split_whitespace().next().unwrap_or("").to_string();
     let mut cx = Ctx {
         file: source_name,
         reference: None,
+        warnings: RefCell::new(warnings),
     };
     // The reference first: `_wcs` centres need it wherever `runmode` stands.
     if let Some(b) = blocks.iter().find(|b| name(b) == "runmode") {
@@ -40,36 +60,65 @@ pub fn parse_par(text: &str, source_name: &str) -> Result<LenstoolPar, ParError>
     let mut cosmology = None;
     let mut potentials = Vec::new();
     let mut potfiles = Vec::new();
-    let mut z_values: Vec<(f64, &Block)> = Vec::new();
+    // (z, block, index in potentials or potfiles, is a potfile)
+    let mut z_values: Vec<(f64, &Block, usize, bool)> = Vec::new();
     for b in &blocks {
         let name = name(b);
-        match name.as_str() {
-            "cosmologie" | "cosmology" => cosmology = Some(cx.cosmology(b)?),
-            "potentiel" | "potential" => {
-                let (p, z) = cx.potential(b)?;
-                potentials.push(p);
-                z_values.push((z, b));
-            }
-            _ if name.starts_with("potfile") => {
-                let (p, z) = cx.potfile(b)?;
-                potfiles.push(p);
-                z_values.push((z, b));
-            }
-            _ => {}
+        if name.starts_with("cosmolog") {
+            cosmology = Some(cx.cosmology(b)?);
+        } else if name.starts_with("potent") {
+            let (p, z) = cx.potential(b)?;
+            z_values.push((z, b, potentials.len(), false));
+            potentials.push(p);
+        } else if name.starts_with("potfile") {
+            let (p, z) = cx.potfile(b)?;
+            z_values.push((z, b, potfiles.len(), true));
+            potfiles.push(p);
         }
     }
     let cosmology = cosmology.ok_or_else(|| cx.model("no `cosmologie` block"))?;
-    let &(z_lens, _) = z_values
+    let &(z_lens, main, _, _) = z_values
         .first()
         .ok_or_else(|| cx.model("no `potentiel` or `potfile` block"))?;
-    if let Some((z, b)) = z_values
-        .iter()
-        .find(|(z, _)| (z - z_lens).abs() > Z_MATCH_TOL)
-    {
-        return Err(cx.unsupported(
-            b,
-            format!("z_lens = {z} differs from {z_lens} (multi-plane models are not supported)"),
-        ));
+    for &(z, b, k, is_potfile) in &z_values {
+        if (z - z_lens).abs() <= Z_MATCH_TOL {
+            continue;
+        }
+        if !options.single_plane {
+            return Err(cx.unsupported(
+                b,
+                format!(
+                    "z_lens = {z} differs from z_lens = {z_lens} of block `{}` (line {}): \
+                     multi-plane models (potentials at several redshifts) are not supported; \
+                     the single-plane approximation puts every potential at z = {z_lens} \
+                     (`wslap maps --single-plane`, or the app's setting \"Lenstool models at \
+                     several redshifts: single-plane approximation\")",
+                    main.header, main.line
+                ),
+            ));
+        }
+        // Angular sizes are kept: kpc radii become arcsec on the block's own plane.
+        let plane = LensPlane::new(cosmology, z).map_err(|source| ParError::Cosmology {
+            file: source_name.into(),
+            source,
+        })?;
+        let to_arcsec = |r: &mut Radius| *r = Radius::Arcsec(r.arcsec(&plane));
+        if is_potfile {
+            to_arcsec(&mut potfiles[k].r_core);
+            to_arcsec(&mut potfiles[k].r_cut);
+        } else if let ParComponent::Dpie { r_core, r_cut, .. } = &mut potentials[k].component {
+            to_arcsec(r_core);
+            to_arcsec(r_cut);
+        }
+        cx.warn(
+            b.line,
+            format!(
+                "single-plane approximation: block `{}` at z = {z} is moved to z_lens = {z_lens} \
+                 (its angular sizes and velocity dispersion are kept; its deflection then \
+                 scales with D_ls/D_s of z_lens, and lensing between the planes is ignored)",
+                b.header
+            ),
+        );
     }
     Ok(LenstoolPar {
         source_name: source_name.to_string(),
@@ -78,27 +127,71 @@ pub fn parse_par(text: &str, source_name: &str) -> Result<LenstoolPar, ParError>
         z_lens,
         potentials,
         potfiles,
+        warnings: cx.warnings.into_inner(),
     })
 }
 
-/// Splits the text into blocks.
-fn read_blocks(text: &str, file: &str) -> Result<Vec<Block>, ParError> {
+/// Whether Lenstool opens a block for the first word of a line between blocks (the names and
+/// prefixes `init_grille.c` compares).
+fn is_lenstool_block(word: &str) -> bool {
+    const EXACT: [&str; 10] = [
+        "runmode",
+        "cleanlens",
+        "source",
+        "shapemodel",
+        "shapelimit",
+        "cline",
+        "champ",
+        "vfield",
+        "vfieldlimit",
+        "cosmolimit",
+    ];
+    const PREFIXES: [&str; 11] = [
+        "image", "grille", "grid", "potent", "limit", "potfile", "multi", "dynfile", "grande",
+        "observ", "cosmolog",
+    ];
+    EXACT.contains(&word) || PREFIXES.iter().any(|p| word.starts_with(p))
+}
+
+/// Splits the text into blocks as Lenstool does (see [`parse_par_with`]).
+fn read_blocks(
+    text: &str,
+    file: &str,
+    warnings: &mut Vec<ParWarning>,
+) -> Result<Vec<Block>, ParError> {
     let mut blocks = Vec::new();
     let mut open: Option<Block> = None;
+    // Inside a run of lines Lenstool skips (after an unknown word, up to an `end`).
+    let mut skipping = false;
     for (i, raw) in text.lines().enumerate() {
         let line = i + 1;
         let body = raw.split('#').next().unwrap_or("").trim();
         let mut words = body.split_whitespace();
         let Some(first) = words.next() else { continue };
         match open.as_mut() {
-            None if first == "fini" => break,
-            None => {
+            None if first == "fini" || first == "finish" => break,
+            None if first == "end" => skipping = false,
+            None if is_lenstool_block(first) => {
+                skipping = false;
                 let header = body.split_whitespace().collect::<Vec<_>>().join(" ");
                 open = Some(Block {
                     header,
                     line,
                     entries: HashMap::new(),
                 });
+            }
+            None => {
+                if !skipping {
+                    warnings.push(ParWarning {
+                        file: file.into(),
+                        line,
+                        message: format!(
+                            "`{first}` is not a Lenstool block: skipped up to the next `end` \
+                             (Lenstool skips it too)"
+                        ),
+                    });
+                }
+                skipping = true;
             }
             Some(_) if first == "end" => blocks.extend(open.take()),
             Some(b) => {
@@ -127,10 +220,12 @@ const VALUE_MUST_BE_NUMBER: [&str; 3] = [
 /// A `cosmologie` keyword, the test its value (and omegaM) must pass, and the message.
 type FlatCheck = (&'static str, fn(f64, f64) -> bool, &'static str);
 
-/// Interprets blocks, with the file name for messages and the frame's sky reference.
+/// Interprets blocks, with the file name for messages, the frame's sky reference and the
+/// warnings so far.
 struct Ctx<'a> {
     file: &'a str,
     reference: Option<SkyReference>,
+    warnings: RefCell<Vec<ParWarning>>,
 }
 
 /// Keywords a `potentiel` block may hold besides the ones a profile reads.
@@ -160,9 +255,10 @@ const SHEAR_KEYS: [&str; 8] = [
     "angle_pos",
     "kappa",
 ];
-const POTFILE_KEYS: [&str; 14] = [
+const POTFILE_KEYS: [&str; 15] = [
     "filein",
     "zlens",
+    "z_lens",
     "type",
     "profil",
     "corekpc",
@@ -177,7 +273,94 @@ const POTFILE_KEYS: [&str; 14] = [
     "rcutscatter",
 ];
 
+/// Every keyword Lenstool reads in a `potentiel` block (`r_potentiel.c`; `mag...` and
+/// `virial...` by prefix). Others are ignored by Lenstool, and so here, with a warning.
+const LENSTOOL_POTENTIAL_KEYS: [&str; 41] = [
+    "profil",
+    "profile",
+    "nid",
+    "x_centre",
+    "y_centre",
+    "x_centre_wcs",
+    "y_centre_wcs",
+    "pmass",
+    "ellip_pot",
+    "ellipticite",
+    "ellipticity",
+    "gamma",
+    "angle_pos",
+    "phi",
+    "core_radius",
+    "scale_radius",
+    "re",
+    "core_radius_kpc",
+    "scale_radius_kpc",
+    "re_kpc",
+    "cut_radius",
+    "virial_radius",
+    "r200",
+    "cut_radius_kpc",
+    "virial_radius_kpc",
+    "r200_kpc",
+    "v_disp",
+    "sigma_e",
+    "exponent",
+    "alpha",
+    "exposant",
+    "n",
+    "beta",
+    "concentration",
+    "c",
+    "rc_slope",
+    "z_lens",
+    "masse",
+    "m200",
+    "mass",
+    "rhos",
+];
+
+/// Every keyword Lenstool reads in a `potfile` block (`r_potfile.c`; `vdscat...` and
+/// `rcutscat...` by prefix).
+const LENSTOOL_POTFILE_KEYS: [&str; 20] = [
+    "filein",
+    "type",
+    "zlens",
+    "z_lens",
+    "mag0",
+    "r200",
+    "select",
+    "core",
+    "corekpc",
+    "cut",
+    "cutkpc",
+    "slope",
+    "m200slope",
+    "sigma",
+    "vdslope",
+    "c200slope",
+    "a",
+    "m200",
+    "b",
+    "c200",
+];
+
+/// Whether Lenstool reads keyword `k` in a block of kind `what` (`"potfile"` or a potential).
+fn lenstool_reads(k: &str, what: &str) -> bool {
+    if what.contains("potfile") {
+        LENSTOOL_POTFILE_KEYS.contains(&k) || k.starts_with("vdscat") || k.starts_with("rcutscat")
+    } else {
+        LENSTOOL_POTENTIAL_KEYS.contains(&k) || k.starts_with("mag") || k.starts_with("virial")
+    }
+}
+
 impl Ctx<'_> {
+    fn warn(&self, line: usize, message: String) {
+        self.warnings.borrow_mut().push(ParWarning {
+            file: self.file.into(),
+            line,
+            message,
+        });
+    }
     fn model(&self, reason: &str) -> ParError {
         ParError::Model {
             file: self.file.into(),
@@ -221,20 +404,32 @@ impl Ctx<'_> {
             keyword: key,
         })
     }
-    /// Fails on a keyword outside `allowed`, naming it and its line.
+    /// Fails on a keyword outside `allowed` that Lenstool reads (it would change the model),
+    /// naming it and its line; a keyword Lenstool does not read is ignored with a warning, as
+    /// Lenstool ignores it.
     fn only(&self, b: &Block, allowed: &[&[&str]], what: &str) -> Result<(), ParError> {
         let known = |k: &str| allowed.iter().any(|s| s.contains(&k)) || k.starts_with("mag");
         let mut unknown: Vec<_> = b.entries.iter().filter(|(k, _)| !known(k)).collect();
         unknown.sort_by_key(|(_, e)| e.line);
-        match unknown.first() {
-            None => Ok(()),
-            Some((k, e)) => Err(ParError::Unsupported {
-                file: self.file.into(),
-                line: e.line,
-                block: b.header.clone(),
-                reason: format!("keyword `{k}` is not supported for {what}"),
-            }),
+        for (k, e) in unknown {
+            if lenstool_reads(k, what) {
+                return Err(ParError::Unsupported {
+                    file: self.file.into(),
+                    line: e.line,
+                    block: b.header.clone(),
+                    reason: format!("keyword `{k}` is not supported for {what}"),
+                });
+            }
+            self.warn(
+                e.line,
+                format!(
+                    "block `{}`: `{k}` is not a keyword Lenstool reads there: ignored (as by \
+                     Lenstool)",
+                    b.header
+                ),
+            );
         }
+        Ok(())
     }
 
     fn reference(&self, b: &Block) -> Result<Option<SkyReference>, ParError> {
@@ -323,16 +518,32 @@ impl Ctx<'_> {
                         (kpc, None) => kpc.map(Radius::Kpc),
                     })
                 };
-                let missing = |keyword| ParError::Missing {
-                    file: self.file.into(),
-                    line: b.line,
-                    block: b.header.clone(),
-                    keyword,
-                };
-                let r_core = radius("core_radius_kpc", "core_radius")?
-                    .ok_or_else(|| missing("core_radius_kpc"))?;
-                let r_cut = radius("cut_radius_kpc", "cut_radius")?
-                    .ok_or_else(|| missing("cut_radius_kpc"))?;
+                // Lenstool's default core is 0 (singular).
+                let r_core =
+                    radius("core_radius_kpc", "core_radius")?.unwrap_or(Radius::Arcsec(0.0));
+                let r_cut = radius("cut_radius_kpc", "cut_radius")?.ok_or_else(|| {
+                    let mut ignored: Vec<_> = b
+                        .entries
+                        .iter()
+                        .filter(|(k, _)| !lenstool_reads(k, "profile 81"))
+                        .collect();
+                    ignored.sort_by_key(|(_, e)| e.line);
+                    let names: Vec<_> = ignored.iter().map(|(k, _)| format!("`{k}`")).collect();
+                    let also = match names.is_empty() {
+                        true => String::new(),
+                        false => format!(
+                            "; {} are not Lenstool keywords (Lenstool ignores them)",
+                            names.join(", ")
+                        ),
+                    };
+                    self.unsupported(
+                        b,
+                        format!(
+                            "no `cut_radius_kpc` or `cut_radius`: Lenstool's default, an \
+                             infinite cut radius, is not supported{also}"
+                        ),
+                    )
+                })?;
                 let e = match (
                     self.opt(b, "ellipticite", 0)?,
                     self.opt(b, "ellipticity", 0)?,
@@ -436,6 +647,11 @@ impl Ctx<'_> {
         if !(p.slope > 0.0 && p.vdslope > 0.0) {
             return Err(self.unsupported(b, "slope and vdslope must be positive".into()));
         }
-        Ok((p, self.req(b, "zlens", 0)?))
+        let z_key = if b.entries.contains_key("zlens") {
+            "zlens"
+        } else {
+            "z_lens"
+        };
+        Ok((p, self.req(b, z_key, 0)?))
     }
 }

@@ -7,5 +7,6 @@ mod common;
 
 mod catalog;
 mod formats;
+mod lenstool;
 mod plot;
 mod simulate;

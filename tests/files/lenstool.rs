@@ -1,0 +1,218 @@
+//! Lenstool `.par` files of the shapes published models have (tests/data/lenstool/, each a
+//! small file written after a public one, see its README.md): each loads as Lenstool loads it,
+//! or says precisely (file, line, block, value) why not.
+
+use glam::DVec2;
+use wslap::{parse_par, parse_par_with, Dpie, LensPlane, MassComponent, ParOptions};
+use wslap::{ParComponent, Radius};
+
+const SINGULAR_CORE: &str = include_str!("../data/lenstool/singular_core.par");
+const MEMBERS: &str = include_str!("../data/lenstool/members.cat");
+const STRAY_END: &str = include_str!("../data/lenstool/stray_end.par");
+const MULTIPLANE: &str = include_str!("../data/lenstool/multiplane.par");
+const GROUP: &str = include_str!("../data/lenstool/group.cat");
+const IDENTITY: &str = include_str!("../data/lenstool/identity.par");
+const HPC_STYLE: &str = include_str!("../data/lenstool/hpc_style.par");
+const PROFILE_8: &str = include_str!("../data/lenstool/profile_8.par");
+
+fn refused(text: &str, name: &str) -> String {
+    parse_par(text, name)
+        .expect_err("must be refused")
+        .to_string()
+}
+
+#[cfg_attr(not(target_arch = "wasm32"), test)]
+#[cfg_attr(target_arch = "wasm32", wasm_bindgen_test::wasm_bindgen_test)]
+fn singular_cores_load_and_no_measurement_members_are_skipped() {
+    let par = parse_par(SINGULAR_CORE, "singular_core.par").expect("loads");
+    assert!(par.warnings.is_empty(), "{:?}", par.warnings);
+    let ParComponent::Dpie { r_core, .. } = par.potentials[0].component else {
+        panic!("O1 is a dPIE");
+    };
+    assert_eq!(r_core, Radius::Arcsec(0.0));
+    assert_eq!(par.potfiles[0].r_core, Radius::Kpc(0.0));
+    let (model, warnings) = par
+        .build_from_texts(&[("members.cat", MEMBERS)])
+        .expect("builds");
+    // Rows 4 and 5 (magnitudes 99.000 and -99) say "no measurement": skipped, with a warning.
+    assert_eq!((model.potentials, model.members), (1, 3));
+    let lines: Vec<usize> = warnings.iter().map(|w| w.line).collect();
+    assert_eq!(lines, [4, 5], "{warnings:?}");
+    for (w, mag) in warnings.iter().zip(["99.000", "-99"]) {
+        let text = w.to_string();
+        assert!(
+            text.starts_with("members.cat: line")
+                && text.contains(mag)
+                && text.contains("no measurement"),
+            "{text}"
+        );
+    }
+    // The singular halo and the singular members are finite everywhere, their centres too.
+    let o1 = DVec2::new(-2.076312, 1.388524);
+    for p in [
+        o1,
+        DVec2::new(10.0, -5.0),
+        DVec2::new(0.0, 0.0),
+        o1 + DVec2::X,
+    ] {
+        let (a, h) = model.lens.deflection_hessian(p);
+        let k = model.lens.kappa(p);
+        assert!(
+            a.is_finite() && k.is_finite() && h.iter().all(|v| v.is_finite()),
+            "{p}"
+        );
+    }
+    // Away from the centres the halo is the a = 0 dPIE of its parameters.
+    let halo = Dpie::new(
+        o1,
+        907.070068,
+        0.0,
+        1000.0 / kpc_per_arcsec(&model.plane),
+        0.528247,
+        90.533509,
+    )
+    .unwrap();
+    let p = o1 + DVec2::new(30.0, 20.0);
+    let members: DVec2 = model.lens.deflection(p) - halo.deflection(p);
+    assert!(
+        members.length() < 0.1 * halo.deflection(p).length(),
+        "{members}"
+    );
+}
+
+fn kpc_per_arcsec(plane: &LensPlane) -> f64 {
+    1.0e3 * plane.mpc_per_arcsec
+}
+
+#[cfg_attr(not(target_arch = "wasm32"), test)]
+#[cfg_attr(target_arch = "wasm32", wasm_bindgen_test::wasm_bindgen_test)]
+fn a_stray_end_before_fini_is_skipped_as_by_lenstool() {
+    let par = parse_par(STRAY_END, "stray_end.par").expect("loads");
+    assert_eq!((par.potentials.len(), par.potfiles.len()), (2, 1));
+    assert!(par.warnings.is_empty(), "{:?}", par.warnings);
+    // DOS line ends (Lenstool drops the CR) read the same.
+    let crlf = parse_par(&STRAY_END.replace('\n', "\r\n"), "stray_end.par").expect("CRLF");
+    assert_eq!(crlf.potentials, par.potentials);
+    // A stray `end` between blocks, or two, anywhere.
+    let text = STRAY_END.replace("potentiel O2\n", "\tend\nend\npotentiel O2\n");
+    let again = parse_par(&text, "x.par").unwrap();
+    let (a, b) = (&again.potentials, &par.potentials);
+    assert!(a.len() == 2 && a.iter().zip(b).all(|(a, b)| a.component == b.component));
+    // Without its `end`, the block that is still open is named.
+    let e = refused(&STRAY_END.replace("\tend\n\tend\nfini\n", ""), "cut.par");
+    assert!(
+        e.contains("cut.par:") && e.contains("`champ` has no `end`"),
+        "{e}"
+    );
+}
+
+#[cfg_attr(not(target_arch = "wasm32"), test)]
+#[cfg_attr(target_arch = "wasm32", wasm_bindgen_test::wasm_bindgen_test)]
+fn a_background_group_is_refused_or_moved_by_the_single_plane_option() {
+    let e = refused(MULTIPLANE, "multiplane.par");
+    for part in [
+        "multiplane.par:42",
+        "`potfile1`",
+        "z_lens = 1.05",
+        "0.375",
+        "multi-plane",
+        "--single-plane",
+    ] {
+        assert!(e.contains(part), "{part}: {e}");
+    }
+    let options = ParOptions { single_plane: true };
+    let par = parse_par_with(MULTIPLANE, "multiplane.par", &options).expect("single plane");
+    assert_eq!(par.z_lens, 0.375);
+    assert_eq!(par.warnings.len(), 1, "{:?}", par.warnings);
+    let w = par.warnings[0].to_string();
+    assert!(
+        w.starts_with("multiplane.par:42:") && w.contains("`potfile1`") && w.contains("1.05"),
+        "{w}"
+    );
+    // The group keeps its angular sizes: its kpc radii are converted on its own plane.
+    let own = LensPlane::new(par.cosmology, 1.05).unwrap();
+    let Radius::Arcsec(core) = par.potfiles[1].r_core else {
+        panic!("converted to arcsec");
+    };
+    assert!((core - 0.15 / kpc_per_arcsec(&own)).abs() < 1e-15, "{core}");
+    assert_eq!(par.potfiles[0].r_core, Radius::Kpc(0.15));
+    let (model, _) = par
+        .build_from_texts(&[("members.cat", MEMBERS), ("group.cat", GROUP)])
+        .expect("builds");
+    assert_eq!((model.potentials, model.members), (2, 3 + 2));
+}
+
+#[cfg_attr(not(target_arch = "wasm32"), test)]
+#[cfg_attr(target_arch = "wasm32", wasm_bindgen_test::wasm_bindgen_test)]
+fn keywords_lenstool_does_not_read_are_ignored_with_a_warning() {
+    let par = parse_par(IDENTITY, "identity.par").expect("loads");
+    assert_eq!(par.warnings.len(), 1, "{:?}", par.warnings);
+    let w = par.warnings[0].to_string();
+    assert!(
+        w.starts_with("identity.par:26:") && w.contains("`identity`"),
+        "{w}"
+    );
+    let r = par.reference.expect("reference from a long runmode");
+    assert_eq!((r.ra_deg, r.dec_deg), (3.586259, -30.400174));
+    assert_eq!(
+        par.potentials[0].component,
+        ParComponent::Dpie {
+            center_arcsec: DVec2::new(-2.076312, 1.388524),
+            sigma_v_km_s: 607.070068,
+            r_core: Radius::Arcsec(18.816964),
+            r_cut: Radius::Arcsec(221.244725),
+            ellipticity: 0.828247,
+            pa_deg: 90.533509,
+        }
+    );
+    // A keyword Lenstool reads but the reader does not implement is still refused.
+    let e = refused(
+        &IDENTITY.replace(" \t identity O1\n", " \t rc_slope 0.5\n"),
+        "x.par",
+    );
+    assert!(e.contains("x.par:26") && e.contains("`rc_slope`"), "{e}");
+}
+
+#[cfg_attr(not(target_arch = "wasm32"), test)]
+#[cfg_attr(target_arch = "wasm32", wasm_bindgen_test::wasm_bindgen_test)]
+fn lenstool_hpc_inputs_say_what_lenstool_would_not_read() {
+    // English names, a `frame` block, comments after values and `finish` are read; `rcut` and
+    // `rcore` are not Lenstool keywords, so the dPIE has no cut radius.
+    let e = refused(HPC_STYLE, "hpc_style.par");
+    for part in [
+        "hpc_style.par:21",
+        "`potential 1`",
+        "cut_radius",
+        "`rcut`, `rcore`",
+    ] {
+        assert!(e.contains(part), "{part}: {e}");
+    }
+    let fixed = HPC_STYLE
+        .replace("\trcut\t500", "\tcut_radius\t500")
+        .replace("\trcore \t5", "\tcore_radius \t5");
+    let par = parse_par(&fixed, "hpc_style.par").expect("loads with Lenstool's keywords");
+    assert_eq!(par.z_lens, 0.4);
+    assert_eq!(par.warnings.len(), 1, "{:?}", par.warnings);
+    let w = par.warnings[0].to_string();
+    assert!(
+        w.starts_with("hpc_style.par:6:") && w.contains("`frame`"),
+        "{w}"
+    );
+    let ParComponent::Dpie {
+        r_cut, ellipticity, ..
+    } = par.potentials[0].component
+    else {
+        panic!("a dPIE");
+    };
+    assert_eq!((r_cut, ellipticity), (Radius::Arcsec(500.0), 0.11));
+}
+
+#[cfg_attr(not(target_arch = "wasm32"), test)]
+#[cfg_attr(target_arch = "wasm32", wasm_bindgen_test::wasm_bindgen_test)]
+fn profiles_other_than_dpie_and_shear_are_named() {
+    let e = refused(PROFILE_8, "profile_8.par");
+    assert!(
+        e.contains("profile_8.par:9") && e.contains("`potentiel 1`") && e.contains("profil 8"),
+        "{e}"
+    );
+}
