@@ -411,6 +411,16 @@ async function applySetting(path, value) {
     const report = await ask('reload', { role: 'arcs' });
     if (report) setFileStatus('arcs', reportText(report));
   }
+  // A Lenstool model is read again with the single-plane setting (its warnings name the
+  // blocks moved; turned off, a multi-plane model is refused and says so).
+  if (path === 'lenstool_single_plane') {
+    try {
+      const report = await ask('reload', { role: 'model' });
+      if (report) setFileStatus('model', reportText(report));
+    } catch (err) {
+      setFileStatus('model', err.message);
+    }
+  }
   await persist();
   return settings;
 }

@@ -8,7 +8,7 @@ use crate::arcs::{is_region_file, ArcCatalog};
 use crate::catalog::{parse_image_catalog, parse_member_catalog, ImageCatalog};
 use crate::cosmology::LensPlane;
 use crate::fits::read_image;
-use crate::lenstool_par::parse_par;
+use crate::lenstool_par::{parse_par_with, ParOptions};
 use crate::map::Map;
 use crate::model::ModelFile;
 use crate::profiles::Lens;
@@ -252,9 +252,10 @@ fn arcs_alone(name: &str, text: &str, pixel_arcsec: f64) -> Result<ArcCatalog, A
 impl LoadedData {
     /// The loaded model file as a lens with its plane and sky reference: a JSON model file, or
     /// a Lenstool parametric model (`.par`, e.g. a published `bestopt.par`) whose potfile
-    /// members are the loaded member catalogue's. `None` without a model file; an error names
-    /// what is missing (a `.par` with a potfile and no member catalogue).
-    pub fn model_lens(&self) -> Result<Option<ModelLens>, AppError> {
+    /// members are the loaded member catalogue's, read with `par_options`. `None` without a
+    /// model file; an error names what is missing (a `.par` with a potfile and no member
+    /// catalogue).
+    pub fn model_lens(&self, par_options: &ParOptions) -> Result<Option<ModelLens>, AppError> {
         let Some(file) = &self.model else {
             return Ok(None);
         };
@@ -267,7 +268,7 @@ impl LoadedData {
                 reference: model.reference,
             }));
         }
-        let par = parse_par(&file.text, &file.name).map_err(|e| err(&e))?;
+        let par = parse_par_with(&file.text, &file.name, par_options).map_err(|e| err(&e))?;
         let mut texts = Vec::new();
         if let Some(potfile) = par.potfiles.first() {
             let members = self.members.as_ref().ok_or_else(|| {
@@ -288,13 +289,15 @@ impl LoadedData {
     }
 
     /// Checks `text` as a file of `role` and keeps it; an error leaves everything as it was.
-    /// `arc_pixel_arcsec` is the pixel of arcs drawn as DS9 regions.
+    /// `arc_pixel_arcsec` is the pixel of arcs drawn as DS9 regions; a Lenstool `.par` model is
+    /// read with `par_options` (its warnings are the report's).
     pub fn load_text(
         &mut self,
         role: DataRole,
         name: &str,
         text: &str,
         arc_pixel_arcsec: f64,
+        par_options: &ParOptions,
     ) -> Result<LoadReport, AppError> {
         let file = |e: &dyn std::fmt::Display| AppError::File(e.to_string());
         let (summary, warnings) = match role {
@@ -329,7 +332,7 @@ impl LoadedData {
                 )
             }
             DataRole::Model if is_lenstool_par(text) => {
-                let par = parse_par(text, name).map_err(|e| file(&e))?;
+                let par = parse_par_with(text, name, par_options).map_err(|e| file(&e))?;
                 let members = match par.potfiles.len() {
                     0 => String::new(),
                     1 => ", and its potfile's members from the member catalogue".to_string(),
@@ -345,7 +348,7 @@ impl LoadedData {
                         par.potentials.len(),
                         par.z_lens
                     ),
-                    Vec::new(),
+                    par.warnings.iter().map(|w| w.to_string()).collect(),
                 )
             }
             DataRole::Model => {
@@ -386,11 +389,12 @@ impl LoadedData {
         &mut self,
         role: DataRole,
         arc_pixel_arcsec: f64,
+        par_options: &ParOptions,
     ) -> Result<Option<LoadReport>, AppError> {
         let Some(NamedText { name, text }) = self.slot(role).clone() else {
             return Ok(None);
         };
-        self.load_text(role, &name, &text, arc_pixel_arcsec)
+        self.load_text(role, &name, &text, arc_pixel_arcsec, par_options)
             .map(Some)
     }
 

@@ -76,7 +76,8 @@ impl Session {
         text: &str,
     ) -> Result<LoadReport, AppError> {
         let pixel = self.settings.reconstruct.constraints.pixel_arcsec;
-        self.data.load_text(role, name, text, pixel)
+        let par = self.settings.par_options();
+        self.data.load_text(role, name, text, pixel, &par)
     }
 
     /// The loaded files parsed into one frame (see [`LoadedData::parse`]).
@@ -111,10 +112,12 @@ impl Session {
     }
 
     /// Checks the loaded file of `role` again with the current settings (a DS9 region file's
-    /// pixels follow the constraint pixel) and reports on it; `None` when none is loaded.
+    /// pixels follow the constraint pixel, a Lenstool model the single-plane setting) and
+    /// reports on it; `None` when none is loaded.
     pub fn reload(&mut self, role: DataRole) -> Result<Option<LoadReport>, AppError> {
         let pixel = self.settings.reconstruct.constraints.pixel_arcsec;
-        self.data.reload(role, pixel)
+        let par = self.settings.par_options();
+        self.data.reload(role, pixel, &par)
     }
 
     /// The last result, or an error saying that nothing was computed yet.

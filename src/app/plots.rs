@@ -249,7 +249,7 @@ impl Session {
         let (RunKind::Reconstruct, Some(file)) = (result.kind, &self.data.model) else {
             return None;
         };
-        let why = match self.data.model_lens() {
+        let why = match self.data.model_lens(&self.settings.par_options()) {
             Err(e) => e.to_string(),
             Ok(None) => return None,
             Ok(Some(model)) => model_frame(result, &model).err()?,
@@ -275,7 +275,7 @@ impl Session {
         };
         // A model that cannot be built (a Lenstool model without its member catalogue) is not
         // drawn; forward mode says why.
-        let Ok(Some(model)) = self.data.model_lens() else {
+        let Ok(Some(model)) = self.data.model_lens(&self.settings.par_options()) else {
             return Ok(None);
         };
         let Ok((origin, geometry)) = model_frame(result, &model) else {

@@ -362,7 +362,7 @@ impl Session {
     fn run_forward(&self) -> Result<SessionResult, AppError> {
         let model = self
             .data
-            .model_lens()?
+            .model_lens(&self.settings.par_options())?
             .ok_or_else(|| AppError::Missing("load a model file first".to_string()))?;
         let p = &self.settings.reconstruct.products;
         let opts = ProductOptions {

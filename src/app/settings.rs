@@ -4,6 +4,7 @@
 use serde::{Deserialize, Serialize};
 
 use crate::cosmology::{Cosmology, LensPlane};
+use crate::lenstool_par::ParOptions;
 use crate::limits::json_error_message;
 use crate::reconstruct::ReconstructConfig;
 
@@ -28,6 +29,10 @@ pub struct AppSettings {
     pub reconstruct: ReconstructConfig,
     /// Systems left out of the fit and predicted (`wslap reconstruct --holdout`), by id.
     pub holdout: Vec<String>,
+    /// A Lenstool model file with potentials at several redshifts is evaluated in the
+    /// single-plane approximation ([`ParOptions::single_plane`], `wslap maps --single-plane`);
+    /// default `false`: such a model is refused.
+    pub lenstool_single_plane: bool,
 }
 
 impl Default for AppSettings {
@@ -43,6 +48,7 @@ impl Default for AppSettings {
             omega_m: 0.3,
             reconstruct,
             holdout: Vec::new(),
+            lenstool_single_plane: false,
         }
     }
 }
@@ -67,6 +73,13 @@ impl AppSettings {
         self.reconstruct
             .validate()
             .map_err(|e| AppError::Setting(e.to_string()))
+    }
+
+    /// How a Lenstool model file is read with these settings.
+    pub fn par_options(&self) -> ParOptions {
+        ParOptions {
+            single_plane: self.lenstool_single_plane,
+        }
     }
 
     /// The lens plane at `z_lens` in flat LCDM with `h0`, `omega_m`.

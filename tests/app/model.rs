@@ -409,3 +409,60 @@ fn a_lenstool_par_is_a_model_file_with_the_member_catalogue_as_its_potfile() {
     let why = s.model_not_compared(s.result().unwrap()).unwrap();
     assert!(why.contains("needs the member catalogue"), "{why}");
 }
+
+/// A Lenstool model with a group at another redshift (tests/data/lenstool/multiplane.par with
+/// one potfile, after A370's CATS bestopt.par): refused, naming the setting; with the
+/// single-plane setting it loads, its report names the block moved, and it evaluates. The
+/// member catalogue's rows with magnitude 99 are skipped with a warning in its report.
+#[cfg_attr(not(target_arch = "wasm32"), test)]
+#[cfg_attr(target_arch = "wasm32", wasm_bindgen_test::wasm_bindgen_test)]
+fn a_multi_plane_lenstool_model_loads_with_the_single_plane_setting() {
+    let full = include_str!("../data/lenstool/multiplane.par");
+    let (start, end) = (
+        full.find("potfile1\n").unwrap(),
+        full.find("cosmologie\n").unwrap(),
+    );
+    let par = [&full[..start], &full[end..]].concat().replace(
+        "\tmag\t\t  17.690000\n\tz_lens     0.3750",
+        "\tmag\t\t  17.69\n\tz_lens     0.6",
+    );
+    let mut s = Session::new();
+    let err = s
+        .load_text(DataRole::Model, "group.par", &par)
+        .unwrap_err()
+        .to_string();
+    assert!(
+        err.contains("group.par:")
+            && err.contains("`potentiel O2`")
+            && err.contains("single-plane approximation"),
+        "{err}"
+    );
+    s.set_field("lenstool_single_plane", json!(true)).unwrap();
+    let report = s.load_text(DataRole::Model, "group.par", &par).unwrap();
+    assert_eq!(report.warnings.len(), 1, "{:?}", report.warnings);
+    assert!(
+        report.warnings[0].contains("`potentiel O2`") && report.warnings[0].contains("z = 0.6"),
+        "{:?}",
+        report.warnings
+    );
+    let members = s
+        .load_text(
+            DataRole::Members,
+            "members.cat",
+            include_str!("../data/lenstool/members.cat"),
+        )
+        .unwrap();
+    assert_eq!(members.summary, "3 members");
+    assert_eq!(members.warnings.len(), 2, "{:?}", members.warnings);
+    assert!(members
+        .warnings
+        .iter()
+        .all(|w| w.contains("no measurement")));
+    s.set_field("reconstruct.products.pixels", json!(48))
+        .unwrap();
+    s.run(RunKind::Forward, &mut |_| Control::Continue).unwrap();
+    // Turned off again, the kept model is refused when read again.
+    s.set_field("lenstool_single_plane", json!(false)).unwrap();
+    let err = s.reload(DataRole::Model).unwrap_err().to_string();
+    assert!(err.contains("multi-plane"), "{err}");
+}

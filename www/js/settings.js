@@ -44,6 +44,9 @@ export const FIELDS = [
   { path: 'reconstruct.solver.iterations', label: 'Iterations', type: 'int' },
   { path: 'holdout', label: 'Hold out systems (ids, e.g. 3, 7)', type: 'list',
     hint: 'left out of the fit, then predicted by the model: their image offsets show how well it finds images it was not given' },
+  { path: 'lenstool_single_plane', label: 'Lenstool models at several redshifts: single-plane approximation', type: 'bool',
+    options: [['false', 'off: refuse them'], ['true', 'on: every potential at the main lens redshift']],
+    hint: 'a .par model with a foreground or background group: on, each such block is moved to the main lens plane (angular sizes and velocity dispersion kept) and named in a warning' },
   { path: 'reconstruct.products.z_source', label: 'z_s of the curves', type: 'number', step: 0.1 },
   { path: 'reconstruct.products.pixels', label: 'Map pixels per side', type: 'int' },
   { path: 'reconstruct.products.size_arcsec', label: 'Map width [arcsec] (empty: the field)', type: 'optional',
@@ -67,6 +70,7 @@ export function valueAt(obj, path) {
 
 function parse(field, raw) {
   if (field.type === 'text' || field.type === 'select') return raw;
+  if (field.type === 'bool') return raw === 'true';
   // The strength is the string "auto" or a JSON number (a numeric string is refused).
   if (field.type === 'strength' && raw.trim().toLowerCase() === 'auto') return 'auto';
   if (field.type === 'list') return raw.split(/[\s,]+/).filter((t) => t !== '');
@@ -81,7 +85,7 @@ export function buildSettings(form, apply) {
   for (const f of FIELDS) {
     const row = document.createElement('div');
     row.className = 'field';
-    const control = f.type === 'select'
+    const control = ['select', 'bool'].includes(f.type)
       ? `<select id="${id(f.path)}">${f.options.map((o) => (Array.isArray(o)
         ? `<option value="${o[0]}">${o[1]}</option>`
         : `<option>${o}</option>`)).join('')}</select>`
