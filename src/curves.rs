@@ -201,7 +201,8 @@ pub fn signed_area_arcsec2(points: &[DVec2]) -> f64 {
 
 /// The zero contours of `field`, traced between pixel centres by marching squares (see the
 /// module doc). A map with fewer than 2 pixels a side, or whose data do not fill it, has none.
-/// Non-finite values count as negative.
+/// Infinite values count by their sign; cells with a NaN corner (no data) have no contour, so
+/// contours end where the data do, as on the map's edge.
 pub fn zero_contours(field: &Map) -> Vec<Contour> {
     let n = field.geometry.pixels;
     if field.data.len() != n * n {
@@ -285,6 +286,10 @@ impl<F: Fn(usize) -> f64> EdgeGrid<F> {
             for i in 0..n - 1 {
                 // Corners counter-clockwise from the bottom left; edge k runs corner k -> k+1.
                 let v = [row0[i], row0[i + 1], row1[i + 1], row1[i]];
+                // A cell with a corner without data (NaN) is outside the map.
+                if v.iter().any(|x| x.is_nan()) {
+                    continue;
+                }
                 let pos = v.map(|x| x >= 0.0);
                 let case = pos
                     .iter()

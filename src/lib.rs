@@ -103,7 +103,9 @@ pub use ds9::{
     polyline_is_open, read_regions, write_marks, write_regions, Ds9Error, Ds9Frame, Mark, Region,
     Shape,
 };
-pub use fits::{read_image, write_image, Card, CardValue, FitsError, FitsWriteOptions};
+pub use fits::{
+    read_image, write_image, Card, CardValue, FitsError, FitsImage, FitsWriteOptions, NoDataPixels,
+};
 #[cfg(not(target_arch = "wasm32"))]
 pub use lenstool_par::load_lenstool_model;
 pub use lenstool_par::{

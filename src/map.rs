@@ -174,10 +174,12 @@ mod tests {
 pub const MAGNIFICATION_CLAMP: f64 = 1.0e6;
 
 /// The magnification `1/det A` of one point with `kappa`, `gamma1`, `gamma2` for `f =
-/// D_ls/D_s`, clamped as [`LensMaps::magnification`] says.
+/// D_ls/D_s`, clamped as [`LensMaps::magnification`] says (NaN without data).
 pub fn magnification_at_point(f: f64, kappa: f64, gamma1: f64, gamma2: f64) -> f64 {
     let det = (1.0 - f * kappa).powi(2) - f * f * (gamma1 * gamma1 + gamma2 * gamma2);
-    if det.abs() >= 1.0 / MAGNIFICATION_CLAMP {
+    if det.is_nan() {
+        f64::NAN
+    } else if det.abs() >= 1.0 / MAGNIFICATION_CLAMP {
         1.0 / det
     } else if det < 0.0 {
         -MAGNIFICATION_CLAMP
@@ -207,6 +209,8 @@ pub enum MapsError {
     BadSize { size_arcsec: f64 },
     #[error("{map}: needs at least 2x2 pixels to take derivatives, has {pixels} a side")]
     TooSmall { map: &'static str, pixels: usize },
+    #[error("the deflection maps have no pixel with data (every pixel is NaN or blank)")]
+    NoData,
     #[error("{map}: pixel (column {i}, row {j}) holds {value}, which is not finite")]
     NotFinite {
         map: &'static str,
@@ -251,7 +255,13 @@ impl LensMaps {
     /// Builds the maps from published deflection maps (arcsec, e.g. HFF `_x-arcsec-deflect`):
     /// `kappa = (dax/dx + day/dy)/2`, `gamma1 = (dax/dx - day/dy)/2`,
     /// `gamma2 = (dax/dy + day/dx)/2`, by central differences (one-sided on the map edges).
-    pub fn from_deflection(alpha_x: Map, alpha_y: Map) -> Result<LensMaps, MapsError> {
+    ///
+    /// NaN pixels have no data (published maps have NaN or blank borders, see
+    /// [`crate::FitsImage::to_map_no_data`]): a pixel without data in either map has none in
+    /// both and NaN in every derived map; next to one, the differences are one-sided as on the
+    /// map edges (NaN with no neighbour along an axis). Infinite values are refused, and so are
+    /// maps with no data at all.
+    pub fn from_deflection(mut alpha_x: Map, mut alpha_y: Map) -> Result<LensMaps, MapsError> {
         if alpha_x.geometry != alpha_y.geometry {
             return Err(MapsError::GeometryMismatch {
                 alpha_x: alpha_x.geometry,
@@ -259,7 +269,15 @@ impl LensMaps {
             });
         }
         for (name, map) in [("alpha_x", &alpha_x), ("alpha_y", &alpha_y)] {
-            check_map(name, map)?;
+            check_map_no_data(name, map)?;
+        }
+        for k in 0..alpha_x.data.len() {
+            if alpha_x.data[k].is_nan() || alpha_y.data[k].is_nan() {
+                (alpha_x.data[k], alpha_y.data[k]) = (f64::NAN, f64::NAN);
+            }
+        }
+        if alpha_x.data.iter().all(|v| v.is_nan()) {
+            return Err(MapsError::NoData);
         }
         let geometry = alpha_x.geometry;
         if !(geometry.size_arcsec.is_finite() && geometry.size_arcsec > 0.0) {
@@ -300,7 +318,8 @@ impl LensMaps {
     /// Magnification for a source with `f = D_ls/D_s`:
     /// `mu = 1/((1 - f kappa)^2 - f^2 |gamma|^2)`. Where `|det A| < 1/MAGNIFICATION_CLAMP` (on a
     /// critical line) the result is `±MAGNIFICATION_CLAMP` with the sign of `det A` (`+` for an
-    /// exact zero or a non-finite input), so the map is finite everywhere.
+    /// exact zero), so the map is finite wherever the fields are; a pixel without data (NaN)
+    /// stays NaN.
     pub fn magnification(&self, f: f64) -> Map {
         self.pointwise(|k, g1, g2| magnification_at_point(f, k, g1, g2))
     }
@@ -355,6 +374,26 @@ impl LensMaps {
 }
 
 /// Checks that `map` has the right length, at least 2x2 pixels and only finite values.
+/// As [`check_map`], but NaN (no data) is allowed; infinities are not.
+fn check_map_no_data(name: &'static str, map: &Map) -> Result<(), MapsError> {
+    let n = map.geometry.pixels;
+    let mut finite = map.clone();
+    let infinite = map.data.iter().position(|v| v.is_infinite());
+    if let Some(k) = infinite {
+        return Err(MapsError::NotFinite {
+            map: name,
+            i: k % n.max(1),
+            j: k / n.max(1),
+            value: map.data[k],
+        });
+    }
+    finite
+        .data
+        .iter_mut()
+        .for_each(|v| *v = if v.is_nan() { 0.0 } else { *v });
+    check_map(name, &finite)
+}
+
 fn check_map(name: &'static str, map: &Map) -> Result<(), MapsError> {
     let n = map.geometry.pixels;
     if n < 2 {
@@ -382,13 +421,26 @@ fn check_map(name: &'static str, map: &Map) -> Result<(), MapsError> {
     }
 }
 
-/// `(d/dx, d/dy)` of `map` at pixel `(i, j)`: central differences, one-sided on the edges.
-/// `h` is the pixel width in arcsec; the map must have at least 2 pixels a side.
+/// `(d/dx, d/dy)` of `map` at pixel `(i, j)`: central differences, one-sided on the edges
+/// and next to pixels without data (NaN); NaN at a pixel without data or with no neighbour
+/// with data along an axis. `h` is the pixel width in arcsec; the map must have at least 2
+/// pixels a side.
 fn gradient(map: &Map, i: usize, j: usize, h: f64) -> (f64, f64) {
     let n = map.geometry.pixels;
-    let (i0, i1) = (i.saturating_sub(1), (i + 1).min(n - 1));
-    let (j0, j1) = (j.saturating_sub(1), (j + 1).min(n - 1));
-    let dx = (map.at(i1, j) - map.at(i0, j)) / ((i1 - i0) as f64 * h);
-    let dy = (map.at(i, j1) - map.at(i, j0)) / ((j1 - j0) as f64 * h);
+    let here = map.at(i, j);
+    let with_data = |k: usize, at: &dyn Fn(usize) -> f64| Some(k).filter(|&k| !at(k).is_nan());
+    let axis = |c: usize, at: &dyn Fn(usize) -> f64| -> f64 {
+        let lo = c.checked_sub(1).and_then(|k| with_data(k, at)).unwrap_or(c);
+        let hi = Some(c + 1)
+            .filter(|&k| k < n)
+            .and_then(|k| with_data(k, at))
+            .unwrap_or(c);
+        if here.is_nan() || hi == lo {
+            return f64::NAN;
+        }
+        (at(hi) - at(lo)) / ((hi - lo) as f64 * h)
+    };
+    let dx = axis(i, &|k| map.at(k, j));
+    let dy = axis(j, &|k| map.at(i, k));
     (dx, dy)
 }

@@ -432,7 +432,13 @@
 //!
 //! Read files may be float or integer (with `BSCALE`, `BZERO`, `BLANK`), in the primary HDU or
 //! the first image extension; the map must be square with square, unrotated pixels,
-//! `CDELT1 < 0` and `CDELT2 > 0` (or the equivalent `CD` matrix).
+//! `CDELT1 < 0` and `CDELT2 > 0` (or the equivalent `CD` matrix). Published deflection maps
+//! often have pixels without data: NaN or `BLANK` pixels, and borders of exact zeros (edge
+//! rows and columns holding only zeros). These are NaN in the maps: a pixel without data in
+//! either deflection map has none in any derived map (next to one, derivatives are one-sided
+//! as on the map's edge), the views draw them grey, read-outs say "no data", critical curves
+//! end where the data end, the radial profile stops before the first of them, and written
+//! FITS files keep them as NaN.
 //!
 //! **DS9 region files.** Written: `# Region file format: DS9 version 4.1`, a `global` line,
 //! then `fk5` (RA, Dec in degrees, when the frame has a sky reference) or `image` (1-based FITS

@@ -98,9 +98,10 @@ pub fn potential_difference(lens: &dyn MassComponent, from: DVec2, to: DVec2) ->
 }
 
 /// `int_{k}^{k+1} g` from samples `g[k-1..=k+2]` a unit apart: the cubic through the four
-/// (error `h^5 g''''`), or the trapezoid at the ends of the samples.
+/// (error `h^5 g''''`), or the trapezoid at the ends of the samples and next to a sample
+/// without data (NaN).
 fn step_integral(g: &[f64], k: usize) -> f64 {
-    if k >= 1 && k + 2 < g.len() {
+    if k >= 1 && k + 2 < g.len() && g[k - 1].is_finite() && g[k + 2].is_finite() {
         (-g[k - 1] + 13.0 * g[k] + 13.0 * g[k + 1] - g[k + 2]) / 24.0
     } else {
         (g[k] + g[k + 1]) / 2.0
@@ -124,7 +125,9 @@ fn cumulative(g: &[f64], origin: usize) -> Vec<f64> {
 /// and then up each column, and along the centre column and then along each row, averaged
 /// (a deflection from a real potential gives the same along both; the average halves what
 /// differs). Each step between pixel centres uses the cubic through four samples, so the error
-/// is of order `h^4 alpha'''` per pixel `h` where the deflection is smooth.
+/// is of order `h^4 alpha'''` per pixel `h` where the deflection is smooth. Pixels without data
+/// (NaN deflection, e.g. the blank borders of published maps) stay NaN, and a pixel whose one
+/// path crosses them takes the other path's value.
 pub fn potential_map(maps: &LensMaps) -> Map {
     let g = maps.geometry();
     let n = g.pixels;
@@ -137,12 +140,13 @@ pub fn potential_map(maps: &LensMaps) -> Map {
         return Map { geometry: g, data };
     }
     // Row first: along the centre row in x, then up every column in y.
+    let mut row_first = vec![0.0; n * n];
     let row: Vec<f64> = (0..n).map(|i| ax.at(i, c) * h).collect();
     let along_row = cumulative(&row, c);
     for (i, base) in along_row.iter().enumerate() {
         let column: Vec<f64> = (0..n).map(|j| ay.at(i, j) * h).collect();
         for (j, v) in cumulative(&column, c).into_iter().enumerate() {
-            data[j * n + i] = 0.5 * (base + v);
+            row_first[j * n + i] = base + v;
         }
     }
     // Column first: along the centre column in y, then along every row in x.
@@ -151,7 +155,17 @@ pub fn potential_map(maps: &LensMaps) -> Map {
     for (j, base) in along_column.iter().enumerate() {
         let row: Vec<f64> = (0..n).map(|i| ax.at(i, j) * h).collect();
         for (i, v) in cumulative(&row, c).into_iter().enumerate() {
-            data[j * n + i] += 0.5 * (base + v);
+            let k = j * n + i;
+            let (a, b) = (row_first[k], base + v);
+            data[k] = if !(ax.data[k].is_finite() && ay.data[k].is_finite()) {
+                f64::NAN
+            } else if a.is_finite() && b.is_finite() {
+                0.5 * (a + b)
+            } else if a.is_finite() {
+                a
+            } else {
+                b
+            };
         }
     }
     Map { geometry: g, data }

@@ -319,7 +319,8 @@ impl Products {
         let curves_ms = t.ms();
         let t = Clock::start();
         let geometry = maps.geometry();
-        let r_max = 0.5 * geometry.size_arcsec - geometry.center.length();
+        let r_max = (0.5 * geometry.size_arcsec - geometry.center.length())
+            .min(data_radius_arcsec(&maps.kappa, DVec2::ZERO));
         let bins = RadialBins::Linear {
             r_min_arcsec: 0.0,
             r_max_arcsec: r_max.max(geometry.pixel_arcsec()),
@@ -528,4 +529,19 @@ fn einstein_radius_on_wider_maps(
         }
     }
     (radius, None)
+}
+
+/// The radius (arcsec) of the largest disc about `center` holding no pixel without data (NaN)
+/// of `map`: the nearest point of the nearest such pixel; infinite when every pixel has data.
+fn data_radius_arcsec(map: &Map, center: DVec2) -> f64 {
+    let g = map.geometry;
+    let half = 0.5 * g.pixel_arcsec();
+    let n = g.pixels;
+    (0..n * n)
+        .filter(|&k| map.data[k].is_nan())
+        .map(|k| {
+            let d = g.pixel_center(k % n, k / n) - center;
+            DVec2::new((d.x.abs() - half).max(0.0), (d.y.abs() - half).max(0.0)).length()
+        })
+        .fold(f64::INFINITY, f64::min)
 }

@@ -1304,3 +1304,40 @@ fn maps_of_a_multi_plane_lenstool_model_need_single_plane() {
     let out = wslap(&["maps", "--model", &par, "--single-plane", "--out", "x"]);
     assert!(!out.status.success());
 }
+
+/// `wslap maps --deflection` with published-style maps whose borders are NaN or zeros
+/// (tests/data/hff_borders_*): used, with a warning counting the pixels without data, which
+/// stay NaN in the maps written.
+#[test]
+fn maps_of_deflection_fits_with_blank_borders() {
+    let data = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data");
+    let x = data
+        .join("hff_borders_x-arcsec-deflect.fits")
+        .display()
+        .to_string();
+    let y = data
+        .join("hff_borders_y-arcsec-deflect.fits")
+        .display()
+        .to_string();
+    let dir = temp_dir("borders");
+    let out = wslap(&[
+        "maps",
+        "--deflection",
+        &x,
+        &y,
+        "--z-lens",
+        "0.3",
+        "--out",
+        &dir.display().to_string(),
+    ]);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "{err}");
+    assert!(
+        err.contains("hff_borders_x-arcsec-deflect.fits: 446 pixels have no data"),
+        "{err}"
+    );
+    let kappa = read_image(&fs::read(dir.join("kappa.fits")).unwrap(), "kappa.fits").unwrap();
+    assert_eq!(kappa.non_finite_count(), 446);
+    let radius = summary(&dir)["einstein_radius_arcsec"].as_f64().unwrap();
+    assert!((3.0..6.0).contains(&radius), "{radius}");
+}

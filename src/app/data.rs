@@ -428,11 +428,17 @@ impl LoadedData {
         let file = |e: &dyn std::fmt::Display| AppError::File(e.to_string());
         let image = read_image(bytes, name).map_err(|e| file(&e))?;
         let (_, reference) = image.geometry().map_err(|e| file(&e))?;
-        let (map, blanks) = image.to_map_filled(0.0).map_err(|e| file(&e))?;
+        let (map, no_data) = image.to_map_no_data().map_err(|e| file(&e))?;
         let n = map.geometry.pixels;
         let mut warnings = Vec::new();
-        if blanks > 0 {
-            warnings.push(format!("{name}: {blanks} blank pixels set to 0"));
+        if no_data.total() > 0 {
+            warnings.push(format!(
+                "{name}: {} pixels have no data ({} NaN or blank, {} in borders of zeros): \
+                 blank in the views, \"no data\" in read-outs",
+                no_data.total(),
+                no_data.blank,
+                no_data.zero_border
+            ));
         }
         let fits = (bytes.len() <= MAX_STORED_FITS_BYTES).then(|| bytes.to_vec());
         if fits.is_none() {

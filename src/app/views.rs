@@ -113,6 +113,9 @@ pub struct HoverReadout {
     /// Magnification at the curves' source redshift (bilinear).
     pub magnification: f64,
     pub z_source: f64,
+    /// The maps have no data there (pixels without data in published deflection maps):
+    /// `kappa` and `magnification` are NaN.
+    pub no_data: bool,
 }
 
 /// The source behind a point of the map and all its images, at the curves' source redshift.
@@ -348,12 +351,14 @@ impl Session {
         let Some(p) = self.kappa_point(opts, px, py)? else {
             return Ok(None);
         };
+        let (kappa, magnification) = (kappa.sample(p), r.products().magnification.sample(p));
         Ok(Some(HoverReadout {
             x_arcsec: p.x,
             y_arcsec: p.y,
-            kappa: kappa.sample(p),
-            magnification: r.products().magnification.sample(p),
+            kappa,
+            magnification,
             z_source: r.products().curves.z_source,
+            no_data: kappa.is_nan() || magnification.is_nan(),
         }))
     }
 }

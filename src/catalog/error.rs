@@ -17,6 +17,14 @@ pub enum CatalogError {
     )]
     Empty { source_name: String, lines: usize },
 
+    /// A member catalogue whose every row has a "no measurement" magnitude
+    /// ([`crate::MAG_NO_MEASUREMENT`]): no member is left.
+    #[error(
+        "{source_name}: all {rows} member row(s) have a no-measurement magnitude (|mag| >= 90, \
+         e.g. 99, or nan): no member to use"
+    )]
+    NoMeasuredMembers { source_name: String, rows: usize },
+
     /// A row with fewer columns than the format needs.
     #[error(
         "{source_name}: line {line}: {found} column(s) found, at least {needed} needed \

@@ -112,7 +112,8 @@ pub fn parse_image_catalog(
 /// `theta` degrees, `mag` required, `lum` 0 when missing (kept as written, not interpreted).
 /// Ids are free text; a repeated id is only a warning. A row whose magnitude says "no
 /// measurement" (`|mag| >=` [`MAG_NO_MEASUREMENT`], e.g. 99 or -99, or `nan`) is skipped with a
-/// warning: Lenstool would give it a meaningless mass.
+/// warning: Lenstool would give it a meaningless mass (a catalogue with no other row is
+/// refused).
 pub fn parse_member_catalog(
     text: &str,
     source_name: &str,
@@ -170,6 +171,12 @@ pub fn parse_member_catalog(
             mag,
             lum: f.optional(7)?,
             line: row.line,
+        });
+    }
+    if members.is_empty() {
+        return Err(CatalogError::NoMeasuredMembers {
+            source_name: source_name.into(),
+            rows: table.rows.len(),
         });
     }
     warn_extra_columns(&extra_lines, source_name, &mut warnings);

@@ -178,7 +178,17 @@ pub(super) fn read_map(
     let bytes = read_bytes(path, InputKind::Fits)?;
     let image = read_image(&bytes, &path.display().to_string()).map_err(|e| e.to_string())?;
     let (_, reference) = image.geometry().map_err(|e| e.to_string())?;
-    let map = image.to_map().map_err(|e| e.to_string())?;
+    let (map, no_data) = image.to_map_no_data().map_err(|e| e.to_string())?;
+    if no_data.total() > 0 {
+        eprintln!(
+            "warning: {}: {} pixels have no data ({} NaN or blank, {} in borders of zeros): \
+             NaN in the maps written, left out of the curves and the profile",
+            path.display(),
+            no_data.total(),
+            no_data.blank,
+            no_data.zero_border
+        );
+    }
     let z_lens = image.card("ZLENS").and_then(|c| c.as_f64());
     Ok((map, reference, z_lens))
 }

@@ -82,6 +82,8 @@ pub enum FitsError {
         i: usize,
         j: usize,
     },
+    #[error("{file}: no pixel has data (every pixel is NaN, blank or in a border of zeros)")]
+    NoData { file: String },
     #[error("{file}: WCS: {reason}")]
     Wcs { file: String, reason: String },
     #[error("cannot write FITS card {keyword}: {reason}")]
@@ -94,6 +96,22 @@ pub enum FitsError {
     },
     #[error("cannot write FITS: pixel (column {i}, row {j}) = {value} is not a finite float32")]
     NonFiniteValue { i: usize, j: usize, value: f64 },
+}
+
+/// The pixels [`FitsImage::to_map_no_data`] found without data.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct NoDataPixels {
+    /// NaN or `BLANK` pixels.
+    pub blank: usize,
+    /// Zeros in the borders of zeros.
+    pub zero_border: usize,
+}
+
+impl NoDataPixels {
+    /// Every pixel without data.
+    pub fn total(&self) -> usize {
+        self.blank + self.zero_border
+    }
 }
 
 /// What goes in the header besides the image and its WCS.
@@ -127,7 +145,8 @@ pub struct FitsImage {
 
 /// Writes `map` as a float32 HFF-style FITS file (module docs; [method §7]). The map's
 /// centre sits at `CRPIX = n/2 + 0.5`, `CRVAL = reference + centre offset` with the
-/// tangent-plane relation of [method §1] ([`SkyReference::offset_to_radec`]).
+/// tangent-plane relation of [method §1] ([`SkyReference::offset_to_radec`]). Pixels without
+/// data (NaN) are written as NaN, the float images' undefined value; infinite ones are refused.
 ///
 /// [method §7]: crate::method#7-file-formats
 /// [method §1]: crate::method#1-frames-and-units
@@ -221,7 +240,8 @@ pub fn write_image(map: &Map, opts: &FitsWriteOptions) -> Result<Vec<u8>, FitsEr
     pad_to_block(&mut out, b' ');
     for (k, &v) in map.data.iter().enumerate() {
         let f = v as f32;
-        if !f.is_finite() {
+        // NaN is a float image's "no data" (FITS 4.0, 5.3); infinities are refused.
+        if f.is_infinite() {
             return Err(FitsError::NonFiniteValue {
                 i: k % n,
                 j: k / n,
@@ -359,6 +379,60 @@ impl FitsImage {
             geometry,
             data: self.data.clone(),
         })
+    }
+
+    /// The image as a [`Map`] in which pixels without data are NaN, as published lens-model
+    /// maps have them: NaN or `BLANK` pixels anywhere, and borders of exact zeros (each edge
+    /// row or column, from the outside in, that holds only zeros and no-data pixels). Fails on
+    /// infinite pixels and on an image with no data at all.
+    pub fn to_map_no_data(&self) -> Result<(Map, NoDataPixels), FitsError> {
+        let (geometry, _) = self.geometry()?;
+        let (w, h) = (self.width, self.height);
+        if let Some(k) = self.data.iter().position(|v| v.is_infinite()) {
+            return Err(FitsError::NonFinitePixels {
+                file: self.source_name.clone(),
+                count: self.data.iter().filter(|v| v.is_infinite()).count(),
+                i: k % w,
+                j: k / w,
+            });
+        }
+        let blank = self.data.iter().filter(|v| v.is_nan()).count();
+        let mut data = self.data.clone();
+        let empty = |v: f64| v == 0.0 || v.is_nan();
+        // The data window [i0, i1) x [j0, j1): edges of zeros and NaN are peeled off.
+        let (mut i0, mut i1, mut j0, mut j1) = (0, w, 0, h);
+        loop {
+            let row = |j: usize, d: &[f64]| (i0..i1).all(|i| empty(d[j * w + i]));
+            let col = |i: usize, d: &[f64]| (j0..j1).all(|j| empty(d[j * w + i]));
+            if i0 < i1 && j0 < j1 && row(j0, &data) {
+                j0 += 1;
+            } else if i0 < i1 && j0 < j1 && row(j1 - 1, &data) {
+                j1 -= 1;
+            } else if i0 < i1 && j0 < j1 && col(i0, &data) {
+                i0 += 1;
+            } else if i0 < i1 && j0 < j1 && col(i1 - 1, &data) {
+                i1 -= 1;
+            } else {
+                break;
+            }
+        }
+        let mut zero_border = 0;
+        for j in 0..h {
+            for i in 0..w {
+                let v = &mut data[j * w + i];
+                if !(i0..i1).contains(&i) || !(j0..j1).contains(&j) {
+                    zero_border += usize::from(*v == 0.0);
+                    *v = f64::NAN;
+                }
+            }
+        }
+        if data.iter().all(|v| v.is_nan()) {
+            return Err(FitsError::NoData {
+                file: self.source_name.clone(),
+            });
+        }
+        let counts = NoDataPixels { blank, zero_border };
+        Ok((Map { geometry, data }, counts))
     }
 
     /// The image as a [`Map`], NaN / infinite pixels replaced by `fill`; also returns how many

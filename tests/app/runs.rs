@@ -380,3 +380,39 @@ fn auto_strength_in_pieces_equals_one_auto_run() {
         .unwrap();
     assert!(s.strength_plan().unwrap().is_none());
 }
+
+/// Published-style deflection maps with NaN and zero borders (tests/data/hff_borders_*, see
+/// hff_borders_reference.py) load with a warning counting the pixels without data; the look-up
+/// runs, the view draws them blank and the read-out says "no data" there.
+#[cfg_attr(not(target_arch = "wasm32"), test)]
+#[cfg_attr(target_arch = "wasm32", wasm_bindgen_test::wasm_bindgen_test)]
+fn deflection_maps_with_blank_borders_read_no_data_there() {
+    let mut s = Session::new();
+    let x = include_bytes!("../data/hff_borders_x-arcsec-deflect.fits");
+    let y = include_bytes!("../data/hff_borders_y-arcsec-deflect.fits");
+    let report = s.load_fits(0, "x.fits", x).unwrap();
+    assert_eq!(report.warnings.len(), 1, "{:?}", report.warnings);
+    assert!(
+        report.warnings[0].starts_with("x.fits: 446 pixels have no data (178 NaN or blank, 268"),
+        "{:?}",
+        report.warnings
+    );
+    s.load_fits(1, "y.fits", y).unwrap();
+    s.set_field("z_lens", json!(0.3)).unwrap();
+    s.run(RunKind::Lookup, &mut |_| Control::Continue).unwrap();
+    let opts = ViewOptions::default();
+    assert!(s.kappa_view(&opts).unwrap().png.starts_with(PNG_MAGIC));
+    let frame = s.kappa_frame(&opts).unwrap();
+    let middle = frame.map_top + frame.map_side / 2.0;
+    let centre = s
+        .hover(&opts, frame.map_left + frame.map_side / 2.0, middle)
+        .unwrap()
+        .expect("inside the map");
+    assert!(!centre.no_data && centre.kappa.is_finite(), "{centre:?}");
+    // The 3 East (left) columns have no data.
+    let edge = s
+        .hover(&opts, frame.map_left + 0.02 * frame.map_side, middle)
+        .unwrap()
+        .expect("inside the map");
+    assert!(edge.no_data && edge.kappa.is_nan(), "{edge:?}");
+}

@@ -47,6 +47,19 @@ fn singular_cores_load_and_no_measurement_members_are_skipped() {
             "{text}"
         );
     }
+    // A catalogue of no-measurement rows only has no member to use, and says so.
+    let only_99: String = MEMBERS
+        .lines()
+        .filter(|l| !l.contains(" 1.0") || l.contains("99"))
+        .map(|l| format!("{l}\n"))
+        .collect();
+    let e = wslap::parse_member_catalog(&only_99, "m.cat", None)
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.starts_with("m.cat: all 2 member row(s)") && e.contains("no-measurement"),
+        "{e}"
+    );
     // The singular halo and the singular members are finite everywhere, their centres too.
     let o1 = DVec2::new(-2.076312, 1.388524);
     for p in [
@@ -215,4 +228,74 @@ fn profiles_other_than_dpie_and_shear_are_named() {
         e.contains("profile_8.par:9") && e.contains("`potentiel 1`") && e.contains("profil 8"),
         "{e}"
     );
+}
+
+/// HFF-style deflection maps with NaN and zero borders and one NaN pixel inside
+/// (tests/data/hff_borders_reference.py: an SIS of theta_E = 6 arcsec, 40 x 40 pixels of 0.5
+/// arcsec): the pixels without data are found, left blank (NaN) in every map and FITS file,
+/// and the curves and the profile use the rest.
+#[cfg_attr(not(target_arch = "wasm32"), test)]
+#[cfg_attr(target_arch = "wasm32", wasm_bindgen_test::wasm_bindgen_test)]
+fn hff_maps_with_blank_and_zero_borders_are_used_without_them() {
+    use wslap::{read_image, Cosmology, LensPlane, NoDataPixels, Products};
+    let read = |bytes: &[u8], name: &str| {
+        let image = read_image(bytes, name).unwrap();
+        let (_, reference) = image.geometry().unwrap();
+        let (map, no_data) = image.to_map_no_data().unwrap();
+        (map, no_data, reference)
+    };
+    let (ax, nx, reference) = read(
+        include_bytes!("../data/hff_borders_x-arcsec-deflect.fits"),
+        "x.fits",
+    );
+    let (ay, ny, _) = read(
+        include_bytes!("../data/hff_borders_y-arcsec-deflect.fits"),
+        "y.fits",
+    );
+    // NaN: 3 East columns and 2 North rows (less the West zeros) and one pixel; zeros: 3 South
+    // rows and 4 West columns.
+    let expected = NoDataPixels {
+        blank: 3 * 35 + 2 * 36 + 1,
+        zero_border: 3 * 40 + 4 * 37,
+    };
+    assert_eq!((nx, ny), (expected, expected));
+    assert!(ax.at(2, 20).is_nan() && ax.at(37, 20).is_nan() && ax.at(20, 1).is_nan());
+    assert!(ax.at(3, 20).is_finite() && ax.at(35, 20).is_finite());
+    let plane = LensPlane::new(Cosmology::default(), 0.3).unwrap();
+    let z_source = 2.0;
+    let f = plane.distance_ratio(z_source).unwrap();
+    let products = Products::from_deflection(ax, ay, plane, reference, z_source).unwrap();
+    let (kappa, mu) = (&products.maps.kappa, &products.magnification);
+    let blank = |m: &wslap::Map| m.data.iter().filter(|v| v.is_nan()).count();
+    assert_eq!(blank(kappa), expected.total());
+    assert_eq!(blank(mu), expected.total());
+    // Inside, kappa is the SIS's theta_E / (2 r), next to the blank pixel too (one-sided
+    // differences; 5% covers the finite differences' truncation at r >= 2 arcsec).
+    let g = kappa.geometry;
+    for (i, j) in [(10, 20), (29, 25), (31, 25), (30, 24), (20, 8), (33, 33)] {
+        let r = g.pixel_center(i, j).length();
+        let want = 6.0 / (2.0 * r);
+        let got = kappa.at(i, j);
+        assert!(
+            (got - want).abs() < 0.05 * want,
+            "kappa({i}, {j}) = {got}, SIS {want}"
+        );
+    }
+    // The tangential curve is the circle f theta_E, closed inside the data.
+    let theta_e = products.curves.einstein_radius_arcsec;
+    assert!(
+        (theta_e - f * 6.0).abs() < 0.02 * f * 6.0,
+        "{theta_e} vs {}",
+        f * 6.0
+    );
+    // The profile stops before the first pixel without data (the one at r = 5.9 arcsec).
+    let edges = &products.profile.r_edges_arcsec;
+    let last = edges[edges.len() - 1];
+    assert!(last > 4.0 && last < 5.93, "{last}");
+    assert!(products.profile.kappa.iter().all(|k| k.is_finite()));
+    // The written FITS files keep the blank pixels as NaN.
+    for (name, bytes) in products.fits_files().unwrap() {
+        let back = read_image(&bytes, name).unwrap();
+        assert_eq!(back.non_finite_count(), expected.total(), "{name}");
+    }
 }

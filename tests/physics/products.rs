@@ -305,13 +305,26 @@ fn from_deflection_rejects_bad_maps() {
     let other = Map::from_fn(MapGeometry::centered(12.0, 4), |_| 0.0);
     let err = LensMaps::from_deflection(zero.clone(), other).unwrap_err();
     assert!(matches!(err, MapsError::GeometryMismatch { .. }), "{err}");
-    let mut nan = zero.clone();
-    nan.data[2 * 4 + 3] = f64::NAN;
-    let err = LensMaps::from_deflection(zero.clone(), nan).unwrap_err();
+    let mut inf = zero.clone();
+    inf.data[2 * 4 + 3] = f64::INFINITY;
+    let err = LensMaps::from_deflection(zero.clone(), inf).unwrap_err();
     assert_eq!(
         err.to_string(),
-        "alpha_y: pixel (column 3, row 2) holds NaN, which is not finite"
+        "alpha_y: pixel (column 3, row 2) holds inf, which is not finite"
     );
+    // NaN is a pixel without data (tests/files/lenstool.rs), in both maps; none at all is
+    // refused.
+    let mut nan = zero.clone();
+    nan.data[2 * 4 + 3] = f64::NAN;
+    let maps = LensMaps::from_deflection(zero.clone(), nan.clone()).unwrap();
+    assert!(maps.alpha_x.at(3, 2).is_nan() && maps.kappa.at(3, 2).is_nan());
+    // (3, 3) on the top edge has no other neighbour along y: no derivative there either.
+    let blank_at = |k: usize| maps.kappa.data[k].is_nan();
+    let blanks: Vec<usize> = (0..16).filter(|&k| blank_at(k)).collect();
+    assert_eq!(blanks, [2 * 4 + 3, 3 * 4 + 3]);
+    let blank = Map::from_fn(g, |_| f64::NAN);
+    let err = LensMaps::from_deflection(blank, nan).unwrap_err();
+    assert_eq!(err, MapsError::NoData);
     let tiny = Map::from_fn(MapGeometry::centered(1.0, 1), |_| 0.0);
     let err = LensMaps::from_deflection(tiny.clone(), tiny).unwrap_err();
     assert!(

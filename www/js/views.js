@@ -24,8 +24,9 @@ async function readOut() {
   try {
     const h = await app.hover(x, y);
     if (h) {
-      const text = `x = ${h.x_arcsec.toFixed(2)}″, y = ${h.y_arcsec.toFixed(2)}″, κ = ${h.kappa.toFixed(3)}, ` +
-        `μ(z_s = ${h.z_source}) = ${h.magnification.toFixed(2)}`;
+      const where = `x = ${h.x_arcsec.toFixed(2)}″, y = ${h.y_arcsec.toFixed(2)}″`;
+      const text = h.no_data ? `${where}: no data (the deflection maps are blank here)`
+        : `${where}, κ = ${h.kappa.toFixed(3)}, μ(z_s = ${h.z_source}) = ${h.magnification.toFixed(2)}`;
       readout.textContent = pin ? `Clicked: ${text}` : text;
     }
   } catch { /* the worker is busy with a run or was restarted */ }

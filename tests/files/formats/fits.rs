@@ -385,12 +385,17 @@ fn writer_rejects_reserved_cards_and_non_finite_pixels() {
         "{err}"
     );
     let mut map = small_map();
-    map.data[17] = f64::NAN;
+    map.data[17] = f64::INFINITY;
     let err = write_image(&map, &small_fits_options()).unwrap_err();
     assert!(
         matches!(err, FitsError::NonFiniteValue { i: 1, j: 1, .. }),
         "{err}"
     );
+    // NaN is a pixel without data: written as NaN, read back as NaN.
+    map.data[17] = f64::NAN;
+    let bytes = write_image(&map, &small_fits_options()).unwrap();
+    let back = read_image(&bytes, "nan.fits").unwrap();
+    assert!(back.data[17].is_nan() && back.non_finite_count() == 1);
     let long = Card {
         keyword: "NOTE".into(),
         value: Some(CardValue::Text("x".repeat(80))),
