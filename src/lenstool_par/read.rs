@@ -134,8 +134,10 @@ pub fn parse_par_with(
 /// Whether Lenstool opens a block for the first word of a line between blocks (the names and
 /// prefixes `init_grille.c` compares).
 fn is_lenstool_block(word: &str) -> bool {
-    const EXACT: [&str; 10] = [
+    // With the English names of Lenstool's newer `best.par` files (`field`, `large`).
+    const EXACT: [&str; 11] = [
         "runmode",
+        "field",
         "cleanlens",
         "source",
         "shapemodel",
@@ -146,9 +148,9 @@ fn is_lenstool_block(word: &str) -> bool {
         "vfieldlimit",
         "cosmolimit",
     ];
-    const PREFIXES: [&str; 11] = [
+    const PREFIXES: [&str; 12] = [
         "image", "grille", "grid", "potent", "limit", "potfile", "multi", "dynfile", "grande",
-        "observ", "cosmolog",
+        "large", "observ", "cosmolog",
     ];
     EXACT.contains(&word) || PREFIXES.iter().any(|p| word.starts_with(p))
 }

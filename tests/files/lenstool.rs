@@ -14,6 +14,7 @@ const GROUP: &str = include_str!("../data/lenstool/group.cat");
 const IDENTITY: &str = include_str!("../data/lenstool/identity.par");
 const HPC_STYLE: &str = include_str!("../data/lenstool/hpc_style.par");
 const PROFILE_8: &str = include_str!("../data/lenstool/profile_8.par");
+const ENGLISH: &str = include_str!("../data/lenstool/english_bestopt.par");
 
 fn refused(text: &str, name: &str) -> String {
     parse_par(text, name)
@@ -218,6 +219,21 @@ fn lenstool_hpc_inputs_say_what_lenstool_would_not_read() {
         panic!("a dPIE");
     };
     assert_eq!((r_cut, ellipticity), (Radius::Arcsec(500.0), 0.11));
+}
+
+#[cfg_attr(not(target_arch = "wasm32"), test)]
+#[cfg_attr(target_arch = "wasm32", wasm_bindgen_test::wasm_bindgen_test)]
+fn a_recent_english_bestopt_loads_without_warnings() {
+    let par = parse_par(ENGLISH, "english_bestopt.par").expect("loads");
+    assert!(par.warnings.is_empty(), "{:?}", par.warnings);
+    assert_eq!((par.potentials.len(), par.z_lens), (2, 0.588));
+    assert_eq!(par.potentials[1].block, "potential O2");
+    let r = par.reference.expect("reference");
+    assert_eq!((r.ra_deg, r.dec_deg), (35.282193, -66.387198));
+    let ParComponent::Dpie { ellipticity, .. } = par.potentials[0].component else {
+        panic!("a dPIE");
+    };
+    assert_eq!(ellipticity, 0.600442);
 }
 
 #[cfg_attr(not(target_arch = "wasm32"), test)]
