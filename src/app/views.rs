@@ -288,7 +288,7 @@ impl Session {
     }
 
     /// The source position (arcsec) behind the point `p` of the result's maps at the curves'
-    /// source redshift; an error when `p` is not on the maps.
+    /// source redshift; an error when `p` is not on the maps or the maps have no data there.
     pub(super) fn source_behind(&self, p: DVec2) -> Result<DVec2, AppError> {
         let products = &self.result()?.products();
         let g = products.maps.geometry();
@@ -299,7 +299,14 @@ impl Session {
                 p.x, p.y
             )));
         }
-        Ok(source_on_maps(&products.maps, products.distance_ratio, p))
+        let beta = source_on_maps(&products.maps, products.distance_ratio, p);
+        if beta.is_nan() {
+            return Err(AppError::Missing(format!(
+                "({:.2}, {:.2}) arcsec: the deflection maps have no data there",
+                p.x, p.y
+            )));
+        }
+        Ok(beta)
     }
 
     /// [`Session::counter_images`] of `p` as a DS9 region file to lay over the cluster image:

@@ -415,4 +415,17 @@ fn deflection_maps_with_blank_borders_read_no_data_there() {
         .unwrap()
         .expect("inside the map");
     assert!(edge.no_data && edge.kappa.is_nan(), "{edge:?}");
+    // Counter images: found from a point with data (all on pixels with data), refused by name
+    // from one without.
+    let c = s.counter_images(glam::DVec2::new(4.0, 1.0)).unwrap();
+    assert!(!c.images.is_empty());
+    for im in &c.images {
+        let p = im.position_arcsec;
+        assert!(p.is_finite() && im.magnification.is_finite(), "{im:?}");
+    }
+    let err = s
+        .counter_images(glam::DVec2::new(-9.5, 0.0))
+        .unwrap_err()
+        .to_string();
+    assert!(err.contains("no data there"), "{err}");
 }
