@@ -1,24 +1,72 @@
 //! The error every settings check shares: a field whose value is outside what a run can use.
 
+use std::borrow::Cow;
+
 use thiserror::Error;
 
 /// A setting or option outside the range a run can use: the field as a settings file names it
 /// (its block first, e.g. `grid.cells`, `products.pixels`, `cosmology.omega_m`), the value
 /// given, and the reason, which states the range.
 #[derive(Debug, Error, Clone, PartialEq)]
-#[error("{field} = {value} is not allowed ({reason})")]
+#[error("{field} = {} is not allowed ({reason})", number(*.value))]
 pub struct BadFieldValue {
     pub field: String,
     pub value: f64,
-    pub reason: &'static str,
+    pub reason: Cow<'static, str>,
 }
 
 impl BadFieldValue {
-    pub fn new(field: impl Into<String>, value: f64, reason: &'static str) -> Self {
+    /// `reason` states the range (a fixed text, or one made with the values it depends on).
+    pub fn new(field: impl Into<String>, value: f64, reason: impl Into<Cow<'static, str>>) -> Self {
         Self {
             field: field.into(),
             value,
-            reason,
+            reason: reason.into(),
         }
+    }
+}
+
+/// `value` as a person would write it in a settings file: whole numbers up to 10^7 in full,
+/// larger and smaller magnitudes in exponent form (`1e15`, not `1000000000000000`).
+fn number(value: f64) -> String {
+    let magnitude = value.abs();
+    if magnitude != 0.0 && magnitude.is_finite() && !(1e-4..1e7).contains(&magnitude) {
+        format!("{value:e}")
+    } else {
+        value.to_string()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn values_are_written_as_in_a_settings_file() {
+        let e = |v: f64| BadFieldValue::new("solver.iterations", v, "at most 10^6").to_string();
+        assert_eq!(
+            e(1e15),
+            "solver.iterations = 1e15 is not allowed (at most 10^6)"
+        );
+        assert_eq!(
+            e(8000.0),
+            "solver.iterations = 8000 is not allowed (at most 10^6)"
+        );
+        assert_eq!(
+            e(0.25),
+            "solver.iterations = 0.25 is not allowed (at most 10^6)"
+        );
+        assert_eq!(
+            e(-2.5e-9),
+            "solver.iterations = -2.5e-9 is not allowed (at most 10^6)"
+        );
+        assert_eq!(
+            e(f64::NAN),
+            "solver.iterations = NaN is not allowed (at most 10^6)"
+        );
+        assert_eq!(
+            e(0.0),
+            "solver.iterations = 0 is not allowed (at most 10^6)"
+        );
     }
 }

@@ -125,7 +125,7 @@ pub use inversion::{
     ConstraintSource, ConstraintSystem, ExcludedSystem, Exclusion, GridConfig, GridError, GridMass,
     HaloProfile, Layer, LayerSplit, LinearSystem, MapPlan, MemberConfig, MemberHalo, MemberModel,
     MembersError, NpyError, ObjectiveConfig, ObjectiveTerms, Regulariser, RowBlock, ScaledLens,
-    Strength, SystemConfig, SystemError, Weighting, LAYER_SHARE_WARN,
+    Strength, SystemConfig, SystemError, Weighting, LAYER_SHARE_WARN, MAX_SINGLE_LAYERS,
 };
 
 // Non-negative quadratic programming.
@@ -133,20 +133,21 @@ pub use solver::{
     accelerated_gradient, column_independence, gram_weighted, locality_order, minimise_exact,
     nnqp_exact, objective as quadratic_objective, Control, NormalEquations, Progress, QadpProblem,
     SolveOutcome, SolveStatus, SolverError, SolverSettings, INDEPENDENCE_MAX_UNKNOWNS,
-    NNQP_EXACT_MAX_UNKNOWNS,
+    MAX_ITERATIONS, NNQP_EXACT_MAX_UNKNOWNS,
 };
 
 // A reconstruction: inputs, settings, the run, cross-validation.
 pub use reconstruct::{
-    check_ensemble_size, cross_validate, fitted_system_ids, fold_groups, image_regions,
-    product_options, reconstruct, reconstruct_with_choice, run_ensemble, strength_candidates,
-    strength_folds, strength_trial, ArrivalTimes, ConvergenceRecord, CrossValidation, Dataset,
-    DatasetError, Ensemble, EnsembleMaps, EnsembleMember, FoldRun, ImageReport, InputText,
-    InputTexts, Inputs, InterpolatedLens, KappaSpread, LayerSource, PredictedImage,
-    PredictedSystem, ProductConfig, ReconstructConfig, ReconstructError, ReconstructSummary,
-    Reconstruction, RunStatus, Solved, SolverConfig, SolverMethod, SourceReport, StrengthCandidate,
-    StrengthChoice, CHOICE_MAP_PIXELS, DEFAULT_FOLDS, MAX_ENSEMBLE_MEMBERS,
-    SHOWN_MIN_MAGNIFICATION,
+    check_ensemble_size, check_memory, cross_validate, fitted_system_ids, fold_groups,
+    image_regions, layer_count, product_options, reconstruct, reconstruct_with_choice,
+    run_ensemble, strength_candidates, strength_folds, strength_trial, ArrivalTimes, Bytes,
+    ConvergenceRecord, CrossValidation, Dataset, DatasetError, Ensemble, EnsembleMaps,
+    EnsembleMember, FoldRun, ImageReport, InputText, InputTexts, Inputs, InterpolatedLens,
+    KappaSpread, LayerSource, MemoryEstimate, MemoryLimit, PredictedImage, PredictedSystem,
+    ProductConfig, ReconstructConfig, ReconstructError, ReconstructSummary, Reconstruction,
+    RunSize, RunStatus, Solved, SolverConfig, SolverMethod, SourceReport, StrengthCandidate,
+    StrengthChoice, TooMuchMemory, CHOICE_MAP_PIXELS, DEFAULT_FOLDS, FALLBACK_MEMORY_LIMIT_BYTES,
+    MAX_ENSEMBLE_MEMBERS, SHOWN_MIN_MAGNIFICATION, WASM_MEMORY_LIMIT_BYTES,
 };
 
 // Figures.

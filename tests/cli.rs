@@ -686,6 +686,75 @@ fn config_errors_say_file_line_and_column_once() {
     assert_eq!(err.matches("line").count(), 1, "{err}");
 }
 
+/// Settings that cannot run are refused before any work, naming the file (or the option) and
+/// the field: a source in front of the lens, an iteration count past the bound, a grid no
+/// memory holds. Each run would otherwise take minutes at least (10^6 QADP iterations).
+#[test]
+fn settings_that_cannot_run_are_refused_before_the_solve() {
+    let dir = temp_dir("settings-early");
+    let images = shared("AS1063/lenstool_cats/cats_gold_mul_gold.cat");
+    let config = dir.join("config.json");
+    let name = config.display().to_string();
+    let with_config = |text: &str, more: &[&str]| {
+        fs::write(&config, text).unwrap();
+        let path = config.to_str().unwrap();
+        let mut args = vec!["--images", &images, "--z-lens", "0.348", "--config", path];
+        args.extend(more);
+        let t = std::time::Instant::now();
+        let err = refused(&dir, "reconstruct", &args);
+        (err, t.elapsed().as_secs_f64())
+    };
+    let slow = "\"solver\": {\"method\": \"qadp\", \"iterations\": 1000000}, \
+                \"objective\": {\"regulariser\": \"none\", \"strength\": 0, \
+                \"image_plane_iterations\": 0}";
+    let (err, seconds) = with_config(
+        &format!("{{{slow}, \"products\": {{\"z_source\": 0.2}}}}"),
+        &[],
+    );
+    assert_eq!(
+        err,
+        format!(
+            "error: {name}: products.z_source = 0.2 is not allowed (a source must be behind the \
+             lens: z_s > z_lens = 0.348)\n"
+        )
+    );
+    assert!(seconds < 30.0, "refused after {seconds} s");
+    let (err, _) = with_config(&format!("{{{slow}}}"), &["--default-z", "0.3"]);
+    assert!(
+        err.starts_with("error: --default-z: constraints.default_z = 0.3 is not allowed (a source must be behind the lens"),
+        "{err}"
+    );
+    let (err, _) = with_config("{\"solver\": {\"iterations\": 1000000000000000}}", &[]);
+    assert!(
+        err.starts_with(&format!(
+            "error: {name}: solver.iterations = 1e15 is not allowed (at most 10^6"
+        )),
+        "{err}"
+    );
+    let (err, _) = with_config(&format!("{{{slow}}}"), &["--iterations", "2000000"]);
+    assert!(
+        err.starts_with("error: --iterations: solver.iterations = 2000000 is not allowed"),
+        "{err}"
+    );
+    // 256^2 cells refined four times over: a matrix of petabytes.
+    let (err, seconds) = with_config(
+        &format!(
+            "{{{slow}, \"grid\": {{\"cells\": 256, \"refinements\": 4, \
+             \"refine_fraction\": 1}}}}"
+        ),
+        &[],
+    );
+    assert!(
+        err.starts_with(&format!("error: {name}: this run would need about ")),
+        "{err}"
+    );
+    assert!(
+        err.contains("(16777216 cells after refinement)") && err.contains("; lower grid.cells"),
+        "{err}"
+    );
+    assert!(seconds < 30.0, "refused after {seconds} s");
+}
+
 #[test]
 fn huge_files_are_refused_before_reading() {
     let dir = temp_dir("huge");

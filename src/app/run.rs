@@ -9,11 +9,11 @@ use crate::inversion::Regulariser;
 use crate::inversion::{build_constraints, build_member_layers, CellGrid, Layer, LinearSystem};
 use crate::products::{own_map_side, ProductOptions, Products};
 use crate::reconstruct::{
-    cross_validate, fitted_system_ids, map_geometry, product_options, reconstruct,
+    check_memory, cross_validate, fitted_system_ids, map_geometry, product_options, reconstruct,
     reconstruct_with_choice, strength_candidates, strength_folds, ConvergenceRecord,
-    CrossValidation, Dataset, DatasetError, Inputs, ReconstructConfig, ReconstructError,
-    Reconstruction, RunStatus, SourceReport, StageTimings, StrengthCandidate, StrengthChoice,
-    DEFAULT_FOLDS,
+    CrossValidation, Dataset, DatasetError, Inputs, MemoryLimit, ReconstructConfig,
+    ReconstructError, Reconstruction, RunSize, RunStatus, SourceReport, StageTimings,
+    StrengthCandidate, StrengthChoice, DEFAULT_FOLDS,
 };
 use crate::solver::Control;
 
@@ -192,6 +192,8 @@ impl Session {
             if config.objective.strength.value().is_some() {
                 return Ok(None);
             }
+            // Before the pool's workers start: each would run out of memory alone.
+            check_memory(inputs, config).map_err(run_error)?;
             let folds = strength_folds(inputs, config).map_err(run_error)?;
             Ok(Some((strength_candidates(config), folds)))
         })
@@ -365,6 +367,10 @@ impl Session {
             .model_lens(&self.settings.par_options())?
             .ok_or_else(|| AppError::Missing("load a model file first".to_string()))?;
         let p = &self.settings.reconstruct.products;
+        RunSize::maps(p.pixels)
+            .memory(&self.settings.reconstruct)
+            .check(MemoryLimit::here())
+            .map_err(|e| AppError::Run(e.to_string()))?;
         let opts = ProductOptions {
             z_source: p.z_source,
             size_arcsec: p.size_arcsec.unwrap_or(FORWARD_SIZE_ARCSEC),

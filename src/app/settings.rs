@@ -6,7 +6,7 @@ use serde::{Deserialize, Serialize};
 use crate::cosmology::{Cosmology, LensPlane};
 use crate::lenstool_par::ParOptions;
 use crate::limits::json_error_message;
-use crate::reconstruct::ReconstructConfig;
+use crate::reconstruct::{MemoryLimit, ReconstructConfig, RunSize, TooMuchMemory};
 
 use super::AppError;
 
@@ -105,7 +105,20 @@ impl AppSettings {
             .map_err(|e| AppError::Setting(format!("{path}: {e}")))?;
         next.check_sources_behind_lens()
             .map_err(|e| AppError::Setting(format!("{path}: {e}")))?;
+        next.check_memory()
+            .map_err(|e| AppError::Setting(format!("{path}: {e}")))?;
         Ok(next)
+    }
+
+    /// The least memory a run with these settings needs (the grid and the maps, before any
+    /// data) must fit in what a run may use here ([`MemoryLimit::here`]: a browser tab's in
+    /// the app), so that a size that cannot run is refused when it is set. Checked when a
+    /// field changes, as the redshifts are; a run checks its own estimate with the data.
+    fn check_memory(&self) -> Result<(), TooMuchMemory> {
+        let config = &self.reconstruct;
+        RunSize::of_settings(config)
+            .memory(config)
+            .check(MemoryLimit::here())
     }
 
     /// The curves' source redshift, and the redshift given to images with z = 0, must be

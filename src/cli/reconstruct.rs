@@ -6,10 +6,10 @@ use std::path::{Path, PathBuf};
 use clap::Args;
 use serde::Serialize;
 use wslap::{
-    check_ensemble_size, cross_validate, export_system, fold_groups, image_regions, reconstruct,
-    run_ensemble, ColorScale, Control, ConvergenceRecord, Cosmology, CrossValidation, Dataset,
-    InputKind, InputText, InputTexts, Inputs, LensPlane, ReconstructConfig, Reconstruction,
-    SolverMethod,
+    check_ensemble_size, check_memory, cross_validate, export_system, fold_groups, image_regions,
+    reconstruct, run_ensemble, ColorScale, Control, ConvergenceRecord, Cosmology, CrossValidation,
+    Dataset, InputKind, InputText, InputTexts, Inputs, LensPlane, ReconstructConfig,
+    Reconstruction, SolverMethod,
 };
 
 use super::input::read_text;
@@ -119,14 +119,37 @@ pub fn run(args: &ReconstructArgs) -> Result<(), String> {
         .map_err(|e| e.to_string())?,
         None => ReconstructConfig::default(),
     };
+    // Where the settings came from, for messages: the file, with the options over it.
+    let settings_name = match &args.config {
+        Some(path) => path.display().to_string(),
+        None => "the default settings".to_string(),
+    };
     if let Some(n) = args.iterations {
         config.solver.iterations = n;
     }
     if args.default_z.is_some() {
         config.constraints.default_z = args.default_z;
     }
+    let option = |flag: &str, e: &dyn std::fmt::Display| format!("{flag}: {e}");
+    config
+        .solver_settings()
+        .validate()
+        .map_err(|e| option("--iterations", &e))?;
+    config
+        .constraints
+        .validate()
+        .map_err(|e| option("--default-z", &e))?;
     let cosmology = Cosmology::new(args.h0, args.omega_m).map_err(|e| e.to_string())?;
     let plane = LensPlane::new(cosmology, args.z_lens).map_err(|e| e.to_string())?;
+    // Known before any data is read: a source in front of the lens is refused at once.
+    if let Err(e) = config.check_behind_lens(args.z_lens) {
+        return Err(
+            match e.field == "constraints.default_z" && args.default_z.is_some() {
+                true => option("--default-z", &e),
+                false => format!("{settings_name}: {e}"),
+            },
+        );
+    }
     let texts = [&args.images, &args.members, &args.arcs].map(|path| {
         let kind = if path == &args.arcs {
             InputKind::Arcs
@@ -162,6 +185,8 @@ pub fn run(args: &ReconstructArgs) -> Result<(), String> {
     if let Some(n) = args.ensemble {
         check_ensemble_size(n).map_err(|e| format!("--ensemble: {e}"))?;
     }
+    // So is a run larger than the machine's memory (`reconstruct` checks it again).
+    check_memory(&inputs, &config).map_err(|e| format!("{settings_name}: {e}"))?;
     let total = config.solver.iterations;
     let exact = config.solver.method == SolverMethod::Exact;
     let mut progress = |r: &ConvergenceRecord| {

@@ -107,7 +107,8 @@ pub struct ConstraintConfig {
     pub sigma_pos_arcsec: f64,
     /// Redshift given to systems whose redshift is unknown (default none: they are left out).
     pub default_z: Option<f64>,
-    /// Largest number of pixels one ellipse may hold (default 10000). Allowed >= 1.
+    /// Largest number of pixels one ellipse may hold (default 10000). Allowed 1 to
+    /// [`crate::limits::MAX_ARC_PIXELS`].
     pub max_pixels_per_image: usize,
 }
 
@@ -153,8 +154,12 @@ impl ConstraintConfig {
                 return Err(bad("default_z", z, "a source redshift must be in (0, 20)"));
             }
         }
-        if self.max_pixels_per_image == 0 {
-            return Err(bad("max_pixels_per_image", 0.0, "must be at least 1"));
+        if !(1..=crate::limits::MAX_ARC_PIXELS).contains(&self.max_pixels_per_image) {
+            return Err(bad(
+                "max_pixels_per_image",
+                self.max_pixels_per_image as f64,
+                "must be 1 to 10^6, the most arc pixels of all systems together",
+            ));
         }
         Ok(())
     }

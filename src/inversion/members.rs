@@ -43,7 +43,7 @@ use crate::profiles::{tnfw_total_mass_unit, Lens, MassComponent, Nfw, ProfileErr
 pub enum MembersError {
     #[error(transparent)]
     BadFieldValue(#[from] crate::error::BadFieldValue),
-    #[error("members: layers = \"{value}\" is not one of none, single, bcg, brightest:N (N >= 1)")]
+    #[error("members: layers = \"{value}\" is not one of none, single, bcg, brightest:N (N from 1 to {MAX_SINGLE_LAYERS})")]
     BadLayers { value: String },
     #[error(
         "{source_name}: line {line}: member {id}: {field} = {value} is not allowed ({reason})"
@@ -77,9 +77,14 @@ pub enum LayerSplit {
     Single,
     /// The brightest member alone, the rest in a second layer.
     Bcg,
-    /// Each of the N brightest alone, the rest in one more layer.
+    /// Each of the N brightest alone, the rest in one more layer (N from 1 to
+    /// [`MAX_SINGLE_LAYERS`]).
     Brightest(usize),
 }
+
+/// Most members with a layer of their own (`brightest:N`): each is an unknown `C` that the
+/// images must measure, which a few tens of them already hardly do.
+pub const MAX_SINGLE_LAYERS: usize = 1000;
 
 impl FromStr for LayerSplit {
     type Err = MembersError;
@@ -95,7 +100,7 @@ impl FromStr for LayerSplit {
                 .strip_prefix("brightest:")
                 .map(|n| n.trim().parse::<usize>())
             {
-                Some(Ok(n)) if n >= 1 => Ok(Self::Brightest(n)),
+                Some(Ok(n)) if (1..=MAX_SINGLE_LAYERS).contains(&n) => Ok(Self::Brightest(n)),
                 _ => Err(bad()),
             },
         }
@@ -239,7 +244,8 @@ impl MemberConfig {
             10.0,
             false,
         )?;
-        if let LayerSplit::Brightest(0) = self.layers {
+        if matches!(self.layers, LayerSplit::Brightest(n) if !(1..=MAX_SINGLE_LAYERS).contains(&n))
+        {
             return Err(MembersError::BadLayers {
                 value: self.layers.to_string(),
             });

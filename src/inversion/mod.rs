@@ -22,7 +22,7 @@ pub use constraints::{
 };
 pub use members::{
     build_member_layers, HaloProfile, Layer, LayerSplit, MemberConfig, MemberHalo, MemberModel,
-    MembersError,
+    MembersError, MAX_SINGLE_LAYERS,
 };
 pub use npy::{export_system, npy_header, write_f64s, write_npy, NpyError};
 pub use regularise::{

@@ -93,7 +93,7 @@ pub struct SystemConfig {
     /// Largest block of `Gamma` rows held at once, in MB (default 64). Allowed [0.001, 1e5].
     pub block_mbytes: f64,
     /// Threads for the whole reconstruction (rows, normal equations, QADP passes, maps, image
-    /// search); 0 (default) = all available (always 1 on wasm32).
+    /// search); 0 (default) = all available (always 1 on wasm32). Allowed 0..=1024.
     pub threads: usize,
 }
 
@@ -130,6 +130,13 @@ impl SystemConfig {
         let mb = self.block_mbytes;
         if !(mb.is_finite() && (1e-3..=1e5).contains(&mb)) {
             return Err(bad("block_mbytes", mb, "must be in [0.001, 1e5] MB"));
+        }
+        if self.threads > 1024 {
+            return Err(bad(
+                "threads",
+                self.threads as f64,
+                "must be 0 (all cores) to 1024",
+            ));
         }
         Ok(())
     }

@@ -163,26 +163,31 @@ impl ReconstructConfig {
             }
         }
         let s = &self.solver;
-        if !(s.start_cell_mass_msun.is_finite() && s.start_cell_mass_msun > 0.0) {
+        if !(s.start_cell_mass_msun.is_finite()
+            && s.start_cell_mass_msun > 0.0
+            && s.start_cell_mass_msun <= 1e18)
+        {
             return Err(ReconstructError::from(BadFieldValue::new(
                 "solver.start_cell_mass_msun",
                 s.start_cell_mass_msun,
-                "the start mass must be positive: a cell that starts at 0 stays at 0",
+                "the start mass must be positive, at most 1e18 Msun: a cell that starts at 0 \
+                 stays at 0",
             )));
         }
-        if !(s.start_c.is_finite() && s.start_c > 0.0) {
+        if !(s.start_c.is_finite() && s.start_c > 0.0 && s.start_c <= 1e3) {
             return Err(ReconstructError::from(BadFieldValue::new(
                 "solver.start_c",
                 s.start_c,
-                "the start C must be positive: a factor that starts at 0 stays at 0",
+                "the start C must be positive, at most 1000: a factor that starts at 0 stays \
+                 at 0",
             )));
         }
         let p = &self.products;
-        if !(p.z_source.is_finite() && p.z_source > 0.0) {
+        if !(p.z_source.is_finite() && p.z_source > 0.0 && p.z_source < 20.0) {
             return Err(ReconstructError::from(BadFieldValue::new(
                 "products.z_source",
                 p.z_source,
-                "must be a positive redshift",
+                "a source redshift must be in (0, 20)",
             )));
         }
         if !(16..=crate::products::MAX_PIXELS).contains(&p.pixels) {
@@ -191,6 +196,35 @@ impl ReconstructConfig {
                 p.pixels as f64,
                 "the map side must be 16 to 8192 pixels",
             )));
+        }
+        if let Some(w) = p.size_arcsec {
+            if !(w.is_finite() && w > 0.0 && w <= 36_000.0) {
+                return Err(ReconstructError::from(BadFieldValue::new(
+                    "products.size_arcsec",
+                    w,
+                    "the map width must be in (0, 36000] arcsec",
+                )));
+            }
+        }
+        Ok(())
+    }
+
+    /// Checks that the redshifts these settings give sources, `products.z_source` (the
+    /// curves') and `constraints.default_z`, lie behind a lens at `z_lens`: known before any
+    /// data is read, so a run refuses them at once.
+    pub fn check_behind_lens(&self, z_lens: f64) -> Result<(), BadFieldValue> {
+        let fields = [
+            ("products.z_source", Some(self.products.z_source)),
+            ("constraints.default_z", self.constraints.default_z),
+        ];
+        for (field, z) in fields {
+            if let Some(z) = z.filter(|&z| z.is_nan() || z <= z_lens) {
+                return Err(BadFieldValue::new(
+                    field,
+                    z,
+                    format!("a source must be behind the lens: z_s > z_lens = {z_lens}"),
+                ));
+            }
         }
         Ok(())
     }

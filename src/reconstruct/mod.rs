@@ -11,6 +11,7 @@ mod config;
 mod crossval;
 mod dataset;
 mod ensemble;
+mod memory;
 mod sources;
 mod summary;
 
@@ -26,6 +27,10 @@ pub use crossval::{
 pub use dataset::{Dataset, DatasetError, InputText, InputTexts};
 pub use ensemble::{
     check_ensemble_size, run_ensemble, Ensemble, EnsembleMaps, EnsembleMember, MAX_ENSEMBLE_MEMBERS,
+};
+pub use memory::{
+    layer_count, Bytes, MemoryEstimate, MemoryLimit, RunSize, TooMuchMemory,
+    FALLBACK_MEMORY_LIMIT_BYTES, WASM_MEMORY_LIMIT_BYTES,
 };
 pub use sources::{
     image_regions, images_on_maps, source_on_maps, ArrivalTimes, ImageReport, InterpolatedLens,
@@ -76,6 +81,8 @@ pub enum ReconstructError {
     Products(#[from] ProductsError),
     #[error(transparent)]
     TooLarge(#[from] crate::limits::TooLarge),
+    #[error(transparent)]
+    Memory(#[from] TooMuchMemory),
     #[error("no system is left to constrain the lens ({0})")]
     NoConstraints(String),
     #[error("cancelled")]
@@ -285,6 +292,9 @@ pub fn reconstruct(
     config: &ReconstructConfig,
     progress: &mut dyn FnMut(&ConvergenceRecord) -> Control,
 ) -> Result<Reconstruction, ReconstructError> {
+    config.validate()?;
+    check_source_redshifts(inputs, config)?;
+    crate::threads::with_limit(config.system.threads, || check_memory(inputs, config))?;
     let choice = crate::threads::with_limit(config.system.threads, || {
         choose_strength(inputs, config, progress)
     })?;
@@ -294,6 +304,38 @@ pub fn reconstruct(
             reconstruct_limited(inputs, config, progress)
         }),
     }
+}
+
+/// The estimated peak memory of [`reconstruct`] with `config` on `inputs`, checked against
+/// [`MemoryLimit::here`] before any work (the `memory` module says what it counts). The
+/// member layers are counted from `members.layers` and the catalogue (an upper bound); an
+/// "auto" strength's candidates, which natively run side by side, count once per core.
+pub fn check_memory(
+    inputs: &Inputs<'_>,
+    config: &ReconstructConfig,
+) -> Result<MemoryEstimate, ReconstructError> {
+    let constraints = build_constraints(inputs.images, &config.constraints, inputs.holdout)?;
+    let layers = match inputs.layers {
+        LayerSource::None => 0,
+        LayerSource::Given(layers) => layers.len(),
+        LayerSource::Members(catalog) => {
+            layer_count(config.members.layers, Some(catalog.members.len()))
+        }
+    };
+    let (pixels, systems) = (constraints.pixels.len(), constraints.systems.len());
+    let mut estimate = RunSize::of(config, pixels, systems, layers).memory(config);
+    if config.objective.strength.value().is_none() {
+        let mut trial = config.clone();
+        trial.products.pixels = trial.products.pixels.min(CHOICE_MAP_PIXELS);
+        let mut size = RunSize::of(&trial, pixels, systems, layers);
+        size.side_by_side = crate::threads::available().min(strength_candidates(config).len());
+        let trials = size.memory(&trial);
+        if trials.bytes > estimate.bytes {
+            estimate = trials;
+        }
+    }
+    estimate.check(MemoryLimit::here())?;
+    Ok(estimate)
 }
 
 /// For an "auto" strength, the cross-validation of every candidate and the one chosen
@@ -476,6 +518,15 @@ fn reconstruct_limited(
             model.layers
         }
     };
+    // The system's true sizes (the layers built, the systems kept), before it is built.
+    RunSize::of(
+        config,
+        constraints.pixels.len(),
+        constraints.systems.len(),
+        layers.len(),
+    )
+    .memory(config)
+    .check(MemoryLimit::here())?;
     let mut convergence = Vec::new();
     let mut timings = StageTimings::default();
     let mut level = 0;
@@ -544,6 +595,9 @@ fn reconstruct_limited(
             pixel_transforms,
             ..system.terms.clone()
         };
+        // The next system replaces this one: its matrix goes first, so that two are never
+        // held at once (the peak of the run, see the `memory` module).
+        system.a = Vec::new();
         system = LinearSystem::build_with(
             &system.grid,
             &layers,
@@ -721,24 +775,16 @@ fn start_values(system: &LinearSystem, solver: &SolverConfig) -> Vec<f64> {
     x
 }
 
-/// Every source must lie behind the lens: the first system at `z_s <= z_l` is an error naming
-/// the file, the line (catalogues) or system, and the value.
+/// Every source must lie behind the lens: the redshifts of the settings
+/// ([`ReconstructConfig::check_behind_lens`]), then the first system at `z_s <= z_l`, an error
+/// naming the file, the line (catalogues) or system, and the value.
 fn check_source_redshifts(
     inputs: &Inputs<'_>,
     config: &ReconstructConfig,
 ) -> Result<(), ReconstructError> {
     let z_lens = inputs.plane.z_lens;
     let behind = |z: f64| z > z_lens;
-    if let Some(z) = config.constraints.default_z {
-        if !behind(z) {
-            return Err(ReconstructError::Config {
-                source_name: "constraints.default_z".to_string(),
-                message: format!(
-                    "z = {z} is not behind the lens (z_lens = {z_lens}): a source must have z_s > z_l"
-                ),
-            });
-        }
-    }
+    config.check_behind_lens(z_lens)?;
     let bad = |source_name: &str, place: String, z: f64| {
         ReconstructError::Config {
         source_name: source_name.to_string(),

@@ -59,8 +59,155 @@ fn config_values_out_of_range_name_the_file_and_field() {
     let err = config_err("{\"products\": {\"z_source\": -1}}");
     assert_eq!(
         err,
-        "config.json: products.z_source = -1 is not allowed (must be a positive redshift)"
+        "config.json: products.z_source = -1 is not allowed (a source redshift must be in \
+         (0, 20))"
     );
+    // Every setting that sizes a run is bounded: the first value past each bound is refused,
+    // naming the file, the field as written and the value.
+    for (block, field, value, says) in [
+        // Below 2^32, so that it is a usize in wasm32 too (the CLI's test gives 1e15).
+        (
+            "solver",
+            "iterations",
+            "4000000000",
+            "= 4e9 is not allowed (at most 10^6",
+        ),
+        (
+            "solver",
+            "iterations",
+            "1000001",
+            "= 1000001 is not allowed (at most 10^6",
+        ),
+        (
+            "solver",
+            "report_every",
+            "0",
+            "= 0 is not allowed (must be 1 to 10^6)",
+        ),
+        (
+            "solver",
+            "report_every",
+            "1000001",
+            "= 1000001 is not allowed (must be 1 to 10^6)",
+        ),
+        (
+            "solver",
+            "start_c",
+            "1001",
+            "= 1001 is not allowed (the start C must be positive",
+        ),
+        (
+            "solver",
+            "start_cell_mass_msun",
+            "1e19",
+            "= 1e19 is not allowed (the start mass",
+        ),
+        (
+            "products",
+            "pixels",
+            "8193",
+            "= 8193 is not allowed (the map side must be 16 to 8192",
+        ),
+        (
+            "products",
+            "pixels",
+            "15",
+            "= 15 is not allowed (the map side must be 16 to 8192",
+        ),
+        (
+            "products",
+            "size_arcsec",
+            "0",
+            "= 0 is not allowed (the map width must be in (0",
+        ),
+        (
+            "products",
+            "z_source",
+            "20",
+            "= 20 is not allowed (a source redshift must be in",
+        ),
+        (
+            "grid",
+            "cells",
+            "257",
+            "= 257 is not allowed (must be in 1..=256)",
+        ),
+        (
+            "grid",
+            "refinements",
+            "5",
+            "= 5 is not allowed (must be in 0..=4)",
+        ),
+        (
+            "objective",
+            "folds",
+            "21",
+            "= 21 is not allowed (must be 2 to 20)",
+        ),
+        (
+            "objective",
+            "image_plane_iterations",
+            "11",
+            "= 11 is not allowed (must be 0 to 10)",
+        ),
+        (
+            "constraints",
+            "max_pixels_per_image",
+            "1000001",
+            "= 1000001 is not allowed (must be 1 to 10^6",
+        ),
+        (
+            "system",
+            "threads",
+            "1025",
+            "= 1025 is not allowed (must be 0 (all cores) to 1024)",
+        ),
+        (
+            "system",
+            "block_mbytes",
+            "1e6",
+            "= 1000000 is not allowed (must be in [0.001, 1e5] MB)",
+        ),
+    ] {
+        let err = config_err(&format!("{{\"{block}\": {{\"{field}\": {value}}}}}"));
+        let expected = format!("config.json: {block}.{field} {says}");
+        assert!(err.starts_with(&expected), "{err}\nexpected: {expected}");
+    }
+    let err = config_err("{\"members\": {\"layers\": \"brightest:1001\"}}");
+    assert!(
+        err.contains("layers = \"brightest:1001\" is not one of none, single, bcg, brightest:N (N from 1 to 1000)"),
+        "{err}"
+    );
+}
+
+/// A setting that a run could not hold in memory is refused with the estimate when it is set,
+/// before any data is loaded, and the settings stay as they were.
+#[cfg_attr(not(target_arch = "wasm32"), test)]
+#[cfg_attr(target_arch = "wasm32", wasm_bindgen_test::wasm_bindgen_test)]
+fn app_settings_too_large_for_memory_are_refused_when_set() {
+    let mut s = wslap::app::Session::new();
+    s.set_field("reconstruct.grid.refine_fraction", serde_json::json!(1.0))
+        .unwrap();
+    // Four refinements of every cell: 32^2 * 4^4 = 262144 cells, a matrix of 550 GB.
+    let err = s
+        .set_field("reconstruct.grid.refinements", serde_json::json!(4))
+        .unwrap_err()
+        .to_string();
+    assert!(
+        err.starts_with(
+            "reconstruct.grid.refinements: a run with these settings would need at least "
+        ),
+        "{err}"
+    );
+    assert!(
+        err.contains("its linear system has 262144 unknowns (262144 cells after refinement), so a 262144 x 262144 matrix of 512 GiB"),
+        "{err}"
+    );
+    assert!(
+        err.ends_with("; lower grid.cells (or grid.refinements)"),
+        "{err}"
+    );
+    assert_eq!(s.settings.reconstruct.grid.refinements, 0);
 }
 
 #[cfg_attr(not(target_arch = "wasm32"), test)]
