@@ -23,7 +23,7 @@ let settings = null;
 // The session's name once your own files have replaced an example.
 const OWN_DATA = 'Your data';
 
-const client = new LensClient({ onCrash: (m) => showError(m) });
+const client = new LensClient({ onCrash: (m) => showError(m), onRestart: restoreSession });
 const ask = (type, payload = {}, onProgress) => client.request(type, payload, onProgress);
 
 // Settings as the worker answered them, numbered in the order it did (`revision`), so that the
@@ -269,6 +269,27 @@ function crossValidate() {
         new Blob([JSON.stringify(cv, null, 2)], { type: 'application/json' })), files);
       $('crossval-box').scrollIntoView({ block: 'nearest' });
     });
+}
+
+/** The core failed in the worker (`message` says how) and the client started a fresh one:
+ * `send` puts the session as last saved (`lastProject`: its files, settings and result) back
+ * into it before any other job; then the page shows it again. */
+async function restoreSession(send, message) {
+  showError(message);
+  setStatus('The core failed; restoring your data…');
+  let report = null;
+  try {
+    if (lastProject) report = await send('openProject', { text: lastProject, name: 'the session' });
+  } finally {
+    // Once the client is ready again, which waits for this function to return; also when the
+    // project did not open (the page then shows the empty session it has).
+    client.ready.then(async () => {
+      await afterOpen(report);
+      const result = report?.result === 'restored' || report?.result === 'recomputed';
+      setStatus(!report ? 'Restarted after the failure, with an empty session.'
+        : `Restarted after the failure: your files${result ? ', settings and last result' : ' and settings'} are back.`);
+    }).catch((err) => showError(err.message));
+  }
 }
 
 async function cancel() {

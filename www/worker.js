@@ -1,5 +1,8 @@
 // Runs the WSLAP+ core (Rust compiled to WebAssembly) off the main thread. It holds one
 // AppSession; one message switch on `msg.type`; every job answers `result` or `error` by id.
+// A failure inside the core (a panic, or memory it could not get) aborts the WebAssembly
+// instance, which cannot be used again: the job's answer says so (`crashed`), the worker takes
+// no more jobs, and lens-client.js replaces it and restores the session.
 
 import init, * as core from './pkg/wslap.js';
 import './js/simd.js';
@@ -26,6 +29,20 @@ async function loadCore() {
 }
 
 let session = null;
+
+// `?test-panic=JOB` (passed on by lens-client.js to the first worker only): the first job of
+// type JOB panics inside the core instead, for the page's test of a failure of the core
+// (tests/e2e/recovery.test.mjs).
+let testPanic = new URLSearchParams(self.location.search).get('test-panic');
+
+/** The message of a failure inside the core: the panic's (worker-global `wslapPanic`, set by
+ * the core's panic hook), else the trap's ("unreachable" for an abort, which is also how an
+ * allocation the browser refuses ends). */
+function coreFailure(err) {
+  const why = self.wslapPanic ?? (err.message === 'unreachable'
+    ? 'it stopped at once, out of memory or at a bug ("unreachable")' : err.message);
+  return `The computation failed inside the core: ${why}; the session was restarted with your data.`;
+}
 
 /** The value at dot path `path` (e.g. 'reconstruct.grid.cells') of `obj`, or undefined. */
 const valueAt = (obj, path) => path.split('.').reduce((o, k) => (o == null ? undefined : o[k]), obj);
@@ -100,12 +117,24 @@ async function start() {
   self.onmessage = (event) => {
     const msg = event.data;
     const progress = (p) => postMessage({ id: msg.id, type: 'progress', ...p });
-    const handler = handlers[msg.type];
+    let handler = handlers[msg.type];
+    if (msg.type === testPanic) {
+      testPanic = null;
+      handler = () => session.fail_for_test();
+    }
     try {
       if (!handler) throw new Error(`unknown job type '${msg.type}'`);
       const result = handler(msg, progress) ?? {};
       postMessage({ id: msg.id, type: 'result', result }, transferables(result));
     } catch (err) {
+      if (err instanceof WebAssembly.RuntimeError) {
+        // The instance is unusable (a call now fails with "recursive use of an object"):
+        // answer this job and any sent meanwhile as crashed; lens-client.js ends this worker.
+        const message = coreFailure(err);
+        self.onmessage = (e) => postMessage({ id: e.data.id, type: 'error', message, crashed: true });
+        postMessage({ id: msg.id, type: 'error', message, crashed: true });
+        return;
+      }
       postMessage({ id: msg.id, type: 'error', message: String(err?.message ?? err) });
     }
   };

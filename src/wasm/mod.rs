@@ -13,6 +13,32 @@ use crate::demo::CLUSTER_MODEL_JSON;
 use crate::model::ModelFile;
 use crate::products::{ProductOptions, Products};
 
+/// Name of the global (the worker's `self`) that holds the message of the last panic.
+const PANIC_GLOBAL: &str = "wslapPanic";
+
+/// Installs, once, a panic hook that hands a panic's message to JavaScript: WebAssembly has
+/// no unwinding, so a panic aborts the instance with a bare "unreachable" and leaves it
+/// unusable; the hook first sets the global `wslapPanic` to the message, which
+/// `www/worker.js` reports when it replaces the instance.
+pub(crate) fn keep_panic_messages() {
+    static ONCE: std::sync::Once = std::sync::Once::new();
+    ONCE.call_once(|| {
+        std::panic::set_hook(Box::new(|info| {
+            let payload = info.payload();
+            let message = payload
+                .downcast_ref::<&str>()
+                .map(|s| s.to_string())
+                .or_else(|| payload.downcast_ref::<String>().cloned())
+                .unwrap_or_else(|| "a panic without a message".to_string());
+            let _ = js_sys::Reflect::set(
+                &js_sys::global(),
+                &JsValue::from_str(PANIC_GLOBAL),
+                &JsValue::from_str(&message),
+            );
+        }));
+    });
+}
+
 /// The crate version, shown by the app.
 #[wasm_bindgen]
 pub fn version() -> String {

@@ -94,10 +94,19 @@ impl AppSession {
     /// An empty session with the app's default settings.
     #[wasm_bindgen(constructor)]
     pub fn new() -> AppSession {
+        super::keep_panic_messages();
         AppSession {
             inner: Session::new(),
             crossval_files: Vec::new(),
         }
+    }
+
+    /// Panics inside the core while the session is in use, as a bug would: for the page's
+    /// test that a failure of the core is reported and the session rebuilt with its data
+    /// (`tests/e2e/recovery.test.mjs`, through the worker's `?test-panic=JOB`). Nothing else
+    /// calls it.
+    pub fn fail_for_test(&mut self) {
+        panic!("the failure a test asked for");
     }
 
     /// Sets the name shown in titles (an example or project name).
