@@ -142,7 +142,7 @@ pub use reconstruct::{
     image_regions, layer_count, product_options, reconstruct, reconstruct_with_choice,
     run_ensemble, strength_candidates, strength_folds, strength_trial, ArrivalTimes, Bytes,
     ConvergenceRecord, CrossValidation, Dataset, DatasetError, Ensemble, EnsembleMaps,
-    EnsembleMember, FoldRun, ImageReport, InputText, InputTexts, Inputs, InterpolatedLens,
+    EnsembleMember, FoldRun, Heap, ImageReport, InputText, InputTexts, Inputs, InterpolatedLens,
     KappaSpread, LayerSource, MemoryEstimate, MemoryLimit, PredictedImage, PredictedSystem,
     ProductConfig, ReconstructConfig, ReconstructError, ReconstructSummary, Reconstruction,
     RunSize, RunStatus, Solved, SolverConfig, SolverMethod, SourceReport, StrengthCandidate,

@@ -29,7 +29,7 @@ pub use ensemble::{
     check_ensemble_size, run_ensemble, Ensemble, EnsembleMaps, EnsembleMember, MAX_ENSEMBLE_MEMBERS,
 };
 pub use memory::{
-    layer_count, Bytes, MemoryEstimate, MemoryLimit, RunSize, TooMuchMemory,
+    layer_count, Bytes, Heap, MemoryEstimate, MemoryLimit, RunSize, TooMuchMemory,
     FALLBACK_MEMORY_LIMIT_BYTES, WASM_MEMORY_LIMIT_BYTES,
 };
 pub use sources::{
