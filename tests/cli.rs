@@ -1312,6 +1312,37 @@ fn reconstruct_ensemble_writes_its_statistics() {
         .fold((f64::MAX, f64::MIN), |(a, b), &r| (a.min(r), b.max(r)));
     assert!(min <= lo && lo <= hi && hi <= max, "{lo} {hi} of {radii:?}");
     assert_eq!(s["mass_within_interval_msun"].as_array().unwrap().len(), 3);
+    // `wslap lookup` gives the ensemble's interval at its redshift, and says why not at another.
+    let lookup = |z: &str| -> serde_json::Value {
+        let out = wslap(&[
+            "lookup",
+            "--maps",
+            out_dir.to_str().unwrap(),
+            "--at-arcsec",
+            "5",
+            "3",
+            "--z-source",
+            z,
+        ]);
+        assert!(
+            out.status.success(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        serde_json::from_slice(&out.stdout).unwrap()
+    };
+    let at2 = lookup("2");
+    let band = &at2["positions"][0]["magnification_interval"];
+    assert!(
+        band[0].as_f64().unwrap() <= band[1].as_f64().unwrap(),
+        "{at2}"
+    );
+    let at3 = lookup("3");
+    assert!(at3["positions"][0].get("magnification_interval").is_none());
+    assert!(
+        at3["interval"].as_str().unwrap().contains("z_s = 2"),
+        "{at3}"
+    );
     // The same seed, the same members.
     let again = dir.join("again");
     assert!(run(&again, "4").status.success());
@@ -1409,4 +1440,117 @@ fn maps_of_deflection_fits_with_blank_borders() {
     assert_eq!(kappa.non_finite_count(), 446);
     let radius = summary(&dir)["einstein_radius_arcsec"].as_f64().unwrap();
     assert!((3.0..6.0).contains(&radius), "{radius}");
+}
+
+/// `wslap lookup` on the maps of an SIS model: kappa, shear and magnification at the source's
+/// redshift against the analytic SIS (kappa = |gamma| = theta_E / 2r, mu = 1 / (1 - theta_E/r)
+/// with theta_E at z_s), at a position in arcsec, at RA/Dec and from a file of positions (with
+/// ids, sexagesimal, a point off the maps); no ensemble interval without an ensemble.
+#[test]
+fn lookup_matches_an_sis() {
+    let dir = temp_dir("lookup");
+    let model = dir.join("model.json");
+    fs::write(
+        &model,
+        r#"{"z_lens": 0.3, "reference": {"ra": 342.18, "dec": -44.53}, "components": [
+            {"type": "sis", "x": 0.0, "y": 0.0, "sigma_v": 1000.0}]}"#,
+    )
+    .unwrap();
+    let maps = dir.join("maps");
+    let out = wslap(&[
+        "maps",
+        "--model",
+        model.to_str().unwrap(),
+        "--size",
+        "120",
+        "--pixels",
+        "480",
+        "--out",
+        maps.to_str().unwrap(),
+    ]);
+    assert!(out.status.success());
+    let plane = wslap::LensPlane::new(wslap::Cosmology::default(), 0.3).unwrap();
+    let f = plane.distance_ratio(2.0).unwrap();
+    let theta_e = f * wslap::sis_theta_e_arcsec(1000.0);
+    let lookup = |args: &[&str]| -> serde_json::Value {
+        let mut all = vec![
+            "lookup",
+            "--maps",
+            maps.to_str().unwrap(),
+            "--z-source",
+            "2",
+        ];
+        all.extend(args);
+        let out = wslap(&all);
+        assert!(
+            out.status.success(),
+            "{args:?}: {}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        serde_json::from_slice(&out.stdout).expect("JSON")
+    };
+    // Bilinear sampling of 0.25" pixels at r = 25": 1e-3 of kappa and mu is ample.
+    let check = |p: &serde_json::Value, r: f64| {
+        let kappa = theta_e / (2.0 * r);
+        let get = |k: &str| p[k].as_f64().unwrap_or_else(|| panic!("{k} in {p}"));
+        assert!(
+            (get("kappa") - kappa).abs() < 1e-3 * kappa,
+            "{p} vs {kappa}"
+        );
+        assert!((get("gamma") - kappa).abs() < 1e-3 * kappa, "{p}");
+        let mu = 1.0 / (1.0 - theta_e / r);
+        assert!(
+            (get("magnification") - mu).abs() < 1e-3 * mu.abs(),
+            "{p} vs {mu}"
+        );
+        assert!(p.get("magnification_interval").is_none());
+    };
+    let at = lookup(&["--at-arcsec", "15", "-20"]);
+    assert!(at["interval"].as_str().unwrap().starts_with("none"));
+    check(&at["positions"][0], 25.0);
+    let radec = &at["positions"][0]["radec_deg"];
+    let (ra, dec) = (radec[0].to_string(), radec[1].to_string());
+    check(&lookup(&["--at", &ra, &dec])["positions"][0], 25.0);
+    // The same point in sexagesimal, with an id, and one far off the maps.
+    let ra_deg = radec[0].as_f64().unwrap();
+    let dec_deg = radec[1].as_f64().unwrap();
+    let sexagesimal = |v: f64, scale: f64| {
+        let sign = if v < 0.0 { "-" } else { "" };
+        let x = v.abs() / scale;
+        let (d, m) = (x.trunc(), (x.fract() * 60.0).trunc());
+        let s = (x * 3600.0) - d * 3600.0 - m * 60.0;
+        format!("{sign}{d}:{m}:{s:.6}")
+    };
+    let file = dir.join("positions.txt");
+    fs::write(
+        &file,
+        format!(
+            "# id RA Dec\nsn1 {} {}\nfar {} {}\n",
+            sexagesimal(ra_deg, 15.0),
+            sexagesimal(dec_deg, 1.0),
+            ra_deg,
+            dec_deg + 0.1
+        ),
+    )
+    .unwrap();
+    let listed = lookup(&["--positions", file.to_str().unwrap()]);
+    let rows = listed["positions"].as_array().unwrap();
+    assert_eq!(rows[0]["id"], "sn1");
+    check(&rows[0], 25.0);
+    assert_eq!(rows[1]["has_data"], false);
+    assert!(rows[1].get("magnification").is_none());
+    // A bad line names the file and line.
+    fs::write(&file, "sn1 342.18\n").unwrap();
+    let out = wslap(&[
+        "lookup",
+        "--maps",
+        maps.to_str().unwrap(),
+        "--z-source",
+        "2",
+        "--positions",
+        file.to_str().unwrap(),
+    ]);
+    assert!(!out.status.success());
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(err.contains("positions.txt: line 1"), "{err}");
 }

@@ -274,8 +274,23 @@ fn load(args: &ImagesArgs) -> Result<Source, String> {
     maps_source(dir, args.z_lens)
 }
 
-/// The deflection maps of `dir` and the lens plane: `z_lens`, else the maps' ZLENS card.
+/// The deflection maps of `dir` as a lens: see [`read_maps_dir`].
 fn maps_source(dir: &Path, z_lens: Option<f64>) -> Result<Source, String> {
+    let (maps, plane, reference) = read_maps_dir(dir, z_lens)?;
+    Ok(Source::Maps {
+        maps: Box::new(maps),
+        plane,
+        reference,
+    })
+}
+
+/// The HFF-style maps of `dir` (`x-arcsec-deflect.fits`, `y-arcsec-deflect.fits`, both at
+/// `D_ls/D_s = 1`), their sky reference and the lens plane at `z_lens`, else at the maps'
+/// `ZLENS` card, in the default cosmology.
+pub(super) fn read_maps_dir(
+    dir: &Path,
+    z_lens: Option<f64>,
+) -> Result<(LensMaps, LensPlane, Option<SkyReference>), String> {
     let x = dir.join("x-arcsec-deflect.fits");
     let y = dir.join("y-arcsec-deflect.fits");
     let (ax, reference, card_z) = read_map(&x)?;
@@ -288,9 +303,5 @@ fn maps_source(dir: &Path, z_lens: Option<f64>) -> Result<Source, String> {
     })?;
     let plane = LensPlane::new(Cosmology::default(), z_lens).map_err(|e| e.to_string())?;
     let maps = LensMaps::from_deflection(ax, ay).map_err(|e| e.to_string())?;
-    Ok(Source::Maps {
-        maps: Box::new(maps),
-        plane,
-        reference,
-    })
+    Ok((maps, plane, reference))
 }

@@ -2,6 +2,7 @@
 
 mod images;
 mod input;
+mod lookup;
 mod maps;
 mod paper;
 mod reconstruct;
@@ -26,6 +27,7 @@ struct Cli {
 enum Command {
     Maps(maps::MapsArgs),
     Images(images::ImagesArgs),
+    Lookup(lookup::LookupArgs),
     Reconstruct(reconstruct::ReconstructArgs),
     Config(reconstruct::ConfigArgs),
     Simulate(simulate::SimulateArgs),
@@ -38,6 +40,7 @@ pub fn run() -> ExitCode {
     let result = match cli.command {
         Command::Maps(args) => maps::run(&args),
         Command::Images(args) => images::run(&args),
+        Command::Lookup(args) => lookup::run(&args),
         Command::Reconstruct(args) => reconstruct::run(&args),
         Command::Config(_) => reconstruct::print_config(),
         Command::Simulate(args) => simulate::run(&args),
