@@ -51,6 +51,10 @@ pub struct PaperArgs {
     /// the open defaults): about half the run time.
     #[arg(long)]
     no_studies: bool,
+    /// Solve the cases with `wslap reconstruct`'s default objective (image-plane residuals, the
+    /// regulariser chosen by cross-validation, the exact minimiser) instead of the paper's QADP.
+    #[arg(long)]
+    default_objective: bool,
 }
 
 pub fn run(args: &PaperArgs) -> Result<(), String> {
@@ -62,6 +66,7 @@ pub fn run(args: &PaperArgs) -> Result<(), String> {
     };
     config.simulation.seed = args.seed;
     config.studies = !args.no_studies;
+    config.default_objective = args.default_objective;
     if let Some(m) = args.start_cell_mass {
         config.reasonable_start_cell_mass_msun = m;
     }

@@ -15,6 +15,12 @@ pub fn markdown(report: &PaperReport) -> String {
         "Truth: soft (dark) mass {:.3e} Msun, galaxies {:.3e} Msun inside the field ({:.3e} and {:.3e} inside the arc region r < {:.1}\", where errors and the grid mass are measured); Einstein radius at z_s = 3: {:.1}\"; {} systems, {} arc pixels.\n",
         t.soft_mass_msun, t.galaxy_mass_msun, t.soft_mass_region_msun, t.galaxy_mass_region_msun, t.arc_region_radius_arcsec, t.einstein_radius_arcsec_z3, t.n_systems, t.n_arc_pixels
     );
+    if report.settings.get("default_objective") == Some(&serde_json::Value::Bool(true)) {
+        let _ = writeln!(
+            s,
+            "Solved with `wslap reconstruct`'s default objective (image-plane residuals, the regulariser and its strength chosen by cross-validation, the exact minimiser, C held near 1 where unmeasured), not the paper's QADP: iteration counts below are the exact solver's exchanges, and the convergence study's starts should agree.\n"
+        );
+    }
     let _ = writeln!(s, "## The three cases\n");
     let _ = writeln!(
         s,

@@ -380,6 +380,10 @@ impl PaperReport {
         let settings = BTreeMap::from([
             ("seed".to_string(), config.simulation.seed.into()),
             ("iterations".to_string(), config.iterations.into()),
+            (
+                "default_objective".to_string(),
+                config.default_objective.into(),
+            ),
             ("long_iterations".to_string(), config.long_iterations.into()),
             ("grid_cells".to_string(), config.grid_cells.into()),
             ("map_pixels".to_string(), config.map_pixels.into()),
