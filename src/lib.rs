@@ -56,6 +56,7 @@ mod render;
 mod simulate;
 mod sky;
 mod solver;
+mod stats;
 mod threads;
 mod units;
 

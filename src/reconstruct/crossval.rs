@@ -177,8 +177,9 @@ impl KappaSpread {
     }
 }
 
-/// Running mean and sum of squared deviations per pixel (Welford).
-struct SpreadSum {
+/// Running mean and sum of squared deviations per pixel (Welford): the folds' kappa here, the
+/// members' in an ensemble.
+pub(super) struct SpreadSum {
     geometry: MapGeometry,
     folds: f64,
     mean: Vec<f64>,
@@ -186,7 +187,7 @@ struct SpreadSum {
 }
 
 impl SpreadSum {
-    fn new(geometry: MapGeometry) -> Self {
+    pub(super) fn new(geometry: MapGeometry) -> Self {
         let n = geometry.pixels * geometry.pixels;
         Self {
             geometry,
@@ -196,7 +197,7 @@ impl SpreadSum {
         }
     }
 
-    fn add(&mut self, kappa: &[f64]) {
+    pub(super) fn add(&mut self, kappa: &[f64]) {
         self.folds += 1.0;
         for ((mean, m2), &k) in self.mean.iter_mut().zip(&mut self.m2).zip(kappa) {
             let d = k - *mean;
@@ -205,7 +206,7 @@ impl SpreadSum {
         }
     }
 
-    fn finish(self) -> Option<KappaSpread> {
+    pub(super) fn finish(self) -> Option<KappaSpread> {
         (self.folds > 0.0).then(|| KappaSpread {
             spread: Map {
                 geometry: self.geometry,

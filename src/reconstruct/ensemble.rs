@@ -28,6 +28,7 @@
 use glam::DVec2;
 use serde::{Deserialize, Serialize};
 
+use super::crossval::SpreadSum;
 use super::{
     fitted_system_ids, reconstruct, reconstruct_with_choice, ConvergenceRecord, Inputs,
     ReconstructConfig, ReconstructError, Reconstruction, StrengthChoice,
@@ -41,6 +42,7 @@ use crate::render::{render_kappa_png, ColorScale, KappaPlotOptions, Overlay};
 use crate::simulate::rng::Rng;
 use crate::sky::SkyReference;
 use crate::solver::{Control, SolveStatus};
+use crate::stats::quantile;
 
 /// Most members of an ensemble: each is a full reconstruction.
 pub const MAX_ENSEMBLE_MEMBERS: usize = 200;
@@ -209,18 +211,6 @@ impl Ensemble {
         ));
         Ok(files)
     }
-}
-
-/// The value at quantile `q` of `sorted` (linear between order statistics).
-fn quantile(sorted: &[f64], q: f64) -> f64 {
-    let n = sorted.len();
-    if n == 1 {
-        return sorted[0];
-    }
-    let t = q * (n - 1) as f64;
-    let (i, frac) = (t.floor() as usize, t - t.floor());
-    let j = (i + 1).min(n - 1);
-    sorted[i] + frac * (sorted[j] - sorted[i])
 }
 
 fn interval(mut values: Vec<f64>) -> Option<[f64; 2]> {
@@ -394,17 +384,15 @@ fn sampled_maps(r: &Reconstruction, geometry: MapGeometry) -> (Map, Map) {
 }
 
 fn statistics(geometry: MapGeometry, kappas: Vec<Map>, magnifs: Vec<Map>) -> EnsembleMaps {
+    let mut kappa = SpreadSum::new(geometry);
+    for k in &kappas {
+        kappa.add(&k.data);
+    }
+    let kappa = kappa.finish().expect("an ensemble has members");
     let n = geometry.pixels * geometry.pixels;
-    let count = kappas.len() as f64;
-    let mut mean = vec![0.0; n];
-    let mut std = vec![0.0; n];
     let mut p = [vec![0.0; n], vec![0.0; n], vec![0.0; n]];
     let mut column = Vec::with_capacity(magnifs.len());
     for i in 0..n {
-        let m = kappas.iter().map(|k| k.data[i]).sum::<f64>() / count;
-        let var = kappas.iter().map(|k| (k.data[i] - m).powi(2)).sum::<f64>() / count;
-        mean[i] = m;
-        std[i] = var.sqrt();
         column.clear();
         column.extend(magnifs.iter().map(|mu| mu.data[i]));
         column.sort_by(f64::total_cmp);
@@ -415,8 +403,8 @@ fn statistics(geometry: MapGeometry, kappas: Vec<Map>, magnifs: Vec<Map>) -> Ens
     let map = |data| Map { geometry, data };
     let [p16, p50, p84] = p;
     EnsembleMaps {
-        kappa_mean: map(mean),
-        kappa_std: map(std),
+        kappa_mean: kappa.mean,
+        kappa_std: kappa.spread,
         magnif_p16: map(p16),
         magnif_p50: map(p50),
         magnif_p84: map(p84),
@@ -430,11 +418,10 @@ mod tests {
     use super::*;
 
     #[test]
-    fn quantiles_interpolate_between_order_statistics() {
-        let v = [1.0, 2.0, 3.0, 4.0, 5.0];
-        assert_eq!(quantile(&v, 0.5), 3.0);
-        assert!((quantile(&v, 0.16) - 1.64).abs() < 1e-12);
-        assert!((quantile(&v, 0.84) - 4.36).abs() < 1e-12);
+    fn interval_is_the_16th_to_84th_percentile_of_the_finite_values() {
+        let v = vec![5.0, 1.0, f64::NAN, 3.0, 2.0, 4.0];
+        let [lo, hi] = interval(v).unwrap();
+        assert!((lo - 1.64).abs() < 1e-12 && (hi - 4.36).abs() < 1e-12);
         assert_eq!(interval(vec![f64::NAN]), None);
     }
 }
