@@ -62,6 +62,10 @@ function describe(name, text) {
   // choosing any example (also the first) is a change that loads it.
   const k = examples.findIndex((e) => e.name === name);
   $('example-select').value = k >= 0 ? String(k) : '';
+  // An example's model file is the true lens it was made from: legends say so.
+  const truth = k >= 0 && examples[k].files.some((f) => f.role === 'model' && f.truth);
+  document.body.dataset.truthModel = truth ? 'yes' : 'no';
+  $('model-curves-label').textContent = truth ? 'true lens' : 'model curves';
 }
 
 async function render() {

@@ -16,6 +16,7 @@ use crate::render::{
 
 use super::data::ModelLens;
 use super::run::{RunKind, SessionResult};
+use super::views::ViewOptions;
 use super::views::ViewPng;
 use super::{AppError, Session};
 
@@ -139,7 +140,7 @@ impl Session {
     /// the loaded model file's profile in the same bins, dashed (see [`Self::model_profile`]),
     /// and a third panel with their relative differences
     /// ([`profile_relative_differences`]).
-    pub fn radial_view(&self) -> Result<ViewPng, AppError> {
+    pub fn radial_view(&self, opts: &ViewOptions) -> Result<ViewPng, AppError> {
         let result = self.result()?;
         let (kappa, mass) = profile_points(&result.products().profile);
         let (mut kappa_series, mut mass_series) = match result.kind {
@@ -157,7 +158,7 @@ impl Session {
             let (kappa, mass) = profile_points(&model);
             let dashed = |points| Series {
                 style: LineStyle::Dashed,
-                ..Series::line(format!("loaded model ({name})"), points, PALETTE[1])
+                ..Series::line(model_name(opts, &name), points, PALETTE[1])
             };
             kappa_series.push(dashed(kappa));
             mass_series.push(dashed(mass));
@@ -165,7 +166,7 @@ impl Session {
             // profile error.
             let (kappa, mass) = profile_relative_differences(&result.products().profile, &model);
             let mut plot = panel(
-                &format!("reconstruction / loaded model - 1 ({name})"),
+                &format!("reconstruction / {} - 1", model_name(opts, &name)),
                 Axis::linear("r [arcsec]"),
                 Axis::linear("relative difference"),
                 vec![
@@ -430,6 +431,15 @@ fn model_frame(result: &SessionResult, model: &ModelLens) -> Result<(DVec2, MapG
         ..g
     };
     Ok((origin, geometry))
+}
+
+/// The loaded model in the radial profile's legends: "true lens" or "loaded model (file)".
+fn model_name(opts: &ViewOptions, file_name: &str) -> String {
+    if opts.model_is_truth {
+        "true lens".to_string()
+    } else {
+        format!("loaded model ({file_name})")
+    }
 }
 
 #[cfg(test)]

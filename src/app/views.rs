@@ -60,6 +60,16 @@ pub(super) fn arc_overlays(arcs: &[ArcPixels], side_mas: u32) -> Vec<OverlayPoin
     sets.collect()
 }
 
+/// How legends name the loaded model file: "the true lens" when it is one, its file name
+/// otherwise, after `prefix` ("critical curves of", ...).
+fn model_label(opts: &ViewOptions, file_name: &str, prefix: &str) -> String {
+    if opts.model_is_truth {
+        format!("{prefix} the true lens")
+    } else {
+        format!("{prefix} {file_name}")
+    }
+}
+
 /// What to draw.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
@@ -71,6 +81,9 @@ pub struct ViewOptions {
     pub show_predicted: bool,
     /// After a reconstruction, the loaded model file's critical curves (white, dashed).
     pub show_model_curves: bool,
+    /// The loaded model file is the true lens (the built-in examples' models): legends call
+    /// it "the true lens" instead of by its file name.
+    pub model_is_truth: bool,
     /// Map side on screen in pixels (default 512).
     pub map_pixels_on_screen: u32,
     /// Where the figures' legends go (default: under the map, so no data are hidden).
@@ -88,6 +101,7 @@ impl Default for ViewOptions {
             show_observed: true,
             show_predicted: true,
             show_model_curves: true,
+            model_is_truth: false,
             map_pixels_on_screen: 512,
             legend: LegendPlace::Below,
             pin_arcsec: None,
@@ -174,7 +188,7 @@ impl Session {
         if opts.show_model_curves {
             if let Some(m) = self.model_curves(r)? {
                 overlay.lines.push(OverlayLines {
-                    label: format!("critical curves of {}", m.name),
+                    label: model_label(opts, &m.name, "critical curves of"),
                     color: MODEL_CURVE_RGB,
                     dashed: true,
                     lines: m.tangential.into_iter().chain(m.radial).collect(),

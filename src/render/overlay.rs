@@ -215,16 +215,28 @@ pub(super) fn draw_overlay(
             halo_stroke(pm, &path, set.color, width, set.dashed, mask);
         }
     }
-    let r = 3.0 * l.s as f32 + 1.0;
     for set in &overlay.points {
         if matches!(set.marker, Marker::Pixel { .. }) {
             continue;
         }
+        let (r, w) = marker_size(set.marker, l.s as f32, width);
         for &p in &set.positions_arcsec {
             if let Some(path) = marker_path(set.marker, l.screen(g, p), r) {
-                halo_stroke(pm, &path, set.color, width, false, mask);
+                halo_stroke(pm, &path, set.color, w, false, mask);
             }
         }
+    }
+}
+
+/// Radius and line width of a point marker at figure scale `s` (curves drawn `width` wide).
+/// The model's predicted images (crosses) and the member galaxies (circles) can number in the
+/// hundreds: they are drawn small and thin so that the map stays readable under them; the
+/// data (plus signs) and a clicked point's images (squares) keep the full size.
+fn marker_size(marker: Marker, s: f32, width: f32) -> (f32, f32) {
+    match marker {
+        Marker::Cross => (2.0 * s + 0.5, 0.6 * width),
+        Marker::Circle => (2.25 * s + 0.5, 0.6 * width),
+        _ => (3.0 * s + 1.0, width),
     }
 }
 

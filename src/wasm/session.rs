@@ -305,7 +305,7 @@ impl AppSession {
             "kappa" => s.kappa_view(&opts),
             "source" => s.source_view(&opts),
             "data" => s.data_view(&opts),
-            "radial" => s.radial_view(),
+            "radial" => s.radial_view(&opts),
             "convergence" => s.convergence_view(),
             other => return Err(JsError::new(&format!("unknown view '{other}'"))),
         }

@@ -35,7 +35,7 @@ fn the_profile_view_compares_a_reconstruction_with_the_loaded_model() {
     s.run(RunKind::Reconstruct, &mut |_| Control::Continue)
         .unwrap();
     let palette_1 = wslap::PALETTE[1];
-    let without = s.radial_view().unwrap();
+    let without = s.radial_view(&ViewOptions::default()).unwrap();
     let without = tiny_skia::Pixmap::decode_png(&without.png).unwrap();
     assert_eq!(
         count_near(&without, palette_1),
@@ -79,7 +79,7 @@ fn the_profile_view_compares_a_reconstruction_with_the_loaded_model() {
         checked += 1;
     }
     assert!(checked >= 3, "{checked} radii checked");
-    let with = s.radial_view().unwrap();
+    let with = s.radial_view(&ViewOptions::default()).unwrap();
     let with = tiny_skia::Pixmap::decode_png(&with.png).unwrap();
     assert!(
         count_near(&with, palette_1) > 200,
@@ -309,7 +309,7 @@ fn the_model_profile_follows_the_sky_frame_and_the_lens_plane() {
     );
     let other_plane = same_frame.replace("\"z_lens\": 0.3", "\"z_lens\": 0.35");
     assert!(profile_of(&mut s, &other_plane).is_none());
-    assert!(s.radial_view().is_ok());
+    assert!(s.radial_view(&ViewOptions::default()).is_ok());
 }
 
 /// A published Lenstool model (AS1063's CATS gold `bestopt.par`) as the model file: forward

@@ -88,6 +88,7 @@ export function viewOptions() {
     show_observed: on('show-observed'),
     show_predicted: on('show-predicted'),
     show_model_curves: on('show-model-curves'),
+    model_is_truth: document.body.dataset.truthModel === 'yes',
     pin_arcsec: pin,
   };
 }
@@ -120,7 +121,7 @@ export function showPng(name, bytes) {
   const el = img();
   el.src = url;
   el.alt = { kappa: 'Convergence map with critical curves', data: 'The loaded data',
-    source: 'Source plane with caustics', radial: 'Radial profile', convergence: 'Convergence plot' }[name] ?? name;
+    source: 'Source plane with caustics', radial: 'Radial profile', convergence: 'Solver progress: objective, grid mass and C against iteration' }[name] ?? name;
   el.dataset.view = name;
   el.dataset.render = String(++renders);
   el.hidden = false;
