@@ -112,8 +112,8 @@ pub enum ImageError {
         cy: f64,
     },
     #[error(
-        "image search: deflection map {map} has geometry {found:?} and {len} values, \
-         expected {expected:?} and pixels^2 values"
+        "image search: deflection map {map} has {found} and {len} values; \
+         expected {expected} and one value per pixel"
     )]
     BadMaps {
         map: &'static str,

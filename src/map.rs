@@ -17,6 +17,17 @@ pub struct MapGeometry {
     pub center: DVec2,
 }
 
+/// In words, for messages: "648 x 648 pixels over 129.6″ centred on (0″, 0″)".
+impl std::fmt::Display for MapGeometry {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(
+            f,
+            "{0} x {0} pixels over {1}″ centred on ({2}″, {3}″)",
+            self.pixels, self.size_arcsec, self.center.x, self.center.y
+        )
+    }
+}
+
 impl MapGeometry {
     /// A map centred on (0, 0).
     pub fn centered(size_arcsec: f64, pixels: usize) -> Self {
@@ -191,7 +202,7 @@ pub fn magnification_at_point(f: f64, kappa: f64, gamma1: f64, gamma2: f64) -> f
 /// What can be wrong with maps handed to [`LensMaps::from_deflection`].
 #[derive(Debug, Error, Clone, PartialEq)]
 pub enum MapsError {
-    #[error("deflection maps differ in geometry: alpha_x is {alpha_x:?}, alpha_y is {alpha_y:?}")]
+    #[error("the deflection maps do not cover the same field: alpha_x has {alpha_x}, alpha_y has {alpha_y}")]
     GeometryMismatch {
         alpha_x: MapGeometry,
         alpha_y: MapGeometry,

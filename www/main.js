@@ -5,7 +5,7 @@ import { LensClient } from './lens-client.js';
 import { loadProject, saveProject } from './js/store.js';
 import { buildFileRows, setFileStatus, ROLES } from './js/files.js';
 import { buildSettings, showSettings } from './js/settings.js';
-import { wireViews, showPng, showSystems, showCrossval, showStrengthChoice, viewOptions, currentView, refreshReadout } from './js/views.js';
+import { wireViews, showPng, showSystems, showCrossval, showStrengthChoice, viewOptions, currentView, refreshReadout, clearPin } from './js/views.js';
 import { showDownloads, save } from './js/downloads.js';
 import { StrengthPool, poolSize, projectForTrials } from './js/pool.js';
 
@@ -22,6 +22,11 @@ let lastProject = null; // the worker's project.json after the last change (rest
 let settings = null;
 // The session's name once your own files have replaced an example.
 const OWN_DATA = 'Your data';
+const NEW_PROJECT = 'New project';
+// Files that failed to load while an earlier file of their role stayed in use: role ->
+// {file, kept}. Said in the caption of the runs made meanwhile; a file of that role that loads,
+// an example or a new project clears it.
+const rejected = new Map();
 
 const client = new LensClient({ onCrash: (m) => showError(m), onRestart: restoreSession });
 const ask = (type, payload = {}, onProgress) => client.request(type, payload, onProgress);
@@ -53,6 +58,25 @@ async function refreshLoaded() {
   $('lookup').disabled = !(loaded.deflection_x && loaded.deflection_y);
   $('crossval').disabled = $('reconstruct').disabled;
   return loaded;
+}
+
+/** What the loaded files allow, as the status line says it when nothing else is to be said. */
+function readyText(loaded) {
+  if (loaded.images || loaded.arcs) return 'Ready: press Reconstruct.';
+  if (loaded.model) return 'Ready: press Forward model.';
+  if (loaded.deflection_x && loaded.deflection_y) return 'Ready: press Deflection look-up.';
+  if (loaded.deflection_x || loaded.deflection_y) return `Load the deflection ${loaded.deflection_x ? 'y' : 'x'} map too for the look-up.`;
+  return 'Load an image catalogue or arcs to reconstruct (Your data), or open an example.';
+}
+
+/** No result on screen: caption, notes, downloads and the clicked point go with it. */
+function showNoResult() {
+  resultKind = null;
+  $('summary').textContent = '';
+  runNotes(null);
+  showStrengthChoice(null);
+  clearPin();
+  $('downloads').innerHTML = '<p class="hint">Run something first.</p>';
 }
 
 function describe(name, text) {
@@ -116,8 +140,9 @@ function caption(info) {
     sum.holdout_image_plane_rms_arcsec);
   // A loaded model file that is not drawn next to a reconstruction says why.
   const note = info.model_note ? ` ${info.model_note}.` : '';
+  const stale = [...rejected.values()].map(({ file, kept }) => ` Made with ${kept}: ${file} had errors and was not loaded.`).join('');
   $('summary').textContent = `${status}Einstein radius ${bound}${s.einstein_radius_arcsec.toFixed(1)}″ at ` +
-    `z_s = ${s.z_source}; ${factors}${offsets}${held}${s.tangential_curves} tangential and ${s.radial_curves} radial critical curves.${note}`;
+    `z_s = ${s.z_source}; ${factors}${offsets}${held}${s.tangential_curves} tangential and ${s.radial_curves} radial critical curves.${note}${stale}`;
 }
 
 /** Under the views: the systems a run left out of the fit and its warnings (collapsed: a
@@ -326,10 +351,11 @@ async function afterOpen(report) {
   await showSessionSettings();
   const loaded = await refreshLoaded();
   for (const { role } of ROLES) setFileStatus(role, loaded[role] ? `${loaded[role]}: loaded` : '');
-  resultKind = null;
+  rejected.clear();
+  showNoResult();
   if (report?.result === 'restored' || report?.result === 'recomputed') await showResult(await ask('resultInfo'));
-  else { $('summary').textContent = ''; runNotes(null); showStrengthChoice(null); }
   await render();
+  return loaded;
 }
 
 async function openProject(text, name, quiet = false) {
@@ -352,9 +378,9 @@ async function loadExample(ex) {
   }
   describe(ex.name, ex.description);
   $('full-app').href = `./?example=${encodeURIComponent(ex.id)}`;
-  await afterOpen(null);
+  const loaded = await afterOpen(null);
   await persist();
-  setStatus('Ready: press Reconstruct.');
+  setStatus(readyText(loaded));
 }
 
 // The example that is open (the session carries its name), if any.
@@ -407,13 +433,30 @@ async function onFile(role, file) {
     }
     setFileStatus(role, reportText(report));
     clearCrossval();
-    if (example) await leaveExample(example, role);
-    await refreshLoaded();
+    if (example) {
+      await leaveExample(example, role);
+      // The example's result drew the example's data: it goes with them.
+      await ask('clearResult');
+      showNoResult();
+    }
+    const loaded = await refreshLoaded();
     await persist();
-    if (!resultKind) await render();
+    if (!resultKind) {
+      await render();
+      setStatus(readyText(loaded));
+    }
   } catch (err) {
-    setFileStatus(role, err.message, true);
+    // The file before it (if any) stays loaded: said next to the file, at the top of the
+    // results and in the next run's caption, so that nobody takes a run on it for one on theirs.
+    const kept = role === 'project' ? null : (await ask('loaded').catch(() => ({})))[role];
+    const still = kept ? ` Still using ${kept} loaded before.` : '';
+    setFileStatus(role, `${err.message}${still ? `\n${still.trim()}` : ''}`, true);
+    showError(`${file.name} was not loaded: ${err.message}${still}`);
+    setStatus(`${file.name} was not loaded (see the message below).`);
+    if (kept) rejected.set(role, { file: file.name, kept });
+    return;
   }
+  rejected.delete(role);
 }
 
 // Files and examples are opened one at a time, in the order they came (a drop of several
@@ -426,6 +469,33 @@ function enqueue(task) {
   return openQueue;
 }
 function queueFile(role, file) { return enqueue(() => onFile(role, file)); }
+
+/** Starts over with nothing loaded and the default settings; the status line offers to undo
+ * it (the project as it was is kept in memory until the page closes). */
+async function newProject() {
+  const before = lastProject;
+  await enqueue(async () => {
+    clearError();
+    await ask('reset');
+    await ask('setName', { name: NEW_PROJECT });
+    describe(NEW_PROJECT, 'Nothing loaded yet: add your catalogues under "Your data", or pick an example.');
+    const loaded = await afterOpen(null);
+    await persist();
+    setStatus(`${readyText(loaded)} `);
+  });
+  if (!before) return;
+  const undo = document.createElement('button');
+  undo.type = 'button';
+  undo.id = 'undo-new-project';
+  undo.className = 'link';
+  undo.textContent = 'Undo New project';
+  undo.addEventListener('click', () => enqueue(async () => {
+    const report = await openProject(before, 'the previous project');
+    await persist();
+    setStatus(`Back to the project as it was${report.message ? `: ${report.message}` : ''}.`);
+  }));
+  $('status').append(undo);
+}
 
 async function applySetting(path, value) {
   if (path === 'reconstruct.products.z_source') return setZ(value);
@@ -481,6 +551,7 @@ async function start() {
   $('forward').addEventListener('click', () => run('forward'));
   $('lookup').addEventListener('click', () => run('lookup'));
   $('crossval').addEventListener('click', crossValidate);
+  $('new-project').addEventListener('click', newProject);
   $('cancel').addEventListener('click', cancel);
   $('scale').addEventListener('change', render);
   for (const id of ['show-members', 'show-observed', 'show-predicted', 'show-model-curves']) $(id).addEventListener('change', render);

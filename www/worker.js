@@ -97,6 +97,7 @@ const handlers = {
   reload: (m) => session.reload(m.role),
   // A fresh session (used after a cancel restarted the worker, or to start over).
   reset: () => { session = new core.AppSession(); return {}; },
+  clearResult: () => { session.clear_result(); return {}; },
 };
 
 function transferables(result) {

@@ -99,8 +99,8 @@ impl AppSettings {
             .pointer_mut(&pointer)
             .ok_or_else(|| AppError::Setting(format!("{path}: no such setting")))?;
         *slot = value;
-        let next: Self =
-            serde_json::from_value(tree).map_err(|e| AppError::Setting(format!("{path}: {e}")))?;
+        let next: Self = serde_json::from_value(tree)
+            .map_err(|e| AppError::Setting(format!("{path}: {}", value_error_words(&e))))?;
         next.validate()
             .map_err(|e| AppError::Setting(format!("{path}: {e}")))?;
         next.check_sources_behind_lens()
@@ -150,4 +150,40 @@ impl AppSettings {
         s.validate()?;
         Ok(s)
     }
+}
+
+/// A setting's type error in words for a person: serde's "invalid type: string \"abc\",
+/// expected usize" becomes "must be a whole number (got the text \"abc\")".
+fn value_error_words(e: &serde_json::Error) -> String {
+    let text = e.to_string();
+    // serde_json adds " at line L column C" to errors of JSON text; a value has none.
+    let text = text.split(" at line ").next().unwrap_or(&text);
+    let kind = |expected: &str| match expected {
+        "usize" | "u64" | "u32" | "u16" | "u8" => "a whole number of 0 or more".to_string(),
+        "i64" | "i32" => "a whole number".to_string(),
+        "f64" | "f32" => "a number".to_string(),
+        "a boolean" => "true or false".to_string(),
+        other => other.replace('`', ""),
+    };
+    let got = |found: &str| {
+        found
+            .replacen("string ", "the text ", 1)
+            .replace('`', "")
+            .replacen("floating point ", "", 1)
+    };
+    if let Some(rest) = text
+        .strip_prefix("invalid type: ")
+        .or_else(|| text.strip_prefix("invalid value: "))
+    {
+        if let Some((found, expected)) = rest.split_once(", expected ") {
+            return format!("must be {} (got {})", kind(expected), got(found));
+        }
+    }
+    if let Some(rest) = text.strip_prefix("unknown variant ") {
+        if let Some((found, expected)) = rest.split_once(", expected ") {
+            let options = expected.trim_start_matches("one of ").replace('`', "");
+            return format!("must be one of {options} (got {})", found.replace('`', ""));
+        }
+    }
+    text.to_string()
 }

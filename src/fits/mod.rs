@@ -39,7 +39,7 @@ const RESERVED: &[&str] = &[
 pub enum FitsError {
     #[error("{file}: empty file (0 bytes)")]
     Empty { file: String },
-    #[error("{file}: not a FITS file: the first card must be `SIMPLE = T`, found `{found}`")]
+    #[error("{file}: not a FITS file: it must start with the card `SIMPLE = T`, but it starts with {found}")]
     NotFits { file: String, found: String },
     #[error("{file}: truncated: the {what} needs {needed} bytes but the file has {got}")]
     Truncated {

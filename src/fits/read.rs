@@ -5,6 +5,39 @@ use super::{FitsError, FitsImage, BLOCK};
 
 use crate::limits::{InputKind, TooLarge, MAX_FITS_PIXELS};
 
+/// What a file that is not FITS starts with, in words: the kind of a well-known binary file
+/// (a FITS map saved as PNG, a compressed FITS), its first text when that is printable, or
+/// "binary data"; never its raw bytes.
+fn what_it_starts_with(bytes: &[u8]) -> String {
+    const KNOWN: [(&[u8], &str); 7] = [
+        (b"\x89PNG", "a PNG image"),
+        (b"\xff\xd8\xff", "a JPEG image"),
+        (
+            b"\x1f\x8b",
+            "gzip-compressed data (decompress the .fits.gz first)",
+        ),
+        (b"BZh", "bzip2-compressed data (decompress it first)"),
+        (b"PK\x03\x04", "a ZIP archive"),
+        (b"%PDF", "a PDF document"),
+        (b"\0asm", "a WebAssembly module"),
+    ];
+    if let Some((_, kind)) = KNOWN.iter().find(|(magic, _)| bytes.starts_with(magic)) {
+        return kind.to_string();
+    }
+    let head = &bytes[..bytes.len().min(CARD_LEN)];
+    match std::str::from_utf8(head) {
+        Ok(text)
+            if text
+                .chars()
+                .all(|c| !c.is_control() || c == '\n' || c == '\t') =>
+        {
+            let line = text.lines().next().unwrap_or("").trim();
+            format!("the text `{}`", line.chars().take(40).collect::<String>())
+        }
+        _ => "binary data".to_string(),
+    }
+}
+
 /// Reads the 2-D image of a FITS file: the primary HDU, or the first `IMAGE` extension when the
 /// primary HDU has no data (`NAXIS = 0`). Values are `BZERO + BSCALE * stored`; integer pixels
 /// equal to `BLANK` become NaN. `source_name` (e.g. the file name) is used in every error.
@@ -16,10 +49,9 @@ pub fn read_image(bytes: &[u8], source_name: &str) -> Result<FitsImage, FitsErro
     TooLarge::check_bytes(&file, InputKind::Fits, bytes.len() as u64)?;
     let first = Card::parse(&bytes[..bytes.len().min(CARD_LEN)]);
     if first.keyword != "SIMPLE" || first.value != Some(CardValue::Logical(true)) {
-        let found = first.keyword.clone() + " " + &first.comment;
         return Err(FitsError::NotFits {
             file,
-            found: found.trim().into(),
+            found: what_it_starts_with(bytes),
         });
     }
     let (header, data_start) = read_header(bytes, 0, &file)?;

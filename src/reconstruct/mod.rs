@@ -828,7 +828,7 @@ fn describe_excluded(constraints: &ConstraintSet) -> String {
     let list: Vec<String> = constraints
         .excluded
         .iter()
-        .map(|e| format!("{}: {:?}", e.id, e.reason))
+        .map(|e| format!("{} ({})", e.id, e.reason))
         .collect();
     format!("left out: {}", list.join(", "))
 }

@@ -128,6 +128,11 @@ impl AppSession {
         to_js(&self.inner.reload(role).map_err(err)?)
     }
 
+    /// Forgets the last result (its maps were made from data that have been replaced).
+    pub fn clear_result(&mut self) {
+        self.inner.result = None;
+    }
+
     /// Forgets the file of `role`.
     pub fn clear(&mut self, role: &str) -> Result<(), JsError> {
         self.inner.data.clear(DataRole::parse(role).map_err(err)?);

@@ -2,6 +2,7 @@
 //! names the file, says line and column once, and the size limits refuse a huge input before
 //! it is parsed. Catalogue cases are in tests/files/catalog.rs, command-line ones in tests/cli.rs.
 
+use wslap::app::Session;
 use wslap::ModelFile;
 use wslap::ReconstructConfig;
 use wslap::{parse_arcs, ArcsError};
@@ -369,4 +370,53 @@ fn fits_nan_and_infinite_pixels_are_refused_as_maps() {
         err,
         "nan.fits: 2 pixels are NaN or infinite (first at column 1, row 0, from 0)"
     );
+}
+
+/// A setting of the wrong type is refused in words a person reads (the form shows it next to
+/// the field), not serde's "invalid type: string, expected usize".
+#[test]
+fn settings_of_the_wrong_type_are_refused_in_words() {
+    let mut s = Session::new();
+    let err = |s: &mut Session, path: &str, v: serde_json::Value| {
+        s.set_field(path, v).unwrap_err().to_string()
+    };
+    let mut all = Vec::new();
+    let m = err(
+        &mut s,
+        "reconstruct.solver.iterations",
+        serde_json::json!("many"),
+    );
+    assert!(m.ends_with("reconstruct.solver.iterations: must be a whole number of 0 or more (got the text \"many\")"), "{m}");
+    all.push(m);
+    let m = err(
+        &mut s,
+        "reconstruct.solver.iterations",
+        serde_json::json!(-3),
+    );
+    assert!(
+        m.ends_with("must be a whole number of 0 or more (got integer -3)"),
+        "{m}"
+    );
+    all.push(m);
+    let m = err(&mut s, "z_lens", serde_json::json!("0.3"));
+    assert!(
+        m.ends_with("z_lens: must be a number (got the text \"0.3\")"),
+        "{m}"
+    );
+    all.push(m);
+    let m = err(
+        &mut s,
+        "reconstruct.solver.method",
+        serde_json::json!("newton"),
+    );
+    assert!(
+        m.ends_with("must be one of exact, qadp, accelerated_gradient (got newton)"),
+        "{m}"
+    );
+    all.push(m);
+    for m in &all {
+        for word in ["usize", "f64", "invalid type", "variant"] {
+            assert!(!m.contains(word), "{m}");
+        }
+    }
 }

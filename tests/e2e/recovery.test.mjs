@@ -81,7 +81,8 @@ test('a grid the browser cannot hold is refused when it is set, with the memory 
     await page.waitForFunction((sel) => document.getElementById(`${document.querySelector(sel).id}-error`).textContent,
       cells, { timeout: SETTLE_TIMEOUT_MS });
     const refusal = await page.textContent(`${cells}-error`);
-    assert.match(refusal, /^reconstruct\.grid\.cells: a run with these settings would need at least \d+\.\d GiB of memory, more than the 2\.5 GiB a browser tab can give a run: its linear system has 16384 unknowns \(16384 cells\), so a 16384 x 16384 matrix of 2\.0 GiB, .*; lower grid\.cells \(or grid\.refinements\)$/);
+    // Next to the labelled field, without the setting's path.
+    assert.match(refusal, /^a run with these settings would need at least \d+\.\d GiB of memory, more than the 2\.5 GiB a browser tab can give a run: its linear system has 16384 unknowns \(16384 cells\), so a 16384 x 16384 matrix of 2\.0 GiB, .*; lower grid\.cells \(or grid\.refinements\)$/);
     assert.equal(await page.inputValue(cells), '32', 'the accepted value comes back');
     await page.locator(`${cells}-error`).scrollIntoViewIfNeeded();
     await page.screenshot({ path: join(ARTIFACTS, 'cells-128-refused.png') });

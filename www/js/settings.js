@@ -119,7 +119,8 @@ export function buildSettings(form, apply) {
       // A cancel restarts the worker and then shows the restored settings.
       if (problem?.cancelled) return;
       if (problem) {
-        err.textContent = problem.message;
+        // Shown next to the labelled field: without the setting's path the core puts first.
+        err.textContent = problem.message.replace(`${f.path}: `, '');
         if (!state.edited) input.value = input.dataset.good ?? '';
         return;
       }

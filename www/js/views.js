@@ -72,6 +72,15 @@ async function listCounterImages() {
   box.hidden = false;
 }
 
+/** Forgets the clicked point and the read-out: they belong to maps that are gone (another
+ * example or project was opened). */
+export function clearPin() {
+  pin = null;
+  point = null;
+  document.getElementById('readout').textContent = '';
+  listCounterImages();
+}
+
 /** Reads out again at the last point, e.g. after z_s changed: μ depends on it; so do the
  * clicked point's images, which are listed again. */
 export async function refreshReadout() {

@@ -461,3 +461,32 @@ fn garbage_and_mutated_files_never_panic() {
         "most damaged files are rejected ({errors} of 400)"
     );
 }
+
+/// A file that is not FITS is named by what it is, never by its raw bytes (a PNG saved as
+/// `.fits` used to echo its binary header into the message).
+#[cfg_attr(not(target_arch = "wasm32"), test)]
+#[cfg_attr(target_arch = "wasm32", wasm_bindgen_test::wasm_bindgen_test)]
+fn a_file_that_is_not_fits_is_described_in_words() {
+    let message = |bytes: &[u8]| read_image(bytes, "map.fits").unwrap_err().to_string();
+    let png = message(b"\x89PNG\r\n\x1a\n\0\0\0\rIHDR\0\0\x02\x88");
+    assert!(png.ends_with("but it starts with a PNG image"), "{png}");
+    let gz = message(b"\x1f\x8b\x08\x00\xff\x01");
+    assert!(gz.contains("gzip-compressed data"), "{gz}");
+    let text = message(b"# x y kappa\n1 2 3\n");
+    assert!(
+        text.ends_with("but it starts with the text `# x y kappa`"),
+        "{text}"
+    );
+    let binary = message(&[0u8, 1, 2, 200, 201, 3, 7, 255, 254, 17]);
+    assert!(
+        binary.ends_with("but it starts with binary data"),
+        "{binary}"
+    );
+    for m in [&png, &gz, &text, &binary] {
+        assert!(m.starts_with("map.fits: not a FITS file"), "{m}");
+        assert!(
+            !m.chars().any(|c| c.is_control() || c == '\u{fffd}'),
+            "{m:?}"
+        );
+    }
+}

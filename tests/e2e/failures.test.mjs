@@ -1,0 +1,102 @@
+// End-to-end: the app's own failures found by using it as a new user would (issue #25): a
+// rejected file says which file is still in use, where the user looks and in the caption; a
+// result, clicked point and status never outlive the data they belong to; New project starts
+// over and can be undone.
+import { test } from 'node:test';
+import assert from 'node:assert/strict';
+import { join } from 'node:path';
+import { openApp, runToMap, setField, waitStatus, ROOT } from './browser.mjs';
+
+const MEMBERS = join(ROOT, 'www', 'examples', 'a1689-sim', 'members.cat');
+
+/** Opens the teaching example with a quick iteration count. */
+async function teaching(page) {
+  await page.selectOption('#example-select', { label: 'Teaching example: one halo, four sources' });
+  await page.waitForFunction(() => /Teaching/.test(document.getElementById('project-name').textContent));
+  await waitStatus(page, /^Ready: press Reconstruct\.$/);
+  await setField(page, '#set-reconstruct-solver-iterations', 400);
+}
+
+test('a rejected file keeps the one before, and says so at the top and in the caption', async () => {
+  const app = await openApp();
+  try {
+    const { page } = app;
+    await waitStatus(page, /^Ready/);
+    await teaching(page);
+    await page.setInputFiles('#file-images', { name: 'bad.cat', mimeType: 'text/plain', buffer: Buffer.from('#REFERENCE 0\n1 not-a-number 2 0.5 0.5 0 2.0 25\n') });
+    await page.waitForSelector('#error:not([hidden])');
+    const error = await page.textContent('#error');
+    assert.match(error, /^bad\.cat was not loaded: .*line 2/s);
+    assert.match(error, /Still using images\.cat loaded before\.$/);
+    assert.match(await page.textContent('#status'), /^bad\.cat was not loaded/);
+    assert.match(await page.textContent('#status-images'), /Still using images\.cat loaded before\./);
+    assert.equal(await page.textContent('#project-name'), 'Teaching example: one halo, four sources');
+    await runToMap(page, '#reconstruct');
+    assert.match(await page.textContent('#summary'), /Made with images\.cat: bad\.cat had errors and was not loaded\./);
+    assert.deepEqual(app.consoleErrors, []);
+  } finally {
+    await app.close();
+  }
+});
+
+test('a result, a clicked point and the status never outlive their data', async () => {
+  const app = await openApp();
+  try {
+    const { page } = app;
+    await waitStatus(page, /^Ready/);
+    await teaching(page);
+    await runToMap(page, '#reconstruct');
+    // A click lists the clicked point's images; another example forgets them.
+    const box = await page.$eval('#view-image', (el) => { const r = el.getBoundingClientRect(); return [r.left, r.top, r.width, r.height]; });
+    await page.mouse.click(box[0] + 0.42 * box[2], box[1] + 0.38 * box[3]);
+    await page.waitForSelector('#counter-images:not([hidden])');
+    await page.selectOption('#example-select', { label: 'Simulated A1689-like cluster (the WSLAP+ paper\'s test)' });
+    await page.waitForFunction(() => /A1689/.test(document.getElementById('project-name').textContent));
+    await waitStatus(page, /^Ready: press Reconstruct\.$/);
+    assert.ok(await page.isHidden('#counter-images'), 'the clicked point of the other example is still listed');
+    assert.equal(await page.textContent('#readout'), '');
+    // Run the example, then replace it with a member catalogue alone: the example's result
+    // (its arcs and members on the map) goes, and the status says what can be done now.
+    await setField(page, '#set-reconstruct-solver-iterations', 300);
+    await runToMap(page, '#reconstruct', 180_000);
+    await page.setInputFiles('#file-members', MEMBERS);
+    await page.waitForFunction(() => document.getElementById('project-name').textContent === 'Your data');
+    await waitStatus(page, /^Load an image catalogue or arcs to reconstruct/);
+    assert.ok(await page.isDisabled('#reconstruct'));
+    assert.equal(await page.textContent('#summary'), '');
+    assert.match(await page.textContent('#downloads'), /Run something first/);
+    await page.waitForFunction(() => document.getElementById('view-image').dataset.view === 'data');
+    assert.deepEqual(app.consoleErrors, []);
+  } finally {
+    await app.close();
+  }
+});
+
+test('New project starts over and can be undone', async () => {
+  const app = await openApp();
+  try {
+    const { page } = app;
+    await waitStatus(page, /^Ready/);
+    await teaching(page);
+    await page.click('#new-project');
+    await page.waitForFunction(() => document.getElementById('project-name').textContent === 'New project');
+    await waitStatus(page, /^Load an image catalogue or arcs/);
+    assert.ok(await page.isDisabled('#reconstruct'));
+    for (const role of ['images', 'model']) assert.equal(await page.textContent(`#status-${role}`), '');
+    // Saved as such: a reload opens the empty project.
+    await page.reload();
+    await waitStatus(page, /^Restored your project/);
+    assert.equal(await page.textContent('#project-name'), 'New project');
+    // Undo is offered right after New project (in this page, not after a reload).
+    await teaching(page);
+    await page.click('#new-project');
+    await page.click('#undo-new-project');
+    await waitStatus(page, /^Back to the project as it was/);
+    assert.equal(await page.textContent('#project-name'), 'Teaching example: one halo, four sources');
+    assert.match(await page.textContent('#status-images'), /images\.cat/);
+    assert.ok(await page.isEnabled('#reconstruct'));
+    assert.deepEqual(app.consoleErrors, []);
+  } finally {
+    await app.close();
+  }
+});
