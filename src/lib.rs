@@ -87,9 +87,9 @@ pub use profiles::{
     add_pixelwise, cell_unit_deflection, dpie_b0_arcsec, gaussian_unit_deflection,
     gaussian_unit_hessian, kk_epsilon, nfw_deflection, nfw_hessian, nfw_mass_cylinder_msun,
     nfw_terms, sis_theta_e_arcsec, tnfw_far_field_coefficients, tnfw_mass_and_kappa_unit, Dpie,
-    ExternalShear, Gaussian, Lens, MassComponent, Nfw, NfwEllipse, NfwTerms, PointMass,
-    ProfileError, Sis, TruncatedNfw, CSE_TERMS, DPIE_CIRCULAR_EPSILON, DPIE_SINGULAR_CORE_ARCSEC,
-    NFW_X_FLOOR,
+    ExternalShear, Gaussian, Lens, MassComponent, MassSheet, Nfw, NfwEllipse, NfwTerms, PointMass,
+    ProfileError, Sie, Sis, TruncatedNfw, CSE_TERMS, DPIE_CIRCULAR_EPSILON,
+    DPIE_SINGULAR_CORE_ARCSEC, NFW_X_FLOOR,
 };
 pub use radial::{radial_profile, rect_disc_area, RadialBins, RadialError, RadialProfile};
 

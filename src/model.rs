@@ -8,13 +8,21 @@
 //!    {"type": "tnfw", "x": 20.0, "y": 3.0, "m200": 1.0e12, "c200": 10.0, "r_trunc": 15.0},
 //!    {"type": "sis", "x": 10.0, "y": -5.0, "sigma_v": 250.0},
 //!    {"type": "point", "x": 0.0, "y": 0.0, "mass": 1.0e12},
-//!    {"type": "gaussian", "x": 0.0, "y": 0.0, "mass": 1.0e13, "sigma": 5.0}]}
+//!    {"type": "gaussian", "x": 0.0, "y": 0.0, "mass": 1.0e13, "sigma": 5.0},
+//!    {"type": "sie", "x": -4.0, "y": 2.0, "sigma_v": 300.0, "q": 0.7, "pa": 45.0},
+//!    {"type": "shear", "gamma1": 0.05, "gamma2": -0.02},
+//!    {"type": "sheet", "kappa": 0.1}]}
 //! ```
 //!
 //! Positions `x`, `y`, widths `sigma` and `r_trunc` are arcsec in the frame of [method §1];
 //! masses are Msun (`m200` with respect to 200 `rho_crit(z_lens)`); `sigma_v` is
 //! km/s; `q` (axis ratio, `0 < q <= 1`, default 1) and `pa` (degrees counter-clockwise from +x,
-//! default 0) are optional on `nfw`. `cosmology` defaults to H0 = 70, Ωm = 0.3; `reference`
+//! default 0) are optional on `nfw` and `sie`. The `sie` has the Einstein radius of the `sis` of
+//! the same `sigma_v` (product-averaged over the axes, lenstronomy's `SIE`). `shear` is an
+//! external shear with sky-frame components `gamma1`, `gamma2`, and `sheet` a uniform
+//! convergence `kappa`, both about the frame origin. Like every field of the crate, `kappa`,
+//! `gamma1` and `gamma2` are for `D_ls/D_s = 1` (see [`crate::MassComponent`]): a source at
+//! `z_s` sees them times `D_ls/D_s`. `cosmology` defaults to H0 = 70, Ωm = 0.3; `reference`
 //! (the sky position of the frame origin, degrees) is optional. Unknown fields are errors.
 //! Components are numbered from 0 in error messages, as in the JSON array.
 //!
@@ -27,7 +35,8 @@ use thiserror::Error;
 use crate::cosmology::{Cosmology, CosmologyError, LensPlane};
 use crate::limits::{json_error_parts, InputKind, TooLarge};
 use crate::profiles::{
-    Gaussian, Lens, MassComponent, Nfw, NfwEllipse, PointMass, ProfileError, Sis, TruncatedNfw,
+    ExternalShear, Gaussian, Lens, MassComponent, MassSheet, Nfw, NfwEllipse, PointMass,
+    ProfileError, Sie, Sis, TruncatedNfw,
 };
 pub use crate::sky::SkyReference;
 
@@ -121,6 +130,20 @@ pub enum ComponentSpec {
         mass: f64,
         sigma: f64,
     },
+    /// Singular isothermal ellipsoid (`sigma_v` in km/s, axis ratio `q`, `pa` in degrees).
+    Sie {
+        x: f64,
+        y: f64,
+        sigma_v: f64,
+        #[serde(default = "default_q")]
+        q: f64,
+        #[serde(default)]
+        pa: f64,
+    },
+    /// External shear (sky-frame components at `D_ls/D_s = 1`).
+    Shear { gamma1: f64, gamma2: f64 },
+    /// Uniform mass sheet of convergence `kappa` at `D_ls/D_s = 1`.
+    Sheet { kappa: f64 },
 }
 
 fn default_q() -> f64 {
@@ -136,6 +159,9 @@ impl ComponentSpec {
             Self::Sis { .. } => "sis",
             Self::Point { .. } => "point",
             Self::Gaussian { .. } => "gaussian",
+            Self::Sie { .. } => "sie",
+            Self::Shear { .. } => "shear",
+            Self::Sheet { .. } => "sheet",
         }
     }
 
@@ -173,6 +199,17 @@ impl ComponentSpec {
             Self::Gaussian { x, y, mass, sigma } => {
                 Box::new(Gaussian::new(DVec2::new(x, y), mass, sigma, plane)?)
             }
+            Self::Sie {
+                x,
+                y,
+                sigma_v,
+                q,
+                pa,
+            } => Box::new(Sie::new(DVec2::new(x, y), sigma_v, q, pa)?),
+            Self::Shear { gamma1, gamma2 } => {
+                Box::new(ExternalShear::from_components(DVec2::ZERO, gamma1, gamma2)?)
+            }
+            Self::Sheet { kappa } => Box::new(MassSheet::new(kappa)?),
         })
     }
 }

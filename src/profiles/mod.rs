@@ -18,6 +18,8 @@ mod nfw_ellipse;
 mod nfw_math;
 mod point;
 mod shear;
+mod sheet;
+mod sie;
 mod sis;
 mod tnfw;
 mod tnfw_near;
@@ -37,6 +39,8 @@ pub use nfw_ellipse::{NfwEllipse, CSE_TERMS};
 pub use nfw_math::{nfw_terms, NfwTerms, X_FLOOR as NFW_X_FLOOR};
 pub use point::PointMass;
 pub use shear::ExternalShear;
+pub use sheet::MassSheet;
+pub use sie::Sie;
 pub use sis::{sis_theta_e_arcsec, Sis};
 pub use tnfw::{
     far_field_coefficients as tnfw_far_field_coefficients, tnfw_mass_and_kappa_unit,

@@ -48,6 +48,26 @@ impl ExternalShear {
         })
     }
 
+    /// Shear with sky-frame components `gamma1`, `gamma2` (finite, `D_ls/D_s = 1`; lenstronomy
+    /// `SHEAR`) about `center` (arcsec).
+    pub fn from_components(center: DVec2, gamma1: f64, gamma2: f64) -> Result<Self, ProfileError> {
+        for (field, value) in [("gamma1", gamma1), ("gamma2", gamma2)] {
+            if !value.is_finite() {
+                return Err(ProfileError::BadParameter {
+                    component: "shear",
+                    field,
+                    value,
+                    reason: "must be finite",
+                });
+            }
+        }
+        Ok(Self {
+            center: require_finite_center("shear", center)?,
+            gamma1,
+            gamma2,
+        })
+    }
+
     /// `(gamma1, gamma2)` in the sky frame.
     pub fn components(&self) -> (f64, f64) {
         (self.gamma1, self.gamma2)

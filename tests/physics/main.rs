@@ -14,4 +14,5 @@ mod model_file;
 mod nfw;
 mod physics;
 mod products;
+mod sie_shear_sheet;
 mod time_delays;

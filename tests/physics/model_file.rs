@@ -203,13 +203,13 @@ fn model_errors_name_component_and_field() {
     );
     assert!(m.contains("unknown field `sigmav`"), "{m}");
 
-    let (e, m) = model_error(&with(r#"{"type": "sie", "x": 0, "y": 0}"#));
+    let (e, m) = model_error(&with(r#"{"type": "epl", "x": 0, "y": 0}"#));
     assert!(
         matches!(e, ModelError::ComponentSyntax { index: 1, .. }),
         "{m}"
     );
     assert!(
-        m.contains("component 1 (sie)") && m.contains("unknown variant `sie`"),
+        m.contains("component 1 (epl)") && m.contains("unknown variant `epl`"),
         "{m}"
     );
 
