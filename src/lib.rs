@@ -25,13 +25,14 @@
 //! Every out-of-range setting is reported as a [`BadFieldValue`] inside the error of the step
 //! that checked it. Two shells sit on this library: the `wslap` command line (`main.rs`) and the
 //! browser app, whose core is [`app`] (called from a web worker through the wasm boundary);
-//! [`paper`] reproduces the paper's test.
+//! [`paper`] reproduces the paper's test; [`playground`] is the live lensing playground.
 //!
 //! [method §1]: crate::method#1-frames-and-units
 
 pub mod app;
 pub mod method;
 pub mod paper;
+pub mod playground;
 
 mod arcs;
 mod catalog;

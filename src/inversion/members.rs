@@ -374,11 +374,11 @@ fn c200_for_rho_s(rho_s: f64, plane: &LensPlane) -> Option<f64> {
 
 /// One member's halo component with its parent-NFW M200 (Msun), c200 and truncation radius
 /// (arcsec).
-type BuiltHalo = (Box<dyn MassComponent>, f64, f64, Option<f64>);
+pub(crate) type BuiltHalo = (Box<dyn MassComponent>, f64, f64, Option<f64>);
 
 /// Builds the halo of one member of catalogue mass `mass_msun` at `position` (module
 /// documentation): a truncated NFW of total mass `M`, or an NFW of `M200 = M`.
-fn member_halo(
+pub(crate) fn member_halo(
     config: &MemberConfig,
     position: DVec2,
     mass_msun: f64,

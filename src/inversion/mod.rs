@@ -20,6 +20,7 @@ pub use constraints::{
     ConstraintPixel, ConstraintSet, ConstraintSource, ConstraintSystem, ExcludedSystem, Exclusion,
     Weighting,
 };
+pub(crate) use members::member_halo;
 pub use members::{
     build_member_layers, HaloProfile, Layer, LayerSplit, MemberConfig, MemberHalo, MemberModel,
     MembersError, MAX_SINGLE_LAYERS,

@@ -7,6 +7,7 @@
 use serde::Serialize;
 use wasm_bindgen::prelude::*;
 
+mod playground;
 mod session;
 
 use crate::demo::CLUSTER_MODEL_JSON;

@@ -13,6 +13,7 @@ mod images;
 mod model_file;
 mod nfw;
 mod physics;
+mod playground;
 mod products;
 mod sie_shear_sheet;
 mod time_delays;

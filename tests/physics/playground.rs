@@ -1,0 +1,126 @@
+//! The playground's scene: its format, its truth model, and that what it shows is the core's
+//! lensing (an SIS's Einstein ring, images that trace back to their source, member galaxies
+//! that are the inversion's own halos).
+
+use glam::DVec2;
+use wslap::playground::{ContourKind, Playground, Scene, SceneError, SourceSpec};
+use wslap::{
+    build_member_layers, CellGrid, LensPlane, MassComponent, Member, MemberCatalog, MemberConfig,
+};
+
+use crate::common::{assert_abs, assert_rel};
+
+const SCENE: &str = r#"{"v": 1, "z_lens": 0.3, "fov": 40,
+ "lenses": [{"type": "sis", "x": 0, "y": 0, "sigma_v": 700},
+            {"type": "member", "x": 6, "y": -4, "mag": 19.0}],
+ "sources": [{"type": "sersic", "x": 0.5, "y": 0.2, "z": 2.0, "r_eff": 0.6, "n": 1.5},
+             {"type": "point", "x": 1.0, "y": -0.5, "z": 2.0},
+             {"type": "gaussian", "x": -1, "y": 1, "z": 1.0, "sigma": 0.4, "q": 0.5, "pa": 30}]}"#;
+
+#[cfg_attr(not(target_arch = "wasm32"), test)]
+#[cfg_attr(target_arch = "wasm32", wasm_bindgen_test::wasm_bindgen_test)]
+fn scene_round_trips_and_its_truth_is_its_lens() {
+    let scene = Scene::from_json_str(SCENE).expect("valid scene");
+    let again = Scene::from_json_str(&scene.to_json_string()).expect("written scene reads");
+    assert_eq!(again, scene);
+    let built = scene.build().expect("builds");
+    let truth = scene
+        .truth_model()
+        .expect("truth")
+        .build_lens()
+        .expect("lens");
+    for p in [DVec2::new(3.0, 1.0), DVec2::new(-7.0, 5.5)] {
+        let d = built.lens.deflection(p) - truth.deflection(p);
+        assert_abs("truth deflection", d.length(), 0.0, 1e-12);
+    }
+    assert_eq!(built.planes.len(), 2, "two source redshifts");
+}
+
+#[cfg_attr(not(target_arch = "wasm32"), test)]
+#[cfg_attr(target_arch = "wasm32", wasm_bindgen_test::wasm_bindgen_test)]
+fn member_galaxies_are_the_inversions_halos() {
+    let scene = Scene::from_json_str(SCENE).expect("valid scene");
+    let plane = LensPlane::new(scene.cosmology, scene.z_lens).expect("plane");
+    let catalog = MemberCatalog {
+        source_name: "members".into(),
+        reference: None,
+        members: vec![Member {
+            id: "1".into(),
+            position: DVec2::new(6.0, -4.0),
+            a_arcsec: 1.0,
+            b_arcsec: 1.0,
+            theta_deg: 0.0,
+            mag: 19.0,
+            lum: 0.0,
+            line: 1,
+        }],
+    };
+    let grid = CellGrid::regular(DVec2::ZERO, 40.0, 8, 1.0).expect("grid");
+    let members =
+        build_member_layers(&catalog, &MemberConfig::default(), &plane, &grid).expect("members");
+    let components = scene.components(&plane).expect("components");
+    let halo = components[1].build(&plane).expect("halo");
+    for p in [DVec2::new(7.0, -4.5), DVec2::new(-3.0, 2.0)] {
+        let d = halo.deflection(p) - members.layers[0].deflection(p);
+        assert_abs("member deflection at C = 1", d.length(), 0.0, 1e-12);
+    }
+}
+
+#[cfg_attr(not(target_arch = "wasm32"), test)]
+#[cfg_attr(target_arch = "wasm32", wasm_bindgen_test::wasm_bindgen_test)]
+fn sis_scene_shows_its_einstein_ring_and_images_trace_back() {
+    let text = r#"{"v": 1, "z_lens": 0.3, "fov": 40,
+        "lenses": [{"type": "sis", "x": 0, "y": 0, "sigma_v": 700}],
+        "sources": [{"type": "point", "x": 1.0, "y": 0.0, "z": 2.0}]}"#;
+    let pg = Playground::new(Scene::from_json_str(text).expect("scene")).expect("playground");
+    let f = pg.built().source_f[0];
+    let theta_e = wslap::sis_theta_e_arcsec(700.0) * f;
+    let frame = pg.frame(256);
+    assert_eq!(frame.image_rgba.len(), 256 * 256 * 4);
+    assert_rel(
+        "Einstein radius",
+        frame.curves[0].einstein_radius_arcsec,
+        theta_e,
+        0.01,
+    );
+    let images = &frame.points[0].images;
+    assert_eq!(
+        images.len(),
+        2,
+        "an SIS makes two images of an off-centre point"
+    );
+    for im in images {
+        let landing = &pg.ray(DVec2::new(im.x, im.y))[0];
+        assert_abs("beta_x", landing.x, 1.0, 1e-3);
+        assert_abs("beta_y", landing.y, 0.0, 1e-3);
+        // SIS images at theta_E +- beta on the axis: mu = theta / (theta - theta_E) there.
+        let r = im.x.abs();
+        assert_rel("magnification", im.magnification, r / (r - theta_e), 1e-3);
+    }
+    // The image nearer the lens (the saddle) arrives last.
+    let saddle = images.iter().find(|i| i.kind == "saddle").expect("saddle");
+    assert!(saddle.delay_days > 0.0, "{images:?}");
+    let again = pg.images_of(DVec2::new(1.0, 0.0), 2.0);
+    assert_eq!(again.len(), 2);
+    let levels = pg.contours(ContourKind::Kappa, 64, 2.0, DVec2::ZERO);
+    assert!(levels.iter().any(|c| c.level == 1.0), "kappa = 1 contour");
+}
+
+#[cfg_attr(not(target_arch = "wasm32"), test)]
+#[cfg_attr(target_arch = "wasm32", wasm_bindgen_test::wasm_bindgen_test)]
+fn bad_scenes_say_what_is_wrong() {
+    let e = Scene::from_json_str(&SCENE.replace("\"v\": 1", "\"v\": 2")).unwrap_err();
+    assert!(matches!(e, SceneError::Version { found: 2 }), "{e}");
+    let e = Scene::from_json_str(&SCENE.replace("\"z\": 1.0", "\"z\": 0.1")).unwrap_err();
+    assert!(e.to_string().contains("z_s = 0.1"), "{e}");
+    let e =
+        Scene::from_json_str(&SCENE.replace("\"sigma_v\": 700", "\"sigma_v\": -7")).unwrap_err();
+    assert!(matches!(e, SceneError::Lens { index: 0, .. }), "{e}");
+    assert!(e.to_string().contains("sigma_v"), "{e}");
+    let e = Scene::from_json_str(&SCENE.replace("\"n\": 1.5", "\"n\": 50")).unwrap_err();
+    assert!(e.to_string().contains("sources[0].n"), "{e}");
+    assert!(matches!(
+        Scene::from_json_str(SCENE).unwrap().sources[2],
+        SourceSpec::Gaussian { q, .. } if q == 0.5
+    ));
+}
