@@ -9,6 +9,13 @@ import { wireViews, showPng, showSystems, showCrossval, showStrengthChoice, view
 import { showDownloads, save } from './js/downloads.js';
 import { StrengthPool, poolSize, projectForTrials } from './js/pool.js';
 
+// `?playground`: the live lensing playground (www/playground/) instead of this app; the rest of
+// this module then never runs.
+if (new URLSearchParams(location.search).has('playground')) {
+  await import('./playground/playground.js');
+  await new Promise(() => {});
+}
+
 const $ = (id) => document.getElementById(id);
 // Page parameters: `?example=ID` opens that built-in example (in the full app only when no
 // project is saved in this browser, which it would replace); `?embed` is the compact demo for
