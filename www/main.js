@@ -9,9 +9,23 @@ import { wireViews, showPng, showSystems, showCrossval, showStrengthChoice, view
 import { showDownloads, save } from './js/downloads.js';
 import { StrengthPool, poolSize, projectForTrials } from './js/pool.js';
 
-// `?playground`: the live lensing playground (www/playground/) instead of this app; the rest of
-// this module then never runs.
-if (new URLSearchParams(location.search).has('playground')) {
+// Offline use once loaded (sw.js), for the lessons and the playground too. Without it (an old
+// browser, a file:// page) the app still works online.
+if ('serviceWorker' in navigator) {
+  navigator.serviceWorker.register('sw.js').catch(() => {});
+}
+
+// `?playground` and `?lesson=ID`: the live lensing playground (www/playground/) and its lessons
+// instead of this app; the rest of this module then never runs. A first visit (no parameters,
+// no project saved in this browser) opens the first lesson: something a newcomer understands,
+// with the research app one click away (`?app`, or any of its parameters).
+const route = new URLSearchParams(location.search);
+let lessonsFirst = false;
+if (!route.has('playground') && !route.has('lesson') && location.search === '') {
+  lessonsFirst = !(await loadProject().catch(() => null));
+  if (lessonsFirst) history.replaceState(null, '', `?lesson=lens-equation${location.hash}`);
+}
+if (lessonsFirst || route.has('playground') || route.has('lesson')) {
   await import('./playground/playground.js');
   await new Promise(() => {});
 }
@@ -606,9 +620,3 @@ async function start() {
 }
 
 start().catch((err) => showError(err.message));
-
-// Offline use once loaded (sw.js). Without it (an old browser, a file:// page) the app still
-// works online.
-if ('serviceWorker' in navigator) {
-  navigator.serviceWorker.register('sw.js').catch(() => {});
-}

@@ -24,6 +24,8 @@ const APP_FILES = [
   'js/store.js',
   'js/views.js',
   'playground/client.js',
+  'playground/lessons.css',
+  'playground/lessons.js',
   'playground/playground.css',
   'playground/playground.js',
   'playground/scene.js',
@@ -31,6 +33,7 @@ const APP_FILES = [
   'pkg/wslap.js',
   self.wslapCore.hasRelaxedSimd() ? self.wslapCore.relaxed : self.wslapCore.baseline,
   'examples/index.json',
+  'lessons/index.json',
 ];
 
 self.addEventListener('install', (event) => {

@@ -402,7 +402,18 @@ impl Playground {
                             .unwrap_or(f64::NAN);
                     }
                 }
-                let levels = arrival_levels(&m.data);
+                // Evenly spaced up to a little past the latest image, and exactly at each
+                // saddle image: the contour through a saddle crosses itself there, the
+                // figure-eight that shows which images pair up.
+                let images = self.images_of(beta, z);
+                let at = |im: &PointImage| m.sample(DVec2::new(im.x, im.y));
+                let latest = images
+                    .iter()
+                    .map(at)
+                    .filter(|t| t.is_finite())
+                    .reduce(f64::max);
+                let mut levels = arrival_levels(&m.data, latest);
+                levels.extend(images.iter().filter(|im| im.kind == "saddle").map(at));
                 (m, levels)
             }
         };
@@ -424,15 +435,20 @@ impl Playground {
     }
 }
 
-/// [`ARRIVAL_LEVELS`] even steps from the minimum of `t` to its median (the far field's
+/// [`ARRIVAL_LEVELS`] even steps from the minimum of `t` to 1.5 times the way to the
+/// `latest` image's arrival time, or without images to the median of `t` (the far field's
 /// arrival time rises as `theta^2` and would take every level).
-fn arrival_levels(t: &[f64]) -> Vec<f64> {
+fn arrival_levels(t: &[f64], latest: Option<f64>) -> Vec<f64> {
     let mut v: Vec<f64> = t.iter().copied().filter(|x| x.is_finite()).collect();
     if v.is_empty() {
         return Vec::new();
     }
     v.sort_by(f64::total_cmp);
-    let (lo, mid) = (v[0], v[v.len() / 2]);
+    let lo = v[0];
+    let mid = match latest {
+        Some(t) if t > lo => lo + 1.5 * (t - lo),
+        _ => v[v.len() / 2],
+    };
     let step = (mid - lo) / ARRIVAL_LEVELS as f64;
     (0..ARRIVAL_LEVELS)
         .map(|k| lo + (k as f64 + 0.5) * step)

@@ -317,7 +317,7 @@ test('?embed is a compact demo that keeps nothing; ?example= opens an example wi
     await page.screenshot({ path: join(ARTIFACTS, 'app-embed.png'), fullPage: true });
 
     // Nothing was saved: the full app opens on its first example, and that one is saved.
-    await page.goto(url);
+    await page.goto(`${url}?app`);
     await waitStatus(page, /^Ready/);
     assert.match(await page.textContent('#project-name'), /^Simulated A1689/);
     assert.ok(await page.isVisible('#files-panel') && await page.isHidden('#full-app'));

@@ -19,10 +19,11 @@ const CHROMIUM_FLAGS = [
   '--disable-component-update', '--disable-sync', '--no-first-run', '--disable-quic',
 ];
 
-/** Starts the server and the browser and opens the page (with `query`, e.g. '?simd=baseline');
+/** Starts the server and the browser and opens the page (with `query`, e.g. '?simd=baseline';
+ * by default `?app`, the research app: a first visit without parameters opens the lessons);
  * returns { page, url, consoleErrors, close }. `serviceWorkers: 'block'` keeps the app's
  * service worker out (so that `page.route` sees the workers' requests). */
-export async function openApp({ width = 1280, height = 900, query = '', serviceWorkers = 'allow' } = {}) {
+export async function openApp({ width = 1280, height = 900, query = '?app', serviceWorkers = 'allow' } = {}) {
   await mkdir(ARTIFACTS, { recursive: true });
   const server = await serve(join(ROOT, 'www'), 0, '127.0.0.1');
   const url = `http://127.0.0.1:${server.address().port}/`;

@@ -124,3 +124,46 @@ fn bad_scenes_say_what_is_wrong() {
         SourceSpec::Gaussian { q, .. } if q == 0.5
     ));
 }
+
+/// The arrival-time contours of the time-delay lesson's scene: one runs exactly through each
+/// saddle image (where the contour crosses itself) and some pass near every image, so the
+/// drawing shows where the images sit on the arrival-time surface.
+#[cfg_attr(not(target_arch = "wasm32"), test)]
+#[cfg_attr(target_arch = "wasm32", wasm_bindgen_test::wasm_bindgen_test)]
+fn arrival_time_contours_run_through_the_saddle_images() {
+    let scene = Scene::from_json_str(
+        r#"{"v": 1, "z_lens": 0.3, "fov": 40,
+            "lenses": [{"type": "sie", "x": 0, "y": 0, "sigma_v": 800, "q": 0.75, "pa": 30}],
+            "sources": [{"type": "point", "x": 2.0, "y": 1.0, "z": 2}]}"#,
+    )
+    .expect("valid scene");
+    let pg = Playground::new(scene).expect("builds");
+    let beta = DVec2::new(2.0, 1.0);
+    let images = pg.images_of(beta, 2.0);
+    let lines = pg.contours(ContourKind::ArrivalTime, 256, 2.0, beta);
+    let pixel = 40.0 / 256.0;
+    let nearest = |p: DVec2| {
+        lines
+            .iter()
+            .flat_map(|l| l.points.iter())
+            .map(|q| q.distance(p))
+            .fold(f64::INFINITY, f64::min)
+    };
+    let saddles: Vec<_> = images.iter().filter(|i| i.kind == "saddle").collect();
+    assert!(!saddles.is_empty(), "{images:?}");
+    for im in &images {
+        let d = nearest(DVec2::new(im.x, im.y));
+        let limit = if im.kind == "saddle" {
+            2.0 * pixel
+        } else {
+            3.0
+        };
+        assert!(
+            d <= limit,
+            "{} image at ({:.2}, {:.2}): nearest contour {d:.2}″",
+            im.kind,
+            im.x,
+            im.y
+        );
+    }
+}

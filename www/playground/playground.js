@@ -48,7 +48,7 @@ root.innerHTML = `
     </select>
     <label><input type="checkbox" id="pg-timing"> ms/frame</label>
     <button id="pg-share" type="button">Share link</button>
-    ${EMBED ? '<a id="pg-open" target="_blank" rel="noopener">Open full</a>' : '<a href="./">Research app</a>'}
+    ${EMBED ? '<a id="pg-open" target="_blank" rel="noopener">Open full</a>' : '<a href="./?app">Research app</a>'}
   </div>
   <div class="pg-main">
     <div class="pg-views" id="pg-views">
@@ -106,7 +106,13 @@ let drag = null; // {list, index, canvas, pointerId}
 let nextSlot = 1;
 // Frame timing: round trips from sending a scene to drawing its frame.
 const stats = { frames: [], longestTaskMs: 0 };
-window.__playground = { stats, get scene() { return scene; }, get frame() { return frame; } };
+window.__playground = {
+  stats,
+  get scene() { return scene; },
+  get frame() { return frame; },
+  /** The full frame on screen is of the scene as it is now (tests wait for this). */
+  get settled() { return frame?.pixels === FULL_PIXELS && frame.sceneText === JSON.stringify(tidyScene(scene)); },
+};
 try {
   new PerformanceObserver((list) => {
     for (const e of list.getEntries()) stats.longestTaskMs = Math.max(stats.longestTaskMs, e.duration);
@@ -139,8 +145,10 @@ async function compute(pixels) {
   const t0 = performance.now();
   sentAt = t0;
   let result;
+  let sent;
   try {
-    result = await client.latest('frame', { type: 'frame', scene: JSON.stringify(tidyScene(scene)), pixels });
+    sent = JSON.stringify(tidyScene(scene));
+    result = await client.latest('frame', { type: 'frame', scene: sent, pixels });
   } catch (e) {
     showError(e.message);
     return;
@@ -153,6 +161,7 @@ async function compute(pixels) {
     createImageBitmap(new ImageData(result.source, n, n)),
   ]);
   frame = result;
+  frame.sceneText = sent;
   draw();
   const ms = performance.now() - t0;
   stats.frames.push({ pixels: n, roundTripMs: ms, computeMs: result.compute_ms, workerMs: result.worker_ms });
@@ -181,9 +190,10 @@ async function refreshContours() {
 
 /** A scene change while dragging (coarse frame) or after it (full frame, contours, link). */
 function changed(final) {
-  compute(final ? FULL_PIXELS : DRAG_PIXELS);
+  const drawn = compute(final ? FULL_PIXELS : DRAG_PIXELS);
   if (final) {
-    refreshContours();
+    // After the worker has this scene: contours asked for at once were drawn for the last.
+    drawn.then(refreshContours);
     history.replaceState(null, '', location.pathname + location.search + encodeFragment(scene));
     updateOpenLink();
   }
@@ -201,11 +211,13 @@ function sizeCanvases() {
   let side;
   let stacked;
   if (EMBED) {
-    const free = h - bar.offsetHeight - 2 * 22 - 16; // two captions, margins
+    // Everything above the views (the bar, a lesson's card) takes its height from them.
+    const top = views.getBoundingClientRect().top + window.scrollY;
+    const free = h - top - 2 * 22 - 18; // two captions, margins
     stacked = w < free * 0.9;
     side = stacked ? Math.min(w - 12, free / 2) : Math.min((w - 24) / 2, free + 22);
   } else {
-    const panel = w >= 900 ? 340 : 0;
+    const panel = w >= 900 ? (document.body.classList.contains('pg-present') ? 480 : 340) : 0;
     const free = h - bar.offsetHeight - head.offsetHeight - 50;
     stacked = w < 700;
     side = stacked ? Math.min(w - 16, 520) : Math.min((w - panel - 48) / 2, free, 620);
@@ -535,6 +547,36 @@ function updateOpenLink() {
   if (a) a.href = location.pathname + '?playground' + encodeFragment(scene);
 }
 
+/** What a lesson (./lessons.js) may do to the playground: put a scene in and set the
+ * toggles as the lesson wants them; `resize` after its panel changed size. */
+export const api = {
+  root,
+  EMBED,
+  hasSharedScene: Boolean(location.hash && decodeFragmentSafe(location.hash)),
+  loadScene(next, show = {}) {
+    scene = structuredClone(next);
+    selected = { list: 'lenses', index: 0 };
+    hover = null;
+    if (show.curves !== undefined) $('pg-curves').checked = show.curves;
+    if (show.caustics !== undefined) $('pg-caustics').checked = show.caustics;
+    if (show.contours !== undefined) $('pg-contours').value = show.contours;
+    showList();
+    showParams();
+    changed(true);
+  },
+  setToggles(show = {}) {
+    if (show.curves !== undefined) $('pg-curves').checked = show.curves;
+    if (show.caustics !== undefined) $('pg-caustics').checked = show.caustics;
+    if (show.contours !== undefined) $('pg-contours').value = show.contours;
+    refreshContours();
+    draw();
+  },
+  resize: () => sizeCanvases(),
+};
+function decodeFragmentSafe(hash) {
+  try { return decodeFragment(hash); } catch { return null; }
+}
+
 $('pg-fov').textContent = '';
 wirePointer(imageCanvas, 'lenses', fov);
 wirePointer(sourceCanvas, 'sources', sourceFov);
@@ -544,3 +586,7 @@ showParams();
 sizeCanvases();
 updateOpenLink();
 compute(FULL_PIXELS).then(() => { root.dataset.ready = '1'; });
+if (params.has('lesson')) {
+  import('./lessons.js').then((m) => m.startLessons(api, params.get('lesson')))
+    .catch((e) => showError(`The lessons could not be opened: ${e.message}`));
+}
