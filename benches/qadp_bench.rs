@@ -95,6 +95,7 @@ fn run(n_grid: usize, n_pix: usize, iterations: usize, threads: usize) {
         iterations,
         report_every: 100,
         threads,
+        keep_iterates: 0,
     };
     let outcome = problem
         .run(&vec![1e-3; n], &settings, &mut |_| Control::Continue)

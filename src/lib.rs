@@ -132,10 +132,10 @@ pub use inversion::{
 
 // Non-negative quadratic programming.
 pub use solver::{
-    accelerated_gradient, column_independence, gram_weighted, locality_order, minimise_exact,
-    nnqp_exact, objective as quadratic_objective, Control, NormalEquations, Progress, QadpProblem,
-    SolveOutcome, SolveStatus, SolverError, SolverSettings, INDEPENDENCE_MAX_UNKNOWNS,
-    MAX_ITERATIONS, NNQP_EXACT_MAX_UNKNOWNS,
+    accelerated_gradient, column_independence, gram_weighted, iterate_schedule, locality_order,
+    minimise_exact, nnqp_exact, objective as quadratic_objective, Control, Iterate,
+    NormalEquations, Progress, QadpProblem, SolveOutcome, SolveStatus, SolverError, SolverSettings,
+    INDEPENDENCE_MAX_UNKNOWNS, MAX_ITERATIONS, MAX_KEPT_ITERATES, NNQP_EXACT_MAX_UNKNOWNS,
 };
 
 // A reconstruction: inputs, settings, the run, cross-validation.

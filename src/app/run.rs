@@ -348,6 +348,7 @@ impl Session {
                 status: RunStatus::Restored,
                 iterations,
                 convergence,
+                iterates: Vec::new(),
                 lens,
                 products,
                 sources,

@@ -68,6 +68,11 @@ pub struct SolverConfig {
     pub start_cell_mass_msun: f64,
     /// Start value of every layer factor C_l (default 0.1).
     pub start_c: f64,
+    /// Iterates of the last solve kept in the result ([`crate::Reconstruction::iterates`]; see
+    /// [`SolverSettings::keep_iterates`]), default 0. Not a setting: the app asks for them,
+    /// to step through the iterations.
+    #[serde(skip)]
+    pub keep_iterates: usize,
 }
 
 impl Default for SolverConfig {
@@ -79,6 +84,7 @@ impl Default for SolverConfig {
             report_every: run.report_every,
             start_cell_mass_msun: 1e10,
             start_c: 0.1,
+            keep_iterates: 0,
         }
     }
 }
@@ -236,6 +242,7 @@ impl ReconstructConfig {
             report_every: self.solver.report_every,
             // One thread count for the whole run (`system.threads`).
             threads: self.system.threads,
+            keep_iterates: self.solver.keep_iterates,
         }
     }
 }

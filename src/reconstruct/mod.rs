@@ -51,7 +51,7 @@ use crate::products::{ProductOptions, Products, ProductsError};
 use crate::profiles::{Lens, MassComponent};
 use crate::sky::SkyReference;
 use crate::solver::{
-    accelerated_gradient, minimise_exact, Control, QadpProblem, SolveOutcome, SolveStatus,
+    accelerated_gradient, minimise_exact, Control, Iterate, QadpProblem, SolveOutcome, SolveStatus,
     SolverError,
 };
 
@@ -202,6 +202,11 @@ pub struct Reconstruction {
     pub status: RunStatus,
     pub iterations: usize,
     pub convergence: Vec<ConvergenceRecord>,
+    /// Solutions on the way to `x` (`solver.keep_iterates` of them at most; none by default
+    /// or after a restore), at increasing iteration counts of the whole run, the last being
+    /// `x`. All are of `system`: those of a grid refined afterwards are dropped, the passes of
+    /// the image-plane weights (same unknowns) follow one another.
+    pub iterates: Vec<Iterate>,
     pub lens: Lens,
     pub products: Products,
     pub sources: Vec<SourceReport>,
@@ -530,7 +535,7 @@ fn reconstruct_limited(
     let mut convergence = Vec::new();
     let mut timings = StageTimings::default();
     let mut level = 0;
-    let (system, x, status, iterations) = loop {
+    let (system, outcome) = loop {
         let t = crate::products::Clock::start();
         let mut system = LinearSystem::build_with(
             &grid,
@@ -571,11 +576,13 @@ fn reconstruct_limited(
             level += 1;
             continue;
         }
-        break (system, outcome.x, outcome.status, outcome.iterations);
+        break (system, outcome);
     };
+    let mut iterates = outcome.iterates;
     // The image-plane weights: solve again with each pixel's residual stretched by the
     // previous solution's magnification tensor (the `regularise` module of the inversion).
-    let (mut system, mut x, mut status, mut iterations) = (system, x, status, iterations);
+    let (mut system, mut x, mut status, mut iterations) =
+        (system, outcome.x, outcome.status, outcome.iterations);
     for _ in 0..config.objective.image_plane_iterations {
         if status == SolveStatus::Cancelled {
             break;
@@ -617,8 +624,21 @@ fn reconstruct_limited(
         };
         let outcome = solve(&system, config, &x, &mut callback)?;
         timings.solve_ms += t.ms();
+        // The pass's start is `x`, the last iterate kept so far (QADP), or nothing of the
+        // run's path (the exact solver starts at 0).
+        iterates.extend(
+            outcome
+                .iterates
+                .into_iter()
+                .filter(|i| i.iteration > 0)
+                .map(|mut i| {
+                    i.iteration += iterations;
+                    i
+                }),
+        );
         (x, status, iterations) = (outcome.x, outcome.status, iterations + outcome.iterations);
     }
+    let iterates = thin_iterates(iterates, config.solver.keep_iterates);
     // First: they bear on the whole result, and a long list of members outside the field
     // would hide them. Timed with the system, whose matrix they factorise.
     let t = crate::products::Clock::start();
@@ -646,6 +666,7 @@ fn reconstruct_limited(
         status: RunStatus::Solved(status),
         iterations,
         convergence,
+        iterates,
         lens,
         products,
         sources,
@@ -671,6 +692,28 @@ fn hold_unmeasured_layers(system: &mut LinearSystem, sigma: f64) {
     }
 }
 
+/// At most `keep` of `iterates` (the passes of the image-plane weights each keep that many),
+/// evenly spread over the list; the first and the last stay.
+fn thin_iterates(iterates: Vec<Iterate>, keep: usize) -> Vec<Iterate> {
+    let n = iterates.len();
+    if n <= keep {
+        return iterates;
+    }
+    if keep < 2 {
+        return iterates.into_iter().skip(n - keep).collect();
+    }
+    let chosen: Vec<usize> = (0..keep)
+        .map(|k| (k as f64 * (n - 1) as f64 / (keep - 1) as f64).round() as usize)
+        .collect();
+    let wanted = |i: &usize| chosen.binary_search(i).is_ok();
+    iterates
+        .into_iter()
+        .enumerate()
+        .filter(|(i, _)| wanted(i))
+        .map(|(_, it)| it)
+        .collect()
+}
+
 /// Minimises `system`'s objective with the configured method from `x0` (the exact solver
 /// needs no start).
 fn solve(
@@ -683,7 +726,8 @@ fn solve(
     let settings = config.solver_settings();
     Ok(match config.solver.method {
         SolverMethod::Exact => {
-            minimise_exact(&system.a, &system.b, n, config.solver.iterations, callback)?
+            let (steps, keep) = (config.solver.iterations, config.solver.keep_iterates);
+            minimise_exact(&system.a, &system.b, n, steps, keep, callback)?
         }
         SolverMethod::Qadp => {
             QadpProblem::with_order(&system.a, &system.b, n, system.solver_order())?

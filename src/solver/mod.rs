@@ -44,8 +44,9 @@ pub use independence::{column_independence, INDEPENDENCE_MAX_UNKNOWNS};
 pub use nnls::{nnqp_exact, NNQP_EXACT_MAX_UNKNOWNS};
 pub use pivoting::minimise_exact;
 pub use qadp::QadpProblem;
-pub use settings::{SolverSettings, MAX_ITERATIONS};
-pub use status::{Control, Progress, SolveOutcome, SolveStatus};
+pub use run::iterate_schedule;
+pub use settings::{SolverSettings, MAX_ITERATIONS, MAX_KEPT_ITERATES};
+pub use status::{Control, Iterate, Progress, SolveOutcome, SolveStatus};
 
 /// What can be wrong with a quadratic program, its start or the solver settings.
 #[derive(Debug, Error, Clone, PartialEq)]

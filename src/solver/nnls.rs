@@ -101,6 +101,7 @@ fn outcome(a: &[f64], b: &[f64], x: Vec<f64>, changes: usize, status: SolveStatu
         x,
         iterations: changes,
         status,
+        iterates: Vec::new(),
     }
 }
 

@@ -22,6 +22,7 @@
 //! whose row of `A` is zero are fixed as in QADP.
 
 use super::independence::cholesky_in_place;
+use super::run::Recorder;
 use super::{check_len, validate_system, SolverError};
 use super::{Control, Progress, SolveOutcome, SolveStatus};
 
@@ -36,12 +37,30 @@ const FULL_EXCHANGE_TRIES: usize = 3;
 /// factorisations. `callback` sees the start `X = 0`, then each step's iterate (its infeasible entries clipped to 0)
 /// and may cancel. The status is [`SolveStatus::Converged`] when every condition holds,
 /// [`SolveStatus::Completed`] when `max_steps` ran out first (the outcome is then the last
-/// step, clipped).
+/// step, clipped). Up to `keep_iterates` of the steps' iterates are kept in the outcome, as
+/// [`SolverSettings::keep_iterates`](super::SolverSettings::keep_iterates) says (the schedule
+/// is over `max_steps`, so all of a run of a few tens of steps are kept when it allows).
 pub fn minimise_exact(
     a: &[f64],
     b: &[f64],
     n: usize,
     max_steps: usize,
+    keep_iterates: usize,
+    callback: &mut dyn FnMut(&Progress) -> Control,
+) -> Result<SolveOutcome, SolverError> {
+    let mut recorder = Recorder::new(max_steps, keep_iterates);
+    let mut outcome = exact_steps(a, b, n, max_steps, &mut recorder, callback)?;
+    outcome.iterates = recorder.finish(&outcome);
+    Ok(outcome)
+}
+
+/// [`minimise_exact`] without the final iterate kept.
+fn exact_steps(
+    a: &[f64],
+    b: &[f64],
+    n: usize,
+    max_steps: usize,
+    recorder: &mut Recorder,
     callback: &mut dyn FnMut(&Progress) -> Control,
 ) -> Result<SolveOutcome, SolverError> {
     validate_system(a, b, n)?;
@@ -79,12 +98,14 @@ pub fn minimise_exact(
         objective: 0.0,
         x: &zero,
     };
+    recorder.offer(0, 0.0, &zero);
     if callback(&start) == Control::Cancel {
         return Ok(SolveOutcome {
             x: zero,
             iterations: 0,
             objective: 0.0,
             status: SolveStatus::Cancelled,
+            iterates: Vec::new(),
         });
     }
     while steps < max_steps {
@@ -121,12 +142,14 @@ pub fn minimise_exact(
             objective: super::objective(a, b, &x),
             x: &x,
         };
+        recorder.offer(steps, progress.objective, &x);
         if callback(&progress) == Control::Cancel {
             return Ok(SolveOutcome {
                 objective: progress.objective,
                 x,
                 iterations: steps,
                 status: SolveStatus::Cancelled,
+                iterates: Vec::new(),
             });
         }
         if broken.is_empty() {
@@ -150,6 +173,7 @@ pub fn minimise_exact(
         x,
         iterations: steps,
         status,
+        iterates: Vec::new(),
     })
 }
 
@@ -238,7 +262,7 @@ mod tests {
             let n = 40;
             let (a, b) = system(n, seed);
             let exact = nnqp_exact(&a, &b, n).unwrap().x;
-            let out = minimise_exact(&a, &b, n, 500, &mut never).unwrap();
+            let out = minimise_exact(&a, &b, n, 500, 0, &mut never).unwrap();
             assert_eq!(out.status, SolveStatus::Converged);
             let zeros = exact.iter().filter(|&&v| v == 0.0).count();
             assert!(zeros > 3, "the test needs active bounds ({zeros})");
@@ -252,7 +276,7 @@ mod tests {
     fn a_zero_row_stays_at_zero() {
         let a = vec![2.0, 0.0, 0.0, 0.0];
         let b = vec![-2.0, 0.0];
-        let out = minimise_exact(&a, &b, 2, 10, &mut never).unwrap();
+        let out = minimise_exact(&a, &b, 2, 10, 0, &mut never).unwrap();
         assert_eq!(out.status, SolveStatus::Converged);
         assert!((out.x[0] - 1.0).abs() < 1e-9 && out.x[1] == 0.0);
     }

@@ -61,4 +61,18 @@ pub struct SolveOutcome {
     /// `phi(x)` (see [`Progress::objective`]).
     pub objective: f64,
     pub status: SolveStatus,
+    /// The iterates kept on the way ([`super::SolverSettings::keep_iterates`]), at increasing
+    /// iteration counts; the last is the outcome itself. Empty when none were asked for.
+    pub iterates: Vec<Iterate>,
+}
+
+/// The solution at one iteration of a run, kept for showing how the run went.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Iterate {
+    /// Number of updates done.
+    pub iteration: usize,
+    /// `phi(x)` there (see [`Progress::objective`]).
+    pub objective: f64,
+    /// The solution there, in the units of the problem.
+    pub x: Vec<f64>,
 }

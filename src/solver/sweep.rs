@@ -572,6 +572,7 @@ mod tests {
                 iterations: 400,
                 report_every: 100,
                 threads,
+                keep_iterates: 0,
             };
             let result = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
                 let x0 = vec![0.1; p.n];

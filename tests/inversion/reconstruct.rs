@@ -418,6 +418,62 @@ fn the_accelerated_gradient_goes_further_than_qadp() {
     assert!(fast.grid_mass_msun() > qadp.grid_mass_msun());
 }
 
+/// `solver.keep_iterates` keeps solutions on the way, without changing the result: at
+/// increasing iteration counts of the whole run, the last one the solution, within the bound.
+/// The passes of the image-plane weights follow one another in one list.
+#[cfg_attr(not(target_arch = "wasm32"), test)]
+#[cfg_attr(target_arch = "wasm32", wasm_bindgen_test::wasm_bindgen_test)]
+fn a_reconstruction_keeps_its_iterates_when_asked() {
+    let truth = Truth::new();
+    let catalog = truth.catalog();
+    let layers = [truth.galaxy_layer()];
+    let inputs = Inputs {
+        images: ConstraintSource::Catalog(&catalog),
+        layers: LayerSource::Given(&layers),
+        plane: truth.plane,
+        reference: None,
+        holdout: &[],
+        catalog: Some(&catalog),
+    };
+    let mut config = ReconstructConfig::paper();
+    config.grid.cells = 12;
+    config.constraints.mode = ConstraintMode::Point;
+    config.solver.iterations = 400;
+    config.products.pixels = 32;
+    let plain = reconstruct(&inputs, &config, &mut quiet).unwrap();
+    assert!(plain.iterates.is_empty(), "none unless asked for");
+    let keep = 40;
+    let check = |r: &wslap::Reconstruction, what: &str| {
+        let kept = &r.iterates;
+        let counts: Vec<usize> = kept.iter().map(|i| i.iteration).collect();
+        assert!(kept.len() >= 2 && kept.len() <= keep, "{what}: {counts:?}");
+        assert!(counts.windows(2).all(|w| w[0] < w[1]), "{what}: {counts:?}");
+        assert_eq!(counts.last(), Some(&r.iterations), "{what}");
+        assert_eq!(kept.last().unwrap().x, r.x, "{what}");
+        let bytes: usize = kept.iter().map(|i| i.x.len() * 8).sum();
+        assert!(
+            bytes <= keep * r.system.n_columns() * 8,
+            "{what}: {bytes} bytes"
+        );
+    };
+    config.solver.keep_iterates = keep;
+    let qadp = reconstruct(&inputs, &config, &mut quiet).unwrap();
+    check(&qadp, "QADP");
+    assert_eq!(qadp.x, plain.x, "keeping iterates changes nothing");
+    assert_eq!(qadp.iterates[0].iteration, 0);
+    assert_ne!(qadp.iterates[keep / 2].x, qadp.x);
+
+    // The default objective: the exact solver, then two passes of the image-plane weights.
+    let mut exact = ReconstructConfig::default();
+    exact.grid.cells = 12;
+    exact.constraints.mode = ConstraintMode::Point;
+    exact.objective.strength = wslap::Strength::Value(0.1);
+    exact.products.pixels = 32;
+    exact.solver.keep_iterates = keep;
+    let r = reconstruct(&inputs, &exact, &mut quiet).unwrap();
+    check(&r, "exact with image-plane passes");
+}
+
 #[cfg(not(target_arch = "wasm32"))]
 pub(crate) mod real {
     //! The two real clusters of ../shared/data, end to end.

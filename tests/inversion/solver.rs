@@ -6,8 +6,9 @@ use crate::common;
 
 use common::assert_rel;
 use wslap::{
-    accelerated_gradient, gram_weighted, nnqp_exact, quadratic_objective as objective, Control,
-    NormalEquations, Progress, QadpProblem, SolveStatus, SolverError, SolverSettings,
+    accelerated_gradient, gram_weighted, iterate_schedule, minimise_exact, nnqp_exact,
+    quadratic_objective as objective, Control, NormalEquations, Progress, QadpProblem,
+    SolveOutcome, SolveStatus, SolverError, SolverSettings, MAX_KEPT_ITERATES,
     NNQP_EXACT_MAX_UNKNOWNS,
 };
 
@@ -97,6 +98,7 @@ fn qadp_matches_exact_on_random_problems() {
             iterations: 6000,
             report_every: 200,
             threads: 0,
+            keep_iterates: 0,
         };
         let (outcome, reports) = run_recorded((&a, &b), &problem, &vec![0.1; n], &settings);
         assert_eq!(outcome.status, SolveStatus::Completed);
@@ -216,6 +218,7 @@ fn reports_at_start_every_k_and_at_the_end() {
         iterations: 250,
         report_every: 100,
         threads: 0,
+        keep_iterates: 0,
     };
     let (outcome, reports) = run_recorded((&a, &b), &problem, &[0.1; 12], &settings);
     let iterations: Vec<usize> = reports.iter().map(|r| r.0).collect();
@@ -323,6 +326,7 @@ fn threads_agree_to_rounding() {
             iterations: 700,
             report_every: 100,
             threads,
+            keep_iterates: 0,
         };
         problem
             .run(&[0.1; 61], &settings, &mut |_| Control::Continue)
@@ -390,6 +394,7 @@ fn the_storage_order_changes_only_the_rounding() {
         iterations: 1500,
         report_every: 500,
         threads: 1,
+        keep_iterates: 0,
     };
     let x0 = vec![0.01; n];
     let plain = QadpProblem::new(&a, &b, n).expect("valid problem");
@@ -449,6 +454,7 @@ fn threaded_runs_report_every_chunk_and_end_on_cancel() {
             iterations: 400,
             report_every: 30,
             threads,
+            keep_iterates: 0,
         };
         let outcome = problem
             .run(&[0.1; 61], &settings, &mut |p| {
@@ -657,6 +663,7 @@ fn accelerated_gradient_matches_exact_on_random_problems() {
             iterations: 3000,
             report_every: 500,
             threads: 0,
+            keep_iterates: 0,
         };
         let mut reports = Vec::new();
         // A start at 0 is allowed here (unlike QADP, nothing stays where it starts).
@@ -695,6 +702,7 @@ fn accelerated_gradient_goes_further_than_qadp_per_iteration() {
         iterations: 300,
         report_every: 300,
         threads: 1,
+        keep_iterates: 0,
     };
     let quiet = &mut |_: &Progress| Control::Continue;
     let fast = accelerated_gradient(&a, &b, n, &vec![0.1; n], &settings, quiet).expect("run");
@@ -745,5 +753,112 @@ fn accelerated_gradient_cancels_and_handles_zero_rows() {
     assert!(
         matches!(err, SolverError::NegativeStart { index: 1, .. }),
         "{err}"
+    );
+}
+
+/// The iterates a run kept: at the scheduled counts (increasing), at most `keep`, the last one
+/// the outcome itself, and each with its own objective.
+fn check_kept(outcome: &SolveOutcome, keep: usize, (a, b): (&[f64], &[f64]), what: &str) {
+    let kept = &outcome.iterates;
+    assert!(
+        !kept.is_empty() && kept.len() <= keep,
+        "{what}: {} kept",
+        kept.len()
+    );
+    let counts: Vec<usize> = kept.iter().map(|i| i.iteration).collect();
+    assert!(counts.windows(2).all(|w| w[0] < w[1]), "{what}: {counts:?}");
+    let last = kept.last().expect("one kept");
+    assert_eq!(last.iteration, outcome.iterations, "{what}");
+    assert_eq!(
+        last.x, outcome.x,
+        "{what}: the last iterate is the solution"
+    );
+    for i in kept {
+        let phi = objective(a, b, &i.x);
+        assert_rel(what, i.objective, phi, REPORTED_OBJECTIVE_RTOL.max(1e-6));
+    }
+}
+
+#[cfg_attr(not(target_arch = "wasm32"), test)]
+#[cfg_attr(target_arch = "wasm32", wasm_bindgen_test::wasm_bindgen_test)]
+fn kept_iterates_follow_the_schedule_and_change_nothing() {
+    let n = 30;
+    let (a, b) = random_problem(&mut Rng(2302), n);
+    let problem = QadpProblem::new(&a, &b, n).expect("valid problem");
+    let plain = SolverSettings {
+        iterations: 3000,
+        report_every: 100,
+        threads: 1,
+        keep_iterates: 0,
+    };
+    let keep = 41;
+    let keeping = SolverSettings {
+        keep_iterates: keep,
+        ..plain
+    };
+    let x0 = vec![0.1; n];
+    let (without, reports_without) = run_recorded((&a, &b), &problem, &x0, &plain);
+    let (with, reports_with) = run_recorded((&a, &b), &problem, &x0, &keeping);
+    assert!(without.iterates.is_empty());
+    // Stopping at the kept counts changes neither the iterates nor the reports.
+    assert_eq!(with.x, without.x);
+    assert_eq!(reports_with, reports_without);
+    check_kept(&with, keep, (&a, &b), "QADP");
+    let counts: Vec<usize> = with.iterates.iter().map(|i| i.iteration).collect();
+    assert_eq!(counts, iterate_schedule(3000, keep));
+    assert_eq!(with.iterates[0].x, x0, "the start is kept");
+    // QADP lowers the objective along the kept iterates, and an early one is not the end.
+    let phi: Vec<f64> = with
+        .iterates
+        .iter()
+        .map(|i| objective(&a, &b, &i.x))
+        .collect();
+    for w in phi.windows(2) {
+        assert!(w[1] <= w[0] + MONOTONE_RTOL * w[0].abs(), "{phi:?}");
+    }
+    assert_ne!(with.iterates[10].x, with.x);
+
+    // A cancelled run ends its iterates with the state it stopped at.
+    let cancelled = problem
+        .run(&x0, &keeping, &mut |p| match p.iteration {
+            500 => Control::Cancel,
+            _ => Control::Continue,
+        })
+        .expect("valid run");
+    assert_eq!(cancelled.status, SolveStatus::Cancelled);
+    check_kept(&cancelled, keep, (&a, &b), "QADP cancelled");
+
+    // The accelerated gradient keeps its iterates the same way.
+    let fast = accelerated_gradient(&a, &b, n, &x0, &keeping, &mut |_| Control::Continue)
+        .expect("valid run");
+    check_kept(&fast, keep, (&a, &b), "accelerated gradient");
+    let fast_plain = accelerated_gradient(&a, &b, n, &x0, &plain, &mut |_| Control::Continue)
+        .expect("valid run");
+    assert_eq!(fast.x, fast_plain.x);
+
+    // The exact solver keeps every step of its few tens.
+    let mut ridge = a.clone();
+    for i in 0..n {
+        ridge[i * n + i] += 1e-3 * a[i * n + i];
+    }
+    let exact =
+        minimise_exact(&ridge, &b, n, 500, keep, &mut |_| Control::Continue).expect("valid run");
+    assert_eq!(exact.status, SolveStatus::Converged);
+    check_kept(&exact, keep, (&ridge, &b), "exact");
+    assert_eq!(
+        exact.iterates.len(),
+        exact.iterations + 1,
+        "start and every step"
+    );
+
+    // The bound is a setting's, checked.
+    let too_many = SolverSettings {
+        keep_iterates: MAX_KEPT_ITERATES + 1,
+        ..plain
+    };
+    let err = problem.run(&x0, &too_many, &mut |_| Control::Continue);
+    assert!(
+        matches!(&err, Err(SolverError::BadFieldValue(e)) if e.to_string().contains("keep_iterates")),
+        "{err:?}"
     );
 }
