@@ -6,6 +6,7 @@
 
 mod data;
 pub mod examples;
+mod iterates;
 mod outputs;
 mod plots;
 mod project;
@@ -22,6 +23,7 @@ pub use data::{
     ArcPixels, DataMarks, DataRole, DataViews, LoadReport, LoadedData, ModelLens, NamedMap,
     NamedText, MAX_STORED_FITS_BYTES,
 };
+pub use iterates::{IterateList, IterateStep, APP_KEPT_ITERATES};
 pub use plots::{profile_relative_differences, ModelCurves};
 pub use project::{Project, ProjectResult, StoredFits, PROJECT_FORMAT, PROJECT_VERSION};
 pub use run::{Outcome, RunKind, SessionResult};

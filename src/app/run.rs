@@ -18,6 +18,7 @@ use crate::reconstruct::{
 use crate::solver::Control;
 
 use super::data::{DataMarks, DataViews};
+use super::iterates::{IterateCache, APP_KEPT_ITERATES};
 use super::{AppError, Session};
 
 /// Map width of a forward model without a `products.size_arcsec` setting (arcsec).
@@ -51,6 +52,8 @@ pub struct SessionResult {
     pub marks: DataMarks,
     /// Wall-clock time of the run in ms.
     pub elapsed_ms: f64,
+    /// The maps of the last iterate drawn (see the `iterates` module).
+    pub(crate) iterate_cache: IterateCache,
 }
 
 impl SessionResult {
@@ -80,17 +83,7 @@ impl SessionResult {
     /// Critical curves, caustics and magnification at `z_source` from the stored maps
     /// (`f = D_ls/D_s(z_source)`), without solving again.
     pub fn redraw(&mut self, z_source: f64) -> Result<(), AppError> {
-        let p = self.products_mut();
-        let f = p
-            .plane
-            .distance_ratio(z_source)
-            .map_err(|e| AppError::Setting(format!("z_source: {e}")))?;
-        p.distance_ratio = f;
-        p.magnification = p.maps.magnification(f);
-        p.curves = critical_curves(&p.maps, f, z_source, None);
-        // Only the stored maps are at hand here: a curve that leaves them gives a lower bound.
-        p.einstein_radius_map_arcsec = own_map_side(&p.curves, p.maps.geometry());
-        Ok(())
+        curves_at(self.products_mut(), z_source)
     }
 
     /// Predicted image positions of every system (arcsec) with `|mu| >=`
@@ -109,6 +102,20 @@ impl SessionResult {
     }
 }
 
+/// Critical curves, caustics and magnification of `p` at `z_source` from its maps.
+pub(super) fn curves_at(p: &mut Products, z_source: f64) -> Result<(), AppError> {
+    let f = p
+        .plane
+        .distance_ratio(z_source)
+        .map_err(|e| AppError::Setting(format!("z_source: {e}")))?;
+    p.distance_ratio = f;
+    p.magnification = p.maps.magnification(f);
+    p.curves = critical_curves(&p.maps, f, z_source, None);
+    // Only the stored maps are at hand here: a curve that leaves them gives a lower bound.
+    p.einstein_radius_map_arcsec = own_map_side(&p.curves, p.maps.geometry());
+    Ok(())
+}
+
 /// "Nothing to fit" is something missing; a file that does not read is the file's error.
 fn dataset_error(e: DatasetError) -> AppError {
     match e {
@@ -117,6 +124,13 @@ fn dataset_error(e: DatasetError) -> AppError {
         }
         other => AppError::File(other.to_string()),
     }
+}
+
+/// `config` keeping [`APP_KEPT_ITERATES`] iterates, for the app to step through.
+fn keeping_iterates(config: &ReconstructConfig) -> ReconstructConfig {
+    let mut config = config.clone();
+    config.solver.keep_iterates = APP_KEPT_ITERATES;
+    config
 }
 
 fn run_error(e: ReconstructError) -> AppError {
@@ -133,6 +147,7 @@ fn reconstruction_result(mut r: Reconstruction, parsed: &Dataset) -> SessionResu
         outcome: Outcome::Reconstruction(Box::new(r)),
         marks: parsed.marks(),
         elapsed_ms: 0.0,
+        iterate_cache: IterateCache::default(),
     }
 }
 
@@ -177,7 +192,7 @@ impl Session {
         progress: &mut dyn FnMut(&ConvergenceRecord) -> Control,
     ) -> Result<SessionResult, AppError> {
         self.with_inputs(|inputs, config, parsed| {
-            let r = reconstruct(inputs, config, progress).map_err(run_error)?;
+            let r = reconstruct(inputs, &keeping_iterates(config), progress).map_err(run_error)?;
             Ok(reconstruction_result(r, parsed))
         })
     }
@@ -234,7 +249,9 @@ impl Session {
         let t = crate::products::Clock::start();
         let mut result = self.with_inputs(|inputs, config, parsed| {
             let choice = StrengthChoice::from_trials(config, folds, trials);
-            let r = reconstruct_with_choice(inputs, config, choice, progress).map_err(run_error)?;
+            let config = keeping_iterates(config);
+            let r =
+                reconstruct_with_choice(inputs, &config, choice, progress).map_err(run_error)?;
             Ok(reconstruction_result(r, parsed))
         })?;
         result.elapsed_ms = t.ms();
@@ -358,6 +375,7 @@ impl Session {
             })),
             marks: parsed.marks(),
             elapsed_ms: t.ms(),
+            iterate_cache: IterateCache::default(),
         });
         Ok(())
     }
@@ -386,6 +404,7 @@ impl Session {
             outcome: Outcome::Maps(Box::new(products)),
             marks: parsed.marks(),
             elapsed_ms: 0.0,
+            iterate_cache: IterateCache::default(),
         })
     }
 
@@ -409,6 +428,7 @@ impl Session {
             outcome: Outcome::Maps(Box::new(products)),
             marks: DataMarks::default(),
             elapsed_ms: 0.0,
+            iterate_cache: IterateCache::default(),
         })
     }
 

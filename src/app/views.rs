@@ -10,8 +10,9 @@ use crate::render::{
 };
 
 use super::data::{ArcPixels, DataMarks};
-use super::{AppError, Session, SHOWN_MIN_MAGNIFICATION};
+use super::{AppError, Session, SessionResult, SHOWN_MIN_MAGNIFICATION};
 use crate::ds9::{write_marks, Mark};
+use crate::products::Products;
 use crate::reconstruct::{
     images_on_maps, source_on_maps, ArrivalTimes, PredictedImage, IMAGE_REGION_RADIUS_ARCSEC,
 };
@@ -91,6 +92,11 @@ pub struct ViewOptions {
     /// A point of the map (arcsec): the images of the source behind it are drawn
     /// ([`Session::counter_images`]).
     pub pin_arcsec: Option<[f64; 2]>,
+    /// After a reconstruction, the kept iterate (index into
+    /// [`crate::Reconstruction::iterates`]) whose kappa map, curves and predicted images the
+    /// mass map and its read-out show instead of the solution's (default none: the solution).
+    /// The pin's images are not drawn then.
+    pub iterate: Option<usize>,
 }
 
 impl Default for ViewOptions {
@@ -105,6 +111,7 @@ impl Default for ViewOptions {
             map_pixels_on_screen: 512,
             legend: LegendPlace::Below,
             pin_arcsec: None,
+            iterate: None,
         }
     }
 }
@@ -159,16 +166,55 @@ fn render(e: impl std::fmt::Display) -> AppError {
     AppError::Run(format!("rendering: {e}"))
 }
 
+/// What the mass map shows: the result's products and predicted images, or those of a kept
+/// iterate ([`ViewOptions::iterate`]).
+struct Shown<'a> {
+    products: &'a Products,
+    predicted: Vec<DVec2>,
+    /// The iterate's iteration count and the run's.
+    iteration: Option<(usize, usize)>,
+}
+
 impl Session {
-    fn kappa_options(&self, opts: &ViewOptions) -> Result<KappaPlotOptions, AppError> {
+    /// Runs `f` on what the mass map drawn with `opts` shows.
+    fn with_shown<T>(
+        &self,
+        opts: &ViewOptions,
+        f: impl FnOnce(&SessionResult, Shown<'_>) -> Result<T, AppError>,
+    ) -> Result<T, AppError> {
         let r = self.result()?;
+        let Some(index) = opts.iterate else {
+            let shown = Shown {
+                products: r.products(),
+                predicted: r.predicted(),
+                iteration: None,
+            };
+            return f(r, shown);
+        };
+        let m = r.at_iterate(index)?;
+        let total = r.reconstruction().map_or(0, |x| x.iterations);
+        let shown = Shown {
+            products: &m.products,
+            predicted: m.predicted.clone(),
+            iteration: Some((m.iteration, total)),
+        };
+        f(r, shown)
+    }
+
+    fn kappa_options(
+        &self,
+        opts: &ViewOptions,
+        shown: &Shown,
+    ) -> Result<KappaPlotOptions, AppError> {
+        let at = shown
+            .iteration
+            .map_or(String::new(), |(k, n)| format!(", iteration {k} of {n}"));
         Ok(KappaPlotOptions {
             scale: opts.scale,
             map_pixels_on_screen: opts.map_pixels_on_screen,
             title: Some(format!(
-                "kappa (z_l = {}), critical curves at z_s = {}",
-                r.products().plane.z_lens,
-                r.products().curves.z_source
+                "kappa (z_l = {}), critical curves at z_s = {}{at}",
+                shown.products.plane.z_lens, shown.products.curves.z_source
             )),
             legend: opts.legend,
             ..KappaPlotOptions::default()
@@ -178,11 +224,15 @@ impl Session {
     /// What the kappa view draws over the map: the curves, the loaded model's curves, the arc
     /// pixels (one colour per system), members, catalogue images and predicted images, as
     /// `opts` selects.
-    fn kappa_overlay(&self, opts: &ViewOptions) -> Result<Overlay<'_>, AppError> {
-        let r = self.result()?;
+    fn kappa_overlay<'a>(
+        &'a self,
+        r: &'a SessionResult,
+        opts: &ViewOptions,
+        shown: &'a Shown,
+    ) -> Result<Overlay<'a>, AppError> {
         let mut overlay = Overlay {
             lines: Vec::new(),
-            curves: Some(&r.products().curves),
+            curves: Some(&shown.products.curves),
             points: Vec::new(),
         };
         if opts.show_model_curves {
@@ -209,7 +259,7 @@ impl Session {
         // Predicted before observed: markers are drawn in this order, and the observed images
         // (the data) stay visible where a predicted image lands on them.
         if opts.show_predicted {
-            let p = r.predicted();
+            let p = shown.predicted.clone();
             let label = format!("predicted, |μ| >= {SHOWN_MIN_MAGNIFICATION}");
             overlay
                 .points
@@ -223,10 +273,8 @@ impl Session {
         }
         // A pin off these maps (left from another result) draws nothing; the app's list of
         // the images says why.
-        if let Some(Ok(c)) = opts
-            .pin_arcsec
-            .map(|[x, y]| self.counter_images(DVec2::new(x, y)))
-        {
+        let pin = opts.pin_arcsec.filter(|_| shown.iteration.is_none());
+        if let Some(Ok(c)) = pin.map(|[x, y]| self.counter_images(DVec2::new(x, y))) {
             let label = format!(
                 "images of the clicked point's source (z_s = {})",
                 c.z_source
@@ -245,14 +293,11 @@ impl Session {
     /// critical curves, arc pixels, members, observed and predicted images; the legend where
     /// `opts.legend` puts it.
     pub fn kappa_view(&self, opts: &ViewOptions) -> Result<ViewPng, AppError> {
-        let r = self.result()?;
-        let overlay = self.kappa_overlay(opts)?;
-        let png = render_kappa_png(
-            &r.products().maps.kappa,
-            &overlay,
-            &self.kappa_options(opts)?,
-        )
-        .map_err(render)?;
+        let png = self.with_shown(opts, |r, shown| {
+            let overlay = self.kappa_overlay(r, opts, &shown)?;
+            let options = self.kappa_options(opts, &shown)?;
+            render_kappa_png(&shown.products.maps.kappa, &overlay, &options).map_err(render)
+        })?;
         Ok(ViewPng {
             name: "kappa.png".to_string(),
             png,
@@ -261,9 +306,11 @@ impl Session {
 
     /// Where the map lies in the kappa view drawn with `opts` (PNG pixels).
     pub fn kappa_frame(&self, opts: &ViewOptions) -> Result<FigureFrame, AppError> {
-        let kappa = &self.result()?.products().maps.kappa;
-        let overlay = self.kappa_overlay(opts)?;
-        kappa_figure_frame_for(kappa, &overlay, &self.kappa_options(opts)?).map_err(render)
+        self.with_shown(opts, |r, shown| {
+            let overlay = self.kappa_overlay(r, opts, &shown)?;
+            let options = self.kappa_options(opts, &shown)?;
+            kappa_figure_frame_for(&shown.products.maps.kappa, &overlay, &options).map_err(render)
+        })
     }
 
     /// The point of the kappa view drawn with `opts` under `(px, py)` (PNG pixels, origin
@@ -367,20 +414,22 @@ impl Session {
         px: f32,
         py: f32,
     ) -> Result<Option<HoverReadout>, AppError> {
-        let r = self.result()?;
-        let kappa = &r.products().maps.kappa;
         let Some(p) = self.kappa_point(opts, px, py)? else {
             return Ok(None);
         };
-        let (kappa, magnification) = (kappa.sample(p), r.products().magnification.sample(p));
-        Ok(Some(HoverReadout {
-            x_arcsec: p.x,
-            y_arcsec: p.y,
-            kappa,
-            magnification,
-            z_source: r.products().curves.z_source,
-            no_data: kappa.is_nan() || magnification.is_nan(),
-        }))
+        self.with_shown(opts, |_, shown| {
+            let products = shown.products;
+            let kappa = products.maps.kappa.sample(p);
+            let magnification = products.magnification.sample(p);
+            Ok(Some(HoverReadout {
+                x_arcsec: p.x,
+                y_arcsec: p.y,
+                kappa,
+                magnification,
+                z_source: products.curves.z_source,
+                no_data: kappa.is_nan() || magnification.is_nan(),
+            }))
+        })
     }
 }
 

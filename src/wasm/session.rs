@@ -296,13 +296,26 @@ impl AppSession {
         }))
     }
 
+    /// The iterates the last reconstruction kept, to step through with the view option
+    /// `iterate: k`: `{iterations, method, steps: [{iteration, objective}]}`, or `null` (no
+    /// reconstruction, or none kept: a restored project).
+    pub fn iterates(&self) -> Result<JsValue, JsError> {
+        let r = self.inner.result().map_err(err)?;
+        match r.iterate_list() {
+            Some(list) => to_js(&list),
+            None => Ok(JsValue::NULL),
+        }
+    }
+
     /// Sets the source redshift and redraws the curves from the stored maps (no new solve).
     pub fn set_z_source(&mut self, z_source: f64) -> Result<JsValue, JsError> {
         self.inner.set_z_source(z_source).map_err(err)?;
         self.settings()
     }
 
-    /// One view as PNG bytes: `kappa`, `source`, `data`, `radial` or `convergence`.
+    /// One view as PNG bytes: `kappa`, `source`, `data`, `radial` or `convergence`. The
+    /// option `iterate: k` draws the mass map of the `k`-th kept iterate
+    /// ([`AppSession::iterates`]).
     pub fn view(&self, name: &str, options: JsValue) -> Result<JsValue, JsError> {
         let opts = view_options(options)?;
         let s = &self.inner;

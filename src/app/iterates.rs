@@ -1,0 +1,155 @@
+//! Stepping through the iterations: the solutions a reconstruction kept on the way
+//! ([`Reconstruction::iterates`]), each drawn as the final one is: its kappa map, its critical
+//! curves at the curves' source redshift and its predicted images, on the result's map. With
+//! QADP the iteration count is the regulariser (`crate::method` §5); this shows what it does.
+//!
+//! One iterate's maps are made when it is first drawn and kept until another is asked for, so
+//! that its hover read-outs and redraws cost nothing more.
+
+use std::cell::{Ref, RefCell};
+
+use glam::DVec2;
+use serde::{Deserialize, Serialize};
+
+use crate::products::{ProductOptions, Products};
+use crate::reconstruct::{images_on_maps, Reconstruction};
+
+use super::run::curves_at;
+use super::{AppError, SessionResult};
+
+/// Iterates a reconstruction in the app keeps: the start, 39 counts spaced evenly in log and
+/// the last (`crate::solver::iterate_schedule`), a step of about 22% between neighbours of a
+/// run of 3000. About 41 × 8 bytes per unknown: 196 kB for the teaching example (24 × 24
+/// cells), 356 kB for the paper's system (1085 unknowns).
+pub const APP_KEPT_ITERATES: usize = 41;
+
+/// One kept iterate as the app lists it.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct IterateStep {
+    /// Iterations done (QADP updates; exchanges of the exact solver), counted over the whole
+    /// run.
+    pub iteration: usize,
+    /// The objective there (the solver's, see [`crate::solver::Progress::objective`]).
+    pub objective: f64,
+}
+
+/// The iterates of the last result, for the app's slider.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct IterateList {
+    /// Iterations of the whole run (the last step's count).
+    pub iterations: usize,
+    /// The solver: "qadp", "exact" or "accelerated_gradient".
+    pub method: String,
+    pub steps: Vec<IterateStep>,
+}
+
+/// The maps, curves and predicted images of one iterate.
+#[derive(Debug)]
+pub(crate) struct IterateMaps {
+    /// Which iterate (index into [`Reconstruction::iterates`]).
+    pub index: usize,
+    /// Its iteration count.
+    pub iteration: usize,
+    pub products: Products,
+    /// Predicted images with `|mu| >=` [`super::SHOWN_MIN_MAGNIFICATION`] of every fitted
+    /// system, from its source position at this iterate.
+    pub predicted: Vec<DVec2>,
+}
+
+/// The last iterate drawn (see the module documentation).
+#[derive(Debug, Default)]
+pub(crate) struct IterateCache(RefCell<Option<IterateMaps>>);
+
+impl SessionResult {
+    /// The kept iterates of a reconstruction; `None` for other results and when none were
+    /// kept (a restored project, a run that kept none).
+    pub fn iterate_list(&self) -> Option<IterateList> {
+        let r = self.reconstruction()?;
+        if r.iterates.is_empty() {
+            return None;
+        }
+        let method = serde_json::to_value(r.config.solver.method)
+            .ok()
+            .and_then(|v| v.as_str().map(str::to_string))
+            .unwrap_or_default();
+        Some(IterateList {
+            iterations: r.iterations,
+            method,
+            steps: r
+                .iterates
+                .iter()
+                .map(|i| IterateStep {
+                    iteration: i.iteration,
+                    objective: i.objective,
+                })
+                .collect(),
+        })
+    }
+
+    /// The maps of iterate `index` at the curves' source redshift, made now unless they are
+    /// the last ones made.
+    pub(crate) fn at_iterate(&self, index: usize) -> Result<Ref<'_, IterateMaps>, AppError> {
+        let final_products = self.products();
+        let z_source = final_products.curves.z_source;
+        let cache = &self.iterate_cache.0;
+        let fresh = matches!(&*cache.borrow(), Some(m) if m.index == index
+            && m.products.curves.z_source == z_source);
+        if !fresh {
+            let r = self.reconstruction().ok_or_else(|| {
+                AppError::Missing("only a reconstruction has iterations to step through".into())
+            })?;
+            let maps = iterate_maps(r, final_products, index)?;
+            *cache.borrow_mut() = Some(maps);
+        }
+        Ok(Ref::map(cache.borrow(), |m| {
+            m.as_ref().expect("made above")
+        }))
+    }
+}
+
+/// Makes the maps of iterate `index` of `r` on the map of `final_products`.
+fn iterate_maps(
+    r: &Reconstruction,
+    final_products: &Products,
+    index: usize,
+) -> Result<IterateMaps, AppError> {
+    let run = |e: &dyn std::fmt::Display| AppError::Run(e.to_string());
+    let count = r.iterates.len();
+    let it = r.iterates.get(index).ok_or_else(|| {
+        AppError::Setting(format!(
+            "iterate {index}: this result kept {count} (0 to {})",
+            count.saturating_sub(1)
+        ))
+    })?;
+    let lens = r.system.reconstructed_lens(&it.x).map_err(|e| run(&e))?;
+    let geometry = final_products.maps.geometry();
+    let z_source = final_products.curves.z_source;
+    let opts = ProductOptions {
+        maps_only: true,
+        z_source,
+        size_arcsec: geometry.size_arcsec,
+        pixels: geometry.pixels,
+        ..ProductOptions::default()
+    };
+    let mut products =
+        Products::from_lens(&lens, final_products.plane, final_products.reference, &opts)
+            .map_err(|e| run(&e))?;
+    curves_at(&mut products, z_source)?;
+    let betas = r.system.betas_arcsec(&it.x).map_err(|e| run(&e))?;
+    let mut predicted = Vec::new();
+    for (beta, &f) in betas.iter().zip(&r.system.distance_ratios) {
+        let images = images_on_maps(&products.maps, f, *beta).map_err(|e| run(&e))?;
+        predicted.extend(
+            images
+                .iter()
+                .filter(|i| i.is_shown())
+                .map(|i| i.position_arcsec),
+        );
+    }
+    Ok(IterateMaps {
+        index,
+        iteration: it.iteration,
+        products,
+        predicted,
+    })
+}
