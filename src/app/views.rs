@@ -191,8 +191,18 @@ impl Session {
             };
             return f(r, shown);
         };
-        let m = r.at_iterate(index)?;
         let total = r.reconstruction().map_or(0, |x| x.iterations);
+        let kept = r.reconstruction().map_or(0, |x| x.iterates.len());
+        if kept > 0 && index == kept - 1 {
+            // The last iterate is the result: its own maps.
+            let shown = Shown {
+                products: r.products(),
+                predicted: r.predicted(),
+                iteration: Some((total, total)),
+            };
+            return f(r, shown);
+        }
+        let m = r.at_iterate(index)?;
         let shown = Shown {
             products: &m.products,
             predicted: m.predicted.clone(),
