@@ -8,6 +8,7 @@ import { buildSettings, showSettings } from './js/settings.js';
 import { wireViews, showPng, showSystems, showCrossval, showStrengthChoice, viewOptions, currentView, refreshReadout, clearPin } from './js/views.js';
 import { showDownloads, save } from './js/downloads.js';
 import { StrengthPool, poolSize, projectForTrials } from './js/pool.js';
+import { wireIterates, showIterates, syncIterates, iterateOption } from './js/iterates.js';
 
 // Offline use once loaded (sw.js), for the lessons and the playground too. Without it (an old
 // browser, a file:// page) the app still works online.
@@ -96,6 +97,7 @@ function showNoResult() {
   $('summary').textContent = '';
   runNotes(null);
   showStrengthChoice(null);
+  showIterates(null);
   clearPin();
   $('downloads').innerHTML = '<p class="hint">Run something first.</p>';
 }
@@ -126,8 +128,12 @@ async function render() {
       $('view-image').hidden = true;
       return;
     }
-    const { png } = await ask('view', { name, options: viewOptions() });
+    // The mass map of the iterate on the slider (js/iterates.js); the other views, the
+    // downloads and the products are the result's.
+    const options = name === 'kappa' ? { ...viewOptions(), ...iterateOption() } : viewOptions();
+    const { png } = await ask('view', { name, options });
     showPng(name, png);
+    syncIterates();
     // The read-out under a still cursor follows the new map (z_s, a new result).
     if (name === 'kappa') await refreshReadout();
   } catch (err) {
@@ -202,6 +208,7 @@ async function showResult(info) {
   runNotes(info.summary);
   showStrengthChoice(info.summary?.strength_choice);
   showDownloads(info.kind, app);
+  showIterates(info.kind === 'reconstruct' ? (await ask('iterates')).iterates : null);
 }
 
 function showProgress(on) {
@@ -555,7 +562,7 @@ async function setZ(z) {
 
 const app = {
   render,
-  hover: (x, y) => ask('hover', { options: viewOptions(), x, y }),
+  hover: (x, y) => ask('hover', { options: { ...viewOptions(), ...iterateOption() }, x, y }),
   counterImages: ([x, y]) => ask('counterImages', { x, y }),
   counterImageRegions: ([x, y]) => ask('counterImageRegions', { x, y }),
   textFile: (name) => ask('textFile', { name }),
@@ -568,6 +575,7 @@ async function start() {
   buildFileRows($('file-rows'), $('drop-zone'), queueFile);
   buildSettings($('settings-form'), applySetting);
   wireViews(app);
+  wireIterates(app);
   $('reconstruct').addEventListener('click', () => run('reconstruct'));
   $('forward').addEventListener('click', () => run('forward'));
   $('lookup').addEventListener('click', () => run('lookup'));

@@ -18,6 +18,7 @@ const APP_FILES = [
   'worker.js',
   'js/downloads.js',
   'js/files.js',
+  'js/iterates.js',
   'js/pool.js',
   'js/settings.js',
   'js/simd.js',

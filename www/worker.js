@@ -84,6 +84,8 @@ const handlers = {
   crossValidate: (m, progress) => session.cross_validate(progress),
   crossvalFiles: () => session.crossval_files(),
   resultInfo: () => session.result_info(),
+  // The iterates the last reconstruction kept (`{iterates: null}` when none), for the slider.
+  iterates: () => ({ iterates: session.iterates() }),
   setZSource: (m) => session.set_z_source(m.z),
   view: (m) => ({ png: session.view(m.name, m.options ?? null) }),
   hover: (m) => session.hover(m.options ?? null, m.x, m.y),
