@@ -6,7 +6,7 @@ use tiny_skia::{Color, Pixmap, Rect, Transform};
 use super::axes::nice_ticks;
 use super::colormap::{color_limits, value_rgb};
 use super::font::{draw_text, fit, text_width, Anchor};
-use super::layout::Layout;
+use super::layout::{text_scale, Layout, MIN_TEXT_SCALE};
 use super::overlay::{below_height, draw_legend, draw_overlay, legend_entries, Key};
 use super::paint::{color, frame, paint};
 use super::{check_map, KappaPlotOptions, Overlay, RenderError};
@@ -73,7 +73,7 @@ fn plan(kappa: &Map, overlay: &Overlay, opts: &KappaPlotOptions) -> Result<Plan,
     let x_ticks = nice_ticks(g.center.x - half, g.center.x + half, 5);
     let y_ticks = nice_ticks(g.center.y - half, g.center.y + half, 5);
     let cb_ticks = nice_ticks(limits.0, limits.1, 5);
-    let s = (opts.map_pixels_on_screen / 256).max(1);
+    let s = text_scale(opts.map_pixels_on_screen);
     let widest = |t: &[(f64, String)]| t.iter().map(|(_, l)| text_width(l, s)).fold(0.0, f32::max);
     let mut layout = Layout::new(
         opts.map_pixels_on_screen,
@@ -131,7 +131,7 @@ pub fn kappa_figure_frame_for(
 }
 
 /// A PNG figure of `kappa` (options: [`super::KappaPlotOptions`]): colour-mapped map with +x right, +y up,
-/// axes in arcsec, colour bar ("kappa" or "log10 kappa"), critical curves, points, a legend
+/// axes in arcsec, colour bar ("κ" or "log₁₀ κ"), critical curves, points, a legend
 /// (in the map's corner or under it, [`KappaPlotOptions::legend`]) and an optional title. The map occupies `opts.map_pixels_on_screen` pixels a side; colour
 /// limits as in [`super::color_limits`].
 pub fn render_kappa_png(
@@ -163,15 +163,17 @@ pub fn render_kappa_png(
     draw_legend(&mut pm, &layout, &legend, opts.legend);
     if let Some(title) = &opts.title {
         // Centred over the map, within the figure: a long title is drawn smaller, down to
-        // scale 1, and only then shortened.
+        // the smallest text scale, and only then shortened.
         let centre = layout.left + layout.m / 2.0;
         let room = 2.0 * centre.min(layout.width as f32 - centre) - 8.0;
-        let mut ts = s;
-        while ts > 1 && text_width(title, ts) > room {
-            ts -= 1;
-        }
+        let full = text_width(title, s);
+        let ts = if full > room {
+            (s * room / full).max(MIN_TEXT_SCALE)
+        } else {
+            s
+        };
         let text = fit(title, room, ts);
-        let at = (centre, 4.0 * s as f32 + 4.0);
+        let at = (centre, 4.0 * s + 4.0);
         draw_text(
             &mut pm,
             &text,
@@ -202,9 +204,8 @@ fn draw_map(pm: &mut Pixmap, kappa: &Map, l: &Layout, opts: &KappaPlotOptions, l
     }
 }
 
-/// A tick: a `len` long line of width `max(1, s/2)` from `(x, y)` along `(dx, dy)`.
-fn tick(pm: &mut Pixmap, (x, y): (f32, f32), (dx, dy): (f32, f32), len: f32, s: u32) {
-    let w = (s / 2).max(1) as f32;
+/// A tick: a `len` long line `w` pixels wide from `(x, y)` along `(dx, dy)`.
+fn tick(pm: &mut Pixmap, (x, y): (f32, f32), (dx, dy): (f32, f32), len: f32, w: f32) {
     let (x, y) = (x.round(), y.round());
     let rect = if dx != 0.0 {
         Rect::from_xywh(
@@ -233,12 +234,12 @@ fn draw_axes(
     xt: &[(f64, String)],
     yt: &[(f64, String)],
 ) {
-    let (s, ch, tk, gap) = (l.s, l.ch(), l.tick(), l.gap());
-    frame(pm, l.left, l.top, l.m, l.m);
+    let (s, ch, tk, gap, lw) = (l.s, l.ch(), l.tick(), l.gap(), l.line());
+    frame(pm, l.left, l.top, l.m, l.m, lw);
     let bottom = l.top + l.m;
     for (v, label) in xt {
         let (x, _) = l.screen(g, DVec2::new(*v, g.center.y));
-        tick(pm, (x, bottom), (0.0, 1.0), tk, s);
+        tick(pm, (x, bottom), (0.0, 1.0), tk, lw);
         draw_text(
             pm,
             label,
@@ -251,7 +252,7 @@ fn draw_axes(
     }
     for (v, label) in yt {
         let (_, y) = l.screen(g, DVec2::new(g.center.x, *v));
-        tick(pm, (l.left, y), (-1.0, 0.0), tk, s);
+        tick(pm, (l.left, y), (-1.0, 0.0), tk, lw);
         draw_text(
             pm,
             label,
@@ -272,7 +273,7 @@ fn draw_axes(
         Anchor::TopCenter,
         true,
     );
-    let pad = 4.0 * s as f32 + 4.0;
+    let pad = 4.0 * s + 4.0;
     draw_text(
         pm,
         "y [arcsec]",
@@ -291,7 +292,7 @@ fn draw_colorbar(
     limits: (f64, f64),
     ticks: &[(f64, String)],
 ) {
-    let (s, tk, gap) = (l.s, l.tick(), l.gap());
+    let (s, tk, gap, lw) = (l.s, l.tick(), l.gap(), l.line());
     let rows = l.m as usize;
     for r in 0..rows {
         let t = 1.0 - (r as f64 + 0.5) / rows as f64;
@@ -300,12 +301,12 @@ fn draw_colorbar(
             pm.fill_rect(rect, &paint(c, false), Transform::identity(), None);
         }
     }
-    frame(pm, l.cb_x, l.top, l.cb_w, l.m);
+    frame(pm, l.cb_x, l.top, l.cb_w, l.m, lw);
     let right = l.cb_x + l.cb_w;
     let mut widest: f32 = 0.0;
     for (v, label) in ticks {
         let y = l.top + l.m - ((v - limits.0) / (limits.1 - limits.0)) as f32 * l.m;
-        tick(pm, (right, y), (1.0, 0.0), tk, s);
+        tick(pm, (right, y), (1.0, 0.0), tk, lw);
         draw_text(
             pm,
             label,
@@ -318,9 +319,9 @@ fn draw_colorbar(
         widest = widest.max(text_width(label, s));
     }
     let default = if opts.scale == ColorScale::Log {
-        "log10 kappa"
+        "log_{10} κ"
     } else {
-        "kappa"
+        "κ"
     };
     let label = opts.colorbar_label.as_deref().unwrap_or(default);
     let x = right + tk + gap + widest + 2.0 * gap;

@@ -6,10 +6,22 @@ use glam::DVec2;
 use super::font::CAP;
 use crate::map::MapGeometry;
 
+/// Map pixels per font unit of text scale.
+const MAP_PX_PER_SCALE: f32 = 256.0;
+/// Smallest text scale (cap height 7 pixels, about 10-pixel type).
+pub(super) const MIN_TEXT_SCALE: f32 = 1.0;
+
+/// The text scale of a figure whose map is `m` pixels a side: proportional to `m` (one font
+/// unit per 256 pixels, so a 512-pixel map has 14-pixel capitals), at least
+/// [`MIN_TEXT_SCALE`].
+pub(super) fn text_scale(m: u32) -> f32 {
+    (m as f32 / MAP_PX_PER_SCALE).max(MIN_TEXT_SCALE)
+}
+
 /// Pixel positions of the parts of the figure.
 pub(super) struct Layout {
-    /// Font scale: pixels per font unit.
-    pub(super) s: u32,
+    /// Text scale: pixels per font unit ([`text_scale`]).
+    pub(super) s: f32,
     /// Map side on screen.
     pub(super) m: f32,
     pub(super) left: f32,
@@ -26,14 +38,8 @@ impl Layout {
     /// The layout of a map `m` pixels a side, with or without a title, with room for y tick
     /// labels `y_label_w` and colour-bar tick labels `cb_label_w` pixels wide.
     pub(super) fn new(m: u32, title: bool, y_label_w: f32, cb_label_w: f32) -> Self {
-        let s = (m / 256).max(1);
-        let sf = s as f32;
-        let (ch, tick, gap, pad) = (
-            (CAP * s) as f32,
-            3.0 * sf + 2.0,
-            2.0 * sf + 2.0,
-            4.0 * sf + 4.0,
-        );
+        let s = text_scale(m);
+        let (ch, tick, gap, pad) = (CAP * s, 3.0 * s + 2.0, 2.0 * s + 2.0, 4.0 * s + 4.0);
         let m = m as f32;
         let top = (if title {
             pad + ch + 3.0 * gap
@@ -44,7 +50,7 @@ impl Layout {
         let left = (pad + ch + 2.0 * gap + y_label_w + gap + tick).round();
         let bottom = tick + gap + ch + 3.0 * gap + ch + pad;
         let legend_top = (top + m + bottom - pad + 2.0 * gap).round();
-        let cb_x = (left + m + 4.0 * sf + 8.0).round();
+        let cb_x = (left + m + 4.0 * s + 8.0).round();
         let cb_w = (m / 24.0).round().max(10.0);
         let right_edge = cb_x + cb_w + tick + gap + cb_label_w + 2.0 * gap + ch + pad;
         Self {
@@ -62,17 +68,21 @@ impl Layout {
 
     /// Width available to a row of the legend under the map (from the map's left edge).
     pub(super) fn legend_avail(&self) -> f32 {
-        self.width as f32 - self.left - (4.0 * self.s as f32 + 4.0)
+        self.width as f32 - self.left - (4.0 * self.s + 4.0)
     }
 
     pub(super) fn ch(&self) -> f32 {
-        (CAP * self.s) as f32
+        CAP * self.s
     }
     pub(super) fn tick(&self) -> f32 {
-        3.0 * self.s as f32 + 2.0
+        3.0 * self.s + 2.0
     }
     pub(super) fn gap(&self) -> f32 {
-        2.0 * self.s as f32 + 2.0
+        2.0 * self.s + 2.0
+    }
+    /// Width of ticks and frames: half a font unit, whole pixels, at least one.
+    pub(super) fn line(&self) -> f32 {
+        (self.s / 2.0).floor().max(1.0)
     }
 
     /// Screen position of `p` (arcsec) on a map of geometry `g`.

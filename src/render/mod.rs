@@ -3,7 +3,8 @@
 //!
 //! Orientation: pixel `i` of the map (+x, West for HFF maps with `CDELT1 < 0`) grows to the
 //! right and row `j` (+y, North) grows upward, as DS9 shows the FITS file; so East is to the
-//! left, as on the sky. Rendering is deterministic (no system fonts; a built-in bitmap font).
+//! left, as on the sky. Rendering is deterministic: no system fonts, the text is drawn from an
+//! embedded font (DejaVu Sans, `src/render/fonts/`) at a size that follows the figure's.
 //!
 //! [method §6]: crate::method#6-products
 
@@ -163,7 +164,8 @@ pub struct KappaPlotOptions {
     pub map_pixels_on_screen: u32,
     /// Title above the map.
     pub title: Option<String>,
-    /// Colour-bar label; default "kappa" or "log10 kappa".
+    /// Colour-bar label (`_{...}` and `^{...}` set sub- and superscripts); default "κ" or
+    /// "log₁₀ κ".
     pub colorbar_label: Option<String>,
     /// Also draw the caustics of [`Overlay::curves`] (default false).
     pub show_caustics: bool,

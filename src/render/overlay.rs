@@ -185,7 +185,7 @@ pub(super) fn draw_overlay(
             fill_pixels(pm, centres, side, set.color, mask);
         }
     }
-    let width = 1.25 * l.s as f32 + 0.5;
+    let width = 1.25 * l.s + 0.5;
     if let Some(c) = overlay.curves {
         let mut sets = vec![
             (&c.tangential, TANGENTIAL_RGB, false),
@@ -219,7 +219,7 @@ pub(super) fn draw_overlay(
         if matches!(set.marker, Marker::Pixel { .. }) {
             continue;
         }
-        let (r, w) = marker_size(set.marker, l.s as f32, width);
+        let (r, w) = marker_size(set.marker, l.s, width);
         for &p in &set.positions_arcsec {
             if let Some(path) = marker_path(set.marker, l.screen(g, p), r) {
                 halo_stroke(pm, &path, set.color, w, false, mask);
@@ -242,15 +242,15 @@ fn marker_size(marker: Marker, s: f32, width: f32) -> (f32, f32) {
 
 /// Sizes of the legend parts: (padding, sample width, row height) in pixels.
 fn legend_metrics(l: &Layout) -> (f32, f32, f32) {
-    let sf = l.s as f32;
-    (3.0 * sf + 2.0, 14.0 * sf, l.ch() + 4.0 * sf)
+    let s = l.s;
+    (3.0 * s + 2.0, 14.0 * s, l.ch() + 4.0 * s)
 }
 
 /// Left offsets and rows of the entries laid out in rows no wider than `avail` pixels (the
 /// legend under the map): `(x offset from the first column, row index)` per entry.
 pub(super) fn below_flow(l: &Layout, entries: &[(String, Key)], avail: f32) -> Vec<(f32, usize)> {
     let (_, sample, _) = legend_metrics(l);
-    let (gap, spacing) = (l.gap() + 2.0 * l.s as f32, 4.0 * l.gap());
+    let (gap, spacing) = (l.gap() + 2.0 * l.s, 4.0 * l.gap());
     let mut out = Vec::with_capacity(entries.len());
     let (mut x, mut row) = (0.0, 0);
     for (label, _) in entries {
@@ -280,7 +280,7 @@ pub(super) fn below_height(l: &Layout, entries: &[(String, Key)], avail: f32) ->
 
 /// Draws one legend row's sample (line, marker or pixel swatch) centred at height `cy`.
 fn draw_sample(pm: &mut Pixmap, l: &Layout, key: &Key, x: f32, cy: f32, sample: f32) {
-    let sf = l.s as f32;
+    let sf = l.s;
     let width = 1.25 * sf + 0.5;
     let (rgb, dashed) = match key {
         Key::Line { rgb, dashed } => (*rgb, *dashed),
@@ -321,7 +321,7 @@ pub(super) fn draw_legend(
         return;
     }
     let (s, ch) = (l.s, l.ch());
-    let sf = s as f32;
+    let sf = s;
     let (pad, sample, row) = legend_metrics(l);
     let gap = l.gap() + 2.0 * sf;
     let text = |pm: &mut Pixmap, label: &str, at: (f32, f32)| {
@@ -356,7 +356,7 @@ pub(super) fn draw_legend(
             Transform::identity(),
             None,
         );
-        frame(pm, x, y, w, h);
+        frame(pm, x, y, w, h, l.line());
     }
     for (k, (label, key)) in entries.iter().enumerate() {
         let cy = y + pad + row * k as f32 + ch / 2.0;

@@ -15,11 +15,12 @@ pub(super) fn paint(c: Color, anti_alias: bool) -> Paint<'static> {
     p
 }
 
-/// A one-pixel black frame around the `w` x `h` box at `(x, y)`.
-pub(super) fn frame(pm: &mut Pixmap, x: f32, y: f32, w: f32, h: f32) {
-    if let Some(r) = Rect::from_xywh(x - 0.5, y - 0.5, w + 1.0, h + 1.0) {
+/// A black frame `line` pixels wide (whole pixels) just outside the `w` x `h` box at `(x, y)`.
+pub(super) fn frame(pm: &mut Pixmap, x: f32, y: f32, w: f32, h: f32, line: f32) {
+    let half = line / 2.0;
+    if let Some(r) = Rect::from_xywh(x - half, y - half, w + line, h + line) {
         let stroke = Stroke {
-            width: 1.0,
+            width: line,
             ..Stroke::default()
         };
         pm.stroke_path(

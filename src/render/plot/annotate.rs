@@ -31,7 +31,7 @@ pub(super) fn references(
     let f = &plan.frame;
     let (s, ch, gap) = (plan.s, plan.ch(), plan.gap());
     let (right, bottom) = (f.left + f.plot_width, f.top + f.plot_height);
-    let width = (s as f32).max(1.5);
+    let width = s.max(1.5);
     let mask = area_mask(pm, f);
     let mut taken: Vec<Taken> = Vec::new();
     for r in refs {

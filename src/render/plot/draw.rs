@@ -59,14 +59,14 @@ pub(super) fn grid_and_axes(pm: &mut Pixmap, plan: &Plan, plot: &LinePlot) {
         plan.pad(),
         plan.tick(),
     );
-    let tw = (s / 2).max(1) as f32;
+    let tw = plan.line();
     let (right, bottom) = (f.left + f.plot_width, f.top + f.plot_height);
     let black = [0, 0, 0];
     for (v, label) in &plan.x_ticks.major {
         let Some(x) = f.sx(*v).map(|x| (x as f32).floor().clamp(f.left, right)) else {
             continue;
         };
-        fill(pm, x, f.top, 1.0, f.plot_height, GRID_RGB, 1.0);
+        fill(pm, x, f.top, plan.line(), f.plot_height, GRID_RGB, 1.0);
         fill(pm, x - (tw / 2.0).floor(), bottom, tw, tk, black, 1.0);
         let half = text_width(label, s) / 2.0;
         let cx = x.clamp(pad + half, f.width as f32 - pad - half);
@@ -82,7 +82,7 @@ pub(super) fn grid_and_axes(pm: &mut Pixmap, plan: &Plan, plot: &LinePlot) {
         let Some(y) = f.sy(*v).map(|y| (y as f32).floor().clamp(f.top, bottom)) else {
             continue;
         };
-        fill(pm, f.left, y, f.plot_width, 1.0, GRID_RGB, 1.0);
+        fill(pm, f.left, y, f.plot_width, plan.line(), GRID_RGB, 1.0);
         fill(pm, f.left - tk, y - (tw / 2.0).floor(), tk, tw, black, 1.0);
         let at = (f.left - tk - gap, y);
         draw_text(pm, label, at, s, Color::BLACK, Anchor::MiddleRight, true);
@@ -246,7 +246,7 @@ pub(super) fn all_series(pm: &mut Pixmap, f: &PlotFrame, series: &[Series]) {
 /// The frame around the plot area and the title above it.
 pub(super) fn frame_and_title(pm: &mut Pixmap, plan: &Plan, plot: &LinePlot) {
     let f = &plan.frame;
-    frame(pm, f.left, f.top, f.plot_width, f.plot_height);
+    frame(pm, f.left, f.top, f.plot_width, f.plot_height, plan.line());
     if plot.title.is_empty() {
         return;
     }

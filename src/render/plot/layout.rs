@@ -7,14 +7,16 @@ use crate::render::RenderError;
 
 /// Smallest plot area side in pixels left after the margins.
 const MIN_AREA_PX: f32 = 24.0;
-/// Image pixels per font unit of text scale (the smaller image side / this, at least 1).
-const PX_PER_SCALE: u32 = 200;
+/// Image pixels per font unit of text scale (the smaller image side / this).
+const PX_PER_SCALE: f32 = 200.0;
+/// Smallest text scale (cap height 7 pixels, about 10-pixel type).
+const MIN_TEXT_SCALE: f32 = 1.0;
 
 /// Everything the drawing needs besides the plot itself.
 pub(super) struct Plan {
     pub(super) frame: PlotFrame,
-    /// Font scale: pixels per font unit.
-    pub(super) s: u32,
+    /// Text scale: pixels per font unit, proportional to the smaller image side.
+    pub(super) s: f32,
     pub(super) x_ticks: Ticks,
     pub(super) y_ticks: Ticks,
 }
@@ -22,24 +24,28 @@ pub(super) struct Plan {
 impl Plan {
     /// Cap height of text.
     pub(super) fn ch(&self) -> f32 {
-        (CAP * self.s) as f32
+        CAP * self.s
     }
     /// Depth of descenders below the cap height.
     pub(super) fn desc(&self) -> f32 {
-        2.0 * self.s as f32
+        2.0 * self.s
     }
     pub(super) fn gap(&self) -> f32 {
-        2.0 * self.s as f32 + 2.0
+        2.0 * self.s + 2.0
     }
     pub(super) fn pad(&self) -> f32 {
-        4.0 * self.s as f32 + 4.0
+        4.0 * self.s + 4.0
     }
     pub(super) fn tick(&self) -> f32 {
-        3.0 * self.s as f32 + 2.0
+        3.0 * self.s + 2.0
+    }
+    /// Width of ticks and frames: half a font unit, whole pixels, at least one.
+    pub(super) fn line(&self) -> f32 {
+        (self.s / 2.0).floor().max(1.0)
     }
 }
 
-fn widest(t: &[(f64, String)], s: u32) -> f32 {
+fn widest(t: &[(f64, String)], s: f32) -> f32 {
     t.iter().map(|(_, l)| text_width(l, s)).fold(0.0, f32::max)
 }
 
@@ -70,8 +76,8 @@ pub(super) fn plan(plot: &LinePlot) -> Result<Plan, RenderError> {
     let x_range = resolve_range("x.range", &plot.x, axis_values(plot, false).into_iter())?;
     let y_range = resolve_range("y.range", &plot.y, axis_values(plot, true).into_iter())?;
     let (w, h) = (plot.width_px as f32, plot.height_px as f32);
-    let s = (plot.width_px.min(plot.height_px) / PX_PER_SCALE).max(1);
-    let sf = s as f32;
+    let s = (plot.width_px.min(plot.height_px) as f32 / PX_PER_SCALE).max(MIN_TEXT_SCALE);
+    let sf = s;
     let mut plan = Plan {
         frame: PlotFrame {
             width: plot.width_px,
@@ -129,12 +135,11 @@ pub(super) fn plan(plot: &LinePlot) -> Result<Plan, RenderError> {
                     Some((f * plot_w as f64, text_width(l, s)))
                 })
                 .collect();
-            pos.windows(2).all(|p| {
-                (p[1].0 - p[0].0) as f32 >= (p[0].1 + p[1].1) / 2.0 + 3.0 * (ADVANCE as f32) * sf
-            })
+            pos.windows(2)
+                .all(|p| (p[1].0 - p[0].0) as f32 >= (p[0].1 + p[1].1) / 2.0 + 3.0 * ADVANCE * sf)
         }
     };
-    let mut right = pad + 3.0 * ADVANCE as f32 * sf;
+    let mut right = pad + 3.0 * ADVANCE * sf;
     let mut x_ticks = choose(plot.x.scale, x_range, x_fits(w - left - right));
     right = right.max(pad + widest(&x_ticks.major, s) / 2.0).round();
     let plot_w = (w - left - right).floor();

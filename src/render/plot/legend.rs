@@ -39,7 +39,7 @@ pub(super) fn draw(
     }
     let f = &plan.frame;
     let (s, ch, desc) = (plan.s, plan.ch(), plan.desc());
-    let sf = s as f32;
+    let sf = s;
     let (pad, sample, gap, row, inset) = (
         3.0 * sf + 3.0,
         16.0 * sf + 8.0,
@@ -96,7 +96,7 @@ pub(super) fn draw(
     if let Some(r) = Rect::from_xywh(x, y, w, h) {
         let p = paint(Color::from_rgba8(255, 255, 255, 235), false);
         pm.fill_rect(r, &p, Transform::identity(), None);
-        frame(pm, x, y, w, h);
+        frame(pm, x, y, w, h, plan.line());
     }
     for (k, (e, label)) in entries.iter().zip(&labels).enumerate() {
         let cy = y + pad + row * k as f32 + ch / 2.0;

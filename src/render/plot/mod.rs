@@ -1,5 +1,5 @@
 //! Line plots: series of `(x, y)` points on linear or log10 axes, horizontal reference lines,
-//! ticks, axis labels, a title and a legend, drawn with tiny-skia and the built-in bitmap font
+//! ticks, axis labels, a title and a legend, drawn with tiny-skia and the embedded font
 //! (e.g. radial profiles, or objective, grid mass and `C` against iteration).
 //!
 //! Points with a NaN or infinite coordinate, or a non-positive one on a log axis, are skipped
