@@ -7,6 +7,7 @@ import { buildFileRows, setFileStatus, ROLES } from './js/files.js';
 import { buildSettings, showSettings } from './js/settings.js';
 import { wireViews, showPng, showSystems, showCrossval, showStrengthChoice, viewOptions, currentView, refreshReadout, clearPin } from './js/views.js';
 import { showDownloads, save } from './js/downloads.js';
+import { wireFigureDownload } from './js/figure-download.js';
 import { StrengthPool, poolSize, projectForTrials } from './js/pool.js';
 import { wireIterates, showIterates, syncIterates, iterateOption } from './js/iterates.js';
 
@@ -567,7 +568,7 @@ const app = {
   counterImageRegions: ([x, y]) => ask('counterImageRegions', { x, y }),
   textFile: (name) => ask('textFile', { name }),
   fitsFile: async (name) => (await ask('fitsFiles')).find((f) => f.name === name).bytes,
-  viewPng: async (name) => (await ask('view', { name, options: viewOptions() })).png,
+  viewPng: async (name, extra = {}) => (await ask('view', { name, options: { ...viewOptions(), ...extra } })).png,
   showError,
 };
 
@@ -576,6 +577,7 @@ async function start() {
   buildSettings($('settings-form'), applySetting);
   wireViews(app);
   wireIterates(app);
+  wireFigureDownload(app);
   $('reconstruct').addEventListener('click', () => run('reconstruct'));
   $('forward').addEventListener('click', () => run('forward'));
   $('lookup').addEventListener('click', () => run('lookup'));

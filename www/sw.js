@@ -17,6 +17,7 @@ const APP_FILES = [
   'lens-client.js',
   'worker.js',
   'js/downloads.js',
+  'js/figure-download.js',
   'js/files.js',
   'js/iterates.js',
   'js/pool.js',

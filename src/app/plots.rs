@@ -16,8 +16,7 @@ use crate::render::{
 
 use super::data::ModelLens;
 use super::run::{RunKind, SessionResult};
-use super::views::ViewOptions;
-use super::views::ViewPng;
+use super::views::{ViewOptions, ViewPng};
 use super::{AppError, Session};
 
 /// One panel's size in pixels: 400 high gives the text two font units (readable at the
@@ -39,14 +38,17 @@ fn panel(title: &str, x: Axis, y: Axis, series: Vec<Series>) -> LinePlot {
     }
 }
 
-fn compose(name: &str, plots: &[LinePlot]) -> Result<ViewPng, AppError> {
+/// The panels `plots` stacked, each drawn [`ViewOptions::figure_scale`] times larger.
+fn compose(name: &str, plots: &[LinePlot], opts: &ViewOptions) -> Result<ViewPng, AppError> {
+    let k = opts.checked_figure_scale()?;
     let render = |e: RenderError| AppError::Run(format!("rendering {name}: {e}"));
     let panels = plots
         .iter()
-        .map(|p| p.render_pixmap())
+        .map(|p| p.scaled(k).render_pixmap())
         .collect::<Result<Vec<_>, _>>()
         .map_err(render)?;
-    let png = compose_grid(&panels, 1, GAP_PX)
+    let gap = (GAP_PX as f32 * k).round() as u32;
+    let png = compose_grid(&panels, 1, gap)
         .map_err(render)?
         .encode_png()
         .map_err(|e| AppError::Run(format!("rendering {name}: {e}")))?;
@@ -139,7 +141,7 @@ impl Session {
     /// the projected mass inside each radius (Msun), both on log10 axes. Over a reconstruction,
     /// the loaded model file's profile in the same bins, dashed (see [`Self::model_profile`]),
     /// and a third panel with their relative differences
-    /// ([`profile_relative_differences`]).
+    /// ([`profile_relative_differences`]). Of `opts` only [`ViewOptions::figure_scale`] applies.
     pub fn radial_view(&self, opts: &ViewOptions) -> Result<ViewPng, AppError> {
         let result = self.result()?;
         let (kappa, mass) = profile_points(&result.products().profile);
@@ -196,7 +198,7 @@ impl Session {
             ),
         ];
         plots.extend(difference);
-        compose("radial-profile.png", &plots)
+        compose("radial-profile.png", &plots, opts)
     }
 
     /// The radial profile of the loaded model file (the true lens of the built-in examples) in
@@ -313,8 +315,9 @@ impl Session {
     }
 
     /// The QADP history: objective, grid mass (Msun) and `C` of every layer against iteration
-    /// (iterations of refinement levels continue after the previous level's).
-    pub fn convergence_view(&self) -> Result<ViewPng, AppError> {
+    /// (iterations of refinement levels continue after the previous level's). Of `opts` only
+    /// [`ViewOptions::figure_scale`] applies.
+    pub fn convergence_view(&self, opts: &ViewOptions) -> Result<ViewPng, AppError> {
         let r = self.result()?;
         let records = r
             .reconstruction()
@@ -385,7 +388,7 @@ impl Session {
                 c_series,
             ));
         }
-        compose("convergence.png", &plots)
+        compose("convergence.png", &plots, opts)
     }
 }
 

@@ -156,7 +156,7 @@ impl Session {
             vmin: Some(0.5),
             vmax: Some(MAX_SHOWN_MAGNIFICATION),
             colormap: Colormap::Magma,
-            map_pixels_on_screen: opts.map_pixels_on_screen,
+            map_pixels_on_screen: opts.map_side_px()?,
             title: Some(format!(
                 "source plane, caustics at z_s = {}",
                 p.curves.z_source
@@ -217,7 +217,7 @@ impl Session {
             vmin: Some(-1.0),
             vmax: Some(1.0),
             colormap: Colormap::Viridis,
-            map_pixels_on_screen: opts.map_pixels_on_screen,
+            map_pixels_on_screen: opts.map_side_px()?,
             title: Some("the data (no mass map yet)".to_string()),
             colorbar_label: Some("(reconstruct to see kappa)".to_string()),
             legend: opts.legend,

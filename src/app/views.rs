@@ -87,6 +87,10 @@ pub struct ViewOptions {
     pub model_is_truth: bool,
     /// Map side on screen in pixels (default 512).
     pub map_pixels_on_screen: u32,
+    /// Every figure drawn this many times larger, text and lines included (default 1; 0.25
+    /// to 4, e.g. 2 or 3 for a slide or a paper): the map side becomes
+    /// `map_pixels_on_screen * figure_scale`, the line plots' panels grow alike.
+    pub figure_scale: f32,
     /// Where the figures' legends go (default: under the map, so no data are hidden).
     pub legend: LegendPlace,
     /// A point of the map (arcsec): the images of the source behind it are drawn
@@ -109,10 +113,34 @@ impl Default for ViewOptions {
             show_model_curves: true,
             model_is_truth: false,
             map_pixels_on_screen: 512,
+            figure_scale: 1.0,
             legend: LegendPlace::Below,
             pin_arcsec: None,
             iterate: None,
         }
+    }
+}
+
+/// Smallest and largest [`ViewOptions::figure_scale`].
+pub const FIGURE_SCALE_RANGE: (f32, f32) = (0.25, 4.0);
+
+impl ViewOptions {
+    /// [`Self::figure_scale`], checked to lie in [`FIGURE_SCALE_RANGE`].
+    pub fn checked_figure_scale(&self) -> Result<f32, AppError> {
+        let k = self.figure_scale;
+        let (lo, hi) = FIGURE_SCALE_RANGE;
+        if !(lo..=hi).contains(&k) {
+            return Err(AppError::Setting(format!(
+                "figure_scale = {k}: must be {lo} to {hi}"
+            )));
+        }
+        Ok(k)
+    }
+
+    /// The map side of the figures in pixels: `map_pixels_on_screen * figure_scale`.
+    pub fn map_side_px(&self) -> Result<u32, AppError> {
+        let k = self.checked_figure_scale()?;
+        Ok((self.map_pixels_on_screen as f32 * k).round() as u32)
     }
 }
 
@@ -221,7 +249,7 @@ impl Session {
             .map_or(String::new(), |(k, n)| format!(", iteration {k} of {n}"));
         Ok(KappaPlotOptions {
             scale: opts.scale,
-            map_pixels_on_screen: opts.map_pixels_on_screen,
+            map_pixels_on_screen: opts.map_side_px()?,
             title: Some(format!(
                 "kappa (z_l = {}), critical curves at z_s = {}{at}",
                 shown.products.plane.z_lens, shown.products.curves.z_source

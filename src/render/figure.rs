@@ -173,7 +173,7 @@ pub fn render_kappa_png(
             s
         };
         let text = fit(title, room, ts);
-        let at = (centre, 4.0 * s + 4.0);
+        let at = (centre, layout.pad());
         draw_text(
             &mut pm,
             &text,
@@ -273,7 +273,7 @@ fn draw_axes(
         Anchor::TopCenter,
         true,
     );
-    let pad = 4.0 * s + 4.0;
+    let pad = l.pad();
     draw_text(
         pm,
         "y [arcsec]",

@@ -8,6 +8,12 @@ use crate::map::MapGeometry;
 
 /// Map pixels per font unit of text scale.
 const MAP_PX_PER_SCALE: f32 = 256.0;
+/// Tick length, gap between parts and padding at the figure's edge, in font units: every
+/// length of the figure is a multiple of the text scale, so a figure drawn twice as large is
+/// the same figure at twice the resolution.
+pub(super) const TICK: f32 = 4.0;
+pub(super) const GAP: f32 = 3.0;
+pub(super) const PAD: f32 = 6.0;
 /// Smallest text scale (cap height 7 pixels, about 10-pixel type).
 pub(super) const MIN_TEXT_SCALE: f32 = 1.0;
 
@@ -39,7 +45,7 @@ impl Layout {
     /// labels `y_label_w` and colour-bar tick labels `cb_label_w` pixels wide.
     pub(super) fn new(m: u32, title: bool, y_label_w: f32, cb_label_w: f32) -> Self {
         let s = text_scale(m);
-        let (ch, tick, gap, pad) = (CAP * s, 3.0 * s + 2.0, 2.0 * s + 2.0, 4.0 * s + 4.0);
+        let (ch, tick, gap, pad) = (CAP * s, TICK * s, GAP * s, PAD * s);
         let m = m as f32;
         let top = (if title {
             pad + ch + 3.0 * gap
@@ -50,7 +56,7 @@ impl Layout {
         let left = (pad + ch + 2.0 * gap + y_label_w + gap + tick).round();
         let bottom = tick + gap + ch + 3.0 * gap + ch + pad;
         let legend_top = (top + m + bottom - pad + 2.0 * gap).round();
-        let cb_x = (left + m + 4.0 * s + 8.0).round();
+        let cb_x = (left + m + 8.0 * s).round();
         let cb_w = (m / 24.0).round().max(10.0);
         let right_edge = cb_x + cb_w + tick + gap + cb_label_w + 2.0 * gap + ch + pad;
         Self {
@@ -68,17 +74,20 @@ impl Layout {
 
     /// Width available to a row of the legend under the map (from the map's left edge).
     pub(super) fn legend_avail(&self) -> f32 {
-        self.width as f32 - self.left - (4.0 * self.s + 4.0)
+        self.width as f32 - self.left - self.pad()
     }
 
     pub(super) fn ch(&self) -> f32 {
         CAP * self.s
     }
     pub(super) fn tick(&self) -> f32 {
-        3.0 * self.s + 2.0
+        TICK * self.s
     }
     pub(super) fn gap(&self) -> f32 {
-        2.0 * self.s + 2.0
+        GAP * self.s
+    }
+    pub(super) fn pad(&self) -> f32 {
+        PAD * self.s
     }
     /// Width of ticks and frames: half a font unit, whole pixels, at least one.
     pub(super) fn line(&self) -> f32 {

@@ -52,7 +52,8 @@ fn halo_stroke(
     mask: Option<&Mask>,
 ) {
     let mut stroke = Stroke {
-        width: width + 2.0,
+        // A third of the line's width on either side.
+        width: width * 5.0 / 3.0,
         line_cap: LineCap::Round,
         line_join: LineJoin::Round,
         ..Stroke::default()
@@ -185,7 +186,7 @@ pub(super) fn draw_overlay(
             fill_pixels(pm, centres, side, set.color, mask);
         }
     }
-    let width = 1.25 * l.s + 0.5;
+    let width = line_width(l);
     if let Some(c) = overlay.curves {
         let mut sets = vec![
             (&c.tangential, TANGENTIAL_RGB, false),
@@ -219,7 +220,7 @@ pub(super) fn draw_overlay(
         if matches!(set.marker, Marker::Pixel { .. }) {
             continue;
         }
-        let (r, w) = marker_size(set.marker, l.s, width);
+        let (r, w) = marker_size(set.marker, l);
         for &p in &set.positions_arcsec {
             if let Some(path) = marker_path(set.marker, l.screen(g, p), r) {
                 halo_stroke(pm, &path, set.color, w, false, mask);
@@ -228,22 +229,33 @@ pub(super) fn draw_overlay(
     }
 }
 
-/// Radius and line width of a point marker at figure scale `s` (curves drawn `width` wide).
-/// The model's predicted images (crosses) and the member galaxies (circles) can number in the
-/// hundreds: they are drawn small and thin so that the map stays readable under them; the
-/// data (plus signs) and a clicked point's images (squares) keep the full size.
-fn marker_size(marker: Marker, s: f32, width: f32) -> (f32, f32) {
+/// Width of the curves and marker strokes (3 pixels on a 512-pixel map).
+fn line_width(l: &Layout) -> f32 {
+    1.5 * l.s
+}
+
+/// Radius of the point markers (7 pixels on a 512-pixel map).
+fn marker_radius(l: &Layout) -> f32 {
+    3.5 * l.s
+}
+
+/// Radius and line width of a point marker (curves are drawn `line_width` wide). The model's
+/// predicted images (crosses) and the member galaxies (circles) can number in the hundreds:
+/// they are drawn small and thin so that the map stays readable under them; the data (plus
+/// signs) and a clicked point's images (squares) keep the full size.
+fn marker_size(marker: Marker, l: &Layout) -> (f32, f32) {
+    let (r, w) = (marker_radius(l), line_width(l));
     match marker {
-        Marker::Cross => (2.0 * s + 0.5, 0.6 * width),
-        Marker::Circle => (2.25 * s + 0.5, 0.6 * width),
-        _ => (3.0 * s + 1.0, width),
+        Marker::Cross => (0.65 * r, 0.6 * w),
+        Marker::Circle => (0.7 * r, 0.6 * w),
+        _ => (r, w),
     }
 }
 
 /// Sizes of the legend parts: (padding, sample width, row height) in pixels.
 fn legend_metrics(l: &Layout) -> (f32, f32, f32) {
     let s = l.s;
-    (3.0 * s + 2.0, 14.0 * s, l.ch() + 4.0 * s)
+    (4.0 * s, 14.0 * s, l.ch() + 4.0 * s)
 }
 
 /// Left offsets and rows of the entries laid out in rows no wider than `avail` pixels (the
@@ -281,7 +293,7 @@ pub(super) fn below_height(l: &Layout, entries: &[(String, Key)], avail: f32) ->
 /// Draws one legend row's sample (line, marker or pixel swatch) centred at height `cy`.
 fn draw_sample(pm: &mut Pixmap, l: &Layout, key: &Key, x: f32, cy: f32, sample: f32) {
     let sf = l.s;
-    let width = 1.25 * sf + 0.5;
+    let width = line_width(l);
     let (rgb, dashed) = match key {
         Key::Line { rgb, dashed } => (*rgb, *dashed),
         Key::Point { rgb, .. } => (*rgb, false),
@@ -297,12 +309,12 @@ fn draw_sample(pm: &mut Pixmap, l: &Layout, key: &Key, x: f32, cy: f32, sample: 
             marker: Marker::Pixel { .. },
             ..
         } => {
-            let side = 6.0 * sf + 2.0;
+            let side = 7.0 * sf;
             let centre = [(x + sample / 2.0, cy)].into_iter();
             fill_pixels(pm, centre, side, rgb, None);
             None
         }
-        Key::Point { marker, .. } => marker_path(*marker, (x + sample / 2.0, cy), 3.0 * sf + 1.0),
+        Key::Point { marker, .. } => marker_path(*marker, (x + sample / 2.0, cy), marker_radius(l)),
     };
     if let Some(p) = path {
         halo_stroke(pm, &p, rgb, width, dashed, None);

@@ -324,7 +324,7 @@ impl AppSession {
             "source" => s.source_view(&opts),
             "data" => s.data_view(&opts),
             "radial" => s.radial_view(&opts),
-            "convergence" => s.convergence_view(),
+            "convergence" => s.convergence_view(&opts),
             other => return Err(JsError::new(&format!("unknown view '{other}'"))),
         }
         .map_err(err)?;

@@ -332,3 +332,50 @@ fn a_clicked_point_shows_the_images_of_its_source() {
         "source plane: {with} yellow pixels with the pin, {without} without"
     );
 }
+
+/// Figures for a slide or a paper: every view drawn at `figure_scale` 2 (3) is a PNG twice
+/// (three times) as wide and high as at 1, up to the rounding of the parts to whole pixels;
+/// a scale outside 0.25 to 4 is refused with its value.
+#[cfg_attr(not(target_arch = "wasm32"), test)]
+#[cfg_attr(target_arch = "wasm32", wasm_bindgen_test::wasm_bindgen_test)]
+fn views_drawn_at_figure_scale_k_are_k_times_larger() {
+    /// Pixels a scaled figure may differ from `k` times the size (parts rounded one by one).
+    const ROUNDING_PX: i64 = 4;
+    let s = solved();
+    let size = |png: &[u8]| {
+        let pm = tiny_skia::Pixmap::decode_png(png).expect("a PNG");
+        (pm.width() as i64, pm.height() as i64)
+    };
+    let views = |opts: &ViewOptions| {
+        [
+            s.kappa_view(opts).unwrap(),
+            s.source_view(opts).unwrap(),
+            s.radial_view(opts).unwrap(),
+            s.convergence_view(opts).unwrap(),
+        ]
+    };
+    let one = views(&ViewOptions::default());
+    for k in [2, 3] {
+        let opts = ViewOptions {
+            figure_scale: k as f32,
+            ..ViewOptions::default()
+        };
+        for (a, b) in one.iter().zip(views(&opts)) {
+            let ((w1, h1), (wk, hk)) = (size(&a.png), size(&b.png));
+            assert!(
+                (wk - k * w1).abs() <= ROUNDING_PX && (hk - k * h1).abs() <= ROUNDING_PX,
+                "{} at {k}x: {wk} x {hk}, at 1x {w1} x {h1}",
+                a.name
+            );
+        }
+    }
+    for bad in [0.0, 5.0, f32::NAN] {
+        let opts = ViewOptions {
+            figure_scale: bad,
+            ..ViewOptions::default()
+        };
+        let err = s.radial_view(&opts).unwrap_err().to_string();
+        assert!(err.contains("figure_scale"), "{err}");
+        assert!(s.kappa_view(&opts).is_err());
+    }
+}

@@ -1,12 +1,13 @@
 // End-to-end: settings typed quickly one after the other all stick (and survive a reload);
-// catalogues dropped on the drop zone load; forward mode with a model file, a PNG download
-// and the read-out following z_s; look-up mode from deflection FITS that survives a reload.
+// catalogues dropped on the drop zone load; forward mode with a model file, a PNG download,
+// "Download figure" at 2x and 3x and the read-out following z_s; look-up mode from deflection
+// FITS that survives a reload.
 import { test } from 'node:test';
 import assert from 'node:assert/strict';
 import { join } from 'node:path';
 import { readFile, writeFile, mkdtemp } from 'node:fs/promises';
 import { tmpdir } from 'node:os';
-import { openApp, imageSize, imageStats, runToMap, waitView, ARTIFACTS, ROOT, SETTLE_TIMEOUT_MS, setField, waitStatus } from './browser.mjs';
+import { openApp, imageSize, imageStats, renderCount, runToMap, waitView, ARTIFACTS, ROOT, SETTLE_TIMEOUT_MS, setField, waitStatus } from './browser.mjs';
 
 const AS1063 = join(ROOT, '..', 'shared', 'data', 'AS1063', 'lenstool_cats');
 const TEACHING_MODEL = join(ROOT, 'www', 'examples', 'teaching', 'model.json');
@@ -161,6 +162,22 @@ test('forward mode draws a model file; the PNG download and the read-out follow'
     const [download] = await Promise.all([page.waitForEvent('download'), page.click('#dl-kappa-png')]);
     assert.equal(download.suggestedFilename(), 'kappa.png');
     assert.deepEqual(pngSize(await readFile(await download.path())), [w, h]);
+
+    // "Download figure" under the view: the view drawn again k times as large, text and lines
+    // included (up to the rounding of its parts to whole pixels).
+    const figure = async (k, name, [w1, h1]) => {
+      await page.selectOption('#figure-scale', String(k));
+      const [dl] = await Promise.all([page.waitForEvent('download'), page.click('#dl-figure')]);
+      assert.equal(dl.suggestedFilename(), name);
+      const [wk, hk] = pngSize(await readFile(await dl.path()));
+      assert.ok(Math.abs(wk - k * w1) <= 4 && Math.abs(hk - k * h1) <= 4, `${name}: ${wk} x ${hk}, shown ${w1} x ${h1}`);
+    };
+    await figure(2, 'kappa@2x.png', [w, h]);
+    const before = await renderCount(page);
+    await page.click('#tab-radial');
+    await waitView(page, 'radial', before);
+    await page.screenshot({ path: join(ARTIFACTS, 'app-forward-radial.png'), fullPage: true });
+    await figure(3, 'radial-profile@3x.png', await imageSize(page, '#view-image'));
     assert.deepEqual(app.consoleErrors, []);
   } finally {
     await app.close();

@@ -31,13 +31,13 @@ impl Plan {
         2.0 * self.s
     }
     pub(super) fn gap(&self) -> f32 {
-        2.0 * self.s + 2.0
+        3.0 * self.s
     }
     pub(super) fn pad(&self) -> f32 {
-        4.0 * self.s + 4.0
+        6.0 * self.s
     }
     pub(super) fn tick(&self) -> f32 {
-        3.0 * self.s + 2.0
+        4.0 * self.s
     }
     /// Width of ticks and frames: half a font unit, whole pixels, at least one.
     pub(super) fn line(&self) -> f32 {

@@ -41,11 +41,11 @@ pub(super) fn draw(
     let (s, ch, desc) = (plan.s, plan.ch(), plan.desc());
     let sf = s;
     let (pad, sample, gap, row, inset) = (
-        3.0 * sf + 3.0,
-        16.0 * sf + 8.0,
-        3.0 * sf + 2.0,
+        4.5 * sf,
+        20.0 * sf,
+        4.0 * sf,
         ch + desc + 2.0 * sf,
-        4.0 * sf + 2.0,
+        5.0 * sf,
     );
     let max_label = f.plot_width - 2.0 * inset - 2.0 * pad - sample - gap;
     let labels: Vec<String> = entries

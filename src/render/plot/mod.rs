@@ -184,6 +184,20 @@ impl LinePlot {
         Ok(())
     }
 
+    /// The same plot drawn `k` times larger: image size and line widths times `k` (sizes
+    /// rounded to whole pixels, widths capped at [`MAX_LINE_WIDTH_PX`]); the text grows with
+    /// the image, so a `k = 2` plot is the `k = 1` one at twice the resolution, e.g. for print.
+    pub fn scaled(&self, k: f32) -> LinePlot {
+        let side = |v: u32| (v as f32 * k).round().clamp(0.0, u32::MAX as f32) as u32;
+        let mut out = self.clone();
+        out.width_px = side(self.width_px);
+        out.height_px = side(self.height_px);
+        for s in &mut out.series {
+            s.width = (s.width * k).min(MAX_LINE_WIDTH_PX);
+        }
+        out
+    }
+
     /// Where the plot area lies in the image and how data map onto it, for the image that
     /// [`Self::render_pixmap`] draws.
     pub fn frame(&self) -> Result<PlotFrame, RenderError> {

@@ -348,3 +348,55 @@ fn a_long_title_stays_inside_the_figure() {
         pm.width()
     );
 }
+
+/// The title's ink above the map: `(height of its bounding box in pixels, how many distinct
+/// grey levels it has)`.
+fn title_ink(map_px: u32) -> (u32, usize) {
+    let opts = KappaPlotOptions {
+        map_pixels_on_screen: map_px,
+        title: Some("Hg".into()),
+        ..KappaPlotOptions::default()
+    };
+    let map = figure_map();
+    let pm = decode(&render_kappa_png(&map, &Overlay::default(), &opts).unwrap());
+    // Above the map, between its sides (the top tick labels stick out beside it).
+    let f = kappa_figure_frame(&map, &opts).unwrap();
+    let (top, left, right) = (f.map_top - 2.0, f.map_left, f.map_left + f.map_side);
+    let mut rows = Vec::new();
+    let mut greys = std::collections::BTreeSet::new();
+    for y in 0..top as u32 {
+        for x in left as u32..right as u32 {
+            let p = pm.pixel(x, y).unwrap();
+            if p.red() < 250 {
+                rows.push(y);
+                greys.insert(p.red());
+            }
+        }
+    }
+    let (lo, hi) = (rows.iter().min().unwrap(), rows.iter().max().unwrap());
+    (hi - lo + 1, greys.len())
+}
+
+/// Text is drawn from an outline font with antialiasing (many grey levels at the glyphs'
+/// edges, where the old bitmap font had black only) and its size follows the figure's: the
+/// title "Hg" (cap height and descender) of a figure twice as large is twice as tall.
+#[cfg_attr(not(target_arch = "wasm32"), test)]
+#[cfg_attr(target_arch = "wasm32", wasm_bindgen_test::wasm_bindgen_test)]
+fn text_is_antialiased_and_scales_with_the_figure() {
+    /// Pixels of difference allowed from rounding the baseline and the glyph edges.
+    const EDGE_PX: i64 = 2;
+    let (h1, greys) = title_ink(512);
+    assert!(greys > 20, "{greys} grey levels in the title");
+    // "Hg" at scale 2: cap height 14 pixels plus the descender of g.
+    assert!((16..=22).contains(&h1), "title ink {h1} pixels high");
+    let (h2, _) = title_ink(1024);
+    assert!(
+        (h2 as i64 - 2 * h1 as i64).abs() <= EDGE_PX,
+        "title {h1} pixels high at 512, {h2} at 1024"
+    );
+    let (h_min, _) = title_ink(64);
+    assert!(
+        h_min >= 8,
+        "the smallest figure's title is {h_min} pixels high"
+    );
+}
