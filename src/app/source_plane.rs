@@ -158,10 +158,10 @@ impl Session {
             colormap: Colormap::Magma,
             map_pixels_on_screen: opts.map_side_px()?,
             title: Some(format!(
-                "source plane, caustics at z_s = {}",
+                "source plane, caustics at z_{{s}} = {}",
                 p.curves.z_source
             )),
-            colorbar_label: Some("log10 total magnification".to_string()),
+            colorbar_label: Some("log_{10} total magnification".to_string()),
             show_caustics: false,
             legend: opts.legend,
         };

@@ -251,7 +251,7 @@ impl Session {
             scale: opts.scale,
             map_pixels_on_screen: opts.map_side_px()?,
             title: Some(format!(
-                "kappa (z_l = {}), critical curves at z_s = {}{at}",
+                "κ (z_{{l}} = {}), critical curves at z_{{s}} = {}{at}",
                 shown.products.plane.z_lens, shown.products.curves.z_source
             )),
             legend: opts.legend,

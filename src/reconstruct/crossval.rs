@@ -148,7 +148,7 @@ impl KappaSpread {
         };
         let title = match curves {
             Some(c) => format!(
-                "Spread of kappa over {folds} folds; critical curves at z_s = {}",
+                "Spread of κ over {folds} folds; critical curves at z_{{s}} = {}",
                 c.z_source
             ),
             None => format!("Spread of kappa over {folds} folds"),

@@ -189,7 +189,7 @@ impl Ensemble {
         }
         let title = match curves {
             Some(c) => format!(
-                "Spread of kappa over {n} members; critical curves at z_s = {}",
+                "Spread of κ over {n} members; critical curves at z_{{s}} = {}",
                 c.z_source
             ),
             None => format!("Spread of kappa over {n} members"),

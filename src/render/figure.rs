@@ -5,7 +5,7 @@ use tiny_skia::{Color, Pixmap, Rect, Transform};
 
 use super::axes::nice_ticks;
 use super::colormap::{color_limits, value_rgb};
-use super::font::{draw_text, fit, text_width, Anchor};
+use super::font::{draw_text, fit, minus_signs, text_width, Anchor};
 use super::layout::{text_scale, Layout, MIN_TEXT_SCALE};
 use super::overlay::{below_height, draw_legend, draw_overlay, legend_entries, Key};
 use super::paint::{color, frame, paint};
@@ -70,9 +70,13 @@ fn plan(kappa: &Map, overlay: &Overlay, opts: &KappaPlotOptions) -> Result<Plan,
     let limits = color_limits(kappa, opts.scale, opts.vmin, opts.vmax)?;
     let g = kappa.geometry;
     let half = g.size_arcsec / 2.0;
-    let x_ticks = nice_ticks(g.center.x - half, g.center.x + half, 5);
-    let y_ticks = nice_ticks(g.center.y - half, g.center.y + half, 5);
-    let cb_ticks = nice_ticks(limits.0, limits.1, 5);
+    let ticks = |lo: f64, hi: f64| -> Vec<(f64, String)> {
+        let t = nice_ticks(lo, hi, 5).into_iter();
+        t.map(|(v, l)| (v, minus_signs(&l))).collect()
+    };
+    let x_ticks = ticks(g.center.x - half, g.center.x + half);
+    let y_ticks = ticks(g.center.y - half, g.center.y + half);
+    let cb_ticks = ticks(limits.0, limits.1);
     let s = text_scale(opts.map_pixels_on_screen);
     let widest = |t: &[(f64, String)]| t.iter().map(|(_, l)| text_width(l, s)).fold(0.0, f32::max);
     let mut layout = Layout::new(

@@ -148,6 +148,12 @@ pub(crate) fn fit(text: &str, max_px: f32, s: f32) -> String {
     }
 }
 
+/// A number's label as figures print it: a leading or exponent hyphen becomes the minus
+/// sign U+2212, as in typeset numbers ("-0.5" -> "−0.5", "1e-6" -> "1e−6").
+pub(crate) fn minus_signs(label: &str) -> String {
+    label.replace('-', "\u{2212}")
+}
+
 /// Where `(x, y)` sits on the text's box (cap height, no descenders).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Anchor {
@@ -294,6 +300,8 @@ mod tests {
         );
         assert_eq!(runs("model_v2.json"), [(Level::Normal, "model_v2.json")]);
         assert_eq!(runs("a_{b"), [(Level::Normal, "a_{b")]);
+        assert_eq!(minus_signs("-0.5"), "\u{2212}0.5");
+        assert_eq!(minus_signs("1e-6"), "1e\u{2212}6");
     }
 
     #[test]

@@ -1,8 +1,8 @@
 //! Margins, text scale and ticks of a line plot.
 
-use super::scale::{axis_values, fraction, resolve_range, ticks, PlotFrame, Ticks};
+use super::scale::{axis_values, fraction, resolve_range, PlotFrame, Ticks};
 use super::{AxisScale, LinePlot};
-use crate::render::font::{text_width, ADVANCE, CAP};
+use crate::render::font::{minus_signs, text_width, ADVANCE, CAP};
 use crate::render::RenderError;
 
 /// Smallest plot area side in pixels left after the margins.
@@ -43,6 +43,15 @@ impl Plan {
     pub(super) fn line(&self) -> f32 {
         (self.s / 2.0).floor().max(1.0)
     }
+}
+
+/// [`super::scale::ticks`] with the labels' hyphens printed as minus signs.
+fn ticks(scale: AxisScale, range: (f64, f64), target: usize) -> Ticks {
+    let mut t = super::scale::ticks(scale, range, target);
+    for (_, label) in &mut t.major {
+        *label = minus_signs(label);
+    }
+    t
 }
 
 fn widest(t: &[(f64, String)], s: f32) -> f32 {
