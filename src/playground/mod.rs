@@ -56,9 +56,13 @@ use crate::potential::{arrival_time_days, potential_difference, potential_map};
 use crate::products::Clock;
 
 mod light;
+mod observe;
 mod scene;
 
 pub use light::{sersic_b, SourcePixels, BACKGROUND_RGB, SOURCE_RGB};
+pub use observe::{
+    observe, Observation, ObserveOptions, ObservedSystem, MAX_OBSERVE_PIXELS, MIN_IMAGE_PIXELS,
+};
 pub use scene::{
     BuiltScene, MemberGalaxy, Scene, SceneError, SceneLens, SourcePlane, SourceSpec,
     DEFAULT_Z_SOURCE, MAX_SCENE_ITEMS, SCENE_VERSION,

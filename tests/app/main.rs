@@ -11,6 +11,7 @@ mod bad_inputs;
 mod iterates;
 mod loading;
 mod model;
+mod observe;
 mod projects;
 mod runs;
 mod views;
