@@ -4,7 +4,7 @@
 use glam::DVec2;
 use wasm_bindgen::prelude::*;
 
-use crate::playground::{ContourKind, Playground, Scene, SourcePixels};
+use crate::playground::{observe, ContourKind, ObserveOptions, Playground, Scene, SourcePixels};
 
 use super::{set, to_js};
 
@@ -49,6 +49,18 @@ impl PlaygroundSession {
             .truth_model()
             .map_err(err)?
             .to_json_string())
+    }
+
+    /// The scene observed as mock data (`options_json`: the `ObserveOptions` fields, any
+    /// missing ones at their defaults; `""` for all defaults): `{images_cat?, arcs_json?,
+    /// members_cat?, model_json, z_lens, settings: [[path, value]], systems, notes}`.
+    pub fn observe(&self, options_json: &str) -> Result<JsValue, JsError> {
+        let options: ObserveOptions = if options_json.trim().is_empty() {
+            ObserveOptions::default()
+        } else {
+            serde_json::from_str(options_json).map_err(|e| err(format!("observe options: {e}")))?
+        };
+        to_js(&observe(self.inner.scene(), &options).map_err(err)?)
     }
 
     /// Holds `width x height` RGBA pixels for the image sources with `slot`.

@@ -56,6 +56,11 @@ async function handle(msg) {
     case 'contours':
       return [session ? session.contours(msg.kind, msg.pixels, msg.z, msg.x, msg.y) : []];
     case 'truth': return [session ? session.truth_model_json() : null];
+    case 'observe': {
+      if (session) session.set_scene(msg.scene);
+      else session = new PlaygroundSession(msg.scene);
+      return [session.observe(JSON.stringify(msg.options ?? {}))];
+    }
     default: throw new Error(`unknown job type ${msg.type}`);
   }
 }
