@@ -402,14 +402,38 @@ async function loadExample(ex) {
   await ask('setField', { path: 'z_lens', value: ex.z_lens });
   for (const [path, value] of Object.entries(ex.settings ?? {})) await ask('setField', { path, value });
   for (const f of ex.files) {
-    const text = await (await fetch(`examples/${f.path}`)).text();
-    await ask('loadText', { role: f.role, name: f.path.split('/').pop(), text });
+    const text = f.text ?? await (await fetch(`examples/${f.path}`)).text();
+    await ask('loadText', { role: f.role, name: f.name ?? f.path.split('/').pop(), text });
   }
   describe(ex.name, ex.description);
   $('full-app').href = `./?example=${encodeURIComponent(ex.id)}`;
   const loaded = await afterOpen(null);
   await persist();
   setStatus(readyText(loaded));
+}
+
+/** `?from=playground`: the playground's "Invert with WSLAP+" left an observation in
+ * sessionStorage (www/playground/observe.js). It opens as an example would (its files given as
+ * text, its model the true lens), with a link back to the scene, and is reconstructed. False
+ * when there is none (a reload after it was opened: the saved project opens instead). */
+async function openFromPlayground() {
+  const key = 'wslap.playground.observation';
+  const text = sessionStorage.getItem(key);
+  sessionStorage.removeItem(key);
+  history.replaceState(null, '', location.pathname + (params.get('simd') ? `?simd=${params.get('simd')}` : ''));
+  if (!text) return false;
+  const handed = JSON.parse(text);
+  const ex = { ...handed, id: 'playground', settings: Object.fromEntries(handed.settings) };
+  // As a built-in example: legends call its model "the true lens", your own file replaces it.
+  examples.push(ex);
+  await enqueue(() => loadExample(ex));
+  const back = document.createElement('a');
+  back.id = 'back-to-playground';
+  back.href = ex.back;
+  back.textContent = 'Back to the playground scene';
+  $('project-description').append(' ', back);
+  await run('reconstruct');
+  return true;
 }
 
 // The example that is open (the session carries its name), if any.
@@ -613,6 +637,7 @@ async function start() {
   const unknown = () => {
     if (wanted !== null && !linked) showError(`no built-in example "${wanted}" (there are: ${examples.map((e) => e.id).join(', ')})`);
   };
+  if (params.get('from') === 'playground' && await openFromPlayground()) return;
   const saved = EMBED ? null : await loadProject();
   if (saved) {
     try {

@@ -7,6 +7,7 @@ import {
   DEFAULT_SCENE, FIELDS, SOURCE_FIELDS, NEW_LENS, NEW_SOURCE, LENS_NAMES, SOURCE_NAMES,
   draggable, encodeFragment, decodeFragment, tidyScene,
 } from './scene.js';
+import { wireObserve } from './observe.js';
 
 const params = new URLSearchParams(location.search);
 const EMBED = params.has('embed');
@@ -48,6 +49,7 @@ root.innerHTML = `
     </select>
     <label><input type="checkbox" id="pg-timing"> ms/frame</label>
     <button id="pg-share" type="button">Share link</button>
+    ${EMBED ? '' : '<button id="pg-observe" type="button" title="Freeze the scene into mock telescope data">Observe</button><button id="pg-invert" type="button" hidden>Invert with WSLAP+</button>'}
     ${EMBED ? '<a id="pg-open" target="_blank" rel="noopener">Open full</a>' : '<a href="./?app">Research app</a>'}
   </div>
   <div class="pg-main">
@@ -190,6 +192,7 @@ async function refreshContours() {
 
 /** A scene change while dragging (coarse frame) or after it (full frame, contours, link). */
 function changed(final) {
+  observed?.clear();
   const drawn = compute(final ? FULL_PIXELS : DRAG_PIXELS);
   if (final) {
     // After the worker has this scene: contours asked for at once were drawn for the last.
@@ -302,6 +305,7 @@ function draw() {
       }
     }
   }
+  observed?.draw(ctx, (x, y) => toCanvas(imageCanvas, fov(), x, y), dpr);
   if (hover?.kind === 'ray') {
     const [px, py] = toCanvas(imageCanvas, fov(), hover.at[0], hover.at[1]);
     marker(ctx, px, py, COLORS.ray, 6 * dpr);
@@ -578,6 +582,11 @@ function decodeFragmentSafe(hash) {
 }
 
 $('pg-fov').textContent = '';
+// Observe, then Invert (./observe.js); not in an embedded playground.
+const observed = EMBED ? null : wireObserve({
+  client, observeButton: $('pg-observe'), invertButton: $('pg-invert'), getScene: () => scene,
+  redraw: draw, say: (text) => { $('pg-readout').textContent = text; }, tidy: tidyScene,
+});
 wirePointer(imageCanvas, 'lenses', fov);
 wirePointer(sourceCanvas, 'sources', sourceFov);
 window.addEventListener('resize', sizeCanvases);
