@@ -4,6 +4,7 @@
 //! deflection maps, redraws curves at another source redshift from the stored maps, renders
 //! the views and answers hover read-outs. `src/wasm/` is a thin shell around it.
 
+mod compare;
 mod data;
 pub mod examples;
 mod iterates;

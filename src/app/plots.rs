@@ -245,6 +245,20 @@ impl Session {
         })
     }
 
+    /// The loaded model file's kappa (`D_ls/D_s = 1`) over a reconstruction's map, in the
+    /// reconstruction's frame, with the file's name; `None` as for [`Self::model_profile`].
+    /// At most `MODEL_MAPS_MAX_PIXELS` per side (the cached maps).
+    pub(crate) fn model_kappa(
+        &self,
+        result: &SessionResult,
+    ) -> Result<Option<(String, crate::map::Map)>, AppError> {
+        self.with_model_maps(result, |m| {
+            let mut kappa = m.maps.kappa.clone();
+            kappa.geometry.center -= m.origin;
+            Ok((m.name.clone(), kappa))
+        })
+    }
+
     /// Why the loaded model file is not compared with `result` (a reconstruction): it cannot be
     /// built (a Lenstool model without its member catalogue) or its lens plane is not the
     /// reconstruction's; `None` when it is compared, or when there is nothing to compare.

@@ -13,6 +13,9 @@ pub enum Colormap {
     #[default]
     Viridis,
     Magma,
+    /// Blue through white to red, white in the middle: for differences about zero with
+    /// symmetric limits.
+    Diverging,
 }
 
 impl Colormap {
@@ -21,6 +24,7 @@ impl Colormap {
         match self {
             Colormap::Viridis => &VIRIDIS,
             Colormap::Magma => &MAGMA,
+            Colormap::Diverging => &DIVERGING,
         }
     }
 
@@ -33,6 +37,33 @@ impl Colormap {
         };
         self.table()[k as usize]
     }
+}
+
+/// [`Colormap::Diverging`]: linear in sRGB from blue (33, 102, 172) through near-white
+/// (247, 247, 247) to red (178, 24, 43), the ends of ColorBrewer's RdBu.
+static DIVERGING: [[u8; 3]; 256] = diverging_table();
+
+const fn diverging_table() -> [[u8; 3]; 256] {
+    const LOW: [f64; 3] = [33.0, 102.0, 172.0];
+    const MID: [f64; 3] = [247.0, 247.0, 247.0];
+    const HIGH: [f64; 3] = [178.0, 24.0, 43.0];
+    let mut out = [[0u8; 3]; 256];
+    let mut k = 0;
+    while k < 256 {
+        let t = k as f64 / 255.0;
+        let (a, b, u) = if t < 0.5 {
+            (LOW, MID, 2.0 * t)
+        } else {
+            (MID, HIGH, 2.0 * t - 1.0)
+        };
+        let mut c = 0;
+        while c < 3 {
+            out[k][c] = (a[c] + (b[c] - a[c]) * u + 0.5) as u8;
+            c += 1;
+        }
+        k += 1;
+    }
+    out
 }
 
 /// How values map to colour: linearly, or by `log10(value)` (values at or below the lower

@@ -313,8 +313,8 @@ impl AppSession {
         self.settings()
     }
 
-    /// One view as PNG bytes: `kappa`, `source`, `data`, `radial` or `convergence`. The
-    /// option `iterate: k` draws the mass map of the `k`-th kept iterate
+    /// One view as PNG bytes: `kappa`, `source`, `data`, `radial`, `convergence` or `compare`.
+    /// The option `iterate: k` draws the mass map of the `k`-th kept iterate
     /// ([`AppSession::iterates`]).
     pub fn view(&self, name: &str, options: JsValue) -> Result<JsValue, JsError> {
         let opts = view_options(options)?;
@@ -325,6 +325,7 @@ impl AppSession {
             "data" => s.data_view(&opts),
             "radial" => s.radial_view(&opts),
             "convergence" => s.convergence_view(&opts),
+            "compare" => s.compare_view(&opts),
             other => return Err(JsError::new(&format!("unknown view '{other}'"))),
         }
         .map_err(err)?;

@@ -2,7 +2,7 @@
 //! loaded into the app as the browser does, reconstructed with the suggested settings; the
 //! reconstruction's Einstein radius against the truth's.
 
-use wslap::app::{DataRole, RunKind, Session};
+use wslap::app::{DataRole, RunKind, Session, ViewOptions};
 use wslap::playground::{observe, ObserveOptions, Playground, Scene};
 use wslap::Control;
 
@@ -43,4 +43,14 @@ fn observing_then_inverting_the_first_lesson_recovers_its_einstein_radius() {
         (ours / truth - 1.0).abs() < EINSTEIN_RADIUS_RTOL,
         "{ours} vs {truth}"
     );
+    // The comparison with the truth draws; without a model there is nothing to compare.
+    let opts = ViewOptions {
+        model_is_truth: true,
+        ..ViewOptions::default()
+    };
+    let png = s.compare_view(&opts).unwrap();
+    assert!(png.png.starts_with(b"\x89PNG"));
+    s.data.clear(DataRole::Model);
+    let e = s.compare_view(&opts).unwrap_err().to_string();
+    assert!(e.contains("model"), "{e}");
 }
