@@ -39,14 +39,20 @@ pub fn sersic_b(n: f64) -> f64 {
     }
 }
 
-/// Elliptical radius of offset `d` (arcsec) for axis ratio `q` and major axis at `pa_deg`:
-/// `sqrt(x'^2 + (y'/q)^2)`, equal to the major-axis distance.
-fn elliptical_radius(d: DVec2, q: f64, pa_deg: f64) -> f64 {
-    let (s, c) = pa_deg.to_radians().sin_cos();
+/// Elliptical radius of offset `d` (arcsec) for axis ratio `q` and major axis at the angle
+/// whose `(sin, cos)` is `sc`: `sqrt(x'^2 + (y'/q)^2)`, equal to the major-axis distance, and
+/// never less than `|d|` (`q <= 1`).
+#[inline]
+fn elliptical_radius(d: DVec2, q: f64, (s, c): (f64, f64)) -> f64 {
     let x = c * d.x + s * d.y;
     let y = (-s * d.x + c * d.y) / q;
     (x * x + y * y).sqrt()
 }
+
+/// Elliptical radii, in units of the source's scale, beyond which a Gaussian and a Sérsic
+/// source add nothing.
+const GAUSSIAN_CUT: f64 = 6.0;
+const SERSIC_CUT: f64 = 8.0;
 
 /// A source ready to be sampled: its brightness (tone-mapped intensity times colour) at a
 /// source-plane position.
@@ -56,6 +62,12 @@ pub struct Painter<'a> {
     pub pixels: Option<&'a SourcePixels>,
     /// `b_n` of a Sérsic source.
     b_n: f64,
+    /// `(sin, cos)` of the position angle.
+    sin_cos: (f64, f64),
+    /// Centre (arcsec) and the square of the distance from it (arcsec^2) beyond which the
+    /// source adds nothing.
+    center: DVec2,
+    reach2: f64,
 }
 
 impl<'a> Painter<'a> {
@@ -64,38 +76,44 @@ impl<'a> Painter<'a> {
             SourceSpec::Sersic { n, .. } => sersic_b(n),
             _ => 0.0,
         };
+        let (pa, reach) = match spec {
+            SourceSpec::Gaussian { sigma, pa, .. } => (pa, GAUSSIAN_CUT * sigma),
+            SourceSpec::Sersic { r_eff, pa, .. } => (pa, SERSIC_CUT * r_eff),
+            // The picture's half-diagonal is at most `size / sqrt(2)`.
+            SourceSpec::Image { size, .. } => (0.0, size),
+            SourceSpec::Point { .. } => (0.0, -1.0),
+        };
         Self {
             spec,
             rgb: SOURCE_RGB[index % SOURCE_RGB.len()],
             pixels,
             b_n,
+            sin_cos: pa.to_radians().sin_cos(),
+            center: spec.position(),
+            reach2: reach * reach.abs(),
         }
     }
 
     /// Adds this source's colour at `beta` (arcsec) to `out`.
     #[inline]
     pub fn add(&self, beta: DVec2, out: &mut [f32; 3]) {
+        // The elliptical radius is never less than the distance: far pixels need no more.
+        if beta.distance_squared(self.center) > self.reach2 {
+            return;
+        }
         let intensity = match self.spec {
-            SourceSpec::Gaussian {
-                x, y, sigma, q, pa, ..
-            } => {
-                let r = elliptical_radius(beta - DVec2::new(x, y), q, pa) / sigma;
-                if r > 6.0 {
+            SourceSpec::Gaussian { x, y, sigma, q, .. } => {
+                let r = elliptical_radius(beta - DVec2::new(x, y), q, self.sin_cos) / sigma;
+                if r > GAUSSIAN_CUT {
                     return;
                 }
                 1.6 * (-0.5 * r * r).exp()
             }
             SourceSpec::Sersic {
-                x,
-                y,
-                r_eff,
-                n,
-                q,
-                pa,
-                ..
+                x, y, r_eff, n, q, ..
             } => {
-                let r = elliptical_radius(beta - DVec2::new(x, y), q, pa) / r_eff;
-                if r > 8.0 {
+                let r = elliptical_radius(beta - DVec2::new(x, y), q, self.sin_cos) / r_eff;
+                if r > SERSIC_CUT {
                     return;
                 }
                 // Twice the half-light brightness reads as "bright"; the core saturates.

@@ -45,19 +45,23 @@
 //! [method §1]: crate::method#1-frames-and-units
 
 use std::collections::HashMap;
+use std::sync::{Mutex, PoisonError};
 
 use glam::DVec2;
 use serde::Serialize;
 
-use crate::curves::{critical_curves, zero_contours, Polyline};
+use crate::curves::{zero_contours, Polyline};
 use crate::image_search::{find_images, ImageKind, ImageSearch, Parity, SearchGrid};
 use crate::map::{magnification_at_point, LensMaps, Map, MapGeometry};
 use crate::potential::{arrival_time_days, potential_difference, potential_map};
 use crate::products::Clock;
 
+mod frame;
 mod light;
 mod observe;
 mod scene;
+
+pub use frame::CURVE_PIXELS;
 
 pub use light::{sersic_b, SourcePixels, BACKGROUND_RGB, SOURCE_RGB};
 pub use observe::{
@@ -68,6 +72,7 @@ pub use scene::{
     DEFAULT_Z_SOURCE, MAX_SCENE_ITEMS, SCENE_VERSION,
 };
 
+use frame::LensCache;
 use light::{to_byte, Painter};
 
 /// Pixels a side of the grid on which [`Playground::images_of`] starts its search.
@@ -173,6 +178,8 @@ pub struct Playground {
     scene: Scene,
     built: BuiltScene,
     pictures: HashMap<u32, SourcePixels>,
+    /// The lens's deflections and curves for the frames drawn since it last changed.
+    cache: Mutex<LensCache>,
 }
 
 impl Playground {
@@ -183,6 +190,7 @@ impl Playground {
             scene,
             built,
             pictures: HashMap::new(),
+            cache: Mutex::default(),
         })
     }
 
@@ -228,23 +236,26 @@ impl Playground {
             .collect()
     }
 
-    /// Renders both views at `pixels` a side (clamped to [16, [`MAX_FRAME_PIXELS`]]): the
-    /// lens's maps on the image-plane grid, every pixel traced to each source's plane, the
-    /// critical curves of each source redshift from those maps and the caustics through the
-    /// exact lens, and the images of the point sources.
+    /// Renders both views at `pixels` a side (clamped to [16, [`MAX_FRAME_PIXELS`]]): every
+    /// pixel traced to each source's plane with the lens's deflection, the critical curves of
+    /// each source redshift (traced on a grid of at most [`CURVE_PIXELS`] a side) and the
+    /// caustics through the exact lens, and the images of the point sources. The deflections
+    /// and curves are kept while the lens stays the same: a frame after only the sources
+    /// changed evaluates no lens.
     pub fn frame(&self, pixels: usize) -> Frame {
         let clock = Clock::start();
         let n = pixels.clamp(16, MAX_FRAME_PIXELS);
         let geometry = MapGeometry::centered(self.scene.fov, n);
         let lens = &self.built.lens;
-        let maps = LensMaps::from_lens(lens, geometry);
+        let mut cache = self.cache.lock().unwrap_or_else(PoisonError::into_inner);
+        cache.keep_if_lens_of(&self.scene);
         let painters = self.painters();
         let mut image_rgba = vec![0u8; n * n * 4];
+        let alpha = cache.deflection(lens, geometry);
         for j in 0..n {
             for i in 0..n {
-                let k = j * n + i;
                 let theta = geometry.pixel_center(i, j);
-                let alpha = DVec2::new(maps.alpha_x.data[k], maps.alpha_y.data[k]);
+                let alpha = alpha[j * n + i];
                 let mut rgb = BACKGROUND_RGB;
                 for (p, f) in painters.iter().zip(&self.built.source_f) {
                     p.add(theta - *f * alpha, &mut rgb);
@@ -264,22 +275,8 @@ impl Playground {
                 put(&mut source_rgba, (n - 1 - j) * n + i, rgb);
             }
         }
-        let curves = self
-            .built
-            .planes
-            .iter()
-            .map(|plane| {
-                let c = critical_curves(&maps, plane.f, plane.z, Some(lens));
-                PlaneCurves {
-                    z: plane.z,
-                    einstein_radius_arcsec: c.einstein_radius_arcsec,
-                    tangential: c.tangential,
-                    radial: c.radial,
-                    tangential_caustics: c.caustics.tangential,
-                    radial_caustics: c.caustics.radial,
-                }
-            })
-            .collect();
+        let curves = cache.curves(&self.built, geometry);
+        let maps = cache.curve_maps(lens, geometry);
         let points = self
             .scene
             .sources
@@ -288,7 +285,7 @@ impl Playground {
             .filter(|(_, s)| matches!(s, SourceSpec::Point { .. }))
             .map(|(k, s)| PointSourceImages {
                 source: k,
-                images: self.images_with(SearchGrid::Maps(&maps), s.position(), s.z()),
+                images: self.images_with(SearchGrid::Maps(maps), s.position(), s.z()),
             })
             .collect();
         Frame {

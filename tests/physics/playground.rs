@@ -3,7 +3,7 @@
 //! that are the inversion's own halos).
 
 use glam::DVec2;
-use wslap::playground::{ContourKind, Playground, Scene, SceneError, SourceSpec};
+use wslap::playground::{ContourKind, Playground, Scene, SceneError, SceneLens, SourceSpec};
 use wslap::{
     build_member_layers, CellGrid, LensPlane, MassComponent, Member, MemberCatalog, MemberConfig,
 };
@@ -166,4 +166,99 @@ fn arrival_time_contours_run_through_the_saddle_images() {
             im.y
         );
     }
+}
+
+/// The page's default scene (www/playground/scene.js): an SIE, a member galaxy and shear;
+/// sources at three redshifts.
+const PAGE_SCENE: &str = r#"{"v": 1, "z_lens": 0.3, "fov": 40,
+ "lenses": [{"type": "sie", "x": 0, "y": 0, "sigma_v": 850, "q": 0.75, "pa": 20},
+            {"type": "member", "x": 7, "y": -5, "mag": 19},
+            {"type": "shear", "gamma1": 0.03, "gamma2": 0.02}],
+ "sources": [{"type": "sersic", "x": 1.2, "y": 0.8, "z": 2, "r_eff": 0.6, "n": 1, "q": 0.7, "pa": 30},
+             {"type": "gaussian", "x": -1.5, "y": -1.0, "z": 1.2, "sigma": 0.35, "q": 1, "pa": 0},
+             {"type": "point", "x": 0.6, "y": -0.4, "z": 3}]}"#;
+
+/// Largest distance (arcsec) from a vertex of `a` to the nearest segment of `b`.
+fn farthest_vertex(a: &[Vec<DVec2>], b: &[Vec<DVec2>]) -> f64 {
+    let to_segment = |p: DVec2, s: DVec2, e: DVec2| {
+        let d = e - s;
+        let t = ((p - s).dot(d) / d.length_squared().max(1e-300)).clamp(0.0, 1.0);
+        p.distance(s + t * d)
+    };
+    a.iter()
+        .flatten()
+        .map(|&p| {
+            b.iter()
+                .flat_map(|line| line.windows(2).map(move |w| to_segment(p, w[0], w[1])))
+                .fold(f64::INFINITY, f64::min)
+        })
+        .fold(0.0, f64::max)
+}
+
+#[cfg_attr(not(target_arch = "wasm32"), test)]
+#[cfg_attr(target_arch = "wasm32", wasm_bindgen_test::wasm_bindgen_test)]
+fn full_frame_curves_from_the_coarser_grid_lie_within_a_pixel_of_the_fine_ones() {
+    use wslap::{critical_curves, LensMaps, MapGeometry};
+    let pg = Playground::new(Scene::from_json_str(PAGE_SCENE).expect("scene")).expect("pg");
+    let frame = pg.frame(512);
+    let geometry = MapGeometry::centered(40.0, 512);
+    let fine_maps = LensMaps::from_lens(&pg.built().lens, geometry);
+    assert_eq!(frame.curves.len(), 3);
+    for (coarse, plane) in frame.curves.iter().zip(&pg.built().planes) {
+        let fine = critical_curves(&fine_maps, plane.f, plane.z, Some(&pg.built().lens));
+        assert_rel(
+            "Einstein radius",
+            coarse.einstein_radius_arcsec,
+            fine.einstein_radius_arcsec,
+            0.002,
+        );
+        for (c, f) in [
+            (&coarse.tangential, &fine.tangential),
+            (&coarse.radial, &fine.radial),
+        ] {
+            assert_eq!(c.is_empty(), f.is_empty(), "z = {}", plane.z);
+            let pixel = geometry.pixel_arcsec();
+            let (there, back) = (farthest_vertex(c, f), farthest_vertex(f, c));
+            assert!(
+                there < pixel && back < pixel,
+                "z = {}: curves {there} and {back} arcsec apart, pixel {pixel}",
+                plane.z
+            );
+        }
+    }
+}
+
+#[cfg_attr(not(target_arch = "wasm32"), test)]
+#[cfg_attr(target_arch = "wasm32", wasm_bindgen_test::wasm_bindgen_test)]
+fn a_frame_with_kept_lens_results_is_the_frame_computed_afresh() {
+    let scene = Scene::from_json_str(PAGE_SCENE).expect("scene");
+    let mut pg = Playground::new(scene.clone()).expect("pg");
+    let first = pg.frame(256);
+    // Only a source moves: the deflections and curves are kept.
+    let mut moved = scene.clone();
+    if let SourceSpec::Sersic { x, .. } = &mut moved.sources[0] {
+        *x += 0.4;
+    }
+    pg.set_scene(moved.clone()).expect("scene");
+    let kept = pg.frame(256);
+    let fresh = Playground::new(moved).expect("pg").frame(256);
+    assert_ne!(kept.image_rgba, first.image_rgba, "the arcs moved");
+    assert_eq!(kept.image_rgba, fresh.image_rgba, "the same lensed image");
+    assert_eq!(kept.source_rgba, fresh.source_rgba);
+    // A lens that moves is evaluated again, and moving it back gives the first frame.
+    let mut lens_moved = scene.clone();
+    if let SceneLens::Member(m) = &mut lens_moved.lenses[1] {
+        m.x += 1.0;
+    }
+    pg.set_scene(lens_moved.clone()).expect("scene");
+    let other = pg.frame(256);
+    let fresh = Playground::new(lens_moved).expect("pg").frame(256);
+    assert_eq!(other.image_rgba, fresh.image_rgba);
+    assert_ne!(other.image_rgba, kept.image_rgba, "the member moved");
+    for (a, b) in other.curves.iter().zip(&fresh.curves) {
+        assert_eq!(a.tangential, b.tangential);
+        assert_eq!(a.radial_caustics, b.radial_caustics);
+    }
+    pg.set_scene(scene).expect("scene");
+    assert_eq!(pg.frame(256).image_rgba, first.image_rgba);
 }
