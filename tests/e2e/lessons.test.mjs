@@ -11,6 +11,9 @@ import { openApp, ARTIFACTS, ROOT } from './browser.mjs';
 
 const TIMEOUT_MS = 120_000;
 const { lessons } = JSON.parse(await readFile(join(ROOT, 'www', 'lessons', 'index.json'), 'utf8'));
+for (const l of lessons) {
+  if (l.scene_file) l.scene = JSON.parse(await readFile(join(ROOT, 'www', l.scene_file), 'utf8'));
+}
 
 /** Waits until the full (512²) frame on screen is of the scene now in the playground. */
 async function fullFrame(page) {

@@ -14,6 +14,10 @@ export async function startLessons(api, id) {
   css.href = new URL('./lessons.css', import.meta.url).href;
   document.head.append(css);
   const { lessons } = await (await fetch(INDEX)).json();
+  // A lesson may share its scene with other pages (`scene_file`, relative to www/).
+  await Promise.all(lessons.filter((l) => l.scene_file).map(async (l) => {
+    l.scene = await (await fetch(new URL(`../${l.scene_file}`, import.meta.url))).json();
+  }));
   const box = document.createElement('section');
   box.id = 'pg-lesson';
   box.className = 'pg-lesson';
