@@ -30,7 +30,7 @@ async function teachingRun(query) {
 }
 
 test('relaxed-SIMD and baseline-SIMD cores load as asked and agree', async () => {
-  const relaxed = await teachingRun('');
+  const relaxed = await teachingRun('?app');
   const baseline = await teachingRun('?simd=baseline');
   assert.match(relaxed.core, /relaxed SIMD/);
   assert.match(baseline.core, /WebAssembly with SIMD\./);
