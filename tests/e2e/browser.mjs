@@ -89,7 +89,8 @@ export async function runToMap(page, button, timeout = 60_000) {
   await waitView(page, 'kappa', before);
 }
 
-/** Statistics of the rendered image `selector` read back through a canvas in the page;
+/** Statistics of the rendered image `selector` read back through a canvas in the page (`sum`:
+ * every colour channel added up, a digest that tells two drawings apart);
  * `near` counts the pixels within `tol` (per channel) of the colour `rgb`. The app sets an
  * image's `src` and `data-view` together and the browser decodes it later, and a view can be
  * drawn again at any time (a new `src`), so the page waits until the image has loaded and
@@ -110,15 +111,17 @@ export async function imageStats(page, selector, { rgb = [0, 0, 0], tol = -1 } =
     let magenta = 0;
     let white = 0;
     let near = 0;
+    let sum = 0;
     for (let k = 0; k < data.length; k += 4) {
       const [r, g, b] = [data[k], data[k + 1], data[k + 2]];
+      sum += r + g + b;
       if (Math.abs(r - want[0]) <= tol && Math.abs(g - want[1]) <= tol && Math.abs(b - want[2]) <= tol) near += 1;
       colours.add((r >> 3) << 10 | (g >> 3) << 5 | (b >> 3));
       if (r > 200 && g < 80 && b < 80) reddish += 1;
       if (r > 220 && g < 100 && b > 220) magenta += 1;
       if (r > 250 && g > 250 && b > 250) white += 1;
     }
-    return { width: c.width, height: c.height, distinctColours: colours.size, reddish, magenta, white, near };
+    return { width: c.width, height: c.height, distinctColours: colours.size, reddish, magenta, white, near, sum };
   }, [rgb, tol]);
 }
 

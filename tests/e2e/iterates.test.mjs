@@ -4,29 +4,13 @@
 import { test } from 'node:test';
 import assert from 'node:assert/strict';
 import { join } from 'node:path';
-import { openApp, renderCount, runToMap, waitView, waitStatus, watchLongTasks, ARTIFACTS } from './browser.mjs';
+import { openApp, imageStats, renderCount, runToMap, waitView, waitStatus, watchLongTasks, ARTIFACTS } from './browser.mjs';
 
 /** A digest of the pixels of `#view-image` once loaded: the sum of every channel and the
  * number of pixels of the tangential curves' red. */
 async function pixels(page) {
-  return page.$eval('#view-image', async (img) => {
-    for (let k = 0; k < 300 && !(img.complete && img.naturalWidth > 0); k++) {
-      await new Promise((r) => setTimeout(r, 100));
-    }
-    const c = document.createElement('canvas');
-    c.width = img.naturalWidth;
-    c.height = img.naturalHeight;
-    const ctx = c.getContext('2d');
-    ctx.drawImage(img, 0, 0);
-    const { data } = ctx.getImageData(0, 0, c.width, c.height);
-    let sum = 0;
-    let red = 0;
-    for (let k = 0; k < data.length; k += 4) {
-      sum += data[k] + data[k + 1] + data[k + 2];
-      if (data[k] > 200 && data[k + 1] < 80 && data[k + 2] < 80) red += 1;
-    }
-    return { sum, red };
-  });
+  const { sum, reddish } = await imageStats(page, '#view-image');
+  return { sum, red: reddish };
 }
 
 const label = (page) => page.textContent('#iterate-label');
