@@ -140,16 +140,17 @@ pub use solver::{
 
 // A reconstruction: inputs, settings, the run, cross-validation.
 pub use reconstruct::{
-    check_ensemble_size, check_memory, cross_validate, fitted_system_ids, fold_groups,
-    image_regions, layer_count, product_options, reconstruct, reconstruct_with_choice,
+    check_ensemble_size, check_memory, cross_validate, estimate_redshift, fitted_system_ids,
+    fold_groups, image_regions, layer_count, product_options, reconstruct, reconstruct_with_choice,
     run_ensemble, strength_candidates, strength_folds, strength_trial, ArrivalTimes, Bytes,
     ConvergenceRecord, CrossValidation, Dataset, DatasetError, Ensemble, EnsembleMaps,
-    EnsembleMember, FoldRun, Heap, ImageReport, InputText, InputTexts, Inputs, InterpolatedLens,
-    KappaSpread, LayerSource, MemoryEstimate, MemoryLimit, PredictedImage, PredictedSystem,
-    ProductConfig, ReconstructConfig, ReconstructError, ReconstructSummary, Reconstruction,
-    RunSize, RunStatus, Solved, SolverConfig, SolverMethod, SourceReport, StrengthCandidate,
-    StrengthChoice, TooMuchMemory, CHOICE_MAP_PIXELS, DEFAULT_FOLDS, FALLBACK_MEMORY_LIMIT_BYTES,
-    MAX_ENSEMBLE_MEMBERS, SHOWN_MIN_MAGNIFICATION, WASM_MEMORY_LIMIT_BYTES,
+    EnsembleMember, FoldRun, FreeZSummary, Heap, ImageReport, InputText, InputTexts, Inputs,
+    InterpolatedLens, KappaSpread, LayerSource, MemoryEstimate, MemoryLimit, PredictedImage,
+    PredictedSystem, ProductConfig, ReconstructConfig, ReconstructError, ReconstructSummary,
+    Reconstruction, RedshiftEstimate, RunSize, RunStatus, Solved, SolverConfig, SolverMethod,
+    SourceReport, StrengthCandidate, StrengthChoice, TooMuchMemory, CHOICE_MAP_PIXELS,
+    DEFAULT_FOLDS, FALLBACK_MEMORY_LIMIT_BYTES, FALLBACK_SIGMA_ARCSEC, MAX_ENSEMBLE_MEMBERS,
+    SHOWN_MIN_MAGNIFICATION, WASM_MEMORY_LIMIT_BYTES,
 };
 
 // Figures.

@@ -334,6 +334,11 @@ impl Session {
             .constraints(config.constraints.mode)
             .map_err(dataset_error)?;
         config.constraints.mode = mode;
+        // Systems whose redshift the run estimated were fitted at it.
+        config.constraints.z_estimates = sources
+            .iter()
+            .filter_map(|s| Some((s.id.clone(), s.z_estimate?)))
+            .collect();
         let constraints = build_constraints(source, &config.constraints, &self.settings.holdout)
             .map_err(|e| run(&e))?;
         let positions: Vec<DVec2> = constraints.pixels.iter().map(|p| p.position).collect();
@@ -372,6 +377,7 @@ impl Session {
                 warnings,
                 timings: StageTimings::default(),
                 strength_choice: None,
+                free_z: None,
             })),
             marks: parsed.marks(),
             elapsed_ms: t.ms(),

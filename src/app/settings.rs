@@ -136,6 +136,9 @@ impl AppSettings {
             )))
         };
         behind("the curves'", self.reconstruct.products.z_source)?;
+        if let Some([_, high]) = self.reconstruct.constraints.free_z_prior {
+            behind("the top of the range of estimated redshifts:", high)?;
+        }
         match self.reconstruct.constraints.default_z {
             Some(z) => behind("the redshift for images with z = 0:", z),
             None => Ok(()),

@@ -55,9 +55,18 @@ pub struct ReconstructArgs {
     /// Systems to leave out of the fit and predict, e.g. 3,7.
     #[arg(long, value_delimiter = ',', value_name = "IDS")]
     holdout: Vec<String>,
-    /// Redshift for systems whose catalogue redshift is 0 (unknown); without it they are left out.
+    /// Redshift for systems whose catalogue redshift is 0 (unknown); without it their redshift
+    /// is estimated (see --free-z).
     #[arg(long)]
     default_z: Option<f64>,
+    /// Systems whose redshift is estimated although the catalogue gives one, e.g. 3,7 (systems
+    /// with z = 0 are estimated anyway). Each is left out of a first fit, its redshift found on
+    /// that lens (sources.json: z_estimate and its 68% z_interval), then fitted at it.
+    #[arg(long, value_delimiter = ',', value_name = "IDS")]
+    free_z: Vec<String>,
+    /// The range an estimated redshift lies in, LOW,HIGH (default 0.5,8).
+    #[arg(long, value_delimiter = ',', num_args = 2, value_name = "LOW,HIGH")]
+    z_prior: Option<Vec<f64>>,
     /// QADP iterations (overrides the configuration).
     #[arg(long)]
     iterations: Option<usize>,
@@ -127,6 +136,12 @@ pub fn run(args: &ReconstructArgs) -> Result<(), String> {
     if let Some(n) = args.iterations {
         config.solver.iterations = n;
     }
+    if !args.free_z.is_empty() {
+        config.constraints.free_z_systems.clone_from(&args.free_z);
+    }
+    if let Some(prior) = &args.z_prior {
+        config.constraints.free_z_prior = Some([prior[0], prior[1]]);
+    }
     if args.default_z.is_some() {
         config.constraints.default_z = args.default_z;
     }
@@ -135,18 +150,23 @@ pub fn run(args: &ReconstructArgs) -> Result<(), String> {
         .solver_settings()
         .validate()
         .map_err(|e| option("--iterations", &e))?;
-    config
-        .constraints
-        .validate()
-        .map_err(|e| option("--default-z", &e))?;
+    config.constraints.validate().map_err(|e| {
+        match e.to_string().contains("free_z_prior") && args.z_prior.is_some() {
+            true => option("--z-prior", &e),
+            false => option("--default-z", &e),
+        }
+    })?;
     let cosmology = Cosmology::new(args.h0, args.omega_m).map_err(|e| e.to_string())?;
     let plane = LensPlane::new(cosmology, args.z_lens).map_err(|e| e.to_string())?;
     // Known before any data is read: a source in front of the lens is refused at once.
     if let Err(e) = config.check_behind_lens(args.z_lens) {
         return Err(
-            match e.field == "constraints.default_z" && args.default_z.is_some() {
-                true => option("--default-z", &e),
-                false => format!("{settings_name}: {e}"),
+            if e.field == "constraints.default_z" && args.default_z.is_some() {
+                option("--default-z", &e)
+            } else if e.field.starts_with("constraints.free_z_prior") && args.z_prior.is_some() {
+                option("--z-prior", &e)
+            } else {
+                format!("{settings_name}: {e}")
             },
         );
     }

@@ -15,9 +15,12 @@
 //! system a total of 1. `sigma_pos_arcsec` (default 0.5, a common image-plane position error)
 //! scales all weights alike, which changes chi^2 but not the solution.
 //!
-//! Systems without a redshift are left out unless `default_z` is given; systems with a single
-//! image and held-out systems are left out too; each is listed in
-//! [`ConstraintSet::excluded`].
+//! Systems without a redshift (and those named in `free_z_systems`) have it estimated when
+//! `free_z_prior` is set (the default): they are left out of a first fit and their redshift
+//! is then found on its lens (`crate::reconstruct`'s `free_z` module), after which they are
+//! fitted at it (`z_estimates`). With `default_z` given instead, systems without a redshift
+//! take it; with neither, they are left out. Systems with a single image and held-out systems
+//! are left out too. Each system left out is listed in [`ConstraintSet::excluded`].
 //!
 //! [method §3]: crate::method#3-the-linear-system
 
@@ -57,6 +60,8 @@ pub enum ConstraintError {
     },
     #[error("constraints: hold-out system \"{id}\" is not in {source_name}")]
     UnknownHoldOut { source_name: String, id: String },
+    #[error("constraints: free_z_systems: system \"{id}\" is not in {source_name}")]
+    UnknownFreeZ { source_name: String, id: String },
     #[error("{source_name}: no system is left to constrain the model (excluded: {excluded})")]
     NoSystems {
         source_name: String,
@@ -105,8 +110,20 @@ pub struct ConstraintConfig {
     pub weighting: Weighting,
     /// Image-plane position error in arcsec (default 0.5). Allowed [1e-4, 100].
     pub sigma_pos_arcsec: f64,
-    /// Redshift given to systems whose redshift is unknown (default none: they are left out).
+    /// Redshift given to systems whose redshift is unknown (default none: estimated, see
+    /// `free_z_prior`).
     pub default_z: Option<f64>,
+    /// Systems whose catalogue redshift is set aside and estimated like an unknown one (ids;
+    /// default none).
+    pub free_z_systems: Vec<String>,
+    /// The range an unknown redshift is estimated in, `[low, high]` (default `[0.5, 8]`; the
+    /// low end is raised to just behind the lens). `null`: systems without a redshift are left
+    /// out (unless `default_z` is given). Allowed 0 < low < high <= 20.
+    pub free_z_prior: Option<[f64; 2]>,
+    /// Redshifts estimated for the systems above, by id: these systems are fitted at them
+    /// (set by the reconstruction, never read from a settings file).
+    #[serde(skip)]
+    pub z_estimates: Vec<(String, f64)>,
     /// Largest number of pixels one ellipse may hold (default 10000). Allowed 1 to
     /// [`crate::limits::MAX_ARC_PIXELS`].
     pub max_pixels_per_image: usize,
@@ -120,12 +137,36 @@ impl Default for ConstraintConfig {
             weighting: Weighting::EqualPerImage,
             sigma_pos_arcsec: 0.5,
             default_z: None,
+            free_z_systems: Vec::new(),
+            free_z_prior: Some(DEFAULT_FREE_Z_PRIOR),
+            z_estimates: Vec::new(),
             max_pixels_per_image: 10_000,
         }
     }
 }
 
+/// The default range of an estimated redshift: from the nearest sources lensed into
+/// arcs by clusters to the most distant lensed galaxies catalogued (the prior).
+pub const DEFAULT_FREE_Z_PRIOR: [f64; 2] = [0.5, 8.0];
+
 impl ConstraintConfig {
+    /// Whether the system `id` with catalogue redshift `z` has its redshift estimated:
+    /// named in `free_z_systems`, or without one while neither `default_z` is given nor
+    /// estimation switched off (`free_z_prior` null).
+    pub fn is_free_z(&self, id: &str, z: Option<f64>) -> bool {
+        self.free_z_prior.is_some()
+            && (self.free_z_systems.iter().any(|s| s == id)
+                || (z.is_none() && self.default_z.is_none()))
+    }
+
+    /// The redshift estimated for `id`, once there is one.
+    fn z_estimate(&self, id: &str) -> Option<f64> {
+        self.z_estimates
+            .iter()
+            .find(|(s, _)| s == id)
+            .map(|&(_, z)| z)
+    }
+
     /// Checks every field against the range in its documentation.
     pub fn validate(&self) -> Result<(), ConstraintError> {
         let bad = |field: &str, value, reason| {
@@ -152,6 +193,22 @@ impl ConstraintConfig {
         if let Some(z) = self.default_z {
             if !(z.is_finite() && z > 0.0 && z < 20.0) {
                 return Err(bad("default_z", z, "a source redshift must be in (0, 20)"));
+            }
+        }
+        if let Some([low, high]) = self.free_z_prior {
+            if !(low.is_finite() && low > 0.0) {
+                return Err(bad(
+                    "free_z_prior[0]",
+                    low,
+                    "a source redshift must be in (0, 20)",
+                ));
+            }
+            if !(high.is_finite() && high > low && high <= 20.0) {
+                return Err(bad(
+                    "free_z_prior[1]",
+                    high,
+                    "the upper end must lie above the lower and at most at 20",
+                ));
             }
         }
         if !(1..=crate::limits::MAX_ARC_PIXELS).contains(&self.max_pixels_per_image) {
@@ -196,6 +253,8 @@ pub struct ConstraintSystem {
 #[serde(rename_all = "snake_case")]
 pub enum Exclusion {
     UnknownRedshift,
+    /// Its redshift is to be estimated from a fit of the other systems.
+    FreeRedshift,
     SingleImage,
     HeldOut,
 }
@@ -205,6 +264,7 @@ impl std::fmt::Display for Exclusion {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         f.write_str(match self {
             Self::UnknownRedshift => "no redshift",
+            Self::FreeRedshift => "redshift to be estimated",
             Self::SingleImage => "a single image",
             Self::HeldOut => "held out",
         })
@@ -407,6 +467,16 @@ pub fn build_constraints(
             id: id.clone(),
         });
     }
+    if let Some(id) = config
+        .free_z_systems
+        .iter()
+        .find(|f| !candidates.iter().any(|c| &c.id == *f))
+    {
+        return Err(ConstraintError::UnknownFreeZ {
+            source_name,
+            id: id.clone(),
+        });
+    }
     let mut set = ConstraintSet {
         systems: Vec::new(),
         pixels: Vec::new(),
@@ -414,7 +484,13 @@ pub fn build_constraints(
         warnings: Vec::new(),
     };
     for c in candidates {
-        let z = c.z.or(config.default_z);
+        let free = config.is_free_z(&c.id, c.z);
+        let estimate = config.z_estimate(&c.id).filter(|_| free);
+        let z = if free {
+            estimate
+        } else {
+            c.z.or(config.default_z)
+        };
         let exclusion = if hold_out.contains(&c.id) {
             Err(Exclusion::HeldOut)
         } else if c.images.len() < 2 && c.single_is_one_image {
@@ -425,6 +501,8 @@ pub fn build_constraints(
             Err(Exclusion::SingleImage)
         } else if let Some(z) = z {
             Ok(z)
+        } else if free {
+            Err(Exclusion::FreeRedshift)
         } else {
             set.warnings.push(format!(
                 "{source_name}: system {} has no redshift and no default_z is set: not used",
@@ -434,13 +512,14 @@ pub fn build_constraints(
         };
         match exclusion {
             Ok(z) => {
-                if c.z.is_none() {
+                if c.z.is_none() && estimate.is_none() {
                     set.warnings.push(format!(
                         "{source_name}: system {} has no redshift: default_z = {z} assumed",
                         c.id
                     ));
                 }
-                add_system(&mut set, c, z, config);
+                let assumed = c.z.is_none() && estimate.is_none();
+                add_system(&mut set, c, z, assumed, config);
             }
             Err(reason) => set.excluded.push(ExcludedSystem { id: c.id, reason }),
         }
@@ -480,7 +559,13 @@ fn first_line(source: ConstraintSource<'_>, id: &str) -> Option<usize> {
 }
 
 /// Appends one system's pixels with their weights (module documentation).
-fn add_system(set: &mut ConstraintSet, c: Candidate, z: f64, config: &ConstraintConfig) {
+fn add_system(
+    set: &mut ConstraintSet,
+    c: Candidate,
+    z: f64,
+    z_assumed: bool,
+    config: &ConstraintConfig,
+) {
     let system = set.systems.len();
     let n_pixels: usize = c.images.iter().map(Vec::len).sum();
     let inv_var = 1.0 / (config.sigma_pos_arcsec * config.sigma_pos_arcsec);
@@ -498,7 +583,6 @@ fn add_system(set: &mut ConstraintSet, c: Candidate, z: f64, config: &Constraint
                 weight: w * inv_var,
             }));
     }
-    let z_assumed = c.z.is_none();
     set.systems.push(ConstraintSystem {
         id: c.id,
         z,

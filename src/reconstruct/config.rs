@@ -222,6 +222,10 @@ impl ReconstructConfig {
         let fields = [
             ("products.z_source", Some(self.products.z_source)),
             ("constraints.default_z", self.constraints.default_z),
+            (
+                "constraints.free_z_prior[1]",
+                self.constraints.free_z_prior.map(|p| p[1]),
+            ),
         ];
         for (field, z) in fields {
             if let Some(z) = z.filter(|&z| z.is_nan() || z <= z_lens) {

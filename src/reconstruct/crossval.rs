@@ -18,8 +18,8 @@ use serde::{Deserialize, Serialize};
 
 use super::summary::{image_offsets_arcsec, median_arcsec, rms_arcsec};
 use super::{
-    reconstruct, ConvergenceRecord, Inputs, ReconstructConfig, ReconstructError, Reconstruction,
-    SourceReport,
+    reconstruct_free_z, ConvergenceRecord, Inputs, ReconstructConfig, ReconstructError,
+    Reconstruction, SourceReport,
 };
 use crate::curves::CriticalCurves;
 use crate::fits::{write_image, Card, FitsWriteOptions};
@@ -309,7 +309,9 @@ pub fn cross_validate(
             holdout: &holdout,
             ..*inputs
         };
-        let r = reconstruct(&fold_inputs, config, &mut |record| progress(fold, record))?;
+        let r = reconstruct_free_z(&fold_inputs, config, false, &mut |record| {
+            progress(fold, record)
+        })?;
         if r.status == SolveStatus::Cancelled {
             status = "Cancelled";
             break;

@@ -11,6 +11,7 @@ mod config;
 mod crossval;
 mod dataset;
 mod ensemble;
+mod free_z;
 mod memory;
 mod sources;
 mod summary;
@@ -28,6 +29,7 @@ pub use dataset::{Dataset, DatasetError, InputText, InputTexts};
 pub use ensemble::{
     check_ensemble_size, run_ensemble, Ensemble, EnsembleMaps, EnsembleMember, MAX_ENSEMBLE_MEMBERS,
 };
+pub use free_z::{estimate_redshift, FreeZSummary, RedshiftEstimate, FALLBACK_SIGMA_ARCSEC};
 pub use memory::{
     layer_count, Bytes, Heap, MemoryEstimate, MemoryLimit, RunSize, TooMuchMemory,
     FALLBACK_MEMORY_LIMIT_BYTES, WASM_MEMORY_LIMIT_BYTES,
@@ -214,6 +216,8 @@ pub struct Reconstruction {
     pub timings: StageTimings,
     /// How the regulariser's strength was chosen, when it was "auto".
     pub strength_choice: Option<StrengthChoice>,
+    /// The systems whose redshift was estimated, when there were any.
+    pub free_z: Option<FreeZSummary>,
 }
 
 /// One candidate (regulariser and strength) of an "auto" strength and how well it predicted.
@@ -257,6 +261,7 @@ impl Reconstruction {
             warnings: &self.warnings,
             timings: self.timings,
             strength_choice: self.strength_choice.as_ref(),
+            free_z: self.free_z.as_ref(),
         }
     }
 
@@ -292,9 +297,23 @@ impl Reconstruction {
 /// still returns the products of the last iterate (its status says `Cancelled`). Every
 /// parallel section of the run (rows, normal equations, QADP passes, maps, image search) uses
 /// at most `system.threads` threads (0: all cores).
+///
+/// Systems without a redshift are first left out, then have it estimated on the lens of the
+/// others and are fitted at it (the `free_z` module).
 pub fn reconstruct(
     inputs: &Inputs<'_>,
     config: &ReconstructConfig,
+    progress: &mut dyn FnMut(&ConvergenceRecord) -> Control,
+) -> Result<Reconstruction, ReconstructError> {
+    reconstruct_free_z(inputs, config, true, progress)
+}
+
+/// [`reconstruct`], and with `free_z` false without estimating any redshift (the systems
+/// without one stay out: cross-validation folds, which compare the fits of the same systems).
+pub(crate) fn reconstruct_free_z(
+    inputs: &Inputs<'_>,
+    config: &ReconstructConfig,
+    free_z: bool,
     progress: &mut dyn FnMut(&ConvergenceRecord) -> Control,
 ) -> Result<Reconstruction, ReconstructError> {
     config.validate()?;
@@ -304,9 +323,13 @@ pub fn reconstruct(
         choose_strength(inputs, config, progress)
     })?;
     match choice {
-        Some(choice) => reconstruct_with_choice(inputs, config, choice, progress),
+        Some(choice) => with_choice(inputs, config, choice, free_z, progress),
         None => crate::threads::with_limit(config.system.threads, || {
-            reconstruct_limited(inputs, config, progress)
+            let first = reconstruct_limited(inputs, config, progress)?;
+            match free_z {
+                true => free_z::add_free_systems(inputs, config, first, None, progress),
+                false => Ok(first),
+            }
         }),
     }
 }
@@ -431,6 +454,19 @@ pub fn strength_trial(
 }
 
 impl StrengthChoice {
+    /// The image-plane error (arcsec, rms over both axes) of the chosen candidate's held-out
+    /// images, from their median offset, which one image near a critical curve cannot
+    /// inflate: for offsets with a Gaussian error `s` per axis the median offset is
+    /// `s sqrt(2 ln 2)` and the rms `s sqrt(2)`. `None` without trials.
+    pub fn holdout_sigma_arcsec(&self) -> Option<f64> {
+        let chosen = self
+            .candidates
+            .iter()
+            .find(|c| c.regulariser == self.chosen_regulariser && c.strength == self.chosen)?;
+        let median = chosen.holdout_median_arcsec?;
+        Some(median * (2.0 / (2.0 * std::f64::consts::LN_2)).sqrt())
+    }
+
     /// The choice among the `trials` of `config`'s candidates: the fewest held-out images with
     /// no predicted image, then the smallest held-out median offset. With fewer than 2 folds
     /// (no trials), the middle candidate, and said so.
@@ -484,11 +520,25 @@ pub fn reconstruct_with_choice(
     choice: StrengthChoice,
     progress: &mut dyn FnMut(&ConvergenceRecord) -> Control,
 ) -> Result<Reconstruction, ReconstructError> {
+    with_choice(inputs, config, choice, true, progress)
+}
+
+fn with_choice(
+    inputs: &Inputs<'_>,
+    config: &ReconstructConfig,
+    choice: StrengthChoice,
+    free_z: bool,
+    progress: &mut dyn FnMut(&ConvergenceRecord) -> Control,
+) -> Result<Reconstruction, ReconstructError> {
     crate::threads::with_limit(config.system.threads, || {
         let mut fixed = config.clone();
         fixed.objective.strength = Strength::Value(choice.chosen);
         fixed.objective.regulariser = choice.chosen_regulariser;
         let mut r = reconstruct_limited(inputs, &fixed, progress)?;
+        if free_z {
+            let sigma = choice.holdout_sigma_arcsec();
+            r = free_z::add_free_systems(inputs, &fixed, r, sigma, progress)?;
+        }
         r.config = config.clone();
         r.strength_choice = Some(choice);
         Ok(r)
@@ -673,6 +723,7 @@ fn reconstruct_limited(
         warnings,
         timings,
         strength_choice: None,
+        free_z: None,
     })
 }
 

@@ -133,6 +133,13 @@ pub struct SourceReport {
     pub z: f64,
     /// True when the redshift was the configured default, not measured.
     pub z_assumed: bool,
+    /// For a system whose redshift was estimated (none in the catalogue, or named free), the
+    /// estimate it was fitted at (`z` is the same; the `free_z` module says how); else `null`.
+    #[serde(default)]
+    pub z_estimate: Option<f64>,
+    /// The 68% interval (16th and 84th percentiles) of `z_estimate`.
+    #[serde(default)]
+    pub z_interval: Option<[f64; 2]>,
     /// True when the system was left out of the fit and is predicted.
     pub held_out: bool,
     /// Source position (arcsec): the solved beta of a fitted system, or the mean back-projected
@@ -350,7 +357,7 @@ type Observed = Vec<(String, DVec2)>;
 /// The redshift (if known) and the observed images of the held-out system `id`: the image
 /// catalogue's positions when it has the system, else the mean of each image's arc pixels;
 /// `None` for an id that is in neither.
-fn held_out_images(inputs: &Inputs<'_>, id: &str) -> Option<(Option<f64>, Observed)> {
+pub(super) fn held_out_images(inputs: &Inputs<'_>, id: &str) -> Option<(Option<f64>, Observed)> {
     if let Some(sys) = inputs
         .catalog
         .and_then(|c| c.systems.iter().find(|s| s.id == id))
@@ -451,6 +458,8 @@ fn finish(
         id,
         z,
         z_assumed,
+        z_estimate: None,
+        z_interval: None,
         held_out,
         beta_arcsec: beta,
         scatter_arcsec: scatter,

@@ -4,7 +4,7 @@
 
 use serde::Serialize;
 
-use super::{ReconstructConfig, SourceReport, StageTimings, StrengthChoice};
+use super::{FreeZSummary, ReconstructConfig, SourceReport, StageTimings, StrengthChoice};
 use crate::inversion::LinearSystem;
 use crate::products::Summary;
 
@@ -21,6 +21,8 @@ pub struct Solved<'a> {
     pub timings: StageTimings,
     /// How an "auto" regulariser strength was chosen.
     pub strength_choice: Option<&'a StrengthChoice>,
+    /// The systems whose redshift was estimated, when there were any.
+    pub free_z: Option<&'a FreeZSummary>,
 }
 
 impl<'a> Solved<'a> {
@@ -97,6 +99,7 @@ impl<'a> Solved<'a> {
             holdout_image_offset_median_arcsec: self.image_offset_median_arcsec(true),
             regulariser_weight: s.terms.penalty_weight,
             strength_choice: self.strength_choice,
+            free_redshifts: self.free_z,
             warnings: self.warnings,
             maps,
             timings_ms: self.timings,
@@ -140,6 +143,9 @@ pub struct ReconstructSummary<'a> {
     /// The cross-validation curve an "auto" strength was chosen from (candidate, held-out
     /// median and rms), and the strength chosen.
     pub strength_choice: Option<&'a StrengthChoice>,
+    /// The systems whose redshift was estimated (`sources.json` has each estimate), and the
+    /// fitted median offset of the others without and with them.
+    pub free_redshifts: Option<&'a FreeZSummary>,
     pub warnings: &'a [String],
     pub maps: Summary,
     pub timings_ms: StageTimings,

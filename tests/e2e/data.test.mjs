@@ -96,7 +96,7 @@ test('a file chosen while an example opens replaces that example once it is open
   }
 });
 
-test('systems without a redshift join the fit once the settings give them one', async () => {
+test('systems without a redshift have it estimated, or take the one the settings give', async () => {
   const app = await openApp();
   try {
     const { page } = app;
@@ -113,24 +113,31 @@ test('systems without a redshift join the fit once the settings give them one', 
       await page.click('#tab-systems');
       await page.waitForSelector('#systems table');
       const systems = await page.locator('#systems tbody tr').count();
+      const estimated = await page.locator('#systems tbody td.z-estimated').allTextContents();
       await page.click('#tab-kappa');
-      return { warnings, systems };
+      return { warnings, systems, estimated };
     };
-    const without = await run();
-    const noZ = without.warnings.filter((t) => /immul_ongoing\.cat: system \S+ has no redshift and no default_z is set: not used/.test(t));
-    assert.ok(noZ.length >= 1, without.warnings.join(' | '));
+    // By default each is left out of a first fit, its redshift estimated on that lens, and
+    // then fitted: the systems table gives the estimate and its 68% interval.
+    const free = await run();
+    const found = free.warnings.filter((t) => /^system \S+: redshift estimated z = [\d.]+ \(68%: [\d.]+ - [\d.]+\)/.test(t));
+    assert.ok(found.length >= 1, free.warnings.join(' | '));
+    assert.equal(free.estimated.length, found.length, free.estimated.join(' | '));
+    for (const cell of free.estimated) assert.match(cell, /^[\d.]+ est\.[\d.]+–[\d.]+$/);
+    assert.deepEqual(free.warnings.filter((t) => /not used/.test(t)), []);
     // A redshift at or in front of the lens is refused and the field keeps its value.
     await page.fill('#set-reconstruct-constraints-default_z', '0.3');
     await page.dispatchEvent('#set-reconstruct-constraints-default_z', 'change');
     await page.waitForFunction(() => /images with z = 0: z_s = 0.3 is not behind the lens/
       .test(document.getElementById('set-reconstruct-constraints-default_z-error').textContent));
     assert.equal(await page.inputValue('#set-reconstruct-constraints-default_z'), '');
+    // A default redshift replaces the estimates.
     await setField(page, '#set-reconstruct-constraints-default_z', 2);
     const withZ = await run();
-    assert.deepEqual(withZ.warnings.filter((t) => /not used/.test(t)), []);
     const assumed = withZ.warnings.filter((t) => /immul_ongoing\.cat: system \S+ has no redshift: default_z = 2 assumed/.test(t));
-    assert.equal(assumed.length, noZ.length, withZ.warnings.join(' | '));
-    assert.equal(withZ.systems, without.systems + noZ.length, `${without.systems} systems, ${noZ.length} without z`);
+    assert.equal(assumed.length, found.length, withZ.warnings.join(' | '));
+    assert.deepEqual(withZ.estimated, []);
+    assert.equal(withZ.systems, free.systems);
     assert.deepEqual(app.consoleErrors, []);
   } finally {
     await app.close();

@@ -117,7 +117,11 @@ fn systems_are_excluded_for_redshift_single_image_and_hold_out() {
         Some(2.0),
         vec![image("4.1", 1.0, 1.0, 0.5, 0.5, 0.0)],
     ));
-    let config = ConstraintConfig::default();
+    // Without estimated redshifts (the default estimates them: below).
+    let config = ConstraintConfig {
+        free_z_prior: None,
+        ..ConstraintConfig::default()
+    };
     let set =
         build_constraints(ConstraintSource::Catalog(&cat), &config, &["3".to_string()]).unwrap();
     let ids: Vec<&str> = set.systems.iter().map(|s| s.id.as_str()).collect();
@@ -152,6 +156,49 @@ fn systems_are_excluded_for_redshift_single_image_and_hold_out() {
     assert_eq!(
         set.warnings[0],
         "test.cat: system 2 has no redshift: default_z = 2.5 assumed"
+    );
+    // The default: system 2's redshift is to be estimated, and so is system 1's when named;
+    // once estimated, both are fitted at the estimate, not assumed.
+    let free = ConstraintConfig {
+        free_z_systems: vec!["1".to_string()],
+        ..ConstraintConfig::default()
+    };
+    let set = build_constraints(ConstraintSource::Catalog(&cat), &free, &[]).unwrap();
+    let reasons: Vec<(&str, Exclusion)> = set
+        .excluded
+        .iter()
+        .map(|e| (e.id.as_str(), e.reason))
+        .collect();
+    assert_eq!(
+        reasons,
+        [
+            ("1", Exclusion::FreeRedshift),
+            ("2", Exclusion::FreeRedshift),
+            ("4", Exclusion::SingleImage)
+        ]
+    );
+    let estimated = ConstraintConfig {
+        z_estimates: vec![("1".to_string(), 1.7), ("2".to_string(), 3.1)],
+        ..free.clone()
+    };
+    let set = build_constraints(ConstraintSource::Catalog(&cat), &estimated, &[]).unwrap();
+    let zs: Vec<(&str, f64, bool)> = set
+        .systems
+        .iter()
+        .map(|s| (s.id.as_str(), s.z, s.z_assumed))
+        .collect();
+    assert_eq!(
+        zs,
+        [("1", 1.7, false), ("2", 3.1, false), ("3", 1.2, false)]
+    );
+    let unknown = ConstraintConfig {
+        free_z_systems: vec!["8".to_string()],
+        ..ConstraintConfig::default()
+    };
+    let err = build_constraints(ConstraintSource::Catalog(&cat), &unknown, &[]).unwrap_err();
+    assert_eq!(
+        err.to_string(),
+        "constraints: free_z_systems: system \"8\" is not in test.cat"
     );
     let err = build_constraints(ConstraintSource::Catalog(&cat), &config, &["9".to_string()])
         .unwrap_err();
