@@ -2,7 +2,7 @@
 // cancel, persistence) and the panels of js/*.js.
 
 import { LensClient } from './lens-client.js';
-import { loadProject, saveProject } from './js/store.js';
+import { loadProject, loadPrevious, saveProject, hasSaved, setAside, setAsideList, deleteSetAside } from './js/store.js';
 import { buildFileRows, setFileStatus, ROLES } from './js/files.js';
 import { buildSettings, showSettings } from './js/settings.js';
 import { wireViews, showPng, showSystems, showCrossval, showStrengthChoice, viewOptions, currentView, refreshReadout, clearPin } from './js/views.js';
@@ -24,7 +24,7 @@ if ('serviceWorker' in navigator) {
 const route = new URLSearchParams(location.search);
 let lessonsFirst = false;
 if (!route.has('playground') && !route.has('lesson') && location.search === '') {
-  lessonsFirst = !(await loadProject().catch(() => null));
+  lessonsFirst = !(await hasSaved());
   if (lessonsFirst) history.replaceState(null, '', `?lesson=lens-equation${location.hash}`);
 }
 if (lessonsFirst || route.has('playground') || route.has('lesson')) {
@@ -638,20 +638,79 @@ async function start() {
     if (wanted !== null && !linked) showError(`no built-in example "${wanted}" (there are: ${examples.map((e) => e.id).join(', ')})`);
   };
   if (params.get('from') === 'playground' && await openFromPlayground()) return;
-  const saved = EMBED ? null : await loadProject();
-  if (saved) {
-    try {
-      await openProject(saved, 'saved project');
-      setStatus(linked
-        ? `Restored your project from this browser (the link's example, "${linked.name}", is in the Example menu).`
-        : 'Restored your project from this browser.');
-      unknown();
-      return;
-    } catch { /* fall back to the example */ }
+  const restored = EMBED ? null : await openSaved();
+  if (!EMBED) await showSetAside();
+  if (restored) {
+    setStatus(linked
+      ? `${restored} (The link's example, "${linked.name}", is in the Example menu.)`
+      : restored);
+    unknown();
+    return;
   }
   const first = linked ?? examples[0];
   if (first) await loadExample(first);
+  if (!$('set-aside').hidden) setStatus(`Your saved project did not open; it is kept (see below). Opened the example "${first?.name}".`);
   unknown();
+}
+
+/** Opens the project kept in this browser: its last copy, else the one saved before it. A copy
+ * that does not open (corrupt, cut short, saved by a newer version) is set aside with the
+ * reason, never dropped (js/store.js). Returns the status to show, or null when none opened. */
+async function openSaved() {
+  for (const [which, read] of [['current', loadProject], ['previous', loadPrevious]]) {
+    const text = await read();
+    if (text == null) continue;
+    try {
+      if (typeof text !== 'string') throw new Error('saved project: it is not text');
+      await openProject(text, 'saved project');
+      return which === 'current' ? 'Restored your project from this browser.'
+        : 'Restored the copy of your project saved before the last one, which did not open (it is kept, see below).';
+    } catch (err) {
+      // The copy stays where it was if the browser refuses to move it: never dropped.
+      await setAside(which, err.message);
+    }
+  }
+  return null;
+}
+
+/** Lists the projects set aside (js/store.js) above the views: what happened, that the copy is
+ * kept, a download and a delete for each. */
+async function showSetAside() {
+  const box = $('set-aside');
+  const entries = await setAsideList();
+  box.replaceChildren();
+  box.hidden = entries.length === 0;
+  for (const e of entries) {
+    const day = e.at.slice(0, 10);
+    const row = document.createElement('div');
+    row.className = 'set-aside-entry';
+    const text = document.createElement('p');
+    const head = document.createElement('strong');
+    head.textContent = 'A project saved in this browser could not be opened';
+    // A copy cut short (a crash in the middle of a save, in an older version) says so first.
+    const cut = /EOF while parsing/.test(e.reason) ? 'it ends too early, cut short while it was saved: ' : '';
+    const why = cut + e.reason.replace(/^saved project: /, '');
+    text.append(head, ` (found on ${day}): ${why}. It was set aside, not deleted: download it to keep it (e.g. to open it with the version that saved it, or to send it with a bug report), or delete it.`);
+    const name = `wslap-project-set-aside-${e.at.replace(/[:.]/g, '-')}.json`;
+    const download = document.createElement('button');
+    download.type = 'button';
+    download.className = 'secondary';
+    download.textContent = 'Download it';
+    download.addEventListener('click', () => save(name, new Blob([e.text], { type: 'application/json' })));
+    const remove = document.createElement('button');
+    remove.type = 'button';
+    remove.className = 'secondary';
+    remove.textContent = 'Delete it';
+    remove.addEventListener('click', async () => {
+      await deleteSetAside(e.id);
+      await showSetAside();
+    });
+    const buttons = document.createElement('div');
+    buttons.className = 'buttons small';
+    buttons.append(download, remove);
+    row.append(text, buttons);
+    box.append(row);
+  }
 }
 
 start().catch((err) => showError(err.message));

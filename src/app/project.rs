@@ -13,6 +13,8 @@
 //! Deflection FITS files (look-up mode) are stored as base64 up to
 //! [`MAX_STORED_FITS_BYTES`] each; a larger one is left out (the app says so when it is
 //! loaded) and must be loaded again. Files without the deflection fields still read.
+//! `format` and `version` are read first: a file of another format, or of a version this build
+//! does not read (one saved by a newer wslap says so), is refused before its other fields are.
 
 use serde::{Deserialize, Serialize};
 
@@ -62,6 +64,41 @@ fn stored_bytes(f: &StoredFits, source_name: &str) -> Result<Vec<u8>, AppError> 
     base64::engine::general_purpose::STANDARD
         .decode(&f.fits_base64)
         .map_err(|e| bad(format!("not base64: {e}")))
+}
+
+/// The two fields of a project file that say what it is, read before the rest: a project of a
+/// newer format may have fields this version cannot read.
+#[derive(Deserialize)]
+struct ProjectHeader {
+    #[serde(default)]
+    format: Option<serde_json::Value>,
+    #[serde(default)]
+    version: Option<serde_json::Value>,
+}
+
+/// Refuses a text that is not JSON, not a project file, or a project of a format version this
+/// build does not read: one saved by a newer wslap is said to be so, with both versions.
+fn check_header(text: &str, source_name: &str) -> Result<(), AppError> {
+    let bad = |why: String| AppError::File(format!("{source_name}: {why}"));
+    let h: ProjectHeader =
+        serde_json::from_str(text).map_err(|e| bad(json_error_message(text, &e)))?;
+    if h.format.as_ref().and_then(|f| f.as_str()) != Some(PROJECT_FORMAT) {
+        return Err(bad(format!(
+            "not a wslap project (its \"format\" is {}, not \"{PROJECT_FORMAT}\")",
+            h.format.map_or("missing".to_string(), |f| f.to_string())
+        )));
+    }
+    match h.version.as_ref().and_then(serde_json::Value::as_u64) {
+        Some(v) if v == u64::from(PROJECT_VERSION) => Ok(()),
+        Some(v) if v > u64::from(PROJECT_VERSION) => Err(bad(format!(
+            "saved by a newer version of wslap (project format version {v}; this version reads \
+             version {PROJECT_VERSION}): open it with that version, or update this one"
+        ))),
+        _ => Err(bad(format!(
+            "project format version {} is not one this version reads (version {PROJECT_VERSION})",
+            h.version.map_or("missing".to_string(), |v| v.to_string())
+        ))),
+    }
 }
 
 /// The stored result.
@@ -161,15 +198,10 @@ impl Session {
         text: &str,
         source_name: &str,
     ) -> Result<ReopenReport, AppError> {
+        check_header(text, source_name)?;
         let p: Project = serde_json::from_str(text).map_err(|e| {
             AppError::File(format!("{source_name}: {}", json_error_message(text, &e)))
         })?;
-        if p.format != PROJECT_FORMAT || p.version != PROJECT_VERSION {
-            return Err(AppError::File(format!(
-                "{source_name}: format '{}' version {} is not a {PROJECT_FORMAT} version {PROJECT_VERSION} file",
-                p.format, p.version
-            )));
-        }
         p.settings
             .validate()
             .map_err(|e| AppError::File(format!("{source_name}: settings: {e}")))?;

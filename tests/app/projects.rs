@@ -44,6 +44,34 @@ fn a_project_reopens_with_the_maps_rebuilt_from_x() {
         .open_project("{\"format\": \"other\", \"version\": 1}", "q.json")
         .unwrap_err();
     assert!(err.to_string().contains("q.json"), "{err}");
+    // A project saved by a newer version says so with both versions, even when the rest of it
+    // would not read here (a field this version does not know).
+    let newer = text
+        .replacen("\"version\": 1", "\"version\": 7", 1)
+        .replacen(
+            "\"settings\": {",
+            "\"settings\": \"moved\", \"settings_v7\": {",
+            1,
+        );
+    assert!(newer.contains("settings_v7") && newer.contains("\"version\": 7"));
+    let err = t.open_project(&newer, "newer.json").unwrap_err();
+    assert_eq!(
+        err.to_string(),
+        "newer.json: saved by a newer version of wslap (project format version 7; this version \
+         reads version 1): open it with that version, or update this one"
+    );
+    let err = t
+        .open_project(
+            "{\"format\": \"wslap-project\", \"version\": 0}",
+            "old.json",
+        )
+        .unwrap_err();
+    assert!(err.to_string().contains("version 0 is not one"), "{err}");
+    // Truncated in the middle of a save: where it ends is said.
+    let err = t
+        .open_project(&text[..text.len() / 2], "cut.json")
+        .unwrap_err();
+    assert!(err.to_string().starts_with("cut.json: line "), "{err}");
     // Not JSON: the place is said once.
     let err = t.open_project("{\"format\": wslap}", "r.json").unwrap_err();
     assert_eq!(err.to_string(), "r.json: line 1, column 12: expected value");
