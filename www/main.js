@@ -641,9 +641,9 @@ async function start() {
   const restored = EMBED ? null : await openSaved();
   if (!EMBED) await showSetAside();
   if (restored) {
-    setStatus(linked
-      ? `${restored} (The link's example, "${linked.name}", is in the Example menu.)`
-      : restored);
+    const link = linked ? ` (the link's example, "${linked.name}", is in the Example menu)` : '';
+    setStatus(restored === 'current' ? `Restored your project from this browser${link}.`
+      : `Restored the copy of your project saved before the last one, which did not open (it is kept, see below)${link}.`);
     unknown();
     return;
   }
@@ -655,7 +655,8 @@ async function start() {
 
 /** Opens the project kept in this browser: its last copy, else the one saved before it. A copy
  * that does not open (corrupt, cut short, saved by a newer version) is set aside with the
- * reason, never dropped (js/store.js). Returns the status to show, or null when none opened. */
+ * reason, never dropped (js/store.js). Returns which copy opened ('current' or 'previous'), or
+ * null when none did. */
 async function openSaved() {
   for (const [which, read] of [['current', loadProject], ['previous', loadPrevious]]) {
     const text = await read();
@@ -663,8 +664,7 @@ async function openSaved() {
     try {
       if (typeof text !== 'string') throw new Error('saved project: it is not text');
       await openProject(text, 'saved project');
-      return which === 'current' ? 'Restored your project from this browser.'
-        : 'Restored the copy of your project saved before the last one, which did not open (it is kept, see below).';
+      return which;
     } catch (err) {
       // The copy stays where it was if the browser refuses to move it: never dropped.
       await setAside(which, err.message);

@@ -101,7 +101,7 @@ test('a last copy that does not open falls back to the one before; a cut save ne
     // A save that is not a whole project (a crash mid-way) is refused; the good copy stays.
     const refused = await page.evaluate(async (text) => (await import('./js/store.js')).saveProject(text),
       good.slice(0, 100));
-    assert.match(refused, /^did not keep the project in this browser: it is not whole JSON .*; the copy saved before is kept$/);
+    assert.match(refused, /^did not keep the project in this browser: it is not whole \(it ends before its closing brace\); the copy saved before is kept$/);
     assert.equal(await idb(page, 'get', 'current'), good);
     // Each save keeps the copy before it, so a bad last copy falls back to it.
     await setField(page, '#set-reconstruct-solver-iterations', 300);

@@ -45,12 +45,14 @@ async function run(mode, action) {
 
 const get = (key) => run('readonly', (s) => s.get(key));
 
-/** Why `text` is not a whole project file, or null when it is one. */
+/** Why `text` is not a whole project file, or null when it is one. The text comes from the
+ * core, which writes whole JSON; what can go wrong on the way is an empty or cut text, which
+ * this finds without parsing it (a project with FITS maps is many MB: parsing it here would
+ * hold up the page at every save). The core parses it in full when it is opened. */
 export function projectProblem(text) {
-  if (typeof text !== 'string' || text === '') return 'it is empty';
-  let p;
-  try { p = JSON.parse(text); } catch (err) { return `it is not whole JSON (${err.message})`; }
-  if (p?.format !== FORMAT) return 'it is not a wslap project';
+  if (typeof text !== 'string' || text.trim() === '') return 'it is empty';
+  if (text.match(/^\s*\{\s*"format":\s*"([^"]*)"/)?.[1] !== FORMAT) return 'it is not a wslap project';
+  if (!/\}\s*$/.test(text)) return 'it is not whole (it ends before its closing brace)';
   return null;
 }
 
