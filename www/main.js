@@ -80,7 +80,25 @@ async function refreshLoaded() {
   $('forward').disabled = !loaded.model;
   $('lookup').disabled = !(loaded.deflection_x && loaded.deflection_y);
   $('crossval').disabled = $('reconstruct').disabled;
+  showSkyWarnings(loaded.sky_warnings ?? []);
   return loaded;
+}
+
+/** Under the status line while the loaded files lie apart on the sky (files of different
+ * clusters): the core's sentence per file, which names both files and their positions. */
+function showSkyWarnings(warnings) {
+  const box = $('sky-warning');
+  box.replaceChildren();
+  box.hidden = warnings.length === 0;
+  if (!warnings.length) return;
+  const head = document.createElement('strong');
+  head.textContent = 'These files are of different parts of the sky. ';
+  box.append(head, warnings.join(' '));
+}
+
+/** A sentence for the status line when the loaded files lie apart on the sky. */
+function skyNote() {
+  return $('sky-warning').hidden ? '' : ' But the files are of different parts of the sky (see below).';
 }
 
 /** What the loaded files allow, as the status line says it when nothing else is to be said. */
@@ -168,7 +186,8 @@ function caption(info) {
     sum.holdout_image_plane_rms_arcsec);
   // A loaded model file that is not drawn next to a reconstruction says why.
   const note = info.model_note ? ` ${info.model_note}.` : '';
-  const stale = [...rejected.values()].map(({ file, kept }) => ` Made with ${kept}: ${file} had errors and was not loaded.`).join('');
+  const stale = [...rejected.values()].map(({ file, kept }) => ` Made with ${kept}: ${file} had errors and was not loaded.`).join('')
+    + ($('sky-warning').hidden ? '' : ' Made with files of different parts of the sky (see the warning above).');
   $('summary').textContent = `${status}Einstein radius ${bound}${s.einstein_radius_arcsec.toFixed(1)}″ at ` +
     `z_s = ${s.z_source}; ${factors}${offsets}${held}${s.tangential_curves} tangential and ${s.radial_curves} radial critical curves.${note}${stale}`;
 }
@@ -496,8 +515,8 @@ async function onFile(role, file) {
     await persist();
     if (!resultKind) {
       await render();
-      setStatus(readyText(loaded));
-    }
+      setStatus(readyText(loaded) + skyNote());
+    } else if (skyNote()) setStatus(skyNote().trim().replace(/^But t/, 'T'));
   } catch (err) {
     // The file before it (if any) stays loaded: said next to the file, at the top of the
     // results and in the next run's caption, so that nobody takes a run on it for one on theirs.

@@ -9,6 +9,7 @@ mod data;
 pub mod examples;
 mod iterates;
 mod outputs;
+mod overlap;
 mod plots;
 mod project;
 mod run;
@@ -25,6 +26,7 @@ pub use data::{
     NamedText, MAX_STORED_FITS_BYTES,
 };
 pub use iterates::{IterateList, IterateStep, APP_KEPT_ITERATES};
+pub use overlap::{separation_arcsec, SkyFootprint, FIELD_MARGIN_ARCSEC};
 pub use plots::{profile_relative_differences, ModelCurves};
 pub use project::{Project, ProjectResult, StoredFits, PROJECT_FORMAT, PROJECT_VERSION};
 pub use run::{Outcome, RunKind, SessionResult};
@@ -83,10 +85,23 @@ impl Session {
         self.data.load_text(role, name, text, pixel, &par)
     }
 
-    /// The loaded files parsed into one frame (see [`LoadedData::parse`]).
+    /// The loaded files parsed into one frame (see [`LoadedData::parse`]); its warnings
+    /// begin with [`Self::sky_warnings`].
     pub fn parsed(&self) -> Result<Dataset, AppError> {
-        self.data
-            .parse(self.settings.reconstruct.constraints.pixel_arcsec)
+        let mut parsed = self
+            .data
+            .parse(self.settings.reconstruct.constraints.pixel_arcsec)?;
+        let mut warnings = self.sky_warnings();
+        warnings.append(&mut parsed.warnings);
+        parsed.warnings = warnings;
+        Ok(parsed)
+    }
+
+    /// One warning per loaded file whose sky positions lie apart from the first file's (see
+    /// [`LoadedData::sky_warnings`]): files of different clusters.
+    pub fn sky_warnings(&self) -> Vec<String> {
+        let pixel = self.settings.reconstruct.constraints.pixel_arcsec;
+        self.data.sky_warnings(pixel, &self.settings.par_options())
     }
 
     /// Loads one deflection FITS map (`axis` 0 for x, 1 for y); nothing changes on an error.

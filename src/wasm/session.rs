@@ -412,7 +412,8 @@ impl AppSession {
     }
 
     /// Which files are loaded: `{images, members, arcs, model, deflection_x, deflection_y}`
-    /// (names or null).
+    /// (names or null), and `sky_warnings`: one sentence per file whose sky positions lie
+    /// apart from the others' (files of different clusters).
     pub fn loaded(&self) -> Result<JsValue, JsError> {
         let d = &self.inner.data;
         let name = |t: &Option<crate::app::NamedText>| t.as_ref().map(|x| x.name.clone());
@@ -420,6 +421,7 @@ impl AppSession {
         to_js(&serde_json::json!({
             "images": name(&d.images), "members": name(&d.members), "arcs": name(&d.arcs),
             "model": name(&d.model), "deflection_x": fits(0), "deflection_y": fits(1),
+            "sky_warnings": self.inner.sky_warnings(),
         }))
     }
 }

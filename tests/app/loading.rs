@@ -263,3 +263,85 @@ fn the_constraint_pixel_resamples_region_arcs() {
         parsed.warnings
     );
 }
+
+/// Real catalogues (`../shared/data`): those of one cluster, and the a1689-sim example's files,
+/// say nothing about the sky; AS1063's images with MACS1931's members are named as apart, with
+/// the files and positions, in the warning of the loaded files and of the run's data.
+#[cfg(not(target_arch = "wasm32"))]
+#[test]
+fn files_of_two_clusters_are_named_and_of_one_cluster_are_not() {
+    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR"));
+    let read = |path: &str| std::fs::read_to_string(root.join(path)).unwrap();
+    let load = |files: &[(DataRole, &str)]| {
+        let mut s = Session::new();
+        for (role, path) in files {
+            let name = path.rsplit('/').next().unwrap();
+            s.load_text(*role, name, &read(path)).unwrap();
+        }
+        s
+    };
+    let as1063 = "../shared/data/AS1063/lenstool_cats/";
+    let macs1931 = "../shared/data/MACS1931/lenstool_cats/";
+    let gold = format!("{as1063}cats_gold_mul_gold.cat");
+    for files in [
+        vec![
+            (DataRole::Images, gold.as_str()),
+            (
+                DataRole::Members,
+                &format!("{as1063}cats_gold_ref_potential_w_clumpNE.cat"),
+            ),
+            (DataRole::Model, &format!("{as1063}cats_gold_bestopt.par")),
+        ],
+        vec![
+            (DataRole::Images, &format!("{macs1931}immul_ongoing.cat")),
+            (DataRole::Members, &format!("{macs1931}m1931.cat")),
+        ],
+        vec![
+            (DataRole::Arcs, "www/examples/a1689-sim/arcs.json"),
+            (DataRole::Members, "www/examples/a1689-sim/members.cat"),
+            (DataRole::Model, "www/examples/a1689-sim/model.json"),
+        ],
+    ] {
+        let s = load(&files);
+        assert!(
+            s.sky_warnings().is_empty(),
+            "{files:?}: {:?}",
+            s.sky_warnings()
+        );
+    }
+    let s = load(&[
+        (DataRole::Images, gold.as_str()),
+        (DataRole::Members, &format!("{macs1931}m1931.cat")),
+    ]);
+    let w = s.sky_warnings();
+    assert_eq!(w.len(), 1, "{w:?}");
+    assert!(
+        w[0].starts_with("m1931.cat (RA 292.9")
+            && w[0].contains("and cats_gold_mul_gold.cat (RA 342.1")
+            && w[0].contains("degrees apart on the sky: they do not cover the same field"),
+        "{}",
+        w[0]
+    );
+    assert!(s.parsed().unwrap().warnings.contains(&w[0]));
+
+    // HFF-style deflection maps of one field (a forward run of the a1689-sim model, whose
+    // `reference` is at RA 197.87, Dec -1.34) under the catalogue of another.
+    let mut f = load(&[(DataRole::Model, "www/examples/a1689-sim/model.json")]);
+    f.set_field("reconstruct.products.pixels", json!(64))
+        .unwrap();
+    f.run(RunKind::Forward, &mut |_| Control::Continue).unwrap();
+    let fits = f.result().unwrap().products().fits_files().unwrap();
+    let x = &fits
+        .iter()
+        .find(|(n, _)| *n == "x-arcsec-deflect.fits")
+        .unwrap()
+        .1;
+    let mut s = load(&[(DataRole::Images, gold.as_str())]);
+    s.load_fits(0, "a1689_x.fits", x).unwrap();
+    let w = s.sky_warnings();
+    assert_eq!(w.len(), 1, "{w:?}");
+    assert!(w[0].starts_with("a1689_x.fits (RA 197.8"), "{}", w[0]);
+    // The same maps over the model of their own field say nothing.
+    f.load_fits(0, "a1689_x.fits", x).unwrap();
+    assert!(f.sky_warnings().is_empty(), "{:?}", f.sky_warnings());
+}

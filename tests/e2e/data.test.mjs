@@ -199,3 +199,34 @@ test('Cancel stops a run at once and the page keeps working', async () => {
     await app.close();
   }
 });
+
+test('catalogues of two clusters are named as apart on the sky, at the top and in the caption', async () => {
+  const app = await openApp();
+  try {
+    const { page } = app;
+    await waitStatus(page, /^Ready/);
+    await page.setInputFiles('#file-images', join(AS1063, 'cats_gold_mul_gold.cat'));
+    await page.waitForFunction(() => /19 systems, 50 images/.test(document.getElementById('status-images').textContent));
+    assert.equal(await page.isHidden('#sky-warning'), true);
+    // MACS J1931's members over AS1063's images: 49 degrees apart.
+    await page.setInputFiles('#file-members', join(MACS1931, 'm1931.cat'));
+    await page.waitForSelector('#sky-warning:not([hidden])');
+    const warning = await page.textContent('#sky-warning');
+    assert.match(warning, /^These files are of different parts of the sky\. m1931\.cat \(RA 292\.9\d+, Dec -26\.5\d+ deg\) and cats_gold_mul_gold\.cat \(RA 342\.1\d+, Dec -44\.5\d+ deg\) are [\d.]+ degrees apart on the sky: they do not cover the same field\./);
+    await waitStatus(page, /But the files are of different parts of the sky \(see below\)\.$/);
+    await page.screenshot({ path: join(ARTIFACTS, 'app-sky-apart.png') });
+    // A run on them says so in its caption and among its warnings.
+    await setField(page, '#set-z_lens', 0.348);
+    await setField(page, '#set-reconstruct-objective-strength', 0.1);
+    await runToMap(page, '#reconstruct', 120_000);
+    assert.match(await page.textContent('#summary'), /Made with files of different parts of the sky \(see the warning above\)\.$/);
+    const items = await page.locator('#run-warnings li').allTextContents();
+    assert.ok(items.some((t) => t.startsWith('m1931.cat (RA 292.9') && /degrees apart/.test(t)), items.slice(0, 3).join(' | '));
+    // The members of the same cluster put it right.
+    await page.setInputFiles('#file-members', join(AS1063, 'cats_gold_ref_potential_w_clumpNE.cat'));
+    await page.waitForSelector('#sky-warning', { state: 'hidden' });
+    assert.deepEqual(app.consoleErrors, []);
+  } finally {
+    await app.close();
+  }
+});
