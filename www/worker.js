@@ -14,19 +14,26 @@ const CORE = {
   baseline: new URL(self.wslapCore.baseline, import.meta.url),
 };
 
+// The core's exports once loaded (its `memory` is the WebAssembly memory the session lives in).
+let exports = null;
+
 // Loads the relaxed-SIMD core where it can run, else (or if it fails to load) the baseline one;
 // returns which.
 async function loadCore() {
   const forced = new URLSearchParams(self.location.search).get('simd');
   if (forced !== 'baseline' && self.wslapCore.hasRelaxedSimd()) {
     try {
-      await init({ module_or_path: CORE.relaxed });
+      exports = await init({ module_or_path: CORE.relaxed });
       return 'relaxed';
     } catch { /* e.g. a build without the second module: use the baseline one */ }
   }
-  await init({ module_or_path: CORE.baseline });
+  exports = await init({ module_or_path: CORE.baseline });
   return 'baseline';
 }
+
+/** The size of the core's WebAssembly memory (bytes). It only grows: its high-water mark.
+ * Also a worker global, read by the soak test (tests/e2e/soak.mjs) from outside the page. */
+self.wslapMemory = () => ({ wasm_bytes: exports?.memory?.buffer?.byteLength ?? null });
 
 let session = null;
 
@@ -96,6 +103,7 @@ const handlers = {
   fitsFiles: () => session.fits_files(),
   openProject: (m) => session.open_project(m.text, m.name),
   loaded: () => session.loaded(),
+  memory: () => self.wslapMemory(),
   reload: (m) => session.reload(m.role),
   // A fresh session (used after a cancel restarted the worker, or to start over).
   reset: () => { session = new core.AppSession(); return {}; },
