@@ -83,9 +83,19 @@ export async function hasSaved() {
   }
 }
 
+// Saves of this page run one after another: two at once would each read back the other's
+// text, take it for a bad copy and put an older one back.
+let saving = Promise.resolve();
+
 /** Saves the project text; returns an error message or null. The copy saved before stays in
- * use until this one is written whole and read back. */
-export async function saveProject(text) {
+ * use until this one is written whole and read back. Saves wait for the one before. */
+export function saveProject(text) {
+  const done = saving.then(() => saveNow(text));
+  saving = done.catch(() => null);
+  return done;
+}
+
+async function saveNow(text) {
   const problem = projectProblem(text);
   if (problem) return `did not keep the project in this browser: ${problem}; the copy saved before is kept`;
   try {
