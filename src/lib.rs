@@ -148,9 +148,16 @@ pub use reconstruct::{
     InterpolatedLens, KappaSpread, LayerSource, MemoryEstimate, MemoryLimit, PredictedImage,
     PredictedSystem, ProductConfig, ReconstructConfig, ReconstructError, ReconstructSummary,
     Reconstruction, RedshiftEstimate, RunSize, RunStatus, Solved, SolverConfig, SolverMethod,
-    SourceReport, StrengthCandidate, StrengthChoice, TooMuchMemory, CHOICE_MAP_PIXELS,
-    DEFAULT_FOLDS, FALLBACK_MEMORY_LIMIT_BYTES, FALLBACK_SIGMA_ARCSEC, MAX_ENSEMBLE_MEMBERS,
-    SHOWN_MIN_MAGNIFICATION, WASM_MEMORY_LIMIT_BYTES,
+    SourceReport, StrengthCandidate, StrengthChoice, SystemCheck, TooMuchMemory, Trust, Verdict,
+    VerdictInputs, CHOICE_MAP_PIXELS, DEFAULT_FOLDS, FALLBACK_MEMORY_LIMIT_BYTES,
+    FALLBACK_SIGMA_ARCSEC, MAX_ENSEMBLE_MEMBERS, SHOWN_MIN_MAGNIFICATION, WASM_MEMORY_LIMIT_BYTES,
+};
+
+// The verdict on a reconstruction and its thresholds.
+pub use reconstruct::{
+    members_with_own_curves, FLAG_OFFSET_ARCSEC, GOOD_FIT_OFFSET_ARCSEC,
+    GOOD_HOLDOUT_OFFSET_ARCSEC, LOST_IMAGE_ARCSEC, LOST_SYSTEMS_SHARE, MAIN_CURVE_MIN_SHARE,
+    SMALL_SCALE_OFFSET_ARCSEC, WORST_SHOWN,
 };
 
 // Figures.
@@ -158,8 +165,8 @@ pub use render::{
     color_limits, compose_grid, compose_png_grid, grid_offsets, kappa_figure_frame,
     kappa_figure_frame_for, render_colormap_rgba, render_kappa_png, value_rgb, Axis, AxisScale,
     ColorScale, Colormap, FigureFrame, GridLayout, KappaPlotOptions, LegendPlace, LinePlot,
-    LineStyle, Marker, Overlay, OverlayPoints, PlotFrame, Reference, RenderError, Series,
-    CAUSTIC_RGB, LOG_RANGE, MAX_COMPOSED_PIXELS, MAX_COMPOSED_SIDE_PX, MAX_LINE_WIDTH_PX,
+    LineStyle, Marker, Overlay, OverlayLabel, OverlayPoints, PlotFrame, Reference, RenderError,
+    Series, CAUSTIC_RGB, LOG_RANGE, MAX_COMPOSED_PIXELS, MAX_COMPOSED_SIDE_PX, MAX_LINE_WIDTH_PX,
     MIN_PIXEL_SIDE_PX, NO_DATA_RGB, PALETTE, PIXEL_ALPHA, PLOT_SIDE_PX, RADIAL_RGB, TANGENTIAL_RGB,
 };
 

@@ -390,6 +390,7 @@ impl Products {
             lines: Vec::new(),
             curves: Some(&self.curves),
             points: Vec::new(),
+            labels: Vec::new(),
         };
         let opts = KappaPlotOptions {
             scale,

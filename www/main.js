@@ -10,6 +10,7 @@ import { showDownloads, save } from './js/downloads.js';
 import { wireFigureDownload } from './js/figure-download.js';
 import { StrengthPool, poolSize, projectForTrials } from './js/pool.js';
 import { wireIterates, showIterates, syncIterates, iterateOption } from './js/iterates.js';
+import { showVerdict } from './js/verdict.js';
 
 // Offline use once loaded (sw.js), for the lessons and the playground too. Without it (an old
 // browser, a file:// page) the app still works online.
@@ -114,6 +115,7 @@ function readyText(loaded) {
 function showNoResult() {
   resultKind = null;
   $('summary').textContent = '';
+  showVerdict(null);
   runNotes(null);
   showStrengthChoice(null);
   showIterates(null);
@@ -162,6 +164,7 @@ async function render() {
 }
 
 function caption(info) {
+  showVerdict(info.summary.verdict);
   const s = info.summary.maps ?? info.summary;
   // The solver, when it is not the paper's QADP.
   const best = info.summary.settings?.solver?.method === 'accelerated_gradient'

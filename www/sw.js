@@ -24,6 +24,8 @@ const APP_FILES = [
   'js/settings.js',
   'js/simd.js',
   'js/store.js',
+  'js/systems-table.js',
+  'js/verdict.js',
   'js/views.js',
   'playground/client.js',
   'playground/lessons.css',

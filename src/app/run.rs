@@ -378,6 +378,7 @@ impl Session {
                 timings: StageTimings::default(),
                 strength_choice: None,
                 free_z: None,
+                member_positions_arcsec: parsed.members_arcsec(),
             })),
             marks: parsed.marks(),
             elapsed_ms: t.ms(),

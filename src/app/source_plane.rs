@@ -150,6 +150,7 @@ impl Session {
                     set(label, COUNTER_IMAGE_RGB, Marker::Circle, pinned)
                 }))
                 .collect(),
+            labels: Vec::new(),
         };
         let plot = KappaPlotOptions {
             scale: ColorScale::Log,
@@ -212,6 +213,7 @@ impl Session {
             lines: Vec::new(),
             curves: None,
             points,
+            labels: Vec::new(),
         };
         let plot = KappaPlotOptions {
             vmin: Some(-1.0),

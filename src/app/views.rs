@@ -6,7 +6,7 @@ use serde::{Deserialize, Serialize};
 
 use crate::render::{
     kappa_figure_frame_for, render_kappa_png, ColorScale, FigureFrame, KappaPlotOptions,
-    LegendPlace, Marker, Overlay, OverlayLines, OverlayPoints,
+    LegendPlace, Marker, Overlay, OverlayLabel, OverlayLines, OverlayPoints,
 };
 
 use super::data::{ArcPixels, DataMarks};
@@ -26,6 +26,8 @@ pub const OBSERVED_RGB: [u8; 3] = [255, 60, 255];
 pub const PREDICTED_RGB: [u8; 3] = [255, 170, 0];
 /// Member galaxies: white circles.
 pub const MEMBER_RGB: [u8; 3] = [255, 255, 255];
+/// The verdict's worst systems: a thick ring at the worst image and the system's id.
+pub const WORST_RGB: [u8; 3] = [255, 90, 0];
 /// The loaded model file's critical curves over a reconstruction: white, dashed.
 pub const MODEL_CURVE_RGB: [u8; 3] = [255, 255, 255];
 /// One colour per multiple-image system (arc pixels, their images mapped back, the systems
@@ -272,6 +274,7 @@ impl Session {
             lines: Vec::new(),
             curves: Some(&shown.products.curves),
             points: Vec::new(),
+            labels: Vec::new(),
         };
         if opts.show_model_curves {
             if let Some(m) = self.model_curves(r)? {
@@ -308,6 +311,22 @@ impl Session {
             overlay
                 .points
                 .push(points("observed", OBSERVED_RGB, Marker::Plus, o));
+            // The verdict's worst systems, of the result (not of an iterate).
+            if let Some(rec) = r.reconstruction().filter(|_| shown.iteration.is_none()) {
+                let worst = rec.verdict().worst;
+                let at: Vec<DVec2> = worst.iter().map(|w| w.position_arcsec).collect();
+                let label = "worst systems (see the verdict)";
+                overlay
+                    .points
+                    .push(points(label, WORST_RGB, Marker::Ring, at));
+                overlay
+                    .labels
+                    .extend(worst.into_iter().map(|w| OverlayLabel {
+                        text: w.id,
+                        position_arcsec: w.position_arcsec,
+                        color: WORST_RGB,
+                    }));
+            }
         }
         // A pin off these maps (left from another result) draws nothing; the app's list of
         // the images says why.

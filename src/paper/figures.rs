@@ -97,6 +97,7 @@ fn mass_maps(run: &PaperRun) -> Result<Vec<u8>, PaperError> {
             lines: vec![true_curves.clone()],
             curves: Some(&c.reconstruction.products.curves),
             points: Vec::new(),
+            labels: Vec::new(),
         };
         pngs.push(
             render_kappa_png(
@@ -111,6 +112,7 @@ fn mass_maps(run: &PaperRun) -> Result<Vec<u8>, PaperError> {
         lines: Vec::new(),
         curves: Some(&run.truth.curves),
         points: vec![arc_points(run)],
+        labels: Vec::new(),
     };
     pngs.push(
         render_kappa_png(
@@ -393,6 +395,7 @@ fn deflection_error(run: &PaperRun) -> Result<Vec<u8>, PaperError> {
         lines: Vec::new(),
         curves: None,
         points: vec![arc_points(run)],
+        labels: Vec::new(),
     };
     render_kappa_png(map, &overlay, &opts).map_err(fig_err("deflection-error"))
 }

@@ -15,6 +15,7 @@ mod free_z;
 mod memory;
 mod sources;
 mod summary;
+mod verdict;
 
 use glam::DVec2;
 use serde::{Deserialize, Serialize};
@@ -39,6 +40,11 @@ pub use sources::{
     PredictedImage, SourceReport, IMAGE_REGION_RADIUS_ARCSEC, SHOWN_MIN_MAGNIFICATION,
 };
 pub use summary::{ReconstructSummary, Solved};
+pub use verdict::{
+    members_with_own_curves, SystemCheck, Trust, Verdict, VerdictInputs, FLAG_OFFSET_ARCSEC,
+    GOOD_FIT_OFFSET_ARCSEC, GOOD_HOLDOUT_OFFSET_ARCSEC, LOST_IMAGE_ARCSEC, LOST_SYSTEMS_SHARE,
+    MAIN_CURVE_MIN_SHARE, SMALL_SCALE_OFFSET_ARCSEC, WORST_SHOWN,
+};
 
 use crate::catalog::{ImageCatalog, MemberCatalog};
 use crate::cosmology::LensPlane;
@@ -218,6 +224,9 @@ pub struct Reconstruction {
     pub strength_choice: Option<StrengthChoice>,
     /// The systems whose redshift was estimated, when there were any.
     pub free_z: Option<FreeZSummary>,
+    /// Positions of the member galaxies of the catalogue (arcsec; none for layers given
+    /// directly), for the verdict's members with critical curves of their own.
+    pub member_positions_arcsec: Vec<DVec2>,
 }
 
 /// One candidate (regulariser and strength) of an "auto" strength and how well it predicted.
@@ -286,10 +295,28 @@ impl Reconstruction {
         self.solved().image_offset_median_arcsec(held_out)
     }
 
+    /// The verdict on the map ([`Verdict::assess`]), with the curves at the products'
+    /// source redshift.
+    pub fn verdict(&self) -> Verdict {
+        self.verdict_with(self.products.summary().tangential_main_area_share)
+    }
+
+    fn verdict_with(&self, main_curve_share: Option<f64>) -> Verdict {
+        let inputs = VerdictInputs {
+            curves: Some((&self.products.curves, self.products.maps.geometry())),
+            main_curve_share,
+            members_arcsec: &self.member_positions_arcsec,
+            c_unmeasured: self.system.members_unmeasured(),
+        };
+        Verdict::assess(&self.sources, inputs)
+    }
+
     /// `summary.json` (what `wslap reconstruct` writes).
     pub fn summary(&self) -> ReconstructSummary<'_> {
+        let maps = self.products.summary();
+        let verdict = self.verdict_with(maps.tangential_main_area_share);
         self.solved()
-            .summary(self.status.name().to_string(), self.products.summary())
+            .summary(self.status.name().to_string(), maps, verdict)
     }
 }
 
@@ -724,7 +751,16 @@ fn reconstruct_limited(
         timings,
         strength_choice: None,
         free_z: None,
+        member_positions_arcsec: member_positions(inputs),
     })
+}
+
+/// The member catalogue's positions (arcsec) of `inputs` (none for layers given directly).
+fn member_positions(inputs: &Inputs<'_>) -> Vec<DVec2> {
+    match inputs.layers {
+        LayerSource::Members(catalog) => catalog.members.iter().map(|m| m.position).collect(),
+        LayerSource::None | LayerSource::Given(_) => Vec::new(),
+    }
 }
 
 /// Gives every layer without a prior whose factor the data hardly measure (independent share

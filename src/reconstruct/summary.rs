@@ -4,7 +4,7 @@
 
 use serde::Serialize;
 
-use super::{FreeZSummary, ReconstructConfig, SourceReport, StageTimings, StrengthChoice};
+use super::{FreeZSummary, ReconstructConfig, SourceReport, StageTimings, StrengthChoice, Verdict};
 use crate::inversion::LinearSystem;
 use crate::products::Summary;
 
@@ -60,9 +60,14 @@ impl<'a> Solved<'a> {
         median_arcsec(self.image_offsets_arcsec(held_out))
     }
 
-    /// `summary.json`, with `status` as written ("Completed", "Cancelled", ...) and the map
-    /// summary of the products.
-    pub fn summary(self, status: String, maps: Summary) -> ReconstructSummary<'a> {
+    /// `summary.json`, with `status` as written ("Completed", "Cancelled", ...), the map
+    /// summary of the products and the verdict on them.
+    pub fn summary(
+        self,
+        status: String,
+        maps: Summary,
+        verdict: Verdict,
+    ) -> ReconstructSummary<'a> {
         let s = self.system;
         ReconstructSummary {
             settings: self.config,
@@ -97,6 +102,7 @@ impl<'a> Solved<'a> {
             holdout_image_plane_rms_arcsec: self.image_plane_rms_arcsec(true),
             image_offset_median_arcsec: self.image_offset_median_arcsec(false),
             holdout_image_offset_median_arcsec: self.image_offset_median_arcsec(true),
+            verdict,
             regulariser_weight: s.terms.penalty_weight,
             strength_choice: self.strength_choice,
             free_redshifts: self.free_z,
@@ -138,6 +144,8 @@ pub struct ReconstructSummary<'a> {
     pub holdout_image_plane_rms_arcsec: Option<f64>,
     pub image_offset_median_arcsec: Option<f64>,
     pub holdout_image_offset_median_arcsec: Option<f64>,
+    /// How far the map can be trusted, and why ([`Verdict::assess`]).
+    pub verdict: Verdict,
     /// The regulariser's absolute weight `lambda` in the objective (0 without one).
     pub regulariser_weight: Option<f64>,
     /// The cross-validation curve an "auto" strength was chosen from (candidate, held-out

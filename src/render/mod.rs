@@ -95,6 +95,9 @@ pub enum Marker {
     Pixel {
         side_mas: u32,
     },
+    /// A wide circle around the position (three times a marker's radius, drawn thick) that
+    /// singles it out, e.g. the worst systems of a verdict.
+    Ring,
 }
 
 /// Opacity of [`Marker::Pixel`] squares.
@@ -147,6 +150,18 @@ pub struct Overlay<'a> {
     pub curves: Option<&'a CriticalCurves>,
     pub lines: Vec<OverlayLines>,
     pub points: Vec<OverlayPoints>,
+    /// Texts on the map, drawn last (e.g. the ids of the systems a ring marks).
+    pub labels: Vec<OverlayLabel>,
+}
+
+/// A text on the map: starts just right of `position_arcsec` (beside a [`Marker::Ring`]
+/// there), in `color` over a dark halo; left of it when it would leave the map.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct OverlayLabel {
+    pub text: String,
+    pub position_arcsec: DVec2,
+    /// sRGB colour.
+    pub color: [u8; 3],
 }
 
 /// Options of [`render_kappa_png`]; `Default` gives a 512-pixel viridis map, linear scale,

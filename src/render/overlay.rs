@@ -9,7 +9,7 @@ use tiny_skia::{
 use super::font::{draw_text, text_width, Anchor};
 use super::layout::Layout;
 use super::paint::{color, frame, paint};
-use super::{LegendPlace, Marker, Overlay, MIN_PIXEL_SIDE_PX, PIXEL_ALPHA};
+use super::{LegendPlace, Marker, Overlay, OverlayLabel, MIN_PIXEL_SIDE_PX, PIXEL_ALPHA};
 use crate::ds9::polyline_is_open;
 use crate::map::MapGeometry;
 
@@ -83,6 +83,7 @@ fn marker_path(marker: Marker, (x, y): (f32, f32), r: f32) -> Option<Path> {
     match marker {
         Marker::Circle => pb.push_circle(x, y, r),
         Marker::Square => pb.push_rect(Rect::from_xywh(x - r, y - r, 2.0 * r, 2.0 * r)?),
+        Marker::Ring => pb.push_circle(x, y, 3.0 * r),
         Marker::Pixel { .. } => return None,
         Marker::Cross | Marker::Plus => {
             let (a, b) = if marker == Marker::Cross {
@@ -227,6 +228,51 @@ pub(super) fn draw_overlay(
             }
         }
     }
+    for label in &overlay.labels {
+        draw_map_label(pm, l, g, label);
+    }
+}
+
+/// Draws `label` beside its position, one ring radius away: right of it, or left of it when
+/// the text would leave the map; nothing when the position is off the map.
+fn draw_map_label(pm: &mut Pixmap, l: &Layout, g: &MapGeometry, label: &OverlayLabel) {
+    let (x, y) = l.screen(g, label.position_arcsec);
+    let inside = |v: f32, lo: f32| v >= lo && v <= lo + l.m;
+    if !(inside(x, l.left) && inside(y, l.top)) {
+        return;
+    }
+    let s = l.s;
+    let gap = 3.0 * marker_radius(l) + 2.0 * s;
+    let right = x + gap + text_width(&label.text, s) <= l.left + l.m;
+    let (at, anchor) = if right {
+        ((x + gap, y), Anchor::MiddleLeft)
+    } else {
+        ((x - gap, y), Anchor::MiddleRight)
+    };
+    // A dark halo: the text drawn offset in eight directions, then in its colour on top.
+    let halo = Color::from_rgba8(0, 0, 0, 200);
+    for (dx, dy) in [
+        (-1.0, -1.0),
+        (0.0, -1.0),
+        (1.0, -1.0),
+        (-1.0, 0.0),
+        (1.0, 0.0),
+        (-1.0, 1.0),
+        (0.0, 1.0),
+        (1.0, 1.0),
+    ] {
+        let p = (at.0 + dx * s, at.1 + dy * s);
+        draw_text(pm, &label.text, p, s, halo, anchor, true);
+    }
+    draw_text(
+        pm,
+        &label.text,
+        at,
+        s,
+        color(label.color, 1.0),
+        anchor,
+        true,
+    );
 }
 
 /// Width of the curves and marker strokes (3 pixels on a 512-pixel map).
@@ -248,6 +294,7 @@ fn marker_size(marker: Marker, l: &Layout) -> (f32, f32) {
     match marker {
         Marker::Cross => (0.65 * r, 0.6 * w),
         Marker::Circle => (0.7 * r, 0.6 * w),
+        Marker::Ring => (r, 1.3 * w),
         _ => (r, w),
     }
 }
@@ -314,6 +361,15 @@ fn draw_sample(pm: &mut Pixmap, l: &Layout, key: &Key, x: f32, cy: f32, sample: 
             fill_pixels(pm, centre, side, rgb, None);
             None
         }
+        // A ring's sample is a circle of the row's height, not a ring of its size on the map.
+        Key::Point {
+            marker: Marker::Ring,
+            ..
+        } => marker_path(
+            Marker::Circle,
+            (x + sample / 2.0, cy),
+            1.2 * marker_radius(l),
+        ),
         Key::Point { marker, .. } => marker_path(*marker, (x + sample / 2.0, cy), marker_radius(l)),
     };
     if let Some(p) = path {

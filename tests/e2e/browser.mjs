@@ -94,9 +94,10 @@ export async function runToMap(page, button, timeout = 60_000) {
  * `near` counts the pixels within `tol` (per channel) of the colour `rgb`. The app sets an
  * image's `src` and `data-view` together and the browser decodes it later, and a view can be
  * drawn again at any time (a new `src`), so the page waits until the image has loaded and
- * reads it in the same task. */
-export async function imageStats(page, selector, { rgb = [0, 0, 0], tol = -1 } = {}) {
-  return page.$eval(selector, async (img, [want, tol]) => {
+ * reads it in the same task. `rows` counts only the top rows of the image (e.g. the map without
+ * the legend under it, whose rows reflow when an entry comes or goes). */
+export async function imageStats(page, selector, { rgb = [0, 0, 0], tol = -1, rows = Infinity } = {}) {
+  return page.$eval(selector, async (img, [want, tol, rows]) => {
     for (let k = 0; k < 300 && !(img.complete && img.naturalWidth > 0); k++) {
       await new Promise((r) => setTimeout(r, 100));
     }
@@ -112,7 +113,8 @@ export async function imageStats(page, selector, { rgb = [0, 0, 0], tol = -1 } =
     let white = 0;
     let near = 0;
     let sum = 0;
-    for (let k = 0; k < data.length; k += 4) {
+    const end = Math.min(data.length, (Number.isFinite(rows) ? rows : c.height) * c.width * 4);
+    for (let k = 0; k < end; k += 4) {
       const [r, g, b] = [data[k], data[k + 1], data[k + 2]];
       sum += r + g + b;
       if (Math.abs(r - want[0]) <= tol && Math.abs(g - want[1]) <= tol && Math.abs(b - want[2]) <= tol) near += 1;
@@ -122,7 +124,7 @@ export async function imageStats(page, selector, { rgb = [0, 0, 0], tol = -1 } =
       if (r > 250 && g > 250 && b > 250) white += 1;
     }
     return { width: c.width, height: c.height, distinctColours: colours.size, reddish, magenta, white, near, sum };
-  }, [rgb, tol]);
+  }, [rgb, tol, rows]);
 }
 
 /** Types `value` into the input `selector` (or picks the option of that value of a select) and

@@ -691,6 +691,7 @@ mod published {
                 positions_arcsec: positions,
                 marker: Marker::Cross,
             }],
+            labels: Vec::new(),
         };
         let opts = KappaPlotOptions {
             scale: ColorScale::Log,

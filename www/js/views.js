@@ -2,6 +2,9 @@
 // thread), the hover/click read-out on the mass map, and the per-system table.
 
 import { button, save } from './downloads.js';
+import { offsetsCell, showSystems } from './systems-table.js';
+
+export { showSystems };
 
 const img = () => document.getElementById('view-image');
 let current = 'kappa';
@@ -143,35 +146,6 @@ const esc = (text) => String(text).replace(/[&<>"']/g, (c) => `&#${c.charCodeAt(
 
 /** A number with `d` decimals, or a dash when there is none. */
 const fmt = (v, d = 2) => (v == null ? '–' : Number(v).toFixed(d));
-
-/** A table cell of observed images: each one's offset from the nearest predicted image and
- * the model's magnification there. */
-const offsetsCell = (observed) => `<td>${observed.map((o) => `${esc(o.id)}: ${fmt(o.offset_arcsec)}${
-  o.magnification == null ? '' : ` (μ ${fmt(o.magnification, 1)})`}`).join('<br>')}</td>`;
-
-/** A system's redshift: as given, assumed (`*`, the default redshift), or estimated by the
- * fit with its 68% interval. */
-const zCell = (s) => (s.z_estimate == null
-  ? `<td>${fmt(s.z, 3)}${s.z_assumed ? '*' : ''}</td>`
-  : `<td class="z-estimated" title="no redshift given: estimated on the lens of the systems with one, 68% interval">${fmt(s.z_estimate, 2)} est.<br><small>${fmt(s.z_interval[0], 2)}–${fmt(s.z_interval[1], 2)}</small></td>`);
-
-/** The per-system table (sources.json rows). */
-export function showSystems(sources) {
-  const box = document.getElementById('systems');
-  // The colour of the system's arc pixels in the views (none for catalogue systems).
-  const swatch = (s) => (s.rgb ? `<span class="swatch" style="background:${s.rgb}" aria-hidden="true"></span>` : '');
-  const rows = sources.map((s) => `<tr><th scope="row">${swatch(s)}${esc(s.id)}${s.held_out ? ' (held out)' : ''}</th>
-    ${zCell(s)}<td>${fmt(s.beta_arcsec[0])}, ${fmt(s.beta_arcsec[1])}</td>
-    <td>${fmt(s.scatter_arcsec)}</td><td>${s.observed.length} / ${s.predicted.length}</td>
-    ${offsetsCell(s.observed)}
-    <td>${fmt(s.image_plane_rms_arcsec)}</td></tr>`).join('');
-  box.innerHTML = sources.length === 0 ? '<p class="hint">No systems: not a reconstruction.</p>'
-    : `<div class="table-scroll"><table><caption>Per system: redshift (est.: estimated by the fit, with its 68% interval; *: the default redshift assumed), solved source position β, source-plane scatter, images observed / predicted (all of them; the map leaves out the demagnified ones, |μ| &lt; 0.1), offsets of the observed images from the nearest predicted one (arcsec) and the model's magnification μ at each observed image: a large offset where |μ| is high usually means the image lies near a critical curve with its source just outside the model's caustic, so its pair has merged</caption>
-    <thead><tr><th scope="col">system</th><th scope="col">z</th><th scope="col">β [″]</th><th scope="col">scatter [″]</th>
-    <th scope="col">images</th><th scope="col">offsets [″] (μ)</th><th scope="col">rms [″]</th></tr></thead><tbody>${rows}</tbody></table></div>`;
-  box.hidden = false;
-  document.getElementById('figure').hidden = true;
-}
 
 /** The curve an "auto" regulariser strength was chosen from (summary.json's
  * `strength_choice`): per candidate strength (and regulariser, when several were tried) the

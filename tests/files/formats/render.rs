@@ -93,6 +93,7 @@ fn golden_figures() {
         lines: Vec::new(),
         curves: Some(&curves),
         points: figure_points(),
+        labels: Vec::new(),
     };
     let opts = KappaPlotOptions {
         map_pixels_on_screen: 256,
@@ -107,6 +108,7 @@ fn golden_figures() {
         lines: Vec::new(),
         curves: Some(&curves),
         points: vec![],
+        labels: Vec::new(),
     };
     let opts = KappaPlotOptions {
         scale: ColorScale::Log,
@@ -131,6 +133,7 @@ fn figure_has_north_up_west_right_a_monotonic_colour_bar_and_the_curves() {
         lines: Vec::new(),
         curves: Some(&curves),
         points: vec![],
+        labels: Vec::new(),
     };
     let opts = KappaPlotOptions::default();
     let png = render_kappa_png(&map, &overlay, &opts).unwrap();
@@ -300,6 +303,7 @@ fn sample_figure() {
         lines: Vec::new(),
         curves: Some(&curves),
         points: figure_points(),
+        labels: Vec::new(),
     };
     let opts = KappaPlotOptions {
         scale: ColorScale::Log,

@@ -1,0 +1,670 @@
+//! The verdict on a reconstruction that a researcher reads at a glance (`summary.json`'s
+//! `verdict`, the box beside the app's map): how far the observed images lie from the images
+//! the map predicts, for the fitted and the held-out systems; whether each system has as many
+//! predicted images as it has observed ones; whether member galaxies draw critical curves of
+//! their own; and what that means for trusting the map, as one of three words with the reasons
+//! in one or two sentences.
+//!
+//! The thresholds are stated with the constants below and argued there. They are rules of
+//! thumb of the field, not statistics: a map judged "good" can still be wrong where no image
+//! constrains it (far from the arcs), which no image-plane check can see.
+
+use glam::DVec2;
+use serde::Serialize;
+
+use super::summary::median_arcsec;
+use super::{ImageReport, SourceReport};
+use crate::curves::{signed_area_arcsec2, CriticalCurves};
+use crate::ds9::polyline_is_open;
+use crate::map::MapGeometry;
+
+/// A fitted median offset up to this (arcsec) is "good": free-form models of the Frontier
+/// Fields clusters reproduce their images to 0.3 - 1 arcsec rms, and this implementation's
+/// defaults fit the synthetic clusters of BENCHMARKS.md to well under it. Beyond it the map
+/// does not bring a typical system's images together and is to be used with care.
+pub const GOOD_FIT_OFFSET_ARCSEC: f64 = 1.0;
+
+/// A held-out median offset up to this (arcsec) is "good": the defaults predict held-out
+/// systems of the synthetic clusters to 0.58 - 1.39 arcsec (median 0.87, README), so up to
+/// 1.5 arcsec the map predicts images it was not given as well as this method can.
+pub const GOOD_HOLDOUT_OFFSET_ARCSEC: f64 = 1.5;
+
+/// A median offset (fitted or held out) above this (arcsec) says "do not trust the small
+/// scales": a member galaxy's Einstein radius is 1 - 3 arcsec, so a map that misplaces typical
+/// images by more than that cannot place mass on the scale of a galaxy; only its large-scale
+/// mass (Einstein radius, enclosed mass) may still hold.
+pub const SMALL_SCALE_OFFSET_ARCSEC: f64 = 3.0;
+
+/// An observed image whose nearest predicted image is farther than this (arcsec), or that has
+/// none, is "not reproduced": the same galaxy scale as [`SMALL_SCALE_OFFSET_ARCSEC`]. Usually
+/// the image lies near a critical curve with its source just outside the model's caustic,
+/// so its pair has merged.
+pub const LOST_IMAGE_ARCSEC: f64 = 3.0;
+
+/// When more than this share of the systems has an image that is not reproduced, the verdict
+/// is "do not trust the small scales": a third of the systems is more than the one or two
+/// awkward systems near a critical curve that any model of a real cluster has.
+pub const LOST_SYSTEMS_SHARE: f64 = 1.0 / 3.0;
+
+/// A system whose largest image offset exceeds this (arcsec) is listed among the worst (twice
+/// [`GOOD_FIT_OFFSET_ARCSEC`]: an image the map places clearly worse than the typical one).
+pub const FLAG_OFFSET_ARCSEC: f64 = 2.0;
+
+/// Below this share of the area inside the tangential curves held by the largest one, the
+/// critical region is broken into islands (one main curve with members' loops beside it holds
+/// 0.8 and more), and the map is to be used with care: its Einstein radius and the images
+/// near the curves depend on how the islands join.
+pub const MAIN_CURVE_MIN_SHARE: f64 = 0.5;
+
+/// The worst systems listed and marked on the map, at most.
+pub const WORST_SHOWN: usize = 5;
+
+/// How far the map can be trusted, from best to worst.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Trust {
+    /// The images are reproduced and predicted about as well as this method can.
+    Good,
+    /// The map holds on the cluster scale, but some systems or features need a second look.
+    UsableWithCare,
+    /// The typical image is missed by more than a galaxy's Einstein radius, or many systems
+    /// are not reproduced: only the large-scale mass may hold.
+    DoNotTrustSmallScales,
+}
+
+impl Trust {
+    /// The words shown: "good", "usable with care", "do not trust the small scales".
+    pub fn words(self) -> &'static str {
+        match self {
+            Trust::Good => "good",
+            Trust::UsableWithCare => "usable with care",
+            Trust::DoNotTrustSmallScales => "do not trust the small scales",
+        }
+    }
+}
+
+/// One system as the verdict sees it.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct SystemCheck {
+    pub id: String,
+    pub held_out: bool,
+    /// Observed images (catalogue images, or arcs).
+    pub observed: usize,
+    /// Predicted images the map shows, `|mu| >=`
+    /// [`super::SHOWN_MIN_MAGNIFICATION`] (the demagnified central ones are almost never
+    /// observed, so they do not count against the observed ones).
+    pub predicted: usize,
+    /// Observed images with no predicted image within [`LOST_IMAGE_ARCSEC`].
+    pub lost: usize,
+    /// The largest offset of an observed image from its nearest predicted image (arcsec);
+    /// `None` when an image has no predicted one at all (worse than any offset).
+    pub offset_max_arcsec: Option<f64>,
+    /// Its worst observed image (arcsec), where the map marks it: the one farthest from its
+    /// nearest predicted image, or one with none.
+    pub position_arcsec: DVec2,
+    /// Why it is among the worst, in a few words (empty when it is not).
+    pub problem: String,
+}
+
+impl SystemCheck {
+    fn of(s: &SourceReport) -> Self {
+        let offsets: Option<Vec<f64>> = s.observed.iter().map(|o| o.offset_arcsec).collect();
+        let lost = s
+            .observed
+            .iter()
+            .filter(|o| o.offset_arcsec.is_none_or(|d| d > LOST_IMAGE_ARCSEC))
+            .count();
+        let position_arcsec = s
+            .observed
+            .iter()
+            .max_by(|a, b| {
+                let d = |o: &ImageReport| o.offset_arcsec.unwrap_or(f64::INFINITY);
+                d(a).total_cmp(&d(b))
+            })
+            .map_or(DVec2::ZERO, |o| o.position_arcsec);
+        let mut check = Self {
+            id: s.id.clone(),
+            held_out: s.held_out,
+            observed: s.observed.len(),
+            predicted: s.predicted.iter().filter(|p| p.is_shown()).count(),
+            lost,
+            offset_max_arcsec: offsets.and_then(|d| d.into_iter().reduce(f64::max)),
+            position_arcsec,
+            problem: String::new(),
+        };
+        check.problem = check.problem_words();
+        check
+    }
+
+    /// Why the system counts among the worst ("" when it does not): images not reproduced,
+    /// fewer predicted images than observed, or an offset above [`FLAG_OFFSET_ARCSEC`].
+    fn problem_words(&self) -> String {
+        let mut words = Vec::new();
+        if self.lost > 0 {
+            let n = self.lost;
+            words.push(format!(
+                "{n} image{} not reproduced",
+                if n == 1 { "" } else { "s" }
+            ));
+        }
+        if self.predicted < self.observed {
+            words.push(format!(
+                "{} predicted for {} observed",
+                self.predicted, self.observed
+            ));
+        }
+        match self.offset_max_arcsec {
+            Some(d) if d > FLAG_OFFSET_ARCSEC && self.lost == 0 => {
+                words.push(format!("offset up to {d:.1}″"))
+            }
+            _ => {}
+        }
+        words.join(", ")
+    }
+
+    /// Ordering key, worst first: more images lost, then the larger offset (none is worst).
+    fn badness(&self) -> (usize, f64) {
+        (self.lost, self.offset_max_arcsec.unwrap_or(f64::INFINITY))
+    }
+}
+
+/// What the verdict was made from besides the systems.
+#[derive(Debug, Clone, Copy, Default)]
+pub struct VerdictInputs<'a> {
+    /// The result's critical curves (at the summary's source redshift) and the geometry of
+    /// the map they were traced on.
+    pub curves: Option<(&'a CriticalCurves, MapGeometry)>,
+    /// Share of the area inside the tangential curves that the largest holds
+    /// (`summary.json`'s `maps.tangential_main_area_share`).
+    pub main_curve_share: Option<f64>,
+    /// Member galaxy positions (arcsec).
+    pub members_arcsec: &'a [DVec2],
+    /// The data hardly measure the members' factors `C`
+    /// ([`crate::inversion::LinearSystem::members_unmeasured`]).
+    pub c_unmeasured: bool,
+}
+
+/// `summary.json`'s `verdict`.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Verdict {
+    pub trust: Trust,
+    /// [`Trust::words`].
+    pub words: String,
+    /// Why, in one or two short sentences.
+    pub reasons: String,
+    /// Median offset of the fitted systems' observed images from their nearest predicted
+    /// images (arcsec).
+    pub fit_offset_median_arcsec: Option<f64>,
+    /// The same for the held-out systems.
+    pub holdout_offset_median_arcsec: Option<f64>,
+    /// Systems judged.
+    pub systems: usize,
+    /// Systems with as many predicted images (shown ones) as observed, with fewer and with
+    /// more.
+    pub systems_matched: usize,
+    pub systems_fewer_predicted: usize,
+    pub systems_more_predicted: usize,
+    /// Systems with an image that is not reproduced (see [`LOST_IMAGE_ARCSEC`]).
+    pub systems_with_lost_images: usize,
+    /// Members inside a tangential critical curve of their own (a closed loop that is not the
+    /// main curve) at `z_source`.
+    pub members_with_own_curves: usize,
+    pub z_source: Option<f64>,
+    /// Share of the tangential curves' area held by the largest (see
+    /// [`MAIN_CURVE_MIN_SHARE`]).
+    pub main_curve_share: Option<f64>,
+    pub c_unmeasured: bool,
+    /// The worst systems (at most [`WORST_SHOWN`]), worst first: those with a
+    /// [`SystemCheck::problem`].
+    pub worst: Vec<SystemCheck>,
+}
+
+/// Members inside a closed tangential loop other than the largest: loops running clockwise
+/// around `lambda_t < 0` (negative area; a positive one is a hole inside another loop).
+/// `geometry` is the map the curves were traced on (a curve cut by its border is no loop).
+pub fn members_with_own_curves(
+    curves: &CriticalCurves,
+    geometry: &MapGeometry,
+    members: &[DVec2],
+) -> usize {
+    let loops: Vec<(&Vec<DVec2>, f64)> = curves
+        .tangential
+        .iter()
+        .filter(|c| c.len() >= 3 && !polyline_is_open(c, geometry))
+        .map(|c| (c, signed_area_arcsec2(c)))
+        .filter(|(_, a)| *a < 0.0)
+        .collect();
+    let Some(main) = loops
+        .iter()
+        .map(|(_, a)| a.abs())
+        .reduce(f64::max)
+        .filter(|a| *a > 0.0)
+    else {
+        return 0;
+    };
+    let own: Vec<&Vec<DVec2>> = loops
+        .iter()
+        .filter(|(_, a)| a.abs() < main)
+        .map(|(c, _)| *c)
+        .collect();
+    members
+        .iter()
+        .filter(|&&m| own.iter().any(|c| inside(c, m)))
+        .count()
+}
+
+/// Point in polygon by the even-odd rule.
+fn inside(poly: &[DVec2], p: DVec2) -> bool {
+    let mut odd = false;
+    let mut j = poly.len() - 1;
+    for i in 0..poly.len() {
+        let (a, b) = (poly[i], poly[j]);
+        if (a.y > p.y) != (b.y > p.y) && p.x < (b.x - a.x) * (p.y - a.y) / (b.y - a.y) + a.x {
+            odd = !odd;
+        }
+        j = i;
+    }
+    odd
+}
+
+impl Verdict {
+    /// The verdict on `sources` with `inputs`. The level is the worst that any rule gives:
+    ///
+    /// - "do not trust the small scales": the fitted or the held-out median offset above
+    ///   [`SMALL_SCALE_OFFSET_ARCSEC`], or more than [`LOST_SYSTEMS_SHARE`] of the systems
+    ///   with an image not reproduced;
+    /// - "usable with care": the fitted median above [`GOOD_FIT_OFFSET_ARCSEC`], the held-out
+    ///   median above [`GOOD_HOLDOUT_OFFSET_ARCSEC`], any system with an image not reproduced,
+    ///   members with critical curves of their own while the data hardly measure their mass
+    ///   (`C`), a system with fewer predicted images than observed, or a main tangential curve
+    ///   with less than [`MAIN_CURVE_MIN_SHARE`] of the critical area;
+    /// - "good" otherwise.
+    ///
+    /// The reasons are the first two of the level given, most serious first.
+    pub fn assess(sources: &[SourceReport], inputs: VerdictInputs<'_>) -> Self {
+        let checks: Vec<SystemCheck> = sources.iter().map(SystemCheck::of).collect();
+        let median = |held: bool| {
+            median_arcsec(super::summary::image_offsets_arcsec(
+                sources.iter().filter(|s| s.held_out == held),
+            ))
+        };
+        let (fit, holdout) = (median(false), median(true));
+        let n = checks.len();
+        let count = |f: &dyn Fn(&SystemCheck) -> bool| checks.iter().filter(|c| f(c)).count();
+        let fewer = count(&|c| c.predicted < c.observed);
+        let more = count(&|c| c.predicted > c.observed);
+        let lost = count(&|c| c.lost > 0);
+        let members = inputs.curves.map_or(0, |(c, g)| {
+            members_with_own_curves(c, &g, inputs.members_arcsec)
+        });
+        let main_share = inputs.main_curve_share;
+        let z_source = inputs.curves.map(|(c, _)| c.z_source);
+
+        let mut bad: Vec<String> = Vec::new();
+        let mut care: Vec<String> = Vec::new();
+        if let Some(m) = fit.filter(|m| *m > SMALL_SCALE_OFFSET_ARCSEC) {
+            bad.push(format!(
+                "The map misses its own images by {m:.1}″ (median), more than a member galaxy's \
+                 Einstein radius: only the large-scale mass may hold."
+            ));
+        }
+        if let Some(m) = holdout.filter(|m| *m > SMALL_SCALE_OFFSET_ARCSEC) {
+            bad.push(format!(
+                "Held-out images are predicted {m:.1}″ off (median): the map does not find \
+                 images it was not given."
+            ));
+        }
+        if n > 0 && lost as f64 > LOST_SYSTEMS_SHARE * n as f64 {
+            bad.push(format!(
+                "{lost} of {n} systems have images the map does not reproduce (nothing \
+                 predicted within {LOST_IMAGE_ARCSEC:.0}″)."
+            ));
+        } else if lost > 0 {
+            care.push(format!(
+                "{lost} of {n} system{} {} an image the map does not reproduce (nothing \
+                 predicted within {LOST_IMAGE_ARCSEC:.0}″).",
+                if n == 1 { "" } else { "s" },
+                if lost == 1 { "has" } else { "have" }
+            ));
+        }
+        let between = |m: f64, good: f64| m > good && m <= SMALL_SCALE_OFFSET_ARCSEC;
+        if let Some(m) = fit.filter(|m| between(*m, GOOD_FIT_OFFSET_ARCSEC)) {
+            care.push(format!(
+                "Images are reproduced to {m:.1}″ (median), above the {GOOD_FIT_OFFSET_ARCSEC:.0}″ \
+                 of a good free-form fit."
+            ));
+        }
+        if let Some(m) = holdout.filter(|m| between(*m, GOOD_HOLDOUT_OFFSET_ARCSEC)) {
+            care.push(format!(
+                "Held-out images are predicted {m:.1}″ off (median), above the \
+                 {GOOD_HOLDOUT_OFFSET_ARCSEC}″ this method reaches on synthetic clusters."
+            ));
+        }
+        if members > 0 && inputs.c_unmeasured {
+            care.push(format!(
+                "{members} member galax{} draw{} critical curves of {} own, with a mass the \
+                 images hardly measure: the small-scale structure there is assumed.",
+                if members == 1 { "y" } else { "ies" },
+                if members == 1 { "s" } else { "" },
+                if members == 1 { "its" } else { "their" }
+            ));
+        }
+        // Systems with fewer predicted images whose every image still has one nearby: two
+        // observed images share one predicted image (a merged pair, or one arc cut in two).
+        let fewer_kept = count(&|c| c.predicted < c.observed && c.lost == 0);
+        if fewer_kept > 0 {
+            care.push(format!(
+                "{fewer_kept} system{} fewer predicted images than observed.",
+                if fewer_kept == 1 { " has" } else { "s have" }
+            ));
+        }
+        if let Some(s) = main_share.filter(|s| *s < MAIN_CURVE_MIN_SHARE) {
+            care.push(format!(
+                "The tangential critical curve is broken into islands (the largest holds {:.0}% \
+                 of the critical area).",
+                100.0 * s
+            ));
+        }
+        let (trust, reasons) = if !bad.is_empty() {
+            (Trust::DoNotTrustSmallScales, bad)
+        } else if !care.is_empty() {
+            (Trust::UsableWithCare, care)
+        } else {
+            let held = holdout.map_or(String::new(), |h| format!(", held-out ones to {h:.2}″"));
+            let fit = fit.map_or("Every image".to_string(), |m| {
+                format!("Fitted images are reproduced to {m:.2}″ (median){held}")
+            });
+            let systems = if n > 0 {
+                " and every system has its observed images predicted."
+            } else {
+                "."
+            };
+            (Trust::Good, vec![format!("{fit}{systems}")])
+        };
+        let mut worst: Vec<SystemCheck> = checks
+            .iter()
+            .filter(|c| !c.problem.is_empty())
+            .cloned()
+            .collect();
+        worst.sort_by(|a, b| {
+            let (la, da) = a.badness();
+            let (lb, db) = b.badness();
+            lb.cmp(&la).then(db.total_cmp(&da))
+        });
+        worst.truncate(WORST_SHOWN);
+        Verdict {
+            trust,
+            words: trust.words().to_string(),
+            reasons: reasons.into_iter().take(2).collect::<Vec<_>>().join(" "),
+            fit_offset_median_arcsec: fit,
+            holdout_offset_median_arcsec: holdout,
+            systems: n,
+            systems_matched: n - fewer - more,
+            systems_fewer_predicted: fewer,
+            systems_more_predicted: more,
+            systems_with_lost_images: lost,
+            members_with_own_curves: members,
+            z_source,
+            main_curve_share: main_share,
+            c_unmeasured: inputs.c_unmeasured,
+            worst,
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::reconstruct::PredictedImage;
+
+    /// A system with one observed image per offset (`None`: no predicted image), each with a
+    /// predicted image shown on the map (`|mu| = 3`), plus `extra` predicted images.
+    fn system(id: &str, held_out: bool, offsets: &[Option<f64>], extra: usize) -> SourceReport {
+        let observed: Vec<ImageReport> = offsets
+            .iter()
+            .enumerate()
+            .map(|(k, d)| ImageReport {
+                id: format!("{id}.{k}"),
+                position_arcsec: DVec2::new(10.0 * k as f64, 5.0),
+                beta_arcsec: DVec2::ZERO,
+                predicted_arcsec: d.map(|d| DVec2::new(10.0 * k as f64 + d, 5.0)),
+                offset_arcsec: *d,
+                magnification: Some(3.0),
+                delay_days: None,
+            })
+            .collect();
+        let predicted = observed
+            .iter()
+            .filter_map(|o| o.predicted_arcsec)
+            .chain((0..extra).map(|k| DVec2::new(-50.0, k as f64)))
+            .map(|p| PredictedImage {
+                position_arcsec: p,
+                magnification: 3.0,
+                delay_days: None,
+            })
+            .collect();
+        SourceReport {
+            id: id.to_string(),
+            z: 2.0,
+            z_assumed: false,
+            z_estimate: None,
+            z_interval: None,
+            held_out,
+            beta_arcsec: DVec2::ZERO,
+            scatter_arcsec: 0.1,
+            observed,
+            predicted,
+            image_plane_rms_arcsec: None,
+        }
+    }
+
+    fn fitted(id: &str, offsets: &[f64]) -> SourceReport {
+        let o: Vec<Option<f64>> = offsets.iter().map(|d| Some(*d)).collect();
+        system(id, false, &o, 0)
+    }
+
+    fn assess(sources: &[SourceReport]) -> Verdict {
+        Verdict::assess(sources, VerdictInputs::default())
+    }
+
+    #[test]
+    fn images_reproduced_to_half_an_arcsec_are_good() {
+        let v = assess(&[fitted("1", &[0.3, 0.5, 0.4]), fitted("2", &[0.6, 0.2])]);
+        assert_eq!(v.trust, Trust::Good, "{}", v.reasons);
+        assert_eq!(v.words, "good");
+        assert_eq!(v.fit_offset_median_arcsec, Some(0.4));
+        assert_eq!((v.systems, v.systems_matched), (2, 2));
+        assert!(v.reasons.contains("0.40″"), "{}", v.reasons);
+        assert!(v.worst.is_empty());
+    }
+
+    #[test]
+    fn the_fitted_median_sets_care_then_distrust() {
+        let v = assess(&[fitted("1", &[1.4, 1.6]), fitted("2", &[1.5])]);
+        assert_eq!(v.trust, Trust::UsableWithCare);
+        assert!(v.reasons.contains("1.5″ (median)"), "{}", v.reasons);
+        let v = assess(&[fitted("1", &[0.9, 1.0])]);
+        assert_eq!(
+            v.trust,
+            Trust::Good,
+            "1.0 arcsec is still good: {}",
+            v.reasons
+        );
+        let v = assess(&[fitted("1", &[2.5, 2.8, 2.9])]);
+        assert_eq!(v.trust, Trust::UsableWithCare, "2.9 arcsec, no image lost");
+        let v = assess(&[fitted("1", &[3.1, 3.2, 2.9]), fitted("2", &[3.1, 3.3])]);
+        assert_eq!(v.trust, Trust::DoNotTrustSmallScales);
+        assert_eq!(v.words, "do not trust the small scales");
+        assert!(
+            v.reasons
+                .starts_with("The map misses its own images by 3.1″"),
+            "{}",
+            v.reasons
+        );
+    }
+
+    #[test]
+    fn held_out_systems_are_judged_by_their_own_median() {
+        let held = |d: f64| system("h", true, &[Some(d), Some(d)], 0);
+        let v = assess(&[fitted("1", &[0.3, 0.4]), held(1.2)]);
+        assert_eq!(v.trust, Trust::Good, "{}", v.reasons);
+        assert_eq!(v.holdout_offset_median_arcsec, Some(1.2));
+        let v = assess(&[fitted("1", &[0.3, 0.4]), held(2.0)]);
+        assert_eq!(v.trust, Trust::UsableWithCare);
+        assert!(
+            v.reasons
+                .starts_with("Held-out images are predicted 2.0″ off"),
+            "{}",
+            v.reasons
+        );
+        let v = assess(&[fitted("1", &[0.3, 0.4]), held(2.8), held(3.6), held(3.4)]);
+        assert_eq!(v.trust, Trust::DoNotTrustSmallScales, "{}", v.reasons);
+    }
+
+    #[test]
+    fn lost_images_count_by_system() {
+        let good = |k: usize| fitted(&k.to_string(), &[0.2, 0.3]);
+        let lost = |id: &str| system(id, false, &[Some(0.2), None, Some(0.3)], 0);
+        let far = |id: &str| fitted(id, &[0.2, 5.0, 0.3]);
+        // One system of five: care.
+        let mut sources: Vec<SourceReport> = (0..4).map(good).collect();
+        sources.push(lost("L"));
+        let v = assess(&sources);
+        assert_eq!(v.trust, Trust::UsableWithCare);
+        assert_eq!(v.systems_with_lost_images, 1);
+        assert_eq!(v.systems_fewer_predicted, 1);
+        assert!(
+            v.reasons.starts_with("1 of 5 systems has an image"),
+            "{}",
+            v.reasons
+        );
+        // Two of five (more than a third), one of them by an offset beyond 3 arcsec.
+        sources.push(far("F"));
+        sources.remove(0);
+        let v = assess(&sources);
+        assert_eq!(v.trust, Trust::DoNotTrustSmallScales, "{}", v.reasons);
+        assert!(v.reasons.starts_with("2 of 5 systems"), "{}", v.reasons);
+        // Worst first: both have one image lost; the one with no predicted image at all first.
+        let ids: Vec<&str> = v.worst.iter().map(|w| w.id.as_str()).collect();
+        assert_eq!(ids, ["L", "F"]);
+        assert_eq!(
+            v.worst[0].problem,
+            "1 image not reproduced, 2 predicted for 3 observed"
+        );
+        assert_eq!(v.worst[1].problem, "1 image not reproduced");
+        assert_eq!(v.worst[1].position_arcsec, DVec2::new(10.0, 5.0));
+    }
+
+    #[test]
+    fn faint_predicted_images_do_not_count_and_extra_ones_are_counted() {
+        let mut s = fitted("1", &[0.2, 0.3]);
+        s.predicted[1].magnification = 0.05;
+        let v = assess(&[s, system("2", false, &[Some(0.2), Some(0.1)], 2)]);
+        assert_eq!(v.systems_fewer_predicted, 1);
+        assert_eq!(v.systems_more_predicted, 1);
+        assert_eq!(v.systems_matched, 0);
+        assert_eq!(v.trust, Trust::UsableWithCare);
+        assert!(
+            v.reasons.contains("1 system has fewer predicted images"),
+            "{}",
+            v.reasons
+        );
+        assert_eq!(v.worst[0].problem, "1 predicted for 2 observed");
+    }
+
+    #[test]
+    fn the_worst_are_capped_and_ordered_by_offset() {
+        let sources: Vec<SourceReport> = (0..8)
+            .map(|k| fitted(&k.to_string(), &[0.2, 2.1 + 0.1 * k as f64]))
+            .collect();
+        let v = assess(&sources);
+        let ids: Vec<&str> = v.worst.iter().map(|w| w.id.as_str()).collect();
+        assert_eq!(ids, ["7", "6", "5", "4", "3"]);
+        assert_eq!(v.worst[0].problem, "offset up to 2.8″");
+    }
+
+    /// A clockwise (critical region inside) circle of `r` arcsec around `c`.
+    fn loop_at(c: DVec2, r: f64) -> Vec<DVec2> {
+        (0..48)
+            .map(|k| {
+                let t = -std::f64::consts::TAU * k as f64 / 48.0;
+                c + r * DVec2::new(t.cos(), t.sin())
+            })
+            .collect()
+    }
+
+    #[test]
+    fn members_inside_loops_of_their_own_count() {
+        let curves = CriticalCurves {
+            z_source: 3.0,
+            tangential: vec![
+                loop_at(DVec2::ZERO, 30.0),
+                loop_at(DVec2::new(40.0, 0.0), 2.0),
+                // A hole inside the main curve (counter-clockwise) is no curve of a member's.
+                loop_at(DVec2::new(10.0, 0.0), 3.0)
+                    .into_iter()
+                    .rev()
+                    .collect(),
+            ],
+            ..CriticalCurves::default()
+        };
+        let g = MapGeometry::centered(120.0, 128);
+        let members = [
+            DVec2::ZERO,              // inside the main curve
+            DVec2::new(40.5, 0.3),    // its own loop
+            DVec2::new(10.0, 0.0),    // in the hole
+            DVec2::new(-45.0, -20.0), // none
+        ];
+        assert_eq!(members_with_own_curves(&curves, &g, &members), 1);
+        let sources = [fitted("1", &[0.2, 0.3])];
+        let inputs = |c_unmeasured| VerdictInputs {
+            curves: Some((&curves, g)),
+            main_curve_share: Some(0.99),
+            members_arcsec: &members,
+            c_unmeasured,
+        };
+        let v = Verdict::assess(&sources, inputs(true));
+        assert_eq!(v.trust, Trust::UsableWithCare);
+        assert_eq!(v.members_with_own_curves, 1);
+        assert_eq!(v.z_source, Some(3.0));
+        assert!(
+            v.reasons
+                .starts_with("1 member galaxy draws critical curves of its own"),
+            "{}",
+            v.reasons
+        );
+        // When the images measure the members' mass, their curves are the data's.
+        assert_eq!(Verdict::assess(&sources, inputs(false)).trust, Trust::Good);
+    }
+
+    #[test]
+    fn a_broken_critical_curve_needs_care() {
+        let inputs = VerdictInputs {
+            main_curve_share: Some(0.3),
+            ..VerdictInputs::default()
+        };
+        let v = Verdict::assess(&[fitted("1", &[0.2])], inputs);
+        assert_eq!(v.trust, Trust::UsableWithCare);
+        assert!(v.reasons.contains("largest holds 30%"), "{}", v.reasons);
+    }
+
+    #[test]
+    fn at_most_two_reasons_most_serious_first() {
+        let inputs = VerdictInputs {
+            main_curve_share: Some(0.3),
+            ..VerdictInputs::default()
+        };
+        let held = system("h", true, &[Some(2.0), Some(2.2)], 0);
+        let lost = system("L", false, &[Some(1.6), None], 0);
+        let v = Verdict::assess(&[fitted("1", &[1.2, 1.4]), held, lost], inputs);
+        assert_eq!(v.trust, Trust::UsableWithCare);
+        let sentences = v.reasons.matches(". ").count() + 1;
+        assert_eq!(sentences, 2, "{}", v.reasons);
+        assert!(
+            v.reasons.starts_with("1 of 3 systems has an image"),
+            "{}",
+            v.reasons
+        );
+        assert!(!v.reasons.contains("islands"), "{}", v.reasons);
+    }
+}

@@ -1,0 +1,58 @@
+// The verdict beside the map after a reconstruction (summary.json's `verdict`, computed by the
+// core): one of "good", "usable with care", "do not trust the small scales", the reasons in a
+// sentence or two, and the numbers behind it. The worst systems are ringed on the map (drawn
+// by the core) and marked in the systems table.
+
+let last = null; // the verdict on screen, or null
+
+/** A length in arcsec, or a dash. */
+const arcsec = (v) => (v == null ? '–' : `${v.toFixed(2)}″`);
+
+/** The verdict's worst systems `[{id, problem, ...}]` (none without a verdict). */
+export function worstSystems() {
+  return last?.worst ?? [];
+}
+
+/** Text for the numbers behind the verdict, one per line. */
+function facts(v) {
+  const out = [`Image offsets (median): fitted ${arcsec(v.fit_offset_median_arcsec)}${
+    v.holdout_offset_median_arcsec == null ? '' : `, held out ${arcsec(v.holdout_offset_median_arcsec)}`}`];
+  const parts = [`${v.systems_matched} as many as observed`];
+  if (v.systems_fewer_predicted) parts.push(`${v.systems_fewer_predicted} fewer`);
+  if (v.systems_more_predicted) parts.push(`${v.systems_more_predicted} more`);
+  out.push(`Predicted images (|μ| ≥ 0.1) of ${v.systems} systems: ${parts.join(', ')}${
+    v.systems_with_lost_images ? `; ${v.systems_with_lost_images} with an image not reproduced` : ''}`);
+  const z = v.z_source == null ? '' : ` at z_s = ${v.z_source}`;
+  const c = v.members_with_own_curves && v.c_unmeasured ? ' (their mass is assumed: C is hardly measured)' : '';
+  out.push(`Members with critical curves of their own${z}: ${v.members_with_own_curves}${c}`);
+  if (v.worst.length) out.push(`Worst systems (ringed on the map; why: Image systems): ${v.worst.map((w) => w.id).join(', ')}`);
+  return out;
+}
+
+/** Shows `verdict` (or hides the box for `null`: no result, or no reconstruction). */
+export function showVerdict(verdict) {
+  last = verdict ?? null;
+  const box = document.getElementById('verdict');
+  if (!box) return;
+  box.replaceChildren();
+  box.hidden = !last;
+  if (!last) return;
+  box.dataset.trust = last.trust;
+  const head = document.createElement('p');
+  head.className = 'verdict-head';
+  const word = document.createElement('strong');
+  word.id = 'verdict-words';
+  word.textContent = last.words;
+  head.append('Verdict: ', word);
+  const reasons = document.createElement('p');
+  reasons.id = 'verdict-reasons';
+  reasons.textContent = last.reasons;
+  const list = document.createElement('ul');
+  list.id = 'verdict-facts';
+  for (const text of facts(last)) {
+    const li = document.createElement('li');
+    li.textContent = text;
+    list.append(li);
+  }
+  box.append(head, reasons, list);
+}
