@@ -36,6 +36,7 @@ pub mod playground;
 
 mod arcs;
 mod catalog;
+mod coordinates;
 mod cosmology;
 mod curves;
 mod demo;
@@ -65,6 +66,9 @@ mod units;
 mod wasm;
 
 // Cosmology, the sky frame and units.
+pub use coordinates::{
+    parse_position, sexagesimal_text, CoordinateError, PositionForm, TypedPosition, SKY_MATCH_DEG,
+};
 pub use cosmology::{Cosmology, CosmologyError, LensPlane};
 pub use sky::{parse_sky_angle, SkyReference};
 

@@ -5,12 +5,13 @@ import { LensClient } from './lens-client.js';
 import { loadProject, loadPrevious, saveProject, hasSaved, setAside, setAsideList, deleteSetAside } from './js/store.js';
 import { buildFileRows, setFileStatus, ROLES } from './js/files.js';
 import { buildSettings, showSettings } from './js/settings.js';
-import { wireViews, showPng, showSystems, showCrossval, showStrengthChoice, viewOptions, currentView, refreshReadout, clearPin } from './js/views.js';
+import { wireViews, showPng, showSystems, showCrossval, showStrengthChoice, viewOptions, currentView, refreshReadout, clearPin, pinAt } from './js/views.js';
 import { showDownloads, save } from './js/downloads.js';
 import { wireFigureDownload } from './js/figure-download.js';
 import { StrengthPool, poolSize, projectForTrials } from './js/pool.js';
 import { wireIterates, showIterates, syncIterates, iterateOption } from './js/iterates.js';
 import { showVerdict } from './js/verdict.js';
+import { wireLocate } from './js/coords.js';
 
 // Offline use once loaded (sw.js), for the lessons and the playground too. Without it (an old
 // browser, a file:// page) the app still works online.
@@ -610,6 +611,7 @@ async function setZ(z) {
 const app = {
   render,
   hover: (x, y) => ask('hover', { options: { ...viewOptions(), ...iterateOption() }, x, y }),
+  pointReadout: ([x, y]) => ask('pointReadout', { options: { ...viewOptions(), ...iterateOption() }, x, y }),
   counterImages: ([x, y]) => ask('counterImages', { x, y }),
   counterImageRegions: ([x, y]) => ask('counterImageRegions', { x, y }),
   textFile: (name) => ask('textFile', { name }),
@@ -622,6 +624,7 @@ async function start() {
   buildFileRows($('file-rows'), $('drop-zone'), queueFile);
   buildSettings($('settings-form'), applySetting);
   wireViews(app);
+  wireLocate({ locate: (text) => ask('locate', { text }), pinAt });
   wireIterates(app);
   wireFigureDownload(app);
   $('reconstruct').addEventListener('click', () => run('reconstruct'));

@@ -16,6 +16,7 @@ const APP_FILES = [
   'main.js',
   'lens-client.js',
   'worker.js',
+  'js/coords.js',
   'js/downloads.js',
   'js/figure-download.js',
   'js/files.js',

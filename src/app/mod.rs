@@ -33,7 +33,8 @@ pub use run::{Outcome, RunKind, SessionResult};
 pub use settings::{AppSettings, APP_MAP_PIXELS};
 pub use views::{
     system_rgb, CounterImages, HoverReadout, ViewOptions, ViewPng, COUNTER_IMAGE_RGB,
-    FIGURE_SCALE_RANGE, MODEL_CURVE_RGB, OBSERVED_RGB, PREDICTED_RGB, SYSTEM_RGB, WORST_RGB,
+    FIGURE_SCALE_RANGE, MODEL_CURVE_RGB, OBSERVED_RGB, POINT_IMAGE_ARCSEC, PREDICTED_RGB,
+    SYSTEM_RGB, WORST_RGB,
 };
 
 /// What the app reports to the user; every message names the file, line or setting.

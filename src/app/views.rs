@@ -11,10 +11,13 @@ use crate::render::{
 
 use super::data::{ArcPixels, DataMarks};
 use super::{AppError, Session, SessionResult, SHOWN_MIN_MAGNIFICATION};
+use crate::coordinates::{parse_position, sexagesimal_text, TypedPosition};
 use crate::ds9::{write_marks, Mark};
+use crate::image_search::magnification_at;
 use crate::products::Products;
 use crate::reconstruct::{
-    images_on_maps, source_on_maps, ArrivalTimes, PredictedImage, IMAGE_REGION_RADIUS_ARCSEC,
+    images_on_maps, source_on_maps, ArrivalTimes, InterpolatedLens, PredictedImage,
+    IMAGE_REGION_RADIUS_ARCSEC,
 };
 
 /// The images of a clicked point's source: yellow squares.
@@ -154,14 +157,21 @@ pub struct ViewPng {
     pub png: Vec<u8>,
 }
 
-/// What is under the cursor on the kappa map.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+/// What is under the cursor on the kappa map (or at a typed position).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct HoverReadout {
+    /// The point in the arcsec frame (offsets from the sky reference when there is one).
     pub x_arcsec: f64,
     pub y_arcsec: f64,
+    /// RA and Dec of the point (degrees) when the data have a sky reference.
+    pub radec_deg: Option<[f64; 2]>,
+    /// The same as `22:48:43.97 -44:31:51.2` ([`crate::sexagesimal_text`]).
+    pub radec_sexagesimal: Option<String>,
     /// `kappa` at `D_ls/D_s = 1` (bilinear).
     pub kappa: f64,
-    /// Magnification at the curves' source redshift (bilinear).
+    /// Magnification at the point at the curves' source redshift: `1 / det A` of the
+    /// interpolated kappa and shear, as the images of [`Session::counter_images`] have it, so
+    /// the two agree at one point.
     pub magnification: f64,
     pub z_source: f64,
     /// The maps have no data there (pixels without data in published deflection maps):
@@ -181,7 +191,22 @@ pub struct CounterImages {
     /// Every image of that source (the point itself among them), with its signed
     /// magnification and its delay in days after the first to arrive, brightest first.
     pub images: Vec<PredictedImage>,
+    /// The magnification at the point itself (as [`HoverReadout::magnification`]).
+    pub point_magnification: f64,
+    /// The image found at the point (index into `images`): the nearest one, when it lies
+    /// within [`POINT_IMAGE_ARCSEC`] or a map pixel of the point. Its magnification is that of
+    /// the found position, which differs from `point_magnification` by the step between them:
+    /// near a critical curve even a small step changes it a lot.
+    pub point_image: Option<usize>,
+    /// Its distance from the point (arcsec).
+    pub point_image_distance_arcsec: Option<f64>,
+    /// RA and Dec of each image as `22:48:43.97 -44:31:51.2` (empty without a sky reference).
+    pub images_sexagesimal: Vec<String>,
 }
+
+/// An image found within this distance of a clicked point (arcsec), or within a map pixel, is
+/// the point's own image.
+pub const POINT_IMAGE_ARCSEC: f64 = 0.2;
 
 pub(super) fn points(label: &str, rgb: [u8; 3], marker: Marker, p: Vec<DVec2>) -> OverlayPoints {
     OverlayPoints {
@@ -396,11 +421,31 @@ impl Session {
             images_on_maps(&products.maps, f, beta).map_err(|e| AppError::Run(e.to_string()))?;
         images.sort_by(|a, b| b.magnification.abs().total_cmp(&a.magnification.abs()));
         ArrivalTimes::new(products).set_delays(products.curves.z_source, beta, &mut images);
+        let pixel = products.maps.geometry().pixel_arcsec();
+        let nearest = images
+            .iter()
+            .enumerate()
+            .map(|(k, i)| (k, i.position_arcsec.distance(p)))
+            .min_by(|a, b| a.1.total_cmp(&b.1))
+            .filter(|(_, d)| *d <= POINT_IMAGE_ARCSEC.max(pixel));
+        let sky = |q: DVec2| {
+            products.reference.map(|r| {
+                let (ra, dec) = r.offset_to_radec(q);
+                sexagesimal_text(ra, dec)
+            })
+        };
         Ok(CounterImages {
             x_arcsec: p.x,
             y_arcsec: p.y,
             z_source: products.curves.z_source,
             beta_arcsec: beta.to_array(),
+            point_magnification: magnification_on(products, p),
+            point_image: nearest.map(|(k, _)| k),
+            point_image_distance_arcsec: nearest.map(|(_, d)| d),
+            images_sexagesimal: images
+                .iter()
+                .filter_map(|i| sky(i.position_arcsec))
+                .collect(),
             images,
         })
     }
@@ -474,20 +519,58 @@ impl Session {
         let Some(p) = self.kappa_point(opts, px, py)? else {
             return Ok(None);
         };
+        self.readout_at(opts, p).map(Some)
+    }
+
+    /// x, y (arcsec), RA/Dec, kappa and magnification at the point `p` (arcsec) of the maps
+    /// the kappa view drawn with `opts` shows (a typed position's read-out).
+    pub fn readout_at(&self, opts: &ViewOptions, p: DVec2) -> Result<HoverReadout, AppError> {
         self.with_shown(opts, |_, shown| {
             let products = shown.products;
             let kappa = products.maps.kappa.sample(p);
-            let magnification = products.magnification.sample(p);
-            Ok(Some(HoverReadout {
+            let magnification = magnification_on(products, p);
+            let radec = products.reference.map(|r| r.offset_to_radec(p));
+            Ok(HoverReadout {
                 x_arcsec: p.x,
                 y_arcsec: p.y,
+                radec_deg: radec.map(|(ra, dec)| [ra, dec]),
+                radec_sexagesimal: radec.map(|(ra, dec)| sexagesimal_text(ra, dec)),
                 kappa,
                 magnification,
                 z_source: products.curves.z_source,
                 no_data: kappa.is_nan() || magnification.is_nan(),
-            }))
+            })
         })
     }
+
+    /// A typed or pasted position ([`crate::parse_position`]) on the result's maps, with the
+    /// result's sky reference; an error (saying what could not be read, or that the point is
+    /// off the maps) otherwise.
+    pub fn locate(&self, text: &str) -> Result<TypedPosition, AppError> {
+        let products = self.result()?.products();
+        let typed = parse_position(text, products.reference)
+            .map_err(|e| AppError::Setting(e.to_string()))?;
+        let g = products.maps.geometry();
+        let p = typed.position_arcsec;
+        if (p - g.center).abs().max_element() > 0.5 * g.size_arcsec {
+            return Err(AppError::Setting(format!(
+                "'{}' ({}) is at ({:.1}, {:.1}) arcsec from the reference, off the {:.0} arcsec maps",
+                text.trim(),
+                typed.form.words(),
+                p.x,
+                p.y,
+                g.size_arcsec
+            )));
+        }
+        Ok(typed)
+    }
+}
+
+/// The magnification at `p` on `products`' maps at their source redshift: `1 / det A` of the
+/// interpolated kappa and shear, as the image search computes it at the images it finds.
+fn magnification_on(products: &Products, p: DVec2) -> f64 {
+    let maps = &products.maps;
+    magnification_at(&InterpolatedLens(maps), products.distance_ratio, p)
 }
 
 impl DataMarks {

@@ -342,6 +342,28 @@ impl AppSession {
         }
     }
 
+    /// The read-out at the point `(x, y)` (arcsec) of the kappa view drawn with `options`:
+    /// as [`AppSession::hover`]'s, for a typed position.
+    pub fn point_readout(&self, options: JsValue, x: f64, y: f64) -> Result<JsValue, JsError> {
+        let opts = view_options(options)?;
+        let p = glam::DVec2::new(x, y);
+        to_js(&self.inner.readout_at(&opts, p).map_err(err)?)
+    }
+
+    /// A typed or pasted position (RA/Dec in degrees or sexagesimal, or x y in arcsec) on the
+    /// result's maps: `{x_arcsec, y_arcsec, form, form_words, radec_deg}`, or the error saying
+    /// what could not be read ("could not read 'xyz' as a coordinate: ...").
+    pub fn locate(&self, text: &str) -> Result<JsValue, JsError> {
+        let t = self.inner.locate(text).map_err(err)?;
+        to_js(&serde_json::json!({
+            "x_arcsec": t.position_arcsec.x,
+            "y_arcsec": t.position_arcsec.y,
+            "form": t.form,
+            "form_words": t.form.words(),
+            "radec_deg": t.radec_deg,
+        }))
+    }
+
     /// The source behind the point `(x, y)` (arcsec; a hover read-out's `x_arcsec, y_arcsec`)
     /// and all its images at the curves' z_s: `{x_arcsec, y_arcsec, z_source, beta_arcsec,
     /// images: [{position_arcsec, magnification}]}`. The view option `pin_arcsec: [x, y]` draws

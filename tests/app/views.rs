@@ -379,3 +379,55 @@ fn views_drawn_at_figure_scale_k_are_k_times_larger() {
         assert!(s.kappa_view(&opts).is_err());
     }
 }
+
+/// A typed position (RA/Dec in degrees or sexagesimal, or arcsec) reads out as a click there
+/// would, with RA/Dec; the read-out and the image list agree on the magnification: at the
+/// point itself, and at the image found there.
+#[cfg_attr(not(target_arch = "wasm32"), test)]
+#[cfg_attr(target_arch = "wasm32", wasm_bindgen_test::wasm_bindgen_test)]
+fn a_typed_position_reads_out_as_a_click_would() {
+    // The teaching catalogue's frame has a sky reference (RA 150, Dec 2.2).
+    let s = solved();
+    let opts = ViewOptions::default();
+    // Image 1.1 of the teaching catalogue.
+    let p = DVec2::new(8.0429, 8.6278);
+    let reference = s.result().unwrap().products().reference.unwrap();
+    let (ra, dec) = reference.offset_to_radec(p);
+    // Sexagesimal RA to 0.01 s and Dec to 0.1 arcsec: within 0.15 arcsec.
+    for text in [
+        format!("{ra:.7} {dec:.7}"),
+        wslap::sexagesimal_text(ra, dec),
+        "8.0429 8.6278 arcsec".to_string(),
+    ] {
+        let t = s.locate(&text).unwrap();
+        let d = t.position_arcsec.distance(p);
+        assert!(d < 0.15, "{text}: {d} arcsec off");
+    }
+    let h = s.readout_at(&opts, p).unwrap();
+    let [hra, hdec] = h.radec_deg.unwrap();
+    assert!((hra - ra).abs() < 1e-9 && (hdec - dec).abs() < 1e-9);
+    let sexagesimal = h.radec_sexagesimal.clone().unwrap();
+    assert_eq!(sexagesimal, "09:59:59.46 +02:12:08.6");
+    let c = s.counter_images(p).unwrap();
+    assert_eq!(c.point_magnification, h.magnification);
+    let k = c.point_image.expect("an image of the source at the point");
+    let found = c.images[k];
+    assert!(c.point_image_distance_arcsec.unwrap() < 0.05, "{c:?}");
+    let at_found = s.readout_at(&opts, found.position_arcsec).unwrap();
+    let tol = 1e-9 * found.magnification.abs().max(1.0);
+    assert!(
+        (at_found.magnification - found.magnification).abs() < tol,
+        "read-out {} at the found image, list {}",
+        at_found.magnification,
+        found.magnification
+    );
+    assert_eq!(c.images_sexagesimal.len(), c.images.len());
+    // Bad input says what it could not read; a point off the maps says so.
+    let e = s.locate("xyz").unwrap_err().to_string();
+    assert!(
+        e.starts_with("could not read 'xyz' as a coordinate: "),
+        "{e}"
+    );
+    let e = s.locate("100 0 arcsec").unwrap_err().to_string();
+    assert!(e.contains("arcsec maps"), "{e}");
+}

@@ -128,3 +128,75 @@ test('the systems table sorts by a column header, by mouse and keyboard, with ar
     await app.close();
   }
 });
+
+test('a typed coordinate reads out κ, μ and the counter-images without the mouse; a bad one says why', async () => {
+  const app = await reconstructed({ width: 1280, height: 720 });
+  try {
+    const { page } = app;
+    // The example's frame: offsets from its sky reference (members.cat's #REFERENCE).
+    const [ra0, dec0] = [197.872917, -1.341111];
+    const [x, y] = [-40.0, -20.0];
+    const ra = ra0 - x / 3600 / Math.cos(dec0 * Math.PI / 180);
+    const dec = dec0 + y / 3600;
+    const readoutAfter = async (text) => {
+      // Emptied first, so that the wait sees this position's read-out, not the last one's.
+      await page.$eval('#readout', (el) => { el.textContent = ''; });
+      await page.fill('#locate-input', text);
+      await page.press('#locate-input', 'Enter');
+      await page.waitForFunction(() => /^Typed: /.test(document.getElementById('readout').textContent));
+    };
+    // RA/Dec in degrees, typed and sent with Enter: the point, its RA/Dec, κ and μ.
+    await readoutAfter(`${ra.toFixed(6)} ${dec.toFixed(6)}`);
+    const readout = await page.textContent('#readout');
+    const m = readout.match(/^Typed: RA, Dec (\d\d:\d\d:\d\d\.\d\d [+-]\d\d:\d\d:\d\d\.\d) \(([\d.]+)°, (-?[\d.]+)°\); x = (-?[\d.]+)″, y = (-?[\d.]+)″ from the reference; κ = ([\d.]+), μ\(z_s = 3\) = (-?[\d.]+) at this point$/);
+    assert.ok(m, readout);
+    assert.ok(Math.abs(Number(m[4]) - x) < 0.01 && Math.abs(Number(m[5]) - y) < 0.01, readout);
+    assert.equal(await page.getAttribute('#locate-form', 'data-read-as'), 'RA/Dec in degrees');
+    // The source's images in their order of arrival, the one at the point named, and the
+    // magnification at the point and at that image side by side.
+    await page.waitForSelector('#counter-images:not([hidden])');
+    const listed = await page.textContent('#counter-images-text');
+    assert.match(listed, /at z_s = 3 it has \d+ images? \(yellow squares where \|μ\| ≥ 0\.1; positions in arcsec, in order of arrival/);
+    assert.match(listed, /^The source behind \(-40\.00″, -20\.00″\)/);
+    assert.match(listed, /1st \(-?[\d.]+, -?[\d.]+\) μ -?[\d.]+ \(parity [+−]\), arrives first at \d\d:\d\d:\d\d\.\d\d/);
+    const atPoint = listed.match(/Magnification at the point itself: (-?[\d.]+); at the image found there \(([\d.]+)″ away\): (-?[\d.]+)\./);
+    assert.ok(atPoint, listed);
+    assert.equal(atPoint[1], Number(m[7]).toFixed(2), 'the read-out and the list give one μ at the point');
+    assert.ok(Number(atPoint[2]) < 0.1, listed);
+    assert.equal([...listed.matchAll(/\(the image at the point\)/g)].length, 1, listed);
+    await page.locator('#figure').screenshot({ path: join(ARTIFACTS, 'verdict-locate-1280.png') });
+    // Sexagesimal and arcsec give the same point.
+    await readoutAfter('13:11:32.17 -01:20:48.0');
+    assert.match(await page.textContent('#readout'), /x = -(39\.9\d|40\.0\d)″, y = -(19\.9\d|20\.0\d)″/);
+    assert.equal(await page.getAttribute('#locate-form', 'data-read-as'), 'RA/Dec, sexagesimal');
+    await readoutAfter('-40 -20 arcsec');
+    assert.match(await page.textContent('#readout'), /x = -40\.00″, y = -20\.00″ from the reference/);
+    // A bad coordinate: the reason next to the box, the pinned point kept.
+    const before = await page.textContent('#readout');
+    await page.fill('#locate-input', 'xyz');
+    await page.click('#locate-go');
+    await page.waitForFunction(() => document.getElementById('locate-error').textContent !== '');
+    assert.equal(await page.textContent('#locate-error'),
+      "could not read 'xyz' as a coordinate: expected two values (RA Dec, or x y in arcsec), found 1");
+    assert.equal(await page.getAttribute('#locate-input', 'aria-invalid'), 'true');
+    assert.equal(await page.textContent('#readout'), before);
+    await page.fill('#locate-input', '13:11:31 -95:00:00');
+    await page.click('#locate-go');
+    await page.waitForFunction(() => /Dec/.test(document.getElementById('locate-error').textContent));
+    assert.match(await page.textContent('#locate-error'), /^could not read '13:11:31 -95:00:00' as a coordinate: Dec '-95:00:00' is outside \+-90 degrees$/);
+    // Off the maps.
+    await page.fill('#locate-input', '500 0 arcsec');
+    await page.click('#locate-go');
+    await page.waitForFunction(() => /off the/.test(document.getElementById('locate-error').textContent));
+    // On a phone the box is usable and nothing overflows.
+    await page.setViewportSize({ width: 390, height: 844 });
+    await page.fill('#locate-input', '-40 -20');
+    await page.press('#locate-input', 'Enter');
+    await page.waitForFunction(() => document.getElementById('locate-error').textContent === '');
+    assert.equal(await page.evaluate(() => document.documentElement.scrollWidth), 390);
+    await page.locator('#figure').screenshot({ path: join(ARTIFACTS, 'verdict-locate-390.png') });
+    assert.deepEqual(app.consoleErrors, []);
+  } finally {
+    await app.close();
+  }
+});

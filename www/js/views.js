@@ -3,6 +3,7 @@
 
 import { button, save } from './downloads.js';
 import { offsetsCell, showSystems } from './systems-table.js';
+import { readoutText, counterImagesText } from './coords.js';
 
 export { showSystems };
 
@@ -27,9 +28,7 @@ async function readOut() {
   try {
     const h = await app.hover(x, y);
     if (h) {
-      const where = `x = ${h.x_arcsec.toFixed(2)}″, y = ${h.y_arcsec.toFixed(2)}″`;
-      const text = h.no_data ? `${where}: no data (the deflection maps are blank here)`
-        : `${where}, κ = ${h.kappa.toFixed(3)}, μ(z_s = ${h.z_source}) = ${h.magnification.toFixed(2)}`;
+      const text = readoutText(h);
       readout.textContent = pin ? `Clicked: ${text}` : text;
     }
   } catch { /* the worker is busy with a run or was restarted */ }
@@ -37,12 +36,14 @@ async function readOut() {
   if (queued) { queued = false; await readOut(); }
 }
 
-/** A delay in days as the list shows it: "first" for the first image, days and years after it. */
-function delayText(days) {
-  if (days == null) return '';
-  if (days === 0) return ', arrives first';
-  const d = `${Math.round(days).toLocaleString('en')} d`;
-  return `, Δt ${Math.abs(days) >= 365.25 ? `${d} (${(days / 365.25).toFixed(1)} yr)` : d}`;
+/** The read-out at the pinned point when it was typed, not clicked (no cursor is over it). */
+async function readPin() {
+  const readout = document.getElementById('readout');
+  try {
+    readout.textContent = `Typed: ${readoutText(await app.pointReadout(pin))}`;
+  } catch (err) {
+    readout.textContent = `Typed: ${err.message}`;
+  }
 }
 
 /** Lists the images of the pinned point's source (or hides the list). */
@@ -55,12 +56,7 @@ async function listCounterImages() {
   }
   let text;
   try {
-    const c = await app.counterImages(pin);
-    const images = c.images.map((i) => `(${fmt(i.position_arcsec[0])}, ${fmt(i.position_arcsec[1])}) ` +
-      `μ ${fmt(i.magnification, 1)} (parity ${i.magnification < 0 ? '−' : '+'})${delayText(i.delay_days)}`);
-    text = `The source behind (${fmt(c.x_arcsec)}″, ${fmt(c.y_arcsec)}″) lies at β = (${fmt(c.beta_arcsec[0])}″, ` +
-      `${fmt(c.beta_arcsec[1])}″); at z_s = ${c.z_source} it has ${images.length} image${images.length === 1 ? '' : 's'} ` +
-      `(yellow squares where |μ| ≥ 0.1; Δt: arrival after the first image): ${images.join('; ')}.`;
+    text = counterImagesText(await app.counterImages(pin));
   } catch (err) {
     text = `The clicked point: ${err.message}.`;
   }
@@ -73,6 +69,14 @@ async function listCounterImages() {
   reg.title = 'The clicked point and its source\'s images as DS9 regions, to lay over the cluster image';
   box.replaceChildren(p, reg, document.createTextNode(' · '), clear);
   box.hidden = false;
+}
+
+/** Pins the point `[x, y]` (arcsec) as a click there would: its read-out, its source's
+ * images listed and drawn (a typed position, js/coords.js). */
+export async function pinAt(p) {
+  pin = p;
+  point = null;
+  await app.render();
 }
 
 /** Forgets the clicked point and the read-out: they belong to maps that are gone (another
@@ -89,6 +93,7 @@ export function clearPin() {
 export async function refreshReadout() {
   if (img().dataset.view !== 'kappa') return;
   if (point) await readOut();
+  else if (pin) await readPin();
   await listCounterImages();
 }
 
