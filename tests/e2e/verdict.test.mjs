@@ -78,6 +78,8 @@ test('the systems table sorts by a column header, by mouse and keyboard, with ar
     const { page } = app;
     await page.click('#tab-systems');
     await page.waitForSelector('#systems table');
+    // The table replaces the map (the figure's grid layout must not show it through [hidden]).
+    assert.equal(await page.isVisible('#figure'), false);
     const fileOrder = (await column(page, 0)).map(([id]) => id);
     assert.equal(fileOrder.length, 30);
     assert.equal(await page.locator('#systems th[aria-sort]').count(), 0);
