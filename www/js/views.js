@@ -1,5 +1,6 @@
 // The result views: tabs, PNGs from the worker shown through blob URLs (decoded off the main
-// thread), the hover/click read-out on the mass map, and the per-system table.
+// thread), the hover/click read-out on the mass map (its texts: js/coords.js); the per-system
+// table is drawn by js/systems-table.js.
 
 import { button, save } from './downloads.js';
 import { offsetsCell, showSystems } from './systems-table.js';
