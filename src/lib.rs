@@ -148,13 +148,14 @@ pub use reconstruct::{
     fold_groups, image_regions, layer_count, product_options, reconstruct, reconstruct_with_choice,
     run_ensemble, strength_candidates, strength_folds, strength_trial, ArrivalTimes, Bytes,
     ConvergenceRecord, CrossValidation, Dataset, DatasetError, Ensemble, EnsembleMaps,
-    EnsembleMember, FoldRun, FreeZSummary, Heap, ImageReport, InputText, InputTexts, Inputs,
-    InterpolatedLens, KappaSpread, LayerSource, MemoryEstimate, MemoryLimit, PredictedImage,
-    PredictedSystem, ProductConfig, ReconstructConfig, ReconstructError, ReconstructSummary,
-    Reconstruction, RedshiftEstimate, RunSize, RunStatus, Solved, SolverConfig, SolverMethod,
-    SourceReport, StrengthCandidate, StrengthChoice, SystemCheck, TooMuchMemory, Trust, Verdict,
-    VerdictInputs, CHOICE_MAP_PIXELS, DEFAULT_FOLDS, FALLBACK_MEMORY_LIMIT_BYTES,
-    FALLBACK_SIGMA_ARCSEC, MAX_ENSEMBLE_MEMBERS, SHOWN_MIN_MAGNIFICATION, WASM_MEMORY_LIMIT_BYTES,
+    EnsembleMember, EnsemblePlan, FoldRun, FreeZSummary, Heap, ImageReport, InputText, InputTexts,
+    Inputs, InterpolatedLens, KappaSpread, LayerSource, MemberDraw, MemberRun, MemoryEstimate,
+    MemoryLimit, PredictedImage, PredictedSystem, ProductConfig, ReconstructConfig,
+    ReconstructError, ReconstructSummary, Reconstruction, RedshiftEstimate, RunSize, RunStatus,
+    Solved, SolverConfig, SolverMethod, SourceReport, StrengthCandidate, StrengthChoice,
+    SystemCheck, TooMuchMemory, Trust, Verdict, VerdictInputs, CHOICE_MAP_PIXELS, DEFAULT_FOLDS,
+    FALLBACK_MEMORY_LIMIT_BYTES, FALLBACK_SIGMA_ARCSEC, MAX_ENSEMBLE_MEMBERS,
+    SHOWN_MIN_MAGNIFICATION, WASM_MEMORY_LIMIT_BYTES,
 };
 
 // The verdict on a reconstruction and its thresholds.

@@ -280,20 +280,7 @@ fn write_ensemble(
     write("ensemble.json", json(&ensemble)?.as_bytes())?;
     // The ranges join the main run's summary.json.
     let mut summary = serde_json::to_value(result.summary()).map_err(|e| e.to_string())?;
-    if let Some(s) = summary.as_object_mut() {
-        s.insert(
-            "einstein_radius_interval_arcsec".to_string(),
-            serde_json::json!(ensemble.einstein_radius_interval_arcsec),
-        );
-        s.insert(
-            "mass_within_interval_msun".to_string(),
-            serde_json::json!(ensemble.mass_within_interval_msun),
-        );
-        s.insert(
-            "ensemble_members".to_string(),
-            serde_json::json!(ensemble.members.len()),
-        );
-    }
+    ensemble.add_to_summary(&mut summary);
     write("summary.json", json(&summary)?.as_bytes())?;
     let radius = ensemble
         .einstein_radius_interval_arcsec

@@ -187,7 +187,29 @@ impl Ensemble {
                 write_image(magnif, &opts(&what, true))?,
             ));
         }
-        let title = match curves {
+        let overlay = Overlay {
+            curves,
+            ..Overlay::default()
+        };
+        if let Some(png) = self.spread_png(&overlay, KappaPlotOptions::default())? {
+            files.push(("kappa-std.png".to_string(), png));
+        }
+        Ok(files)
+    }
+
+    /// `kappa-std.png`: the spread of kappa over the members (linear, from 0) with what
+    /// `overlay` draws on top (the critical curves of the main run), on a map of `base`'s size
+    /// with its legend; `None` without maps.
+    pub fn spread_png(
+        &self,
+        overlay: &Overlay<'_>,
+        base: KappaPlotOptions,
+    ) -> Result<Option<Vec<u8>>, ProductsError> {
+        let Some(maps) = &self.maps else {
+            return Ok(None);
+        };
+        let n = self.members.len();
+        let title = match overlay.curves {
             Some(c) => format!(
                 "Spread of κ over {n} members; critical curves at z_{{s}} = {}",
                 c.z_source
@@ -199,17 +221,29 @@ impl Ensemble {
             vmin: Some(0.0),
             title: Some(title),
             colorbar_label: Some("kappa std".to_string()),
-            ..KappaPlotOptions::default()
+            ..base
         };
-        let overlay = Overlay {
-            curves,
-            ..Overlay::default()
-        };
-        files.push((
-            "kappa-std.png".to_string(),
-            render_kappa_png(&maps.kappa_std, &overlay, &plot)?,
-        ));
-        Ok(files)
+        Ok(Some(render_kappa_png(&maps.kappa_std, overlay, &plot)?))
+    }
+
+    /// Adds the ensemble's ranges to a `summary.json` object, as `wslap reconstruct
+    /// --ensemble` writes them: `einstein_radius_interval_arcsec`, `mass_within_interval_msun`
+    /// and `ensemble_members`.
+    pub fn add_to_summary(&self, summary: &mut serde_json::Value) {
+        if let Some(s) = summary.as_object_mut() {
+            s.insert(
+                "einstein_radius_interval_arcsec".to_string(),
+                serde_json::json!(self.einstein_radius_interval_arcsec),
+            );
+            s.insert(
+                "mass_within_interval_msun".to_string(),
+                serde_json::json!(self.mass_within_interval_msun),
+            );
+            s.insert(
+                "ensemble_members".to_string(),
+                serde_json::json!(self.members.len()),
+            );
+        }
     }
 }
 
@@ -238,6 +272,9 @@ pub fn check_ensemble_size(members: usize) -> Result<(), ReconstructError> {
 /// `members` reconstructions of `inputs` that differ as the module says, with `main`'s
 /// settings, sampled on `main`'s maps. `progress` sees the member number (1-based) and every
 /// solver report, and may cancel.
+///
+/// The same as [`EnsemblePlan::new`], [`EnsemblePlan::run_member`] for every member in turn
+/// and [`EnsemblePlan::combine`]: the app runs the members in web workers that way.
 pub fn run_ensemble(
     inputs: &Inputs<'_>,
     config: &ReconstructConfig,
@@ -246,121 +283,273 @@ pub fn run_ensemble(
     seed: u64,
     progress: &mut dyn FnMut(usize, &ConvergenceRecord) -> Control,
 ) -> Result<Ensemble, ReconstructError> {
-    check_ensemble_size(members)?;
-    let ids = fitted_system_ids(inputs, config)?;
-    if ids.len() < 2 {
-        return Err(ReconstructError::Folds {
-            folds: 2,
-            systems: ids.len(),
-        });
-    }
-    // The main run's settings, its strength fixed, its grid and map held.
-    let choice: Option<&StrengthChoice> = main.strength_choice.as_ref();
-    let grid = &main.system.grid;
-    let cell = grid.width_arcsec / grid.cells_per_side.max(1) as f64;
-    let geometry = main.products.maps.geometry();
-    let z_source = main.products.curves.z_source;
-    let mut member_config = config.clone();
-    member_config.grid.width_arcsec = Some(grid.width_arcsec);
-    member_config.products.size_arcsec = Some(geometry.size_arcsec);
-    member_config.products.pixels = geometry.pixels;
-    let mut rng = Rng::stream(seed, 0xE25E);
+    let plan = EnsemblePlan::new(inputs, config, main, members, seed)?;
     let mut runs = Vec::new();
-    let mut kappas = Vec::new();
-    let mut magnifs = Vec::new();
-    let mut status = "Completed";
-    for k in 0..members {
-        let member = k + 1;
+    let mut complete = true;
+    for member in 1..=members {
+        let mut report = |rec: &ConvergenceRecord| progress(member, rec);
+        match plan.run_member(inputs, config, member, &mut report)? {
+            Some(run) => runs.push(run),
+            None => {
+                complete = false;
+                break;
+            }
+        }
+    }
+    plan.combine(runs, complete)
+}
+
+/// How one member differs from the main run: the systems it fits and its grid's shift.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct MemberDraw {
+    /// 1-based member number.
+    pub member: usize,
+    /// The systems it fits (drawn at least once).
+    pub fitted: Vec<String>,
+    /// The fitted systems of the main run it leaves out (never drawn).
+    pub left_out: Vec<String>,
+    /// How far its grid is moved from the main run's (arcsec).
+    pub grid_shift_arcsec: DVec2,
+}
+
+/// An ensemble before its members run: what they share, taken from the main run (its grid,
+/// its maps, its strength), and every member's draw, all made from `seed` in member order.
+/// A member then runs anywhere the same inputs and settings are ([`Self::run_member`]: a
+/// thread, a web worker) and gives the same reconstruction; [`Self::combine`] makes the
+/// ensemble of the members in any order.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct EnsemblePlan {
+    pub seed: u64,
+    /// The main run's products' source redshift (magnifications and Einstein radii).
+    pub z_source: f64,
+    /// The main run's map: every member is sampled on it.
+    pub geometry: MapGeometry,
+    /// The main run's grid: its centre and width (arcsec) and cells per side.
+    pub grid_center_arcsec: DVec2,
+    pub grid_width_arcsec: f64,
+    pub grid_cells_per_side: usize,
+    /// The main run's "auto" choice of the strength (`None` for a fixed strength): the members
+    /// use its strength and do not choose again.
+    pub strength_choice: Option<StrengthChoice>,
+    /// The radii of the main run's `summary.json` masses (arcsec).
+    pub radii_arcsec: Vec<f64>,
+    pub draws: Vec<MemberDraw>,
+}
+
+/// One member's reconstruction: its record and its maps on the plan's map.
+#[derive(Debug, Clone, PartialEq)]
+pub struct MemberRun {
+    pub record: EnsembleMember,
+    /// kappa at `D_ls/D_s = 1`.
+    pub kappa: Map,
+    /// Magnification at the plan's `z_source`.
+    pub magnif: Map,
+}
+
+impl EnsemblePlan {
+    /// The plan of `members` members of `main` (the reconstruction of `inputs` with `config`)
+    /// drawn from `seed`: the bootstrap over the fitted systems, redrawn until at least two
+    /// distinct systems are fitted, then the grid's shift, member after member from one
+    /// random stream.
+    pub fn new(
+        inputs: &Inputs<'_>,
+        config: &ReconstructConfig,
+        main: &Reconstruction,
+        members: usize,
+        seed: u64,
+    ) -> Result<Self, ReconstructError> {
+        check_ensemble_size(members)?;
+        let ids = fitted_system_ids(inputs, config)?;
+        if ids.len() < 2 {
+            return Err(ReconstructError::Folds {
+                folds: 2,
+                systems: ids.len(),
+            });
+        }
+        let grid = &main.system.grid;
+        let cell = grid.width_arcsec / grid.cells_per_side.max(1) as f64;
+        let mut rng = Rng::stream(seed, 0xE25E);
+        let draws = (1..=members)
+            .map(|member| {
+                let drawn = loop {
+                    let mut drawn = vec![false; ids.len()];
+                    for _ in 0..ids.len() {
+                        drawn[rng.index(ids.len())] = true;
+                    }
+                    if drawn.iter().filter(|&&d| d).count() >= 2 {
+                        break drawn;
+                    }
+                };
+                let pick = |want: bool| {
+                    ids.iter()
+                        .zip(&drawn)
+                        .filter(|(_, &d)| d == want)
+                        .map(|(id, _)| id.clone())
+                        .collect()
+                };
+                let shift = DVec2::new(rng.range(-0.5, 0.5), rng.range(-0.5, 0.5)) * cell;
+                MemberDraw {
+                    member,
+                    fitted: pick(true),
+                    left_out: pick(false),
+                    grid_shift_arcsec: shift,
+                }
+            })
+            .collect();
+        Ok(Self {
+            seed,
+            z_source: main.products.curves.z_source,
+            geometry: main.products.maps.geometry(),
+            grid_center_arcsec: grid.center,
+            grid_width_arcsec: grid.width_arcsec,
+            grid_cells_per_side: grid.cells_per_side,
+            strength_choice: main.strength_choice.clone(),
+            radii_arcsec: main
+                .products
+                .summary()
+                .mass_within_arcsec
+                .iter()
+                .map(|(r, _)| *r)
+                .collect(),
+            draws,
+        })
+    }
+
+    /// The number of members.
+    pub fn members(&self) -> usize {
+        self.draws.len()
+    }
+
+    /// Member `member` (1-based) of the plan, reconstructed from the `inputs` and `config`
+    /// of the main run: its systems, its grid moved, the main run's grid width, map and
+    /// strength. `None` when `progress` cancelled it.
+    pub fn run_member(
+        &self,
+        inputs: &Inputs<'_>,
+        config: &ReconstructConfig,
+        member: usize,
+        progress: &mut dyn FnMut(&ConvergenceRecord) -> Control,
+    ) -> Result<Option<MemberRun>, ReconstructError> {
+        let draw = member
+            .checked_sub(1)
+            .and_then(|k| self.draws.get(k))
+            .ok_or_else(|| {
+                BadFieldValue::new(
+                    "member",
+                    member as f64,
+                    format!("this ensemble has members 1 to {}", self.members()),
+                )
+            })?;
         let clock = crate::products::Clock::start();
-        // Bootstrap over systems, redrawn until at least two distinct systems are fitted.
-        let drawn = loop {
-            let mut drawn = vec![false; ids.len()];
-            for _ in 0..ids.len() {
-                drawn[rng.index(ids.len())] = true;
-            }
-            if drawn.iter().filter(|&&d| d).count() >= 2 {
-                break drawn;
-            }
-        };
+        let mut member_config = config.clone();
+        member_config.grid.width_arcsec = Some(self.grid_width_arcsec);
+        member_config.grid.center_arcsec = Some(self.grid_center_arcsec + draw.grid_shift_arcsec);
+        member_config.products.size_arcsec = Some(self.geometry.size_arcsec);
+        member_config.products.pixels = self.geometry.pixels;
         let left_out: Vec<String> = inputs
             .holdout
             .iter()
+            .chain(&draw.left_out)
             .cloned()
-            .chain(
-                ids.iter()
-                    .zip(&drawn)
-                    .filter(|(_, &d)| !d)
-                    .map(|(id, _)| id.clone()),
-            )
             .collect();
-        let shift = DVec2::new(rng.range(-0.5, 0.5), rng.range(-0.5, 0.5)) * cell;
-        member_config.grid.center_arcsec = Some(grid.center + shift);
         let member_inputs = Inputs {
             holdout: &left_out,
             ..*inputs
         };
-        let mut report = |rec: &ConvergenceRecord| progress(member, rec);
-        let r = match choice {
+        let r = match &self.strength_choice {
             Some(c) => {
-                reconstruct_with_choice(&member_inputs, &member_config, c.clone(), &mut report)?
+                reconstruct_with_choice(&member_inputs, &member_config, c.clone(), progress)?
             }
-            None => reconstruct(&member_inputs, &member_config, &mut report)?,
+            None => reconstruct(&member_inputs, &member_config, progress)?,
         };
         if r.status == SolveStatus::Cancelled {
-            status = "Cancelled";
-            break;
+            return Ok(None);
         }
-        let (kappa, magnif) = sampled_maps(&r, geometry);
-        kappas.push(kappa);
-        magnifs.push(magnif);
+        let (kappa, magnif) = sampled_maps(&r, self.geometry);
         let summary = r.products.summary();
-        runs.push(EnsembleMember {
+        let record = EnsembleMember {
             member,
-            fitted: ids
-                .iter()
-                .zip(&drawn)
-                .filter(|(_, &d)| d)
-                .map(|(id, _)| id.clone())
-                .collect(),
-            grid_shift_arcsec: shift,
+            fitted: draw.fitted.clone(),
+            grid_shift_arcsec: draw.grid_shift_arcsec,
             status: r.status.name().to_string(),
             c: r.layer_factors(),
             einstein_radius_arcsec: summary.einstein_radius_arcsec,
             mass_within_arcsec: summary.mass_within_arcsec,
             left_out_image_offset_median_arcsec: r.image_offset_median_arcsec(true),
             elapsed_ms: clock.ms(),
-        });
+        };
+        Ok(Some(MemberRun {
+            record,
+            kappa,
+            magnif,
+        }))
     }
-    let radii: Vec<f64> = main
-        .products
-        .summary()
-        .mass_within_arcsec
-        .iter()
-        .map(|(r, _)| *r)
-        .collect();
-    let mass_within_interval_msun = radii
-        .iter()
-        .enumerate()
-        .map(|(i, &r)| {
-            let values: Option<Vec<f64>> = runs
-                .iter()
-                .map(|m| m.mass_within_arcsec.get(i).and_then(|(_, v)| *v))
-                .collect();
-            (r, values.and_then(interval))
+
+    /// The ensemble of `runs` (members of this plan, in any order, each once), "Completed"
+    /// when `complete`, else "Cancelled". Fails when a run is not of this plan (its number or
+    /// its maps) or comes twice.
+    pub fn combine(
+        &self,
+        mut runs: Vec<MemberRun>,
+        complete: bool,
+    ) -> Result<Ensemble, ReconstructError> {
+        runs.sort_by_key(|r| r.record.member);
+        for (k, run) in runs.iter().enumerate() {
+            let m = run.record.member;
+            if m == 0 || m > self.members() || (k > 0 && runs[k - 1].record.member == m) {
+                return Err(BadFieldValue::new(
+                    "member",
+                    m as f64,
+                    format!(
+                        "an ensemble of {} members has each of 1 to {0} once",
+                        self.members()
+                    ),
+                )
+                .into());
+            }
+            if run.kappa.geometry != self.geometry || run.magnif.geometry != self.geometry {
+                return Err(BadFieldValue::new(
+                    "member",
+                    m as f64,
+                    "its maps are not on the ensemble's map",
+                )
+                .into());
+            }
+        }
+        let records: Vec<&EnsembleMember> = runs.iter().map(|r| &r.record).collect();
+        let mass_within_interval_msun = self
+            .radii_arcsec
+            .iter()
+            .enumerate()
+            .map(|(i, &r)| {
+                let values: Option<Vec<f64>> = records
+                    .iter()
+                    .map(|m| m.mass_within_arcsec.get(i).and_then(|(_, v)| *v))
+                    .collect();
+                (r, values.and_then(interval))
+            })
+            .collect();
+        let einstein_radius_interval_arcsec =
+            interval(records.iter().map(|m| m.einstein_radius_arcsec).collect());
+        let mut members = Vec::with_capacity(runs.len());
+        let mut kappas = Vec::with_capacity(runs.len());
+        let mut magnifs = Vec::with_capacity(runs.len());
+        for run in runs {
+            members.push(run.record);
+            kappas.push(run.kappa);
+            magnifs.push(run.magnif);
+        }
+        Ok(Ensemble {
+            status: if complete { "Completed" } else { "Cancelled" }.to_string(),
+            seed: self.seed,
+            z_source: self.z_source,
+            members,
+            einstein_radius_interval_arcsec,
+            mass_within_interval_msun,
+            note: NOTE.to_string(),
+            maps: (!kappas.is_empty()).then(|| statistics(self.geometry, kappas, magnifs)),
         })
-        .collect();
-    Ok(Ensemble {
-        status: status.to_string(),
-        seed,
-        z_source,
-        einstein_radius_interval_arcsec: interval(
-            runs.iter().map(|m| m.einstein_radius_arcsec).collect(),
-        ),
-        mass_within_interval_msun,
-        members: runs,
-        note: NOTE.to_string(),
-        maps: (!kappas.is_empty()).then(|| statistics(geometry, kappas, magnifs)),
-    })
+    }
 }
 
 /// A member's kappa (`D_ls/D_s = 1`) and magnification at the products' z_s on the pixels of
