@@ -6,6 +6,7 @@
 
 mod compare;
 mod data;
+mod ensemble;
 pub mod examples;
 mod iterates;
 mod outputs;
@@ -25,6 +26,7 @@ pub use data::{
     ArcPixels, DataMarks, DataRole, DataViews, LoadReport, LoadedData, ModelLens, NamedMap,
     NamedText, MAX_STORED_FITS_BYTES,
 };
+pub use ensemble::{member_run, EnsembleReadout, EnsembleSettings};
 pub use iterates::{IterateList, IterateStep, APP_KEPT_ITERATES};
 pub use overlap::{separation_arcsec, SkyFootprint, FIELD_MARGIN_ARCSEC};
 pub use plots::{profile_relative_differences, ModelCurves};

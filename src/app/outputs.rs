@@ -9,13 +9,20 @@ use crate::reconstruct::image_regions;
 use super::{AppError, SessionResult};
 
 impl SessionResult {
-    /// `summary.json`: the CLI's reconstruction summary, or the map summary of a forward model
-    /// or look-up (what `wslap maps` writes).
+    /// `summary.json`: the CLI's reconstruction summary (with an ensemble's intervals, as
+    /// `wslap reconstruct --ensemble` writes them), or the map summary of a forward model or
+    /// look-up (what `wslap maps` writes).
     pub fn summary_json(&self) -> Result<String, AppError> {
-        match self.reconstruction() {
-            Some(r) => pretty(&r.summary()),
-            None => pretty(&self.products().summary()),
-        }
+        let Some(r) = self.reconstruction() else {
+            return pretty(&self.products().summary());
+        };
+        let Some(ensemble) = &self.ensemble else {
+            return pretty(&r.summary());
+        };
+        let mut summary =
+            serde_json::to_value(r.summary()).map_err(|e| AppError::Run(e.to_string()))?;
+        ensemble.add_to_summary(&mut summary);
+        pretty(&summary)
     }
 
     /// `sources.json` (empty list without a reconstruction).

@@ -11,7 +11,7 @@ use crate::products::{own_map_side, ProductOptions, Products};
 use crate::reconstruct::{
     check_memory, cross_validate, fitted_system_ids, map_geometry, product_options, reconstruct,
     reconstruct_with_choice, strength_candidates, strength_folds, ConvergenceRecord,
-    CrossValidation, Dataset, DatasetError, Inputs, MemoryLimit, ReconstructConfig,
+    CrossValidation, Dataset, DatasetError, Ensemble, Inputs, MemoryLimit, ReconstructConfig,
     ReconstructError, Reconstruction, RunSize, RunStatus, SourceReport, StageTimings,
     StrengthCandidate, StrengthChoice, DEFAULT_FOLDS,
 };
@@ -54,6 +54,8 @@ pub struct SessionResult {
     pub elapsed_ms: f64,
     /// The maps of the last iterate drawn (see the `iterates` module).
     pub(crate) iterate_cache: IterateCache,
+    /// The ensemble run after the reconstruction (see the `ensemble` module), if any.
+    pub ensemble: Option<Box<Ensemble>>,
 }
 
 impl SessionResult {
@@ -148,6 +150,7 @@ fn reconstruction_result(mut r: Reconstruction, parsed: &Dataset) -> SessionResu
         marks: parsed.marks(),
         elapsed_ms: 0.0,
         iterate_cache: IterateCache::default(),
+        ensemble: None,
     }
 }
 
@@ -171,7 +174,7 @@ impl Session {
     }
 
     /// Runs `f` on the reconstruction's inputs (the loaded data in one frame) and settings.
-    fn with_inputs<T>(
+    pub(super) fn with_inputs<T>(
         &self,
         f: impl FnOnce(&Inputs<'_>, &ReconstructConfig, &Dataset) -> Result<T, AppError>,
     ) -> Result<T, AppError> {
@@ -383,6 +386,7 @@ impl Session {
             marks: parsed.marks(),
             elapsed_ms: t.ms(),
             iterate_cache: IterateCache::default(),
+            ensemble: None,
         });
         Ok(())
     }
@@ -412,6 +416,7 @@ impl Session {
             marks: parsed.marks(),
             elapsed_ms: 0.0,
             iterate_cache: IterateCache::default(),
+            ensemble: None,
         })
     }
 
@@ -436,6 +441,7 @@ impl Session {
             marks: DataMarks::default(),
             elapsed_ms: 0.0,
             iterate_cache: IterateCache::default(),
+            ensemble: None,
         })
     }
 

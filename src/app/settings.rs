@@ -8,6 +8,8 @@ use crate::lenstool_par::ParOptions;
 use crate::limits::json_error_message;
 use crate::reconstruct::{MemoryLimit, ReconstructConfig, RunSize, TooMuchMemory};
 
+use super::ensemble::EnsembleSettings;
+
 use super::AppError;
 
 /// Map side in pixels the app uses by default (the CLI's default is 512).
@@ -33,6 +35,9 @@ pub struct AppSettings {
     /// single-plane approximation ([`ParOptions::single_plane`], `wslap maps --single-plane`);
     /// default `false`: such a model is refused.
     pub lenstool_single_plane: bool,
+    /// After each reconstruction, an ensemble of that many more (0, the default: none), as
+    /// `wslap reconstruct --ensemble N --seed S` runs it.
+    pub ensemble: EnsembleSettings,
 }
 
 impl Default for AppSettings {
@@ -49,6 +54,7 @@ impl Default for AppSettings {
             reconstruct,
             holdout: Vec::new(),
             lenstool_single_plane: false,
+            ensemble: EnsembleSettings::default(),
         }
     }
 }
@@ -70,6 +76,7 @@ impl AppSettings {
                 )));
             }
         }
+        self.ensemble.validate()?;
         self.reconstruct
             .validate()
             .map_err(|e| AppError::Setting(e.to_string()))
@@ -106,6 +113,9 @@ impl AppSettings {
         next.check_sources_behind_lens()
             .map_err(|e| AppError::Setting(format!("{path}: {e}")))?;
         next.check_memory()
+            .map_err(|e| AppError::Setting(format!("{path}: {e}")))?;
+        next.ensemble
+            .check_memory(next.reconstruct.products.pixels, MemoryLimit::here())
             .map_err(|e| AppError::Setting(format!("{path}: {e}")))?;
         Ok(next)
     }

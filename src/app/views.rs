@@ -177,6 +177,8 @@ pub struct HoverReadout {
     /// The maps have no data there (pixels without data in published deflection maps):
     /// `kappa` and `magnification` are NaN.
     pub no_data: bool,
+    /// The result's ensemble there (not for an earlier iterate), if it has one.
+    pub ensemble: Option<super::EnsembleReadout>,
 }
 
 /// The source behind a point of the map and all its images, at the curves' source redshift.
@@ -539,6 +541,10 @@ impl Session {
                 magnification,
                 z_source: products.curves.z_source,
                 no_data: kappa.is_nan() || magnification.is_nan(),
+                ensemble: match shown.iteration {
+                    Some((k, n)) if k < n => None,
+                    _ => self.ensemble_at(p),
+                },
             })
         })
     }

@@ -7,6 +7,7 @@
 use serde::Serialize;
 use wasm_bindgen::prelude::*;
 
+mod ensemble;
 mod playground;
 mod session;
 

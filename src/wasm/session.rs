@@ -14,14 +14,14 @@ const PROGRESS_INTERVAL_MS: f64 = 100.0;
 
 /// Passes QADP reports on to a JavaScript callback at most every [`PROGRESS_INTERVAL_MS`], with
 /// `elapsed_ms` and any extra fields.
-struct Throttle<'a> {
+pub(super) struct Throttle<'a> {
     progress: &'a js_sys::Function,
     clock: crate::products::Clock,
     last: f64,
 }
 
 impl<'a> Throttle<'a> {
-    fn new(progress: &'a js_sys::Function) -> Self {
+    pub(super) fn new(progress: &'a js_sys::Function) -> Self {
         Self {
             progress,
             clock: crate::products::Clock::start(),
@@ -29,7 +29,7 @@ impl<'a> Throttle<'a> {
         }
     }
 
-    fn report(&mut self, r: &ConvergenceRecord, extra: &[(&str, f64)]) {
+    pub(super) fn report(&mut self, r: &ConvergenceRecord, extra: &[(&str, f64)]) {
         let now = self.clock.ms();
         if now - self.last < PROGRESS_INTERVAL_MS {
             return;
@@ -47,7 +47,7 @@ impl<'a> Throttle<'a> {
     }
 }
 
-fn err(e: impl std::fmt::Display) -> JsError {
+pub(super) fn err(e: impl std::fmt::Display) -> JsError {
     JsError::new(&e.to_string())
 }
 
@@ -63,7 +63,9 @@ fn bytes(png: &[u8]) -> JsValue {
 }
 
 /// Files as an array of `{name, bytes}`.
-fn files_js<'a>(files: impl Iterator<Item = (&'a str, &'a [u8])>) -> Result<JsValue, JsError> {
+pub(super) fn files_js<'a>(
+    files: impl Iterator<Item = (&'a str, &'a [u8])>,
+) -> Result<JsValue, JsError> {
     let out = js_sys::Array::new();
     for (name, data) in files {
         let obj = js_sys::Object::new();
@@ -77,10 +79,12 @@ fn files_js<'a>(files: impl Iterator<Item = (&'a str, &'a [u8])>) -> Result<JsVa
 /// One session: loaded data, settings and the last result.
 #[wasm_bindgen]
 pub struct AppSession {
-    inner: Session,
+    pub(super) inner: Session,
     /// The files of the last cross-validation's convergence maps (see
     /// [`Session::crossval_files`]).
     crossval_files: Vec<(&'static str, Vec<u8>)>,
+    /// The ensemble members handed over so far (see `super::ensemble`).
+    pub(super) ensemble_runs: Vec<super::ensemble::HandedMember>,
 }
 
 impl Default for AppSession {
@@ -98,6 +102,7 @@ impl AppSession {
         AppSession {
             inner: Session::new(),
             crossval_files: Vec::new(),
+            ensemble_runs: Vec::new(),
         }
     }
 
@@ -313,7 +318,8 @@ impl AppSession {
         self.settings()
     }
 
-    /// One view as PNG bytes: `kappa`, `source`, `data`, `radial`, `convergence` or `compare`.
+    /// One view as PNG bytes: `kappa`, `source`, `data`, `radial`, `convergence`, `compare`
+    /// or `spread` (the ensemble's).
     /// The option `iterate: k` draws the mass map of the `k`-th kept iterate
     /// ([`AppSession::iterates`]).
     pub fn view(&self, name: &str, options: JsValue) -> Result<JsValue, JsError> {
@@ -326,6 +332,7 @@ impl AppSession {
             "radial" => s.radial_view(&opts),
             "convergence" => s.convergence_view(&opts),
             "compare" => s.compare_view(&opts),
+            "spread" => s.spread_view(&opts),
             other => return Err(JsError::new(&format!("unknown view '{other}'"))),
         }
         .map_err(err)?;
@@ -404,7 +411,8 @@ impl AppSession {
     }
 
     /// A download: `summary.json`, `sources.json`, `images.reg`, `convergence.json`,
-    /// `critical-curves.json`, `critical-curves.reg` or `project.json` as text.
+    /// `critical-curves.json`, `critical-curves.reg`, `ensemble.json` or `project.json` as
+    /// text.
     pub fn text_file(&self, name: &str) -> Result<String, JsError> {
         if name == "project.json" {
             return self.inner.project_json().map_err(err);
@@ -417,6 +425,7 @@ impl AppSession {
             "critical-curves.json" => Ok(r.products().curves_json()),
             "critical-curves.reg" => Ok(r.products().regions()),
             "images.reg" => r.images_regions().map_err(err),
+            "ensemble.json" => self.inner.ensemble_json().map_err(err),
             other => Err(JsError::new(&format!("unknown file '{other}'"))),
         }
     }

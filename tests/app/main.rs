@@ -8,6 +8,7 @@ mod common;
 mod fixtures;
 
 mod bad_inputs;
+mod ensemble;
 mod iterates;
 mod loading;
 mod model;
