@@ -12,6 +12,7 @@ import { StrengthPool, poolSize, projectForTrials } from './js/pool.js';
 import { wireIterates, showIterates, syncIterates, iterateOption } from './js/iterates.js';
 import { showVerdict } from './js/verdict.js';
 import { wireLocate } from './js/coords.js';
+import { runEnsemble, showEnsemble, ensembleCaption } from './js/ensemble.js';
 
 // Offline use once loaded (sw.js), for the lessons and the playground too. Without it (an old
 // browser, a file:// page) the app still works online.
@@ -120,6 +121,7 @@ function showNoResult() {
   runNotes(null);
   showStrengthChoice(null);
   showIterates(null);
+  showEnsemble(null, app);
   clearPin();
   $('downloads').innerHTML = '<p class="hint">Run something first.</p>';
 }
@@ -193,7 +195,7 @@ function caption(info) {
   const stale = [...rejected.values()].map(({ file, kept }) => ` Made with ${kept}: ${file} had errors and was not loaded.`).join('')
     + ($('sky-warning').hidden ? '' : ' Made with files of different parts of the sky (see the warning above).');
   $('summary').textContent = `${status}Einstein radius ${bound}${s.einstein_radius_arcsec.toFixed(1)}″ at ` +
-    `z_s = ${s.z_source}; ${factors}${offsets}${held}${s.tangential_curves} tangential and ${s.radial_curves} radial critical curves.${note}${stale}`;
+    `z_s = ${s.z_source}; ${factors}${offsets}${held}${s.tangential_curves} tangential and ${s.radial_curves} radial critical curves.${ensembleCaption(sum)}${note}${stale}`;
 }
 
 /** Under the views: the systems a run left out of the fit and its warnings (collapsed: a
@@ -233,12 +235,22 @@ async function showResult(info) {
   showStrengthChoice(info.summary?.strength_choice);
   showDownloads(info.kind, app);
   showIterates(info.kind === 'reconstruct' ? (await ask('iterates')).iterates : null);
+  showEnsemble(info.summary?.ensemble_members ? await ask('ensembleInfo') : null, app);
+  if (currentView() === 'spread' && !info.summary?.ensemble_members) $('tab-kappa').click();
 }
 
 function showProgress(on) {
   $('progress-box').hidden = !on;
   $('cancel').hidden = !on;
   for (const id of ['reconstruct', 'forward', 'lookup', 'crossval']) $(id).disabled = on || $(id).disabled;
+}
+
+/** The progress bar at `k` of `total` units after `elapsed_ms`, with `words` and the time left. */
+function progressAt(elapsedMs, k, total, words) {
+  const frac = Math.min(1, k / total);
+  const left = frac > 0 ? (elapsedMs / frac - elapsedMs) / 1000 : NaN;
+  $('progress').value = frac;
+  $('progress-text').textContent = `${words}, about ${Number.isFinite(left) ? left.toFixed(0) : '?'} s left`;
 }
 
 /** Runs `job(onProgress)` in the worker with the progress bar and Cancel shown: `status` while
@@ -251,13 +263,7 @@ async function inWorker(status, job, position, done) {
   $('progress-text').textContent = 'Building the linear system…';
   setStatus(status);
   try {
-    const answer = await job((p) => {
-      const [k, total, words] = position(p);
-      const frac = Math.min(1, k / total);
-      const left = frac > 0 ? (p.elapsed_ms / frac - p.elapsed_ms) / 1000 : NaN;
-      $('progress').value = frac;
-      $('progress-text').textContent = `${words}, about ${Number.isFinite(left) ? left.toFixed(0) : '?'} s left`;
-    });
+    const answer = await job((p) => progressAt(p.elapsed_ms, ...position(p)));
     await done(answer);
   } catch (err) {
     if (err.cancelled) return;
@@ -269,7 +275,8 @@ async function inWorker(status, job, position, done) {
   }
 }
 
-// The pool of an "auto" strength's candidates while they run (Cancel closes it).
+// The pool of an "auto" strength's candidates or of an ensemble's members while they run
+// (Cancel closes it).
 let pool = null;
 
 function run(kind) {
@@ -291,7 +298,25 @@ function run(kind) {
       await showResult(info);
       await persist();
       await render();
+      if (kind === 'reconstruct') await ensemble(wall);
     });
+}
+
+/** After a reconstruction that took `mainMs`, the ensemble the settings ask for (js/ensemble.js),
+ * with the same progress bar and Cancel; the map stays usable meanwhile. */
+async function ensemble(mainMs) {
+  const total = settings?.reconstruct?.solver?.iterations ?? 1;
+  const info = await runEnsemble({
+    ask,
+    iterations: total,
+    onPool: (p) => { pool = p; },
+    onProgress: (p) => progressAt(p.elapsed_ms, p.units, p.total, p.words),
+  });
+  if (!info) return;
+  setStatus(`Done in ${(mainMs / 1000).toFixed(2)} s; ensemble of ${info.summary.ensemble_members} members in ${
+    (info.ensemble_ms / 1000).toFixed(2)} s.`);
+  await showResult(info);
+  await render();
 }
 
 /** An "auto" regulariser strength: each candidate of `plan` is cross-validated in a pool
@@ -377,10 +402,11 @@ async function cancel() {
   // While the candidates run, the main worker waits with the session as it was: stopping the
   // pool is enough.
   if (pool) {
+    const text = pool.cancelledText ?? 'Cancelled. The loaded data and the previous result are kept.';
     pool.close();
     pool = null;
     showProgress(false);
-    setStatus('Cancelled. The loaded data and the previous result are kept.');
+    setStatus(text);
     return;
   }
   client.cancel();
@@ -617,6 +643,7 @@ const app = {
   textFile: (name) => ask('textFile', { name }),
   fitsFile: async (name) => (await ask('fitsFiles')).find((f) => f.name === name).bytes,
   viewPng: async (name, extra = {}) => (await ask('view', { name, options: { ...viewOptions(), ...extra } })).png,
+  ensembleFiles: () => ask('ensembleFiles'),
   showError,
 };
 

@@ -18,6 +18,7 @@ const APP_FILES = [
   'worker.js',
   'js/coords.js',
   'js/downloads.js',
+  'js/ensemble.js',
   'js/figure-download.js',
   'js/files.js',
   'js/iterates.js',

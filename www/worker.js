@@ -88,6 +88,14 @@ const handlers = {
   strengthPlan: () => ({ plan: session.strength_plan() }),
   strengthTrial: (m, progress) => session.strength_trial(m.candidate, m.folds, progress),
   runWithTrials: (m, progress) => session.run_with_trials(m.trials, m.folds, progress),
+  // An ensemble (js/ensemble.js): the plan (`{plan: null}` without one), a member (in a pool
+  // worker), each member handed to the main worker, then combined.
+  ensemblePlan: () => ({ plan: session.ensemble_plan() }),
+  ensembleMember: (m, progress) => session.ensemble_member(m.plan, m.member, progress),
+  ensembleAdd: (m) => session.ensemble_add(m.record, m.kappa, m.magnif),
+  ensembleFinish: (m) => session.ensemble_finish(m.plan, m.complete),
+  ensembleInfo: () => session.ensemble_info(),
+  ensembleFiles: () => session.ensemble_files(),
   crossValidate: (m, progress) => session.cross_validate(progress),
   crossvalFiles: () => session.crossval_files(),
   resultInfo: () => session.result_info(),
@@ -114,6 +122,7 @@ const handlers = {
 
 function transferables(result) {
   if (result?.png) return [result.png.buffer];
+  if (result?.kappa && result?.magnif) return [result.kappa.buffer, result.magnif.buffer];
   if (Array.isArray(result)) return result.filter((f) => f?.bytes).map((f) => f.bytes.buffer);
   return [];
 }

@@ -3,6 +3,8 @@
 // and the box where a position is typed or pasted (RA/Dec in degrees or sexagesimal, or x y in
 // arcsec): the core reads it (`locate`) and the page pins it as a click would, without the mouse.
 
+import { ensembleReadout } from './ensemble.js';
+
 /** A number with `d` decimals, or a dash. */
 const fmt = (v, d = 2) => (v == null ? '–' : Number(v).toFixed(d));
 
@@ -17,7 +19,7 @@ export function whereText(h) {
 export function readoutText(h) {
   const where = whereText(h);
   if (h.no_data) return `${where}: no data (the deflection maps are blank here)`;
-  return `${where}; κ = ${h.kappa.toFixed(3)}, μ(z_s = ${h.z_source}) = ${h.magnification.toFixed(2)} at this point`;
+  return `${where}; κ = ${h.kappa.toFixed(3)}, μ(z_s = ${h.z_source}) = ${h.magnification.toFixed(2)} at this point${ensembleReadout(h)}`;
 }
 
 /** "1st", "2nd", … */

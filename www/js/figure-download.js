@@ -7,7 +7,8 @@ import { save } from './downloads.js';
 /** Figure scales offered (the core accepts 0.25 to 4); the first one after 1 is preselected. */
 export const FIGURE_SCALES = [1, 2, 3];
 /** File names of the views, as in the downloads panel. */
-const FILE_NAMES = { kappa: 'kappa', source: 'source-plane', radial: 'radial-profile', convergence: 'convergence', data: 'data' };
+const FILE_NAMES = { kappa: 'kappa', source: 'source-plane', radial: 'radial-profile', convergence: 'convergence', data: 'data',
+  spread: 'kappa-std' };
 
 /** The file name of view `view` drawn at scale `k`: `kappa.png`, `kappa@2x.png`. */
 export function figureFileName(view, k) {

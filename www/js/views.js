@@ -139,7 +139,8 @@ export function showPng(name, bytes) {
   const el = img();
   el.src = url;
   el.alt = { kappa: 'Convergence map with critical curves', data: 'The loaded data',
-    source: 'Source plane with caustics', radial: 'Radial profile', convergence: 'Solver progress: objective, grid mass and C against iteration' }[name] ?? name;
+    source: 'Source plane with caustics', radial: 'Radial profile', convergence: 'Solver progress: objective, grid mass and C against iteration',
+    spread: 'Standard deviation of the ensemble\'s convergence with the critical curves' }[name] ?? name;
   el.dataset.view = name;
   el.dataset.render = String(++renders);
   el.hidden = false;

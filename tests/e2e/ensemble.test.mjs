@@ -1,0 +1,131 @@
+// End-to-end: the "Ensemble members" setting runs that many more reconstructions after
+// Reconstruct, spread over a pool of workers (www/js/ensemble.js) with one progress bar; the
+// result gains the spread view, the ensemble's downloads, its intervals in the caption and its
+// values in the read-out. Cancel during the members stops every worker and leaves the app
+// usable.
+import { test } from 'node:test';
+import assert from 'node:assert/strict';
+import { readFile } from 'node:fs/promises';
+import { join } from 'node:path';
+import { openApp, ARTIFACTS, fitsAxes, imageStats, renderCount, setField, waitStatus, waitView } from './browser.mjs';
+
+// The pool workers' URLs carry `worker=pool-N` (lens-client.js).
+const POOL = /[?&]worker=pool-\d+/;
+const poolWorkers = (page) => page.workers().filter((w) => POOL.test(w.url()));
+const ENSEMBLE_DONE = /^Done in \d+\.\d+ s; ensemble of (\d+) members in \d+\.\d+ s\./;
+
+/** Downloads `id`'s file; resolves with its name and bytes. */
+async function download(page, id) {
+  const [dl] = await Promise.all([page.waitForEvent('download'), page.click(`#${id}`)]);
+  return { name: dl.suggestedFilename(), bytes: await readFile(await dl.path()) };
+}
+
+test('an ensemble of the built-in example gives the spread view, the downloads and the intervals', async () => {
+  const app = await openApp({ query: '?app&workers=2' });
+  try {
+    const { page } = app;
+    await waitStatus(page, /^Ready/);
+    assert.equal(await page.inputValue('#set-ensemble-members'), '0');
+    assert.equal(await page.isHidden('#tab-spread'), true);
+    await setField(page, '#set-ensemble-members', 3);
+    await page.click('#reconstruct');
+    // One progress bar for all the members, the pool's two workers running them.
+    await page.waitForFunction(() => /^Ensemble: member [1-3] of 3, \d done; 2 workers running members? [\d, ]+, about/
+      .test(document.getElementById('progress-text').textContent), null, { timeout: 120_000 });
+    assert.equal(poolWorkers(page).length, 2);
+    await waitStatus(page, ENSEMBLE_DONE, 300_000);
+    assert.equal(poolWorkers(page).length, 0);
+    await page.waitForSelector('#progress-box', { state: 'hidden' });
+
+    // The intervals: in the caption and under the views.
+    const caption = await page.textContent('#summary');
+    assert.match(caption, /Ensemble of 3 members \(16th – 84th percentile\): Einstein radius \d+\.\d – \d+\.\d″/);
+    assert.match(await page.innerText('#ensemble-summary'), /Einstein radius at z_s = 3, 16th – 84th percentile/);
+    assert.equal(await page.locator('#ensemble-masses li').count(), 3);
+
+    // The spread view.
+    assert.equal(await page.isVisible('#tab-spread'), true);
+    const before = await renderCount(page);
+    await page.click('#tab-spread');
+    await waitView(page, 'spread', before);
+    const stats = await imageStats(page, '#view-image');
+    assert.ok(stats.distinctColours > 50, `spread figure has ${stats.distinctColours} colours`);
+    assert.ok(stats.reddish > 50, 'the tangential critical curve (red) is drawn');
+    await page.screenshot({ path: join(ARTIFACTS, 'app-ensemble-spread.png'), fullPage: true });
+
+    // The read-out on the mass map: the magnification's interval and kappa's spread.
+    const back = await renderCount(page);
+    await page.click('#tab-kappa');
+    await waitView(page, 'kappa', back);
+    const box = await page.locator('#view-image').boundingBox();
+    await page.mouse.click(box.x + box.width * 0.45, box.y + box.height * 0.4);
+    await page.waitForFunction(() => /^Clicked: .*ensemble of 3: κ std \d\.\d{3}, μ 16–84% -?\d+\.\d\d to -?\d+\.\d\d \(median -?\d+\.\d\d\)/
+      .test(document.getElementById('readout').textContent), null, { timeout: 30_000 });
+
+    // The downloads: the five maps on the result's map, ensemble.json and the figure.
+    await page.click('#downloads-panel summary');
+    for (const name of ['kappa-mean', 'kappa-std', 'magnif-p16', 'magnif-p50', 'magnif-p84']) {
+      const f = await download(page, `dl-${name}-fits-panel`);
+      assert.equal(f.name, `${name}.fits`);
+      assert.deepEqual(fitsAxes(f.bytes), [256, 256]);
+      assert.match(f.bytes.subarray(0, 2880 * 2).toString('latin1'), /NMEMBERS= +3/);
+    }
+    const ensemble = JSON.parse((await download(page, 'dl-ensemble-json-panel')).bytes.toString('utf8'));
+    assert.equal(ensemble.members.length, 3);
+    assert.equal(ensemble.seed, 1);
+    assert.equal(ensemble.status, 'Completed');
+    const png = await download(page, 'dl-kappa-std-png-panel');
+    assert.equal(png.bytes.subarray(1, 4).toString('latin1'), 'PNG');
+    const summary = JSON.parse((await download(page, 'dl-summary-json')).bytes.toString('utf8'));
+    assert.equal(summary.ensemble_members, 3);
+    assert.deepEqual(summary.einstein_radius_interval_arcsec, ensemble.einstein_radius_interval_arcsec);
+    assert.equal(summary.mass_within_interval_msun.length, 3);
+    await page.click('#downloads-panel summary');
+
+    await page.locator('#ensemble-box').scrollIntoViewIfNeeded();
+    await page.screenshot({ path: join(ARTIFACTS, 'app-ensemble-result.png'), fullPage: true });
+    await page.setViewportSize({ width: 390, height: 844 });
+    const overflow = await page.evaluate(() => document.documentElement.scrollWidth - window.innerWidth);
+    assert.ok(overflow <= 0, `page is ${overflow}px wider than a phone`);
+    await page.locator('#ensemble-box').screenshot({ path: join(ARTIFACTS, 'app-ensemble-result-phone.png') });
+    assert.deepEqual(app.consoleErrors, []);
+  } finally {
+    await app.close();
+  }
+});
+
+test('Cancel during the members stops every worker and the app stays usable', async () => {
+  const app = await openApp({ query: '?app&workers=2' });
+  try {
+    const { page } = app;
+    await waitStatus(page, /^Ready/);
+    await setField(page, '#set-ensemble-members', 20);
+    await page.click('#reconstruct');
+    await page.waitForFunction(() => /^Ensemble: .* running members? \d/.test(document.getElementById('progress-text').textContent),
+      null, { timeout: 120_000 });
+    const workers = poolWorkers(page);
+    assert.equal(workers.length, 2);
+    const closed = workers.map((w) => new Promise((resolve) => w.once('close', resolve)));
+    const t0 = Date.now();
+    await page.click('#cancel');
+    await waitStatus(page, /^Cancelled the ensemble: every worker was stopped/);
+    await Promise.all(closed);
+    assert.ok(Date.now() - t0 < 5000, 'cancel took too long');
+    assert.equal(poolWorkers(page).length, 0);
+    assert.equal(await page.isHidden('#progress-box'), true);
+    assert.equal(await page.isEnabled('#reconstruct'), true);
+    // The reconstruction stays, without an ensemble.
+    assert.match(await page.textContent('#summary'), /Einstein radius/);
+    assert.doesNotMatch(await page.textContent('#summary'), /Ensemble of/);
+    assert.equal(await page.isHidden('#tab-spread'), true);
+    // A later run with a smaller ensemble completes.
+    await setField(page, '#set-ensemble-members', 2);
+    await page.click('#reconstruct');
+    await waitStatus(page, ENSEMBLE_DONE, 300_000);
+    assert.equal(Number((await page.textContent('#status')).match(ENSEMBLE_DONE)[1]), 2);
+    assert.equal(poolWorkers(page).length, 0);
+    assert.deepEqual(app.consoleErrors, []);
+  } finally {
+    await app.close();
+  }
+});
