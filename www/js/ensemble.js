@@ -118,6 +118,9 @@ export async function runEnsemble({ ask, onPool, iterations, onProgress }) {
   return info;
 }
 
+// The result's ensemble on screen (ensemble.json), or null: its z_s for the caption.
+let shown = null;
+
 /** A number in the caption's style. */
 const fixed = (v, d) => (v == null || !Number.isFinite(v) ? '–' : v.toFixed(d));
 const mass = (v) => v.toExponential(2).replace('e+', 'e');
@@ -129,7 +132,9 @@ export function ensembleCaption(summary) {
   const n = summary?.ensemble_members;
   if (!n) return '';
   const r = summary.einstein_radius_interval_arcsec;
-  const radius = r ? `Einstein radius ${fixed(r[0], 1)} – ${fixed(r[1], 1)}″` : 'no Einstein radius';
+  // The members' radii are at the z_s of the run, which the curves' may have left since.
+  const z = shown && shown.z_source !== summary.maps?.z_source ? ` at z_s = ${shown.z_source}` : '';
+  const radius = r ? `Einstein radius${z} ${fixed(r[0], 1)} – ${fixed(r[1], 1)}″` : 'no Einstein radius';
   const masses = (summary.mass_within_interval_msun ?? []).filter(([, m]) => m)
     .map(([within, [lo, hi]]) => `${mass(lo)} – ${mass(hi)} M☉ within ${fixed(within, 0)}″`);
   return ` Ensemble of ${n} members (16th – 84th percentile): ${radius}${masses.length ? `; ${masses.join(', ')}` : ''}.`;
@@ -153,6 +158,7 @@ export function showEnsemble(ensemble, app) {
   const box = document.getElementById('ensemble-box');
   const tab = document.getElementById('tab-spread');
   document.getElementById('ensemble-downloads')?.remove();
+  shown = ensemble;
   tab.hidden = !ensemble;
   if (!ensemble) {
     box.replaceChildren();
