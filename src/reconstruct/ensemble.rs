@@ -12,8 +12,10 @@
 //!   is not mistaken for structure.
 //!
 //! The start is not varied: the default objective has one minimiser, which the exact solver
-//! finds from any start ([method §9]). Redshifts are not drawn: catalogue redshifts carry no
-//! uncertainty, and systems without one use the configured default.
+//! finds from any start ([method §9]). Catalogue redshifts are not drawn (they carry no
+//! uncertainty); a system whose redshift the main run estimated is fitted by each member at a
+//! redshift drawn from that estimate (a normal of the interval's width on each side of the
+//! most probable value, not below the interval).
 //!
 //! Every member's maps are sampled on the main run's map. Per pixel, the ensemble gives the
 //! mean and standard deviation of kappa and the 16th, 50th and 84th percentiles of the
@@ -56,6 +58,9 @@ pub struct EnsembleMember {
     pub fitted: Vec<String>,
     /// How far its grid was moved from the main run's (arcsec).
     pub grid_shift_arcsec: DVec2,
+    /// The redshifts it fitted the systems at whose redshift the main run estimated.
+    #[serde(default)]
+    pub redshifts: Vec<(String, f64)>,
     pub status: String,
     /// `C_l` per layer.
     pub c: Vec<f64>,
@@ -101,10 +106,11 @@ pub struct EnsembleMaps {
     pub member_magnif: Vec<Map>,
 }
 
-const NOTE: &str = "Members differ in the systems fitted (bootstrap over systems) and in the \
-     grid's placement (up to half a cell); the strength of the regulariser is the main run's. \
-     Not included: the members' mass-to-light law, the cosmology, redshift errors, and mass \
-     that no image constrains.";
+const NOTE: &str = "Members differ in the systems fitted (bootstrap over systems), in the \
+     grid's placement (up to half a cell) and in the redshifts of the systems whose redshift \
+     was estimated (drawn from the estimate); the strength of the regulariser is the main \
+     run's. Not included: the members' mass-to-light law, the cosmology, errors of catalogue \
+     redshifts, and mass that no image constrains.";
 
 impl Ensemble {
     /// The files of `wslap reconstruct --ensemble`: `kappa-mean.fits`, `kappa-std.fits`,
@@ -310,6 +316,10 @@ pub struct MemberDraw {
     pub left_out: Vec<String>,
     /// How far its grid is moved from the main run's (arcsec).
     pub grid_shift_arcsec: DVec2,
+    /// The redshift it fits each system at whose redshift the main run estimated (drawn from
+    /// the estimate).
+    #[serde(default)]
+    pub redshifts: Vec<(String, f64)>,
 }
 
 /// An ensemble before its members run: what they share, taken from the main run (its grid,
@@ -359,7 +369,13 @@ impl EnsemblePlan {
         seed: u64,
     ) -> Result<Self, ReconstructError> {
         check_ensemble_size(members)?;
-        let ids = fitted_system_ids(inputs, config)?;
+        // Systems whose redshift the main run estimated are fitted by every member, at a
+        // redshift drawn from the estimate (from a stream of their own: the other draws are
+        // those of an ensemble without them).
+        let estimated = super::free_z::estimates_of(&main.sources);
+        let mut fitting = config.clone();
+        fitting.constraints.z_estimates = super::free_z::most_probable_of(&estimated);
+        let ids = fitted_system_ids(inputs, &fitting)?;
         if ids.len() < 2 {
             return Err(ReconstructError::Folds {
                 folds: 2,
@@ -369,6 +385,7 @@ impl EnsemblePlan {
         let grid = &main.system.grid;
         let cell = grid.width_arcsec / grid.cells_per_side.max(1) as f64;
         let mut rng = Rng::stream(seed, 0xE25E);
+        let mut z_rng = Rng::stream(seed, 0x2ED5);
         let draws = (1..=members)
             .map(|member| {
                 let drawn = loop {
@@ -393,6 +410,7 @@ impl EnsemblePlan {
                     fitted: pick(true),
                     left_out: pick(false),
                     grid_shift_arcsec: shift,
+                    redshifts: super::free_z::draw(&estimated, &mut z_rng),
                 }
             })
             .collect();
@@ -446,6 +464,10 @@ impl EnsemblePlan {
         member_config.grid.center_arcsec = Some(self.grid_center_arcsec + draw.grid_shift_arcsec);
         member_config.products.size_arcsec = Some(self.geometry.size_arcsec);
         member_config.products.pixels = self.geometry.pixels;
+        member_config
+            .constraints
+            .z_estimates
+            .clone_from(&draw.redshifts);
         let left_out: Vec<String> = inputs
             .holdout
             .iter()
@@ -471,6 +493,7 @@ impl EnsemblePlan {
             member,
             fitted: draw.fitted.clone(),
             grid_shift_arcsec: draw.grid_shift_arcsec,
+            redshifts: draw.redshifts.clone(),
             status: r.status.name().to_string(),
             c: r.layer_factors(),
             einstein_radius_arcsec: summary.einstein_radius_arcsec,

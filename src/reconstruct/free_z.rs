@@ -35,9 +35,10 @@
 //! the interval per system; `summary.json` the fitted median offset of the systems with a
 //! redshift before and after they were added (adding them must not spoil those).
 //!
-//! What the interval does not include: the uncertainty of the lens itself beyond `sigma`
-//! (an ensemble run re-estimates the redshifts on each member's lens), and the estimate's
-//! effect back on the lens (the second fit takes `z_estimate` as known).
+//! What the interval does not include: the uncertainty of the lens itself beyond `sigma`,
+//! and the estimate's effect back on the lens (the second fit takes `z_estimate` as known).
+//! An ensemble carries the interval into the maps: each member fits these systems at a
+//! redshift drawn from it ([`draw`]).
 
 use glam::DVec2;
 use serde::{Deserialize, Serialize};
@@ -213,6 +214,42 @@ pub(super) fn add_free_systems(
         known_fit_median_with_arcsec: known_with,
     });
     Ok(r)
+}
+
+/// The systems of `sources` whose redshift was estimated: id, most probable redshift and 68%
+/// interval.
+pub(super) fn estimates_of(sources: &[super::SourceReport]) -> Vec<(String, f64, [f64; 2])> {
+    sources
+        .iter()
+        .filter_map(|s| Some((s.id.clone(), s.z_estimate?, s.z_interval?)))
+        .collect()
+}
+
+/// The most probable redshift of each of `estimated`, as `z_estimates` takes them.
+pub(super) fn most_probable_of(estimated: &[(String, f64, [f64; 2])]) -> Vec<(String, f64)> {
+    estimated
+        .iter()
+        .map(|(id, z, _)| (id.clone(), *z))
+        .collect()
+}
+
+/// A redshift for each of `estimated` drawn from its estimate: a normal on each side of the
+/// most probable `z` whose width is the interval's on that side (a split normal holding 68%
+/// inside the interval), kept within `[z_lo, 2 z_hi - z]`: not below the interval, whose low
+/// end lies inside the prior and behind the lens.
+pub(super) fn draw(
+    estimated: &[(String, f64, [f64; 2])],
+    rng: &mut crate::simulate::rng::Rng,
+) -> Vec<(String, f64)> {
+    estimated
+        .iter()
+        .map(|(id, z, [lo, hi])| {
+            let n = rng.normal();
+            let width = if n < 0.0 { z - lo } else { hi - z };
+            let drawn = (z + n * width).clamp(*lo, (2.0 * hi - z).max(*lo));
+            (id.clone(), drawn)
+        })
+        .collect()
 }
 
 /// The estimate of the redshift of the source of `images` (arcsec) on `lens` (deflection at
@@ -409,6 +446,18 @@ mod tests {
         assert!(lo <= 2.0 && 2.0 <= hi && lo > 1.0 && hi > 4.0, "{lo} {hi}");
         let chi2: Vec<f64> = zs.iter().map(|&z| (z - 3.33).powi(2)).collect();
         assert!((most_probable(&zs, &chi2, 33) - 3.33).abs() < 1e-9);
+    }
+
+    #[test]
+    fn drawn_redshifts_follow_the_interval() {
+        let mut rng = crate::simulate::rng::Rng::stream(7, 1);
+        let estimated = [("1".to_string(), 3.0, [2.5, 4.0])];
+        let draws: Vec<f64> = (0..4000).map(|_| draw(&estimated, &mut rng)[0].1).collect();
+        assert!(draws.iter().all(|&z| (2.5..=5.0).contains(&z)));
+        let inside = draws.iter().filter(|&&z| z > 2.5 && z < 4.0).count() as f64 / 4000.0;
+        assert!((inside - 0.68).abs() < 0.1, "{inside}");
+        let above = draws.iter().filter(|&&z| z > 3.0).count() as f64 / 4000.0;
+        assert!((above - 0.5).abs() < 0.05, "{above}");
     }
 
     #[test]

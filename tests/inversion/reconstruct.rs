@@ -551,6 +551,46 @@ fn blanked_redshifts_of_a_synthetic_cluster_are_found_again() {
     assert_eq!(known.sigma_arcsec, wslap::FALLBACK_SIGMA_ARCSEC);
 }
 
+/// An ensemble carries an estimated redshift's interval into its members: each fits the
+/// system at a redshift drawn from the estimate, inside the range the draw allows, and the
+/// members' redshifts differ (c_smooth, two systems blanked, small maps to keep it short).
+#[cfg(not(target_arch = "wasm32"))]
+#[test]
+fn ensemble_members_draw_estimated_redshifts() {
+    let text = include_str!("../data/fidelity/c_smooth/images.cat");
+    let (catalog, _) = wslap::parse_image_catalog(text, "c_smooth/images.cat", None).unwrap();
+    let mut config = ReconstructConfig::default();
+    config.objective.strength = wslap::Strength::Value(0.01);
+    config.products.pixels = 64;
+    config.constraints.free_z_systems = vec!["9".to_string(), "24".to_string()];
+    let plane = LensPlane::new(Cosmology::default(), 0.32).unwrap();
+    let inputs = Inputs {
+        images: ConstraintSource::Catalog(&catalog),
+        layers: LayerSource::None,
+        plane,
+        reference: catalog.reference,
+        holdout: &[],
+        catalog: Some(&catalog),
+    };
+    let main = reconstruct(&inputs, &config, &mut quiet).unwrap();
+    let ensemble =
+        wslap::run_ensemble(&inputs, &config, &main, 3, 1, &mut |_, _| Control::Continue).unwrap();
+    for id in ["9", "24"] {
+        let s = main.sources.iter().find(|s| s.id == id).unwrap();
+        let (z, [lo, hi]) = (s.z_estimate.unwrap(), s.z_interval.unwrap());
+        let drawn: Vec<f64> = ensemble
+            .members
+            .iter()
+            .map(|m| m.redshifts.iter().find(|(s, _)| s == id).unwrap().1)
+            .collect();
+        assert!(
+            drawn.iter().all(|&d| d >= lo && d <= 2.0 * hi - z),
+            "system {id}: {drawn:?} for {z} ({lo} - {hi})"
+        );
+        assert!(drawn.windows(2).any(|w| w[0] != w[1]), "{drawn:?}");
+    }
+}
+
 #[cfg(not(target_arch = "wasm32"))]
 pub(crate) mod real {
     //! The two real clusters of ../shared/data, end to end.
