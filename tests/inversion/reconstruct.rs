@@ -474,6 +474,29 @@ fn a_reconstruction_keeps_its_iterates_when_asked() {
     check(&r, "exact with image-plane passes");
 }
 
+/// The images of `c_smooth` (tests/data/fidelity: lenstronomy's synthetic cluster of 25
+/// systems without members, z_l = 0.32).
+#[cfg(not(target_arch = "wasm32"))]
+fn c_smooth() -> ImageCatalog {
+    let text = include_str!("../data/fidelity/c_smooth/images.cat");
+    wslap::parse_image_catalog(text, "c_smooth/images.cat", None)
+        .unwrap()
+        .0
+}
+
+/// The inputs of a reconstruction of `c_smooth`'s images alone.
+#[cfg(not(target_arch = "wasm32"))]
+fn c_smooth_inputs(catalog: &ImageCatalog) -> Inputs<'_> {
+    Inputs {
+        images: ConstraintSource::Catalog(catalog),
+        layers: LayerSource::None,
+        plane: LensPlane::new(Cosmology::default(), 0.32).unwrap(),
+        reference: catalog.reference,
+        holdout: &[],
+        catalog: Some(catalog),
+    }
+}
+
 /// Redshifts blanked on a synthetic cluster made with lenstronomy (tests/data/fidelity,
 /// `c_smooth`: 25 systems, no members): every third system is estimated (`free_z_systems`)
 /// and compared with its true redshift. The bars: median |dz|/(1+z) below 0.1, the
@@ -483,8 +506,7 @@ fn a_reconstruction_keeps_its_iterates_when_asked() {
 #[cfg(not(target_arch = "wasm32"))]
 #[test]
 fn blanked_redshifts_of_a_synthetic_cluster_are_found_again() {
-    let text = include_str!("../data/fidelity/c_smooth/images.cat");
-    let (catalog, _) = wslap::parse_image_catalog(text, "c_smooth/images.cat", None).unwrap();
+    let catalog = c_smooth();
     let mut config = ReconstructConfig::default();
     // The strength "auto" picks for this cluster, fixed to keep the test short (the
     // estimates then start from the fallback image error instead of the measured one).
@@ -499,15 +521,7 @@ fn blanked_redshifts_of_a_synthetic_cluster_are_found_again() {
         .collect();
     assert_eq!(free.len(), 8);
     config.constraints.free_z_systems.clone_from(&free);
-    let plane = LensPlane::new(Cosmology::default(), 0.32).unwrap();
-    let inputs = Inputs {
-        images: ConstraintSource::Catalog(&catalog),
-        layers: LayerSource::None,
-        plane,
-        reference: catalog.reference,
-        holdout: &[],
-        catalog: Some(&catalog),
-    };
+    let inputs = c_smooth_inputs(&catalog);
     let r = reconstruct(&inputs, &config, &mut quiet).unwrap();
     assert_eq!(
         r.system.constraints.systems.len(),
@@ -557,21 +571,12 @@ fn blanked_redshifts_of_a_synthetic_cluster_are_found_again() {
 #[cfg(not(target_arch = "wasm32"))]
 #[test]
 fn ensemble_members_draw_estimated_redshifts() {
-    let text = include_str!("../data/fidelity/c_smooth/images.cat");
-    let (catalog, _) = wslap::parse_image_catalog(text, "c_smooth/images.cat", None).unwrap();
+    let catalog = c_smooth();
     let mut config = ReconstructConfig::default();
     config.objective.strength = wslap::Strength::Value(0.01);
     config.products.pixels = 64;
     config.constraints.free_z_systems = vec!["9".to_string(), "24".to_string()];
-    let plane = LensPlane::new(Cosmology::default(), 0.32).unwrap();
-    let inputs = Inputs {
-        images: ConstraintSource::Catalog(&catalog),
-        layers: LayerSource::None,
-        plane,
-        reference: catalog.reference,
-        holdout: &[],
-        catalog: Some(&catalog),
-    };
+    let inputs = c_smooth_inputs(&catalog);
     let main = reconstruct(&inputs, &config, &mut quiet).unwrap();
     let ensemble =
         wslap::run_ensemble(&inputs, &config, &main, 3, 1, &mut |_, _| Control::Continue).unwrap();
