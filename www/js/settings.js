@@ -110,6 +110,8 @@ export function buildSettings(form, apply) {
     input.addEventListener('change', async () => {
       const err = document.getElementById(`${id(f.path)}-error`);
       const ticket = ++changes;
+      // The message was about the value before: this one is being checked.
+      err.textContent = '';
       state.edited = false;
       state.waiting = ticket;
       let settings = null;
