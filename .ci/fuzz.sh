@@ -46,6 +46,9 @@ if ! cargo +nightly fuzz --version >/dev/null 2>&1; then
   fi
 fi
 
+# FUZZ_EXTRA is given relative to where the command runs (the repository root for npm run):
+# made absolute before moving into fuzz/.
+[ -n "${FUZZ_EXTRA:-}" ] && FUZZ_EXTRA="$(realpath "$FUZZ_EXTRA")"
 cd "$ROOT/fuzz" || exit 1
 [ ${#targets[@]} -gt 0 ] || mapfile -t targets < <(cargo +nightly fuzz list)
 
