@@ -156,17 +156,18 @@ pub(super) fn add_free_systems(
             None => not_estimated.push(id.clone()),
         }
     }
-    let known_without = median_arcsec(image_offsets_arcsec(
-        first.sources.iter().filter(|s| !s.held_out),
-    ));
-    if estimates.is_empty() {
-        let mut first = first;
-        first.warnings.push(format!(
+    let left_out = (!not_estimated.is_empty()).then(|| {
+        format!(
             "no redshift could be estimated for system(s) {}: not used",
             not_estimated.join(", ")
-        ));
+        )
+    });
+    if estimates.is_empty() {
+        let mut first = first;
+        first.warnings.extend(left_out);
         return Ok(first);
     }
+    let known_without = first.image_offset_median_arcsec(false);
     let mut second = config.clone();
     second.constraints.z_estimates = estimates.iter().map(|(id, e)| (id.clone(), e.z)).collect();
     let mut r = reconstruct_limited(inputs, &second, progress)?;
@@ -198,12 +199,7 @@ pub(super) fn add_free_systems(
             )
         })
         .collect();
-    if !not_estimated.is_empty() {
-        notes.push(format!(
-            "no redshift could be estimated for system(s) {}: not used",
-            not_estimated.join(", ")
-        ));
-    }
+    notes.extend(left_out);
     r.warnings.extend(notes);
     r.free_z = Some(FreeZSummary {
         systems: estimates,
