@@ -107,6 +107,14 @@ fn weights_per_image_system_and_pixel() {
     assert_eq!((set.pixels[3].system, set.pixels[3].image), (1, 0));
 }
 
+/// Each system left out of `set`, by id, and why.
+fn exclusions(set: &ConstraintSet) -> Vec<(&str, Exclusion)> {
+    set.excluded
+        .iter()
+        .map(|e| (e.id.as_str(), e.reason))
+        .collect()
+}
+
 #[cfg_attr(not(target_arch = "wasm32"), test)]
 #[cfg_attr(target_arch = "wasm32", wasm_bindgen_test::wasm_bindgen_test)]
 fn systems_are_excluded_for_redshift_single_image_and_hold_out() {
@@ -126,13 +134,8 @@ fn systems_are_excluded_for_redshift_single_image_and_hold_out() {
         build_constraints(ConstraintSource::Catalog(&cat), &config, &["3".to_string()]).unwrap();
     let ids: Vec<&str> = set.systems.iter().map(|s| s.id.as_str()).collect();
     assert_eq!(ids, ["1"]);
-    let excluded: Vec<(&str, Exclusion)> = set
-        .excluded
-        .iter()
-        .map(|e| (e.id.as_str(), e.reason))
-        .collect();
     assert_eq!(
-        excluded,
+        exclusions(&set),
         [
             ("2", Exclusion::UnknownRedshift),
             ("3", Exclusion::HeldOut),
@@ -164,13 +167,8 @@ fn systems_are_excluded_for_redshift_single_image_and_hold_out() {
         ..ConstraintConfig::default()
     };
     let set = build_constraints(ConstraintSource::Catalog(&cat), &free, &[]).unwrap();
-    let reasons: Vec<(&str, Exclusion)> = set
-        .excluded
-        .iter()
-        .map(|e| (e.id.as_str(), e.reason))
-        .collect();
     assert_eq!(
-        reasons,
+        exclusions(&set),
         [
             ("1", Exclusion::FreeRedshift),
             ("2", Exclusion::FreeRedshift),
