@@ -526,7 +526,11 @@
 //! gradient and curvature) at each strength of `objective.candidates` (default 0.01, 0.1, 1),
 //! over `objective.folds` (default 4) folds of the systems, keeping the one whose held-out
 //! images land closest to their predictions (first fewest held-out images without any
-//! prediction, then the smallest median offset).
+//! prediction, then the smallest median offset). A held-out system is predicted from the
+//! source `beta = (sum_k W_k)^-1 sum_k W_k beta_k`, its images `theta_k` back-projected to
+//! `beta_k` and weighted by `W_k = M_k^T M_k` (`M_k` the capped inverse Jacobian above): to
+//! first order the source whose images land closest to the observed ones, the image-plane
+//! counterpart of the fit's own source positions.
 //!
 //! **Exact solution.** With a positive strength the objective is strictly convex in the cells,
 //! and the default solver (`solver.method = "exact"`) finds its minimiser by block principal

@@ -4,8 +4,9 @@
 //! `k mod folds`, so that neighbouring ids, often neighbours on the sky, are spread over the
 //! groups). Each group is held out in turn: the lens is reconstructed from the other systems
 //! with the same settings (exactly `wslap reconstruct --holdout GROUP`) and the group's images
-//! are predicted by it (beta from the back-projected observed images, then the lens equation
-//! solved forward). So every system is predicted once, by a lens that never saw it.
+//! are predicted by it (beta from the back-projected observed images, each weighted by its
+//! inverse lens Jacobian as the image-plane fit weighs them, then the lens equation solved
+//! forward). So every system is predicted once, by a lens that never saw it.
 //!
 //! A fit's own image offsets say how well the model reproduces its constraints; these say how
 //! well it predicts, which is what matters when a model is used to look for new images or to

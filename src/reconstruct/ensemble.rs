@@ -2,12 +2,18 @@
 //!
 //! One reconstruction is one answer; an ensemble is many, each as good as the first, that
 //! differ in what the data leave open. Member `k` is a full reconstruction with the main run's
-//! settings (its regulariser and strength: an "auto" choice is made once, by the main run)
-//! and with
+//! settings and with
 //!
 //! - **the systems fitted drawn at random** (bootstrap over systems): as many draws with
 //!   replacement as there are fitted systems; the systems drawn at least once are fitted
 //!   (a system drawn twice counts once), the others (about a third) are left out;
+//! - **the regulariser and its strength chosen again on that draw**, when the main run's were
+//!   "auto": the main run's cross-validation is not rerun, but its rule (fewest unmatched, then
+//!   smallest median held-out offset) is applied to the held-out offsets of the systems the
+//!   member drew, each counted as often as drawn ([`StrengthChoice::best_for`]). Candidates
+//!   the data cannot tell apart then share the members, so the choice's own uncertainty is in
+//!   the spread (on the six synthetic clusters of `tests/data/fidelity`, 20 members: the main
+//!   run's choice in 3 to 16 of them);
 //! - **the grid moved** by up to half a cell in x and y (uniform), so that where the cells fall
 //!   is not mistaken for structure.
 //!
@@ -33,7 +39,7 @@ use serde::{Deserialize, Serialize};
 use super::crossval::SpreadSum;
 use super::{
     fitted_system_ids, reconstruct, reconstruct_with_choice, ConvergenceRecord, Inputs,
-    ReconstructConfig, ReconstructError, Reconstruction, StrengthChoice,
+    ReconstructConfig, ReconstructError, Reconstruction, Regulariser, StrengthChoice,
 };
 use crate::curves::CriticalCurves;
 use crate::error::BadFieldValue;
@@ -61,6 +67,11 @@ pub struct EnsembleMember {
     /// The redshifts it fitted the systems at whose redshift the main run estimated.
     #[serde(default)]
     pub redshifts: Vec<(String, f64)>,
+    /// The regulariser and strength it used (`None`: a fixed strength, the main run's).
+    #[serde(default)]
+    pub regulariser: Option<Regulariser>,
+    #[serde(default)]
+    pub strength: Option<f64>,
     pub status: String,
     /// `C_l` per layer.
     pub c: Vec<f64>,
@@ -107,10 +118,10 @@ pub struct EnsembleMaps {
 }
 
 const NOTE: &str = "Members differ in the systems fitted (bootstrap over systems), in the \
-     grid's placement (up to half a cell) and in the redshifts of the systems whose redshift \
-     was estimated (drawn from the estimate); the strength of the regulariser is the main \
-     run's. Not included: the members' mass-to-light law, the cosmology, errors of catalogue \
-     redshifts, and mass that no image constrains.";
+     regulariser and strength an \"auto\" choice makes on those systems, in the grid's \
+     placement (up to half a cell) and in the redshifts of the systems whose redshift was \
+     estimated (drawn from the estimate). Not included: the members' mass-to-light law, the \
+     cosmology, errors of catalogue redshifts, and mass that no image constrains.";
 
 impl Ensemble {
     /// The files of `wslap reconstruct --ensemble`: `kappa-mean.fits`, `kappa-std.fits`,
@@ -320,6 +331,13 @@ pub struct MemberDraw {
     /// the estimate).
     #[serde(default)]
     pub redshifts: Vec<(String, f64)>,
+    /// The regulariser and strength it uses: the main run's "auto" rule applied to the
+    /// cross-validation of the systems it drew ([`StrengthChoice::best_for`]). `None` with a
+    /// fixed strength (the main run's is used).
+    #[serde(default)]
+    pub regulariser: Option<Regulariser>,
+    #[serde(default)]
+    pub strength: Option<f64>,
 }
 
 /// An ensemble before its members run: what they share, taken from the main run (its grid,
@@ -388,29 +406,35 @@ impl EnsemblePlan {
         let mut z_rng = Rng::stream(seed, 0x2ED5);
         let draws = (1..=members)
             .map(|member| {
-                let drawn = loop {
-                    let mut drawn = vec![false; ids.len()];
+                // How many times each system was drawn.
+                let counts = loop {
+                    let mut counts = vec![0usize; ids.len()];
                     for _ in 0..ids.len() {
-                        drawn[rng.index(ids.len())] = true;
+                        counts[rng.index(ids.len())] += 1;
                     }
-                    if drawn.iter().filter(|&&d| d).count() >= 2 {
-                        break drawn;
+                    if counts.iter().filter(|&&n| n > 0).count() >= 2 {
+                        break counts;
                     }
                 };
                 let pick = |want: bool| {
                     ids.iter()
-                        .zip(&drawn)
-                        .filter(|(_, &d)| d == want)
+                        .zip(&counts)
+                        .filter(|(_, &n)| (n > 0) == want)
                         .map(|(id, _)| id.clone())
                         .collect()
                 };
                 let shift = DVec2::new(rng.range(-0.5, 0.5), rng.range(-0.5, 0.5)) * cell;
+                let choice = main.strength_choice.as_ref().and_then(|c| {
+                    c.best_for(|id| ids.iter().position(|i| i == id).map_or(0, |k| counts[k]))
+                });
                 MemberDraw {
                     member,
                     fitted: pick(true),
                     left_out: pick(false),
                     grid_shift_arcsec: shift,
                     redshifts: super::free_z::draw(&estimated, &mut z_rng),
+                    regulariser: choice.map(|c| c.0),
+                    strength: choice.map(|c| c.1),
                 }
             })
             .collect();
@@ -480,7 +504,11 @@ impl EnsemblePlan {
         };
         let r = match &self.strength_choice {
             Some(c) => {
-                reconstruct_with_choice(&member_inputs, &member_config, c.clone(), progress)?
+                let choice = match (draw.regulariser, draw.strength) {
+                    (Some(kind), Some(strength)) => c.with_chosen(kind, strength),
+                    _ => c.clone(),
+                };
+                reconstruct_with_choice(&member_inputs, &member_config, choice, progress)?
             }
             None => reconstruct(&member_inputs, &member_config, progress)?,
         };
@@ -494,6 +522,8 @@ impl EnsemblePlan {
             fitted: draw.fitted.clone(),
             grid_shift_arcsec: draw.grid_shift_arcsec,
             redshifts: draw.redshifts.clone(),
+            regulariser: draw.regulariser,
+            strength: draw.strength,
             status: r.status.name().to_string(),
             c: r.layer_factors(),
             einstein_radius_arcsec: summary.einstein_radius_arcsec,

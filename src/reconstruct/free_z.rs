@@ -360,31 +360,7 @@ fn image_offsets2(lensing: &[(DVec2, DVec2, [f64; 3])], f: f64, max_stretch: f64
             )
         })
         .collect();
-    // W_k = M_k^T M_k (symmetric); beta = (sum W_k)^-1 sum W_k beta_k.
-    let w = |m: &[f64; 4]| {
-        [
-            m[0] * m[0] + m[2] * m[2],
-            m[0] * m[1] + m[2] * m[3],
-            m[1] * m[1] + m[3] * m[3],
-        ]
-    };
-    let (mut s, mut rhs) = ([0.0; 3], DVec2::ZERO);
-    for (b, m) in &terms {
-        let wk = w(m);
-        s[0] += wk[0];
-        s[1] += wk[1];
-        s[2] += wk[2];
-        rhs += DVec2::new(wk[0] * b.x + wk[1] * b.y, wk[1] * b.x + wk[2] * b.y);
-    }
-    let det = s[0] * s[2] - s[1] * s[1];
-    let beta = if det.abs() > 1e-300 {
-        DVec2::new(
-            (s[2] * rhs.x - s[1] * rhs.y) / det,
-            (s[0] * rhs.y - s[1] * rhs.x) / det,
-        )
-    } else {
-        terms.iter().map(|(b, _)| *b).sum::<DVec2>() / terms.len() as f64
-    };
+    let beta = super::sources::image_plane_source(&terms);
     terms
         .iter()
         .map(|(b, m)| {

@@ -244,6 +244,18 @@ pub struct StrengthCandidate {
     pub holdout_unmatched: usize,
     /// Median offset of the fitted images in the folds (arcsec).
     pub fit_median_arcsec: Option<f64>,
+    /// Per held-out system, its images' offsets from their predictions (arcsec; `None` for an
+    /// image with no predicted image): what an ensemble member re-scores the candidates on
+    /// for the systems it drew ([`StrengthChoice::best_for`]).
+    #[serde(default)]
+    pub holdout_by_system: Vec<SystemOffsets>,
+}
+
+/// The held-out images of one system and their offsets (arcsec; `None`: no predicted image).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct SystemOffsets {
+    pub id: String,
+    pub offsets_arcsec: Vec<Option<f64>>,
 }
 
 /// The curve "auto" chose the strength from (`summary.json`'s `strength_choice`).
@@ -478,6 +490,14 @@ pub fn strength_trial(
         holdout_rms_arcsec: cv.holdout_image_plane_rms_arcsec,
         holdout_unmatched: cv.holdout_images_unmatched,
         fit_median_arcsec: cv.fit_image_offset_median_arcsec,
+        holdout_by_system: cv
+            .systems
+            .iter()
+            .map(|s| SystemOffsets {
+                id: s.report.id.clone(),
+                offsets_arcsec: s.report.observed.iter().map(|i| i.offset_arcsec).collect(),
+            })
+            .collect(),
     })
 }
 
@@ -493,6 +513,55 @@ impl StrengthChoice {
             .find(|c| c.regulariser == self.chosen_regulariser && c.strength == self.chosen)?;
         let median = chosen.holdout_median_arcsec?;
         Some(median * (2.0 / (2.0 * std::f64::consts::LN_2)).sqrt())
+    }
+
+    /// The candidate (regulariser, strength) this choice's rule picks when the held-out
+    /// systems count `weight(id)` times each (a bootstrap draw: 0 for a system not drawn, 2
+    /// for one drawn twice): the fewest unmatched images, then the smallest median offset,
+    /// both over the drawn systems' images. `None` without the candidates' per-system
+    /// offsets (a choice made before they were kept) or when no drawn system was predicted.
+    ///
+    /// An ensemble member re-makes the choice this way on its own draw, so that the
+    /// uncertainty of the choice itself (which candidates the data cannot tell apart) enters
+    /// the ensemble's spread without running the cross-validation again.
+    pub fn best_for(&self, weight: impl Fn(&str) -> usize) -> Option<(Regulariser, f64)> {
+        let score = |c: &StrengthCandidate| {
+            let mut unmatched = 0;
+            let mut offsets = Vec::new();
+            for system in &c.holdout_by_system {
+                let w = weight(&system.id);
+                for o in &system.offsets_arcsec {
+                    match o {
+                        Some(o) => offsets.extend(std::iter::repeat_n(*o, w)),
+                        None => unmatched += w,
+                    }
+                }
+            }
+            let median = summary::median_arcsec(offsets)?;
+            Some((unmatched, median))
+        };
+        if self
+            .candidates
+            .iter()
+            .any(|c| c.holdout_by_system.is_empty())
+        {
+            return None;
+        }
+        self.candidates
+            .iter()
+            .filter_map(|c| Some((score(c)?, c)))
+            .min_by(|(a, _), (b, _)| a.0.cmp(&b.0).then(a.1.total_cmp(&b.1)))
+            .map(|(_, c)| (c.regulariser, c.strength))
+    }
+
+    /// The same choice with `regulariser` and `strength` used instead of the chosen ones
+    /// (an ensemble member's own choice), its candidates kept.
+    pub fn with_chosen(&self, regulariser: Regulariser, strength: f64) -> Self {
+        Self {
+            chosen: strength,
+            chosen_regulariser: regulariser,
+            ..self.clone()
+        }
     }
 
     /// The choice among the `trials` of `config`'s candidates: the fewest held-out images with
@@ -735,6 +804,7 @@ fn reconstruct_limited(
         &products,
         inputs,
         config.constraints.default_z,
+        config.objective.max_stretch,
     )?;
     timings.sources_ms = t.ms();
     Ok(Reconstruction {
@@ -963,4 +1033,104 @@ fn describe_excluded(constraints: &ConstraintSet) -> String {
         .map(|e| format!("{} ({})", e.id, e.reason))
         .collect();
     format!("left out: {}", list.join(", "))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn candidate(
+        kind: Regulariser,
+        strength: f64,
+        systems: &[(&str, &[Option<f64>])],
+    ) -> StrengthCandidate {
+        StrengthCandidate {
+            regulariser: kind,
+            strength,
+            holdout_median_arcsec: None,
+            holdout_rms_arcsec: None,
+            holdout_unmatched: 0,
+            fit_median_arcsec: None,
+            holdout_by_system: systems
+                .iter()
+                .map(|(id, o)| SystemOffsets {
+                    id: id.to_string(),
+                    offsets_arcsec: o.to_vec(),
+                })
+                .collect(),
+        }
+    }
+
+    fn choice(candidates: Vec<StrengthCandidate>) -> StrengthChoice {
+        StrengthChoice {
+            folds: 2,
+            candidates,
+            chosen: 1.0,
+            chosen_regulariser: Regulariser::Gradient,
+            rule: String::new(),
+        }
+    }
+
+    #[test]
+    fn a_draw_rescores_the_candidates_on_the_systems_it_drew() {
+        let g = Regulariser::Gradient;
+        let c = Regulariser::Curvature;
+        let choice = choice(vec![
+            candidate(
+                g,
+                0.01,
+                &[
+                    ("1", &[Some(0.1), Some(0.1)]),
+                    ("2", &[Some(1.0), Some(1.0)]),
+                ],
+            ),
+            candidate(
+                c,
+                0.1,
+                &[
+                    ("1", &[Some(0.3), Some(0.3)]),
+                    ("2", &[Some(0.2), Some(0.2)]),
+                ],
+            ),
+        ]);
+        // Both once: medians 0.55 against 0.25.
+        assert_eq!(choice.best_for(|_| 1), Some((c, 0.1)));
+        // System 1 alone: 0.1 against 0.3.
+        assert_eq!(
+            choice.best_for(|id| usize::from(id == "1")),
+            Some((g, 0.01))
+        );
+        // System 1 drawn twice, 2 once: medians 0.1 against 0.3 (a draw counts its repeats).
+        assert_eq!(
+            choice.best_for(|id| if id == "1" { 2 } else { 1 }),
+            Some((g, 0.01))
+        );
+        // Nothing drawn that was predicted: no choice.
+        assert_eq!(choice.best_for(|_| 0), None);
+    }
+
+    #[test]
+    fn unmatched_images_of_drawn_systems_come_first() {
+        let g = Regulariser::Gradient;
+        let c = Regulariser::Curvature;
+        let choice = choice(vec![
+            candidate(g, 0.01, &[("1", &[Some(0.1)]), ("2", &[None, Some(0.1)])]),
+            candidate(
+                c,
+                0.1,
+                &[("1", &[Some(0.5)]), ("2", &[Some(0.5), Some(0.5)])],
+            ),
+        ]);
+        assert_eq!(choice.best_for(|_| 1), Some((c, 0.1)));
+        assert_eq!(
+            choice.best_for(|id| usize::from(id == "1")),
+            Some((g, 0.01))
+        );
+    }
+
+    #[test]
+    fn a_choice_without_per_system_offsets_is_not_remade() {
+        let choice = choice(vec![candidate(Regulariser::Gradient, 0.01, &[])]);
+        assert_eq!(choice.best_for(|_| 1), None);
+    }
 }

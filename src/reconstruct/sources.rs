@@ -9,7 +9,7 @@ use crate::ds9::{write_marks, Mark};
 use crate::image_search::{
     find_images, magnification_at, source_position, ImageError, ImageSearch, SearchGrid,
 };
-use crate::inversion::{ConstraintSource, LinearSystem};
+use crate::inversion::{capped_inverse_jacobian, ConstraintSource, LinearSystem};
 use crate::map::{LensMaps, Map};
 use crate::potential::{arrival_time_days, potential_at, potential_map};
 use crate::products::Products;
@@ -142,8 +142,9 @@ pub struct SourceReport {
     pub z_interval: Option<[f64; 2]>,
     /// True when the system was left out of the fit and is predicted.
     pub held_out: bool,
-    /// Source position (arcsec): the solved beta of a fitted system, or the mean back-projected
-    /// observed image of a held-out one.
+    /// Source position (arcsec): the solved beta of a fitted system, or for a held-out one
+    /// the mean of its back-projected observed images weighted by their inverse lens Jacobians
+    /// (the source whose predicted images lie closest to the observed ones, to first order).
     pub beta_arcsec: DVec2,
     /// Root mean square distance of the back-projected constraint pixels (held out: observed
     /// images) from beta, arcsec.
@@ -227,6 +228,7 @@ pub(super) fn report(
     products: &Products,
     inputs: &Inputs<'_>,
     default_z: Option<f64>,
+    max_stretch: f64,
 ) -> Result<Vec<SourceReport>, ReconstructError> {
     let betas = system.betas_arcsec(x)?;
     let times = ArrivalTimes::new(products);
@@ -292,11 +294,18 @@ pub(super) fn report(
         let Ok(f) = inputs.plane.distance_ratio(z) else {
             continue;
         };
-        let back: Vec<DVec2> = observed
+        // Each image back-projected, with the inverse of its lens Jacobian: the source that
+        // puts the predicted images closest to the observed ones (to first order), as the
+        // image-plane fit does for the fitted systems.
+        let terms: Vec<(DVec2, [f64; 4])> = observed
             .iter()
-            .map(|(_, p)| source_position(lens, f, *p))
+            .map(|(_, p)| {
+                let (alpha, h) = lens.deflection_hessian(*p);
+                (*p - f * alpha, capped_inverse_jacobian(h, f, max_stretch))
+            })
             .collect();
-        let beta = back.iter().copied().sum::<DVec2>() / back.len().max(1) as f64;
+        let back: Vec<DVec2> = terms.iter().map(|(b, _)| *b).collect();
+        let beta = image_plane_source(&terms);
         let d2: Vec<f64> = back.iter().map(|b| b.distance_squared(beta)).collect();
         let predicted = images_on_maps(&products.maps, f, beta)?;
         reports.push(finish(
@@ -314,6 +323,40 @@ pub(super) fn report(
         ));
     }
     Ok(reports)
+}
+
+/// The source position that minimises `sum_k |M_k (beta_k - beta)|^2` over a system's
+/// images: `beta_k` an image back-projected (arcsec), `M_k` the inverse of the lens Jacobian
+/// there (row-major, its stretch capped: [`capped_inverse_jacobian`]), so that `M_k (beta_k -
+/// beta)` is, to first order, the image-plane offset of the image the source at `beta` makes
+/// near image `k`. The weighted mean `(sum W_k)^-1 sum W_k beta_k` with `W_k = M_k^T M_k`: a
+/// strongly magnified image, whose back-projection the lens pins down, weighs more than a
+/// faint counter-image far from the curves. The plain mean when the weights are singular.
+pub(super) fn image_plane_source(terms: &[(DVec2, [f64; 4])]) -> DVec2 {
+    let w = |m: &[f64; 4]| {
+        [
+            m[0] * m[0] + m[2] * m[2],
+            m[0] * m[1] + m[2] * m[3],
+            m[1] * m[1] + m[3] * m[3],
+        ]
+    };
+    let (mut s, mut rhs) = ([0.0; 3], DVec2::ZERO);
+    for (b, m) in terms {
+        let wk = w(m);
+        s[0] += wk[0];
+        s[1] += wk[1];
+        s[2] += wk[2];
+        rhs += DVec2::new(wk[0] * b.x + wk[1] * b.y, wk[1] * b.x + wk[2] * b.y);
+    }
+    let det = s[0] * s[2] - s[1] * s[1];
+    if det.abs() > 1e-300 {
+        DVec2::new(
+            (s[2] * rhs.x - s[1] * rhs.y) / det,
+            (s[0] * rhs.y - s[1] * rhs.x) / det,
+        )
+    } else {
+        terms.iter().map(|(b, _)| *b).sum::<DVec2>() / terms.len().max(1) as f64
+    }
 }
 
 /// Arrival times on a lens's product maps: its potential map, made once.
@@ -466,5 +509,59 @@ fn finish(
         image_plane_rms_arcsec: (!offsets.is_empty()).then(|| rms(&offsets)),
         observed,
         predicted,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// `sum_k |M_k (beta_k - beta)|^2`.
+    fn cost(terms: &[(DVec2, [f64; 4])], beta: DVec2) -> f64 {
+        terms
+            .iter()
+            .map(|(b, m)| {
+                let d = *b - beta;
+                DVec2::new(m[0] * d.x + m[1] * d.y, m[2] * d.x + m[3] * d.y).length_squared()
+            })
+            .sum()
+    }
+
+    #[test]
+    fn the_image_plane_source_is_the_minimiser_of_the_image_plane_offsets() {
+        // A tangentially stretched image (M stretches x by 8), a mildly magnified one and a
+        // demagnified one with a sheared M.
+        let terms = [
+            (DVec2::new(1.0, 0.3), [8.0, 0.0, 0.0, 1.2]),
+            (DVec2::new(1.6, -0.2), [1.5, 0.2, 0.2, 1.1]),
+            (DVec2::new(0.6, 0.5), [0.4, -0.1, -0.1, 0.7]),
+        ];
+        let beta = image_plane_source(&terms);
+        let best = cost(&terms, beta);
+        // Brute force around it: no point of a fine grid does better.
+        for i in -50..=50 {
+            for j in -50..=50 {
+                let p = beta + DVec2::new(i as f64, j as f64) * 2e-3;
+                assert!(cost(&terms, p) >= best - 1e-12, "{p} beats {beta}");
+            }
+        }
+        // The strongly stretched image pulls the source along x far more than the plain mean.
+        let mean = terms.iter().map(|(b, _)| *b).sum::<DVec2>() / 3.0;
+        assert!((beta.x - 1.0).abs() < 0.3 * (mean.x - 1.0).abs());
+    }
+
+    #[test]
+    fn equal_weights_give_the_plain_mean() {
+        let terms = [
+            (DVec2::new(1.0, 2.0), [2.0, 0.0, 0.0, 2.0]),
+            (DVec2::new(3.0, -2.0), [2.0, 0.0, 0.0, 2.0]),
+        ];
+        assert!(image_plane_source(&terms).distance(DVec2::new(2.0, 0.0)) < 1e-12);
+        // Singular weights fall back to the plain mean.
+        let zero = [
+            (DVec2::new(1.0, 2.0), [0.0; 4]),
+            (DVec2::new(3.0, 0.0), [0.0; 4]),
+        ];
+        assert!(image_plane_source(&zero).distance(DVec2::new(2.0, 1.0)) < 1e-12);
     }
 }
