@@ -32,7 +32,12 @@ impl Session {
     /// reconstruction minus model (linear, diverging, symmetric limits), with the observed
     /// images and arc pixels over the difference. Both maps are on the model's grid over the
     /// reconstruction's map ([`Session::model_profile`] explains when a model is compared).
+    /// Of the options' sizes only [`ViewOptions::figure_scale`] applies: the panels, the gaps
+    /// and their text grow with it.
     pub fn compare_view(&self, opts: &ViewOptions) -> Result<ViewPng, AppError> {
+        let scale = opts.checked_figure_scale()?;
+        let scaled = |px: u32| (px as f32 * scale).round().max(1.0) as u32;
+        let (panel_px, gap_px) = (scaled(PANEL_MAP_PX), scaled(PANEL_GAP_PX));
         let r = self.result()?;
         let Some((name, truth)) = self.model_kappa(r)? else {
             return Err(AppError::Missing(
@@ -63,7 +68,7 @@ impl Session {
             scale: ColorScale::Log,
             vmin: Some(vmin),
             vmax: Some(vmax),
-            map_pixels_on_screen: PANEL_MAP_PX,
+            map_pixels_on_screen: panel_px,
             title: Some(title),
             legend: LegendPlace::Below,
             ..KappaPlotOptions::default()
@@ -111,7 +116,7 @@ impl Session {
                 vmin: Some(-limit),
                 vmax: Some(limit),
                 colormap: Colormap::Diverging,
-                map_pixels_on_screen: PANEL_MAP_PX,
+                map_pixels_on_screen: panel_px,
                 title: Some(format!("reconstruction - {truth_label} (red: too much)")),
                 colorbar_label: Some("kappa difference".to_string()),
                 legend: LegendPlace::Below,
@@ -119,8 +124,7 @@ impl Session {
             },
         )
         .map_err(render)?;
-        let png =
-            compose_png_grid(&[ours_png, truth_png, diff_png], 3, PANEL_GAP_PX).map_err(render)?;
+        let png = compose_png_grid(&[ours_png, truth_png, diff_png], 3, gap_px).map_err(render)?;
         Ok(ViewPng {
             name: "compare-with-truth.png".to_string(),
             png,

@@ -50,6 +50,22 @@ fn observing_then_inverting_the_first_lesson_recovers_its_einstein_radius() {
     };
     let png = s.compare_view(&opts).unwrap();
     assert!(png.png.starts_with(b"\x89PNG"));
+    // "Download figure" at 2x: the three panels drawn twice as large (parts rounded one by one).
+    let size = |png: &[u8]| {
+        let pm = tiny_skia::Pixmap::decode_png(png).expect("a PNG");
+        (pm.width() as i64, pm.height() as i64)
+    };
+    let twice = s
+        .compare_view(&ViewOptions {
+            figure_scale: 2.0,
+            ..opts
+        })
+        .unwrap();
+    let ((w1, h1), (w2, h2)) = (size(&png.png), size(&twice.png));
+    assert!(
+        (w2 - 2 * w1).abs() <= 8 && (h2 - 2 * h1).abs() <= 8,
+        "compare at 2x: {w2} x {h2}, at 1x {w1} x {h1}"
+    );
     s.data.clear(DataRole::Model);
     let e = s.compare_view(&opts).unwrap_err().to_string();
     assert!(e.contains("model"), "{e}");
