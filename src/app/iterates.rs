@@ -16,6 +16,8 @@ use serde::{Deserialize, Serialize};
 use crate::map::MapGeometry;
 use crate::products::{ProductOptions, Products};
 use crate::reconstruct::{images_on_maps, Reconstruction};
+use crate::solver::Iterate;
+use base64::Engine as _;
 
 use super::run::curves_at;
 use super::{AppError, SessionResult};
@@ -25,6 +27,107 @@ use super::{AppError, SessionResult};
 /// run of 3000. About 41 × 8 bytes per unknown (the teaching example, 24 × 24
 /// cells and 4 systems: 192 kB), 356 kB for the paper's system (1085 unknowns).
 pub const APP_KEPT_ITERATES: usize = 41;
+
+/// Most values (iterates x unknowns) a project file keeps of the iterates: 1 MiB as `f32`,
+/// 1.4 MB of base64. The app's 41 iterates of the paper's system (1085 unknowns) are 44 505
+/// values; a larger run keeps every other iterate (the first and the last always) until they fit.
+pub const MAX_STORED_ITERATE_VALUES: usize = 1 << 18;
+
+/// The kept iterates in a project file, for the iteration slider after a reload: their counts
+/// and objectives, and their solutions as little-endian `f32` in base64 (the slider's maps do
+/// not need more; the result itself is the project's full-precision `x`).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct StoredIterates {
+    /// Unknowns of each iterate (the length of `X`).
+    pub unknowns: usize,
+    pub steps: Vec<IterateStep>,
+    /// `steps.len() * unknowns` values, iterate after iterate.
+    pub x_f32_base64: String,
+}
+
+impl StoredIterates {
+    /// `iterates` for a project file, thinned to at most [`MAX_STORED_ITERATE_VALUES`] values;
+    /// `None` when there are fewer than two (no slider) or they do not all have one length.
+    pub fn from_iterates(iterates: &[Iterate]) -> Option<Self> {
+        let unknowns = iterates.first()?.x.len();
+        if unknowns == 0 || iterates.iter().any(|i| i.x.len() != unknowns) {
+            return None;
+        }
+        let mut kept: Vec<&Iterate> = iterates.iter().collect();
+        while kept.len() > 2 && kept.len() * unknowns > MAX_STORED_ITERATE_VALUES {
+            let last = kept.len() - 1;
+            kept = kept
+                .iter()
+                .enumerate()
+                .filter(|(k, _)| k % 2 == 0 || *k == last)
+                .map(|(_, i)| *i)
+                .collect();
+        }
+        if kept.len() < 2 || kept.len() * unknowns > MAX_STORED_ITERATE_VALUES {
+            return None;
+        }
+        let bytes: Vec<u8> = kept
+            .iter()
+            .flat_map(|i| i.x.iter().flat_map(|v| (*v as f32).to_le_bytes()))
+            .collect();
+        Some(Self {
+            unknowns,
+            steps: kept
+                .iter()
+                .map(|i| IterateStep {
+                    iteration: i.iteration,
+                    objective: i.objective,
+                })
+                .collect(),
+            x_f32_base64: base64::engine::general_purpose::STANDARD.encode(bytes),
+        })
+    }
+
+    /// The iterates again, checked against the result's `unknowns`; the error says what does
+    /// not fit.
+    pub fn to_iterates(&self, unknowns: usize) -> Result<Vec<Iterate>, String> {
+        if self.unknowns != unknowns {
+            return Err(format!(
+                "they have {} unknowns, the result {unknowns}",
+                self.unknowns
+            ));
+        }
+        let values = self.steps.len().saturating_mul(unknowns);
+        if values > MAX_STORED_ITERATE_VALUES {
+            return Err(format!(
+                "{values} values, more than the {MAX_STORED_ITERATE_VALUES} a project keeps"
+            ));
+        }
+        let bytes = base64::engine::general_purpose::STANDARD
+            .decode(&self.x_f32_base64)
+            .map_err(|e| format!("not base64: {e}"))?;
+        if bytes.len() != values * 4 {
+            return Err(format!(
+                "{} bytes for {} iterates of {unknowns} unknowns (want {})",
+                bytes.len(),
+                self.steps.len(),
+                values * 4
+            ));
+        }
+        let x: Vec<f64> = bytes
+            .chunks_exact(4)
+            .map(|b| f64::from(f32::from_le_bytes([b[0], b[1], b[2], b[3]])))
+            .collect();
+        if x.iter().any(|v| !v.is_finite()) {
+            return Err("a value is not a finite number".to_string());
+        }
+        Ok(self
+            .steps
+            .iter()
+            .zip(x.chunks_exact(unknowns))
+            .map(|(s, x)| Iterate {
+                iteration: s.iteration,
+                objective: s.objective,
+                x: x.to_vec(),
+            })
+            .collect())
+    }
+}
 
 /// One kept iterate as the app lists it.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
@@ -65,7 +168,7 @@ pub(crate) struct IterateCache(RefCell<Option<IterateMaps>>);
 
 impl SessionResult {
     /// The kept iterates of a reconstruction; `None` for other results and when none were
-    /// kept (a restored project, a run that kept none).
+    /// kept (a run that kept none, a project saved before projects kept them).
     pub fn iterate_list(&self) -> Option<IterateList> {
         let r = self.reconstruction()?;
         if r.iterates.is_empty() {

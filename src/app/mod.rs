@@ -27,7 +27,9 @@ pub use data::{
     NamedText, MAX_STORED_FITS_BYTES,
 };
 pub use ensemble::{member_run, EnsembleReadout, EnsembleSettings};
-pub use iterates::{IterateList, IterateStep, APP_KEPT_ITERATES};
+pub use iterates::{
+    IterateList, IterateStep, StoredIterates, APP_KEPT_ITERATES, MAX_STORED_ITERATE_VALUES,
+};
 pub use overlap::{separation_arcsec, SkyFootprint, FIELD_MARGIN_ARCSEC};
 pub use plots::{profile_relative_differences, ModelCurves};
 pub use project::{Project, ProjectResult, StoredFits, PROJECT_FORMAT, PROJECT_VERSION};

@@ -1,6 +1,7 @@
 //! The project file: one JSON document with the data texts, the settings and the result
-//! (summary, per-system reports, convergence and the solution vector `X`), so that reloading
-//! a project rebuilds the maps from `X` without iterating again.
+//! (summary, per-system reports, convergence, the solution vector `X` and the iterates kept
+//! for the iteration slider), so that reloading a project rebuilds the maps from `X` without
+//! iterating again, and the slider steps through the same iterates.
 //!
 //! ```json
 //! {"format": "wslap-project", "version": 1, "name": "...",
@@ -8,8 +9,12 @@
 //!           "deflection_x": {"name": "...", "fits_base64": "..."}, "deflection_y": null},
 //!  "settings": {...AppSettings...},
 //!  "result": {"kind": "reconstruct", "summary": {...}, "x": [...], "iterations": 8000,
-//!             "sources": [...], "convergence": [...]}}
+//!             "sources": [...], "convergence": [...],
+//!             "iterates": {"unknowns": 580, "steps": [{"iteration": 0, "objective": 1.2}, ...],
+//!                          "x_f32_base64": "..."}}}
 //! ```
+//! The iterates are kept as `f32`, at most [`super::MAX_STORED_ITERATE_VALUES`] values (a run
+//! with more keeps every other one, [`StoredIterates::from_iterates`]).
 //! Deflection FITS files (look-up mode) are stored as base64 up to
 //! [`MAX_STORED_FITS_BYTES`] each; a larger one is left out (the app says so when it is
 //! loaded) and must be loaded again. Files without the deflection fields still read.
@@ -22,6 +27,7 @@ use crate::limits::json_error_message;
 use crate::reconstruct::{ConvergenceRecord, SourceReport};
 
 use super::data::{NamedText, MAX_STORED_FITS_BYTES};
+use super::iterates::StoredIterates;
 use super::outputs::pretty;
 use super::run::RunKind;
 use super::{AppError, AppSettings, Session};
@@ -116,6 +122,10 @@ pub struct ProjectResult {
     pub sources: Vec<SourceReport>,
     #[serde(default)]
     pub convergence: Vec<ConvergenceRecord>,
+    /// The iterates a reconstruction kept, for the iteration slider after a reload (absent in
+    /// files written before them, and for other results).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub iterates: Option<StoredIterates>,
 }
 
 /// A saved session.
@@ -170,6 +180,9 @@ impl Session {
                     .reconstruction()
                     .map(|x| x.convergence.clone())
                     .unwrap_or_default(),
+                iterates: r
+                    .reconstruction()
+                    .and_then(|x| StoredIterates::from_iterates(&x.iterates)),
             }),
         };
         pretty(&Project {
@@ -236,8 +249,26 @@ impl Session {
             None => ("none", "project opened".to_string()),
             Some(r) => match (r.kind, r.x) {
                 (RunKind::Reconstruct, Some(x)) => {
-                    match next.restore_reconstruction(x, r.iterations, r.convergence, r.sources) {
-                        Ok(()) => ("restored", "maps rebuilt from the stored solution X".into()),
+                    // Iterates that do not fit the result are left out, and the message says so.
+                    let (iterates, dropped) = match r.iterates.map(|i| i.to_iterates(x.len())) {
+                        None => (Vec::new(), String::new()),
+                        Some(Ok(i)) => (i, String::new()),
+                        Some(Err(e)) => (
+                            Vec::new(),
+                            format!("; its stored iterates were not used ({e})"),
+                        ),
+                    };
+                    match next.restore_reconstruction(
+                        x,
+                        r.iterations,
+                        r.convergence,
+                        r.sources,
+                        iterates,
+                    ) {
+                        Ok(()) => (
+                            "restored",
+                            format!("maps rebuilt from the stored solution X{dropped}"),
+                        ),
                         Err(e) => (
                             "solve_needed",
                             format!("the stored solution was not used ({e}): reconstruct again"),

@@ -15,7 +15,7 @@ use crate::reconstruct::{
     ReconstructError, Reconstruction, RunSize, RunStatus, SourceReport, StageTimings,
     StrengthCandidate, StrengthChoice, DEFAULT_FOLDS,
 };
-use crate::solver::Control;
+use crate::solver::{Control, Iterate};
 
 use super::data::{DataMarks, DataViews};
 use super::iterates::{IterateCache, APP_KEPT_ITERATES};
@@ -313,14 +313,15 @@ impl Session {
 
     /// Rebuilds a reconstruction from a stored solution `x` without iterating: the same
     /// constraints, grid, layers and linear system as the run that found `x` (no grid
-    /// refinements), the lens of `x` and its products. Sources and convergence come from the
-    /// project.
+    /// refinements), the lens of `x` and its products. Sources, convergence and the kept
+    /// `iterates` (for the iteration slider; none: no slider) come from the project.
     pub fn restore_reconstruction(
         &mut self,
         x: Vec<f64>,
         iterations: usize,
         convergence: Vec<ConvergenceRecord>,
         sources: Vec<SourceReport>,
+        iterates: Vec<Iterate>,
     ) -> Result<(), AppError> {
         let t = crate::products::Clock::start();
         let run = |e: &dyn std::fmt::Display| AppError::Run(e.to_string());
@@ -373,7 +374,7 @@ impl Session {
                 status: RunStatus::Restored,
                 iterations,
                 convergence,
-                iterates: Vec::new(),
+                iterates,
                 lens,
                 products,
                 sources,

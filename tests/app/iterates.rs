@@ -3,8 +3,10 @@
 
 use crate::fixtures::teaching_session;
 use serde_json::json;
-use wslap::app::{RunKind, Session, ViewOptions, APP_KEPT_ITERATES};
-use wslap::Control;
+use wslap::app::{
+    RunKind, Session, StoredIterates, ViewOptions, APP_KEPT_ITERATES, MAX_STORED_ITERATE_VALUES,
+};
+use wslap::{Control, Iterate};
 
 /// The teaching example with the paper's QADP (the app's example settings), quick.
 fn qadp_session() -> Session {
@@ -88,19 +90,81 @@ fn the_mass_map_steps_through_the_kept_iterates() {
     assert!(err.contains(&format!("iterate {}", counts.len())), "{err}");
 }
 
+/// Relative difference allowed between kappa of an iterate before and after a reload (the
+/// project keeps the iterates as `f32`).
+const STORED_ITERATE_RTOL: f64 = 1e-5;
+
 #[cfg_attr(not(target_arch = "wasm32"), test)]
 #[cfg_attr(target_arch = "wasm32", wasm_bindgen_test::wasm_bindgen_test)]
-fn a_restored_project_has_no_iterates_to_step_through() {
+fn a_restored_project_keeps_its_iterates_to_step_through() {
     let s = qadp_session();
     let project = s.project_json().unwrap();
     let mut t = Session::new();
-    t.open_project(&project, "project.json").unwrap();
-    let r = t.result().unwrap();
-    assert!(r.reconstruction().is_some());
-    assert!(r.iterate_list().is_none());
+    let report = t.open_project(&project, "project.json").unwrap();
+    assert_eq!(report.result, "restored", "{}", report.message);
+    let list = s.result().unwrap().iterate_list().unwrap();
+    assert_eq!(t.result().unwrap().iterate_list(), Some(list.clone()));
+    let early = list.steps.iter().position(|i| i.iteration >= 10).unwrap();
+    let at = ViewOptions {
+        iterate: Some(early),
+        ..ViewOptions::default()
+    };
+    let (before, _) = centre_and_png(&s, &at);
+    let (after, _) = centre_and_png(&t, &at);
+    assert!(
+        (after / before - 1.0).abs() < STORED_ITERATE_RTOL,
+        "kappa {after} after the reload, {before} before"
+    );
+
+    // A project of before the iterates were kept opens without them: no slider.
+    let mut value: serde_json::Value = serde_json::from_str(&project).unwrap();
+    value["result"].as_object_mut().unwrap().remove("iterates");
+    let mut u = Session::new();
+    u.open_project(&value.to_string(), "old.json").unwrap();
+    assert!(u.result().unwrap().iterate_list().is_none());
     let opts = ViewOptions {
         iterate: Some(0),
         ..ViewOptions::default()
     };
-    assert!(t.kappa_view(&opts).is_err());
+    assert!(u.kappa_view(&opts).is_err());
+
+    // Iterates that do not fit the result are left out, and the message says why.
+    value["result"]["iterates"] = serde_json::to_value(
+        StoredIterates::from_iterates(&s.result().unwrap().reconstruction().unwrap().iterates)
+            .unwrap(),
+    )
+    .unwrap();
+    value["result"]["iterates"]["unknowns"] = json!(3);
+    let report = u.open_project(&value.to_string(), "odd.json").unwrap();
+    assert_eq!(report.result, "restored");
+    assert!(
+        report.message.contains("stored iterates were not used")
+            && report.message.contains("3 unknowns"),
+        "{}",
+        report.message
+    );
+    assert!(u.result().unwrap().iterate_list().is_none());
+}
+
+/// A run with more iterate values than a project keeps is thinned (the first and the last
+/// stay); a single iterate is not kept (no slider).
+#[cfg_attr(not(target_arch = "wasm32"), test)]
+#[cfg_attr(target_arch = "wasm32", wasm_bindgen_test::wasm_bindgen_test)]
+fn stored_iterates_are_bounded() {
+    let unknowns = MAX_STORED_ITERATE_VALUES / 10;
+    let iterates: Vec<Iterate> = (0..41)
+        .map(|k| Iterate {
+            iteration: k * 10,
+            objective: 1.0 / (k as f64 + 1.0),
+            x: vec![k as f64; unknowns],
+        })
+        .collect();
+    let stored = StoredIterates::from_iterates(&iterates).unwrap();
+    assert!(stored.steps.len() * unknowns <= MAX_STORED_ITERATE_VALUES);
+    assert!(stored.steps.len() >= 6, "{} kept", stored.steps.len());
+    assert_eq!(stored.steps[0].iteration, 0);
+    assert_eq!(stored.steps.last().unwrap().iteration, 400);
+    let back = stored.to_iterates(unknowns).unwrap();
+    assert_eq!(back.last().unwrap().x, iterates.last().unwrap().x);
+    assert!(StoredIterates::from_iterates(&iterates[..1]).is_none());
 }
