@@ -475,14 +475,39 @@ async function openFromPlayground() {
   const ex = { ...handed, id: 'playground', settings: Object.fromEntries(handed.settings) };
   // As a built-in example: legends call its model "the true lens", your own file replaces it.
   examples.push(ex);
+  // What makes it one after a reload (the saved project holds its files): kept without them.
+  try {
+    localStorage.setItem(OBSERVED_KEY, JSON.stringify({ ...ex, files: ex.files.map(({ text: _, ...f }) => f) }));
+  } catch { /* no storage: after a reload its model is called by its file name */ }
   await enqueue(() => loadExample(ex));
+  backToPlayground(ex);
+  await run('reconstruct');
+  return true;
+}
+
+/** localStorage key of the last observation opened from the playground, without its files. */
+const OBSERVED_KEY = 'wslap.playground.opened';
+
+/** The last observation opened from the playground, as an example (its files without their
+ * texts): a saved project of it reopens with its model as the true lens and the link back. */
+function observedExample() {
+  try {
+    const ex = JSON.parse(localStorage.getItem(OBSERVED_KEY) ?? 'null');
+    return ex?.id === 'playground' && typeof ex.name === 'string' && Array.isArray(ex.files) ? ex : null;
+  } catch {
+    return null;
+  }
+}
+
+/** The link back to the playground scene `ex` was observed from, after its description. */
+function backToPlayground(ex) {
+  if (!ex.back || !String(ex.back).startsWith('./?playground')) return;
+  $('back-to-playground')?.remove();
   const back = document.createElement('a');
   back.id = 'back-to-playground';
   back.href = ex.back;
   back.textContent = 'Back to the playground scene';
   $('project-description').append(' ', back);
-  await run('reconstruct');
-  return true;
 }
 
 // The example that is open (the session carries its name), if any.
@@ -690,8 +715,11 @@ async function start() {
     if (wanted !== null && !linked) showError(`no built-in example "${wanted}" (there are: ${examples.map((e) => e.id).join(', ')})`);
   };
   if (params.get('from') === 'playground' && await openFromPlayground()) return;
+  const observed = observedExample();
+  if (observed) examples.push(observed);
   const restored = EMBED ? null : await openSaved();
   if (!EMBED) await showSetAside();
+  if (restored && observed && $('project-name').textContent === observed.name) backToPlayground(observed);
   if (restored) {
     const link = linked ? ` (the link's example, "${linked.name}", is in the Example menu)` : '';
     setStatus(restored === 'current' ? `Restored your project from this browser${link}.`

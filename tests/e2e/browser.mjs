@@ -22,8 +22,9 @@ const CHROMIUM_FLAGS = [
 /** Starts the server and the browser and opens the page (with `query`, e.g. '?simd=baseline';
  * by default `?app`, the research app: a first visit without parameters opens the lessons);
  * returns { page, url, consoleErrors, close }. `serviceWorkers: 'block'` keeps the app's
- * service worker out (so that `page.route` sees the workers' requests). */
-export async function openApp({ width = 1280, height = 900, query = '?app', serviceWorkers = 'allow' } = {}) {
+ * service worker out (so that `page.route` sees the workers' requests); `hasTouch` gives the
+ * page a touch screen. */
+export async function openApp({ width = 1280, height = 900, query = '?app', serviceWorkers = 'allow', hasTouch = false } = {}) {
   await mkdir(ARTIFACTS, { recursive: true });
   const server = await serve(join(ROOT, 'www'), 0, '127.0.0.1');
   const url = `http://127.0.0.1:${server.address().port}/`;
@@ -31,7 +32,7 @@ export async function openApp({ width = 1280, height = 900, query = '?app', serv
     executablePath: process.env.CHROMIUM ?? '/usr/bin/chromium',
     args: CHROMIUM_FLAGS,
   });
-  const page = await browser.newPage({ viewport: { width, height }, serviceWorkers });
+  const page = await browser.newPage({ viewport: { width, height }, serviceWorkers, hasTouch });
   const consoleErrors = [];
   page.on('console', (m) => { if (m.type() === 'error') consoleErrors.push(m.text()); });
   page.on('pageerror', (e) => consoleErrors.push(String(e)));
@@ -51,6 +52,15 @@ export async function openApp({ width = 1280, height = 900, query = '?app', serv
       await new Promise((r) => server.close(r));
     },
   };
+}
+
+const PNG_SIGNATURE = [0x89, 0x50, 0x4e, 0x47, 0x0d, 0x0a, 0x1a, 0x0a];
+
+/** `[width, height]` from the IHDR chunk of the PNG `bytes` (a Buffer); throws on another file. */
+export function pngSize(bytes) {
+  if (PNG_SIGNATURE.some((b, k) => bytes[k] !== b)) throw new Error('not a PNG');
+  if (bytes.subarray(12, 16).toString('latin1') !== 'IHDR') throw new Error('a PNG without IHDR first');
+  return [bytes.readUInt32BE(16), bytes.readUInt32BE(20)];
 }
 
 /** `[width, height]` of the image `selector` once it has loaded (read in the task that sees

@@ -7,18 +7,10 @@ import assert from 'node:assert/strict';
 import { join } from 'node:path';
 import { readFile, writeFile, mkdtemp } from 'node:fs/promises';
 import { tmpdir } from 'node:os';
-import { openApp, imageSize, imageStats, renderCount, runToMap, waitView, ARTIFACTS, ROOT, SETTLE_TIMEOUT_MS, setField, waitStatus } from './browser.mjs';
+import { openApp, imageSize, imageStats, pngSize, renderCount, runToMap, waitView, ARTIFACTS, ROOT, SETTLE_TIMEOUT_MS, setField, waitStatus } from './browser.mjs';
 
 const AS1063 = join(ROOT, '..', 'shared', 'data', 'AS1063', 'lenstool_cats');
 const TEACHING_MODEL = join(ROOT, 'www', 'examples', 'teaching', 'model.json');
-const PNG_SIGNATURE = [0x89, 0x50, 0x4e, 0x47, 0x0d, 0x0a, 0x1a, 0x0a];
-
-/** Width and height from a PNG's IHDR chunk. */
-function pngSize(bytes) {
-  assert.deepEqual([...bytes.subarray(0, 8)], PNG_SIGNATURE, 'not a PNG');
-  assert.equal(bytes.subarray(12, 16).toString('latin1'), 'IHDR');
-  return [bytes.readUInt32BE(16), bytes.readUInt32BE(20)];
-}
 
 const good = (page, sel) => page.$eval(sel, (el) => [el.value, el.dataset.good]);
 

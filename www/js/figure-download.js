@@ -8,6 +8,7 @@ import { save } from './downloads.js';
 export const FIGURE_SCALES = [1, 2, 3];
 /** File names of the views, as in the downloads panel. */
 const FILE_NAMES = { kappa: 'kappa', source: 'source-plane', radial: 'radial-profile', convergence: 'convergence', data: 'data',
+  compare: 'compare-with-truth',
   spread: 'kappa-std' };
 
 /** The file name of view `view` drawn at scale `k`: `kappa.png`, `kappa@2x.png`. */
