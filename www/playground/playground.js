@@ -7,7 +7,7 @@ import {
   DEFAULT_SCENE, FIELDS, SOURCE_FIELDS, NEW_LENS, NEW_SOURCE, LENS_NAMES, SOURCE_NAMES,
   draggable, encodeFragment, decodeFragment, tidyScene,
 } from './scene.js';
-import { wireObserve } from './observe.js';
+import { wireObserve, wireObserveOptions } from './observe.js';
 
 const params = new URLSearchParams(location.search);
 const EMBED = params.has('embed');
@@ -49,6 +49,7 @@ root.innerHTML = `
     </select>
     <label><input type="checkbox" id="pg-timing"> ms/frame</label>
     <button id="pg-share" type="button">Share link</button>
+    ${EMBED ? '' : '<button id="pg-download" type="button" title="Both views drawn again at 1024 pixels a side, as a PNG for a slide or a paper">Download PNG</button>'}
     ${EMBED ? '' : '<button id="pg-observe" type="button" title="Freeze the scene into mock telescope data">Observe</button><button id="pg-invert" type="button" hidden>Invert with WSLAP+</button>'}
     ${EMBED ? '<a id="pg-open" target="_blank" rel="noopener">Open full</a>' : '<a href="./?app">Research app</a>'}
   </div>
@@ -66,6 +67,7 @@ root.innerHTML = `
     </div>
     <aside class="pg-panel" id="pg-panel">
       <div class="pg-readout" id="pg-readout">Hover the image plane to see where a ray lands; hover the source plane to see every image of that point.</div>
+      ${EMBED ? '' : '<details class="pg-observe-opts" id="pg-observe-opts"></details>'}
       <div class="pg-palette">
         <span>Add lens:</span>
         ${Object.keys(NEW_LENS).map((k) => `<button type="button" data-lens="${k}">${LENS_NAMES[k]}</button>`).join('')}
@@ -265,38 +267,47 @@ function marker(ctx, px, py, color, r, label) {
   }
 }
 
-function draw() {
-  const dpr = window.devicePixelRatio || 1;
+/** Draws both views: on screen (`draw()`), or into the canvases of a downloaded figure
+ * (`target`: its canvases, bitmaps and frame, and `unit`, canvas pixels per CSS pixel of the
+ * screen's lines and text; no hover marks). */
+function draw(target = null) {
+  const t = target ?? {
+    image: imageCanvas, source: sourceCanvas, imageBitmap, sourceBitmap, frame,
+    unit: window.devicePixelRatio || 1, hover,
+  };
+  const { unit: dpr, hover: marks } = t;
+  const fr = t.frame;
   const lw = 1.6 * dpr;
   const font = `${Math.round(12 * dpr)}px system-ui, sans-serif`;
   // Image plane.
-  let ctx = imageCanvas.getContext('2d');
+  const image = t.image;
+  let ctx = image.getContext('2d');
   ctx.font = font;
   ctx.fillStyle = '#080a14';
-  ctx.fillRect(0, 0, imageCanvas.width, imageCanvas.height);
-  if (imageBitmap) {
+  ctx.fillRect(0, 0, image.width, image.height);
+  if (t.imageBitmap) {
     ctx.imageSmoothingEnabled = true;
-    ctx.drawImage(imageBitmap, 0, 0, imageCanvas.width, imageCanvas.height);
+    ctx.drawImage(t.imageBitmap, 0, 0, image.width, image.height);
   }
   for (const c of contours) {
-    polyline(ctx, imageCanvas, fov(), c.points, c.closed, COLORS[$('pg-contours').value] ?? '#fff', lw * 0.7);
+    polyline(ctx, image, fov(), c.points, c.closed, COLORS[$('pg-contours').value] ?? '#fff', lw * 0.7);
   }
-  if (frame && $('pg-curves').checked) {
-    for (const plane of frame.curves) {
-      for (const t of plane.tangential) polyline(ctx, imageCanvas, fov(), t, false, COLORS.tangential, lw);
-      for (const r of plane.radial) polyline(ctx, imageCanvas, fov(), r, false, COLORS.radial, lw);
+  if (fr && $('pg-curves').checked) {
+    for (const plane of fr.curves) {
+      for (const c of plane.tangential) polyline(ctx, image, fov(), c, false, COLORS.tangential, lw);
+      for (const r of plane.radial) polyline(ctx, image, fov(), r, false, COLORS.radial, lw);
     }
   }
   scene.lenses.forEach((l, k) => {
     if (!draggable(l)) return;
-    const [px, py] = toCanvas(imageCanvas, fov(), l.x, l.y);
+    const [px, py] = toCanvas(image, fov(), l.x, l.y);
     const on = selected.list === 'lenses' && selected.index === k;
     marker(ctx, px, py, COLORS.lens, (on ? 9 : 7) * dpr, on ? LENS_NAMES[l.type] : '');
   });
-  if (frame) {
-    for (const p of frame.points) {
+  if (fr) {
+    for (const p of fr.points) {
       for (const im of p.images) {
-        const [px, py] = toCanvas(imageCanvas, fov(), im.x, im.y);
+        const [px, py] = toCanvas(image, fov(), im.x, im.y);
         const r = Math.min(10, 2 + 2 * Math.sqrt(Math.abs(im.magnification))) * dpr;
         ctx.beginPath();
         ctx.arc(px, py, r, 0, 2 * Math.PI);
@@ -305,43 +316,107 @@ function draw() {
       }
     }
   }
-  observed?.draw(ctx, (x, y) => toCanvas(imageCanvas, fov(), x, y), dpr);
-  if (hover?.kind === 'ray') {
-    const [px, py] = toCanvas(imageCanvas, fov(), hover.at[0], hover.at[1]);
+  observed?.draw(ctx, (x, y) => toCanvas(image, fov(), x, y), dpr);
+  if (marks?.kind === 'ray') {
+    const [px, py] = toCanvas(image, fov(), marks.at[0], marks.at[1]);
     marker(ctx, px, py, COLORS.ray, 6 * dpr);
   }
-  if (hover?.kind === 'images') {
-    for (const im of hover.images) {
-      const [px, py] = toCanvas(imageCanvas, fov(), im.x, im.y);
+  if (marks?.kind === 'images') {
+    for (const im of marks.images) {
+      const [px, py] = toCanvas(image, fov(), im.x, im.y);
       marker(ctx, px, py, COLORS.image, 7 * dpr, `μ=${im.magnification.toFixed(1)}`);
     }
   }
   // Source plane.
-  ctx = sourceCanvas.getContext('2d');
+  const source = t.source;
+  ctx = source.getContext('2d');
   ctx.font = font;
   ctx.fillStyle = '#080a14';
-  ctx.fillRect(0, 0, sourceCanvas.width, sourceCanvas.height);
-  if (sourceBitmap) ctx.drawImage(sourceBitmap, 0, 0, sourceCanvas.width, sourceCanvas.height);
-  if (frame && $('pg-caustics').checked) {
-    for (const plane of frame.curves) {
-      for (const t of plane.tangential_caustics) polyline(ctx, sourceCanvas, sourceFov(), t, false, COLORS.tcaustic, lw);
-      for (const r of plane.radial_caustics) polyline(ctx, sourceCanvas, sourceFov(), r, false, COLORS.rcaustic, lw);
+  ctx.fillRect(0, 0, source.width, source.height);
+  if (t.sourceBitmap) ctx.drawImage(t.sourceBitmap, 0, 0, source.width, source.height);
+  if (fr && $('pg-caustics').checked) {
+    for (const plane of fr.curves) {
+      for (const c of plane.tangential_caustics) polyline(ctx, source, sourceFov(), c, false, COLORS.tcaustic, lw);
+      for (const r of plane.radial_caustics) polyline(ctx, source, sourceFov(), r, false, COLORS.rcaustic, lw);
     }
   }
   scene.sources.forEach((s, k) => {
-    const [px, py] = toCanvas(sourceCanvas, sourceFov(), s.x, s.y);
+    const [px, py] = toCanvas(source, sourceFov(), s.x, s.y);
     const on = selected.list === 'sources' && selected.index === k;
     marker(ctx, px, py, COLORS.source, (on ? 8 : 6) * dpr, `z=${s.z}`);
   });
-  if (hover?.kind === 'ray') {
-    for (const l of hover.landings) {
-      const [px, py] = toCanvas(sourceCanvas, sourceFov(), l.x, l.y);
+  if (marks?.kind === 'ray') {
+    for (const l of marks.landings) {
+      const [px, py] = toCanvas(source, sourceFov(), l.x, l.y);
       marker(ctx, px, py, COLORS.ray, 6 * dpr, `z=${l.z}`);
     }
   }
-  if (hover?.kind === 'images') {
-    const [px, py] = toCanvas(sourceCanvas, sourceFov(), hover.at[0], hover.at[1]);
+  if (marks?.kind === 'images') {
+    const [px, py] = toCanvas(source, sourceFov(), marks.at[0], marks.at[1]);
     marker(ctx, px, py, COLORS.image, 6 * dpr);
+  }
+}
+
+// ---------------------------------------------------------------- figure download
+
+/** Pixels a side of each view in a downloaded figure: the core's largest frame, twice the
+ * full frame on screen. */
+const FIGURE_PIXELS = 1024;
+/** Screen pixels a side the figure's lines and text are sized for: a view this wide on screen
+ * looks like the figure shrunk to it. */
+const FIGURE_DESIGN_SIDE = 420;
+
+/** Both views of the scene drawn again by the core at FIGURE_PIXELS a side, side by side with
+ * their captions, lines and text as on screen grown with the figure; a PNG Blob. */
+async function figurePng() {
+  const sent = JSON.stringify(tidyScene(scene));
+  const big = await client.request({ type: 'frame', scene: sent, pixels: FIGURE_PIXELS });
+  // The next live frame is computed for the scene again (the worker's session is shared).
+  const n = big.pixels;
+  const [imageBits, sourceBits] = await Promise.all([
+    createImageBitmap(new ImageData(big.image, n, n)),
+    createImageBitmap(new ImageData(big.source, n, n)),
+  ]);
+  const unit = n / FIGURE_DESIGN_SIDE;
+  const panel = () => { const c = document.createElement('canvas'); c.width = n; c.height = n; return c; };
+  const [image, source] = [panel(), panel()];
+  draw({ image, source, imageBitmap: imageBits, sourceBitmap: sourceBits, frame: big, unit, hover: null });
+  const gap = Math.round(12 * unit);
+  const fontPx = Math.round(13 * unit);
+  const band = Math.round(fontPx * 1.8);
+  const fig = document.createElement('canvas');
+  fig.width = 2 * n + 3 * gap;
+  fig.height = n + band + 2 * gap;
+  const ctx = fig.getContext('2d');
+  ctx.fillStyle = '#0c0f1c';
+  ctx.fillRect(0, 0, fig.width, fig.height);
+  ctx.drawImage(image, gap, gap);
+  ctx.drawImage(source, 2 * gap + n, gap);
+  ctx.fillStyle = '#c9cfe6';
+  ctx.font = `${fontPx}px system-ui, sans-serif`;
+  ctx.textBaseline = 'middle';
+  const y = gap + n + band / 2;
+  ctx.fillText(`Image plane, ${fov()}″ across (what the telescope sees)`, gap, y);
+  ctx.fillText(`Source plane, ${sourceFov()}″ across (without the lens)`, 2 * gap + n, y);
+  return new Promise((resolve, reject) => fig.toBlob((b) => (b ? resolve(b) : reject(new Error('the browser made no PNG'))), 'image/png'));
+}
+
+async function downloadFigure() {
+  const button = $('pg-download');
+  button.disabled = true;
+  try {
+    const blob = await figurePng();
+    const a = document.createElement('a');
+    a.href = URL.createObjectURL(blob);
+    a.download = `lensing-playground-${FIGURE_PIXELS}px.png`;
+    document.body.append(a);
+    a.click();
+    a.remove();
+    setTimeout(() => URL.revokeObjectURL(a.href), 10_000);
+  } catch (e) {
+    showError(`The figure could not be made: ${e.message}`);
+  } finally {
+    button.disabled = false;
   }
 }
 
@@ -533,10 +608,11 @@ $('pg-upload').addEventListener('change', async (ev) => {
 
 // ---------------------------------------------------------------- toggles, share, embed
 
-$('pg-curves').onchange = draw;
-$('pg-caustics').onchange = draw;
+$('pg-curves').onchange = () => draw();
+$('pg-caustics').onchange = () => draw();
 $('pg-contours').onchange = refreshContours;
 $('pg-timing').onchange = () => { $('pg-ms').hidden = !$('pg-timing').checked; };
+if (!EMBED) $('pg-download').onclick = downloadFigure;
 $('pg-share').onclick = async () => {
   const link = location.origin + location.pathname + '?playground' + encodeFragment(scene);
   try {
@@ -585,7 +661,8 @@ $('pg-fov').textContent = '';
 // Observe, then Invert (./observe.js); not in an embedded playground.
 const observed = EMBED ? null : wireObserve({
   client, observeButton: $('pg-observe'), invertButton: $('pg-invert'), getScene: () => scene,
-  redraw: draw, say: (text) => { $('pg-readout').textContent = text; }, tidy: tidyScene,
+  redraw: () => draw(), say: (text) => { $('pg-readout').textContent = text; }, tidy: tidyScene,
+  getOptions: wireObserveOptions($('pg-observe-opts'), fov),
 });
 wirePointer(imageCanvas, 'lenses', fov);
 wirePointer(sourceCanvas, 'sources', sourceFov);
