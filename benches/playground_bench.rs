@@ -5,12 +5,13 @@
 //! cargo bench --bench playground_bench -- [PIXELS] [REPEATS]
 //! ```
 //! (defaults 512 5). Scene: the page's default scene (www/playground/scene.js). Prints the
-//! median wall time of the whole frame and of its stages.
+//! median wall time of the whole frame (drawn again with nothing changed, and after the SIE
+//! moved: a released lens drag) and of its stages.
 
 use std::time::Instant;
 
 use glam::DVec2;
-use wslap::playground::{Playground, Scene};
+use wslap::playground::{Playground, Scene, CURVE_PIXELS};
 use wslap::{critical_curves, LensMaps, MapGeometry, MassComponent};
 
 const SCENE: &str = r#"{"v": 1, "z_lens": 0.3, "fov": 40,
@@ -60,6 +61,35 @@ fn main() {
             }
             std::hint::black_box(s);
         });
+        // A frame after the lens moved (a released drag): nothing of the lens is kept.
+        let mut moving = Playground::new(pg.scene().clone()).expect("playground");
+        let mut step = 0;
+        let lens_moved = median_ms(repeats, || {
+            step += 1;
+            let moved = SCENE.replace(
+                r#""sie", "x": 0,"#,
+                &format!(r#""sie", "x": {},"#, 0.1 * step as f64),
+            );
+            let scene = Scene::from_json_str(&moved).expect("moved scene");
+            moving.set_scene(scene).expect("scene");
+            std::hint::black_box(moving.frame(pixels));
+        });
+        // The same without the point source: what its image search costs.
+        let no_point = SCENE.replace(
+            r#",
+             {"type": "point", "x": 0.6, "y": -0.4, "z": 3}"#,
+            "",
+        );
+        let pg_np = Playground::new(Scene::from_json_str(&no_point).expect("scene")).expect("pg");
+        let without_point = median_ms(repeats, || {
+            std::hint::black_box(pg_np.frame(pixels));
+        });
+        let curve_maps = median_ms(repeats, || {
+            std::hint::black_box(LensMaps::from_lens(
+                lens,
+                MapGeometry::centered(pg.scene().fov, pixels.min(CURVE_PIXELS)),
+            ));
+        });
         let m = LensMaps::from_lens(lens, geometry);
         let curves = median_ms(repeats, || {
             for p in &pg.built().planes {
@@ -80,9 +110,10 @@ fn main() {
             })
             .sum();
         println!(
-            "{pixels}^2: frame {frame:.1} ms; maps with Hessian {maps:.1} ms; deflection only \
-             {deflection:.1} ms; curves of {} planes {curves:.1} ms ({vertices} curve and \
-             caustic vertices)",
+            "{pixels}^2: frame {frame:.1} ms (lens and sources kept; {without_point:.1} ms \
+             without the point source's images), {lens_moved:.1} ms after the lens moved; maps with Hessian {maps:.1} ms ({curve_maps:.1} ms on the curve grid); \
+             deflection only {deflection:.1} ms; curves of {} planes {curves:.1} ms \
+             ({vertices} curve and caustic vertices)",
             pg.built().planes.len()
         );
     });
