@@ -101,9 +101,9 @@ pub use radial::{radial_profile, rect_disc_area, RadialBins, RadialError, Radial
 // The inputs: catalogues, arcs, regions, Lenstool models, FITS.
 pub use arcs::{arcs_from_regions, parse_arcs, ArcCatalog, ArcSystem, ArcsError};
 pub use catalog::{
-    parse_image_catalog, parse_member_catalog, CatalogError, Image, ImageCatalog, ImageSystem,
-    Member, MemberCatalog, DEGREE_LOOKALIKE, FIELD_ERROR_DEG, FIELD_WARN_DEG, MAG_NO_MEASUREMENT,
-    Z_AGREEMENT_TOL,
+    arclet_ellipticity, parse_arclet_catalog, parse_image_catalog, parse_member_catalog, Arclet,
+    ArcletCatalog, CatalogError, Image, ImageCatalog, ImageSystem, Member, MemberCatalog,
+    DEGREE_LOOKALIKE, FIELD_ERROR_DEG, FIELD_WARN_DEG, MAG_NO_MEASUREMENT, Z_AGREEMENT_TOL,
 };
 pub use ds9::{
     polyline_is_open, read_regions, write_marks, write_regions, Ds9Error, Ds9Frame, Mark, Region,
@@ -133,6 +133,9 @@ pub use inversion::{
     MembersError, NpyError, ObjectiveConfig, ObjectiveTerms, Regulariser, RowBlock, ScaledLens,
     Strength, SystemConfig, SystemError, Weighting, LAYER_SHARE_WARN, MAX_SINGLE_LAYERS,
 };
+pub use inversion::{
+    kappa_gamma, with_ring, ShearConfig, ShearPoint, ShearSet, MIN_ONE_MINUS_KAPPA,
+};
 
 // Non-negative quadratic programming.
 pub use solver::{
@@ -153,8 +156,8 @@ pub use reconstruct::{
     MemoryLimit, PredictedImage, PredictedSystem, ProductConfig, ReconstructConfig,
     ReconstructError, ReconstructSummary, Reconstruction, RedshiftEstimate, RunSize, RunStatus,
     Solved, SolverConfig, SolverMethod, SourceReport, StrengthCandidate, StrengthChoice,
-    SystemCheck, TooMuchMemory, Trust, Verdict, VerdictInputs, CHOICE_MAP_PIXELS, DEFAULT_FOLDS,
-    FALLBACK_MEMORY_LIMIT_BYTES, FALLBACK_SIGMA_ARCSEC, MAX_ENSEMBLE_MEMBERS,
+    SystemCheck, TooMuchMemory, Trust, Verdict, VerdictInputs, WeakLensingFit, CHOICE_MAP_PIXELS,
+    DEFAULT_FOLDS, FALLBACK_MEMORY_LIMIT_BYTES, FALLBACK_SIGMA_ARCSEC, MAX_ENSEMBLE_MEMBERS,
     SHOWN_MIN_MAGNIFICATION, WASM_MEMORY_LIMIT_BYTES,
 };
 

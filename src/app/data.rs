@@ -5,7 +5,9 @@ use glam::DVec2;
 use serde::{Deserialize, Serialize};
 
 use crate::arcs::{is_region_file, ArcCatalog};
-use crate::catalog::{parse_image_catalog, parse_member_catalog, ImageCatalog};
+use crate::catalog::{
+    parse_arclet_catalog, parse_image_catalog, parse_member_catalog, ImageCatalog,
+};
 use crate::cosmology::LensPlane;
 use crate::fits::read_image;
 use crate::lenstool_par::{parse_par_with, ParOptions};
@@ -29,18 +31,21 @@ pub enum DataRole {
     Arcs,
     /// Parametric model file (forward mode).
     Model,
+    /// Lenstool arclet catalogue (`id x y a b theta z`, weak lensing).
+    Shear,
 }
 
 impl DataRole {
-    /// Parses `images`, `members`, `arcs` or `model`.
+    /// Parses `images`, `members`, `arcs`, `shear` or `model`.
     pub fn parse(s: &str) -> Result<Self, AppError> {
         match s {
             "images" => Ok(Self::Images),
             "members" => Ok(Self::Members),
             "arcs" => Ok(Self::Arcs),
             "model" => Ok(Self::Model),
+            "shear" => Ok(Self::Shear),
             other => Err(AppError::File(format!(
-                "unknown file role '{other}' (images, members, arcs or model)"
+                "unknown file role '{other}' (images, members, arcs, shear or model)"
             ))),
         }
     }
@@ -84,6 +89,8 @@ pub struct LoadedData {
     pub members: Option<NamedText>,
     pub arcs: Option<NamedText>,
     pub model: Option<NamedText>,
+    /// Arclet catalogue (weak lensing).
+    pub shear: Option<NamedText>,
     /// Deflection maps along x and y (look-up mode).
     pub deflection: [Option<NamedMap>; 2],
 }
@@ -316,6 +323,14 @@ impl LoadedData {
                     w.iter().map(|w| w.to_string()).collect(),
                 )
             }
+            DataRole::Shear => {
+                let (c, w) = parse_arclet_catalog(text, name, None).map_err(|e| file(&e))?;
+                let n = c.arclets.len();
+                (
+                    format!("{n} arclets (weak lensing)"),
+                    w.iter().map(|w| w.to_string()).collect(),
+                )
+            }
             DataRole::Arcs => {
                 let regions = is_region_file(text);
                 let a = arcs_alone(name, text, arc_pixel_arcsec)?;
@@ -410,6 +425,7 @@ impl LoadedData {
             DataRole::Members => &mut self.members,
             DataRole::Arcs => &mut self.arcs,
             DataRole::Model => &mut self.model,
+            DataRole::Shear => &mut self.shear,
         }
     }
 
@@ -475,6 +491,7 @@ impl LoadedData {
             images: text(&self.images),
             members: text(&self.members),
             arcs: text(&self.arcs),
+            shear: text(&self.shear),
         };
         Dataset::read(&files, arc_pixel_arcsec).map_err(|e| AppError::File(e.to_string()))
     }

@@ -53,6 +53,9 @@ pub struct ProjectData {
     pub members: Option<NamedText>,
     pub arcs: Option<NamedText>,
     pub model: Option<NamedText>,
+    /// The arclet catalogue (weak lensing); absent in projects saved before it existed.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub shear: Option<NamedText>,
     pub deflection_x: Option<StoredFits>,
     pub deflection_y: Option<StoredFits>,
 }
@@ -194,6 +197,7 @@ impl Session {
                 members: d.members.clone(),
                 arcs: d.arcs.clone(),
                 model: d.model.clone(),
+                shear: d.shear.clone(),
                 deflection_x: stored(0),
                 deflection_y: stored(1),
             },
@@ -229,6 +233,7 @@ impl Session {
             (R::Members, &p.data.members),
             (R::Arcs, &p.data.arcs),
             (R::Model, &p.data.model),
+            (R::Shear, &p.data.shear),
         ] {
             if let Some(f) = file {
                 next.load_text(role, &f.name, &f.text)

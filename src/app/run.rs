@@ -6,11 +6,14 @@ use serde::{Deserialize, Serialize};
 
 use crate::curves::critical_curves;
 use crate::inversion::Regulariser;
-use crate::inversion::{build_constraints, build_member_layers, CellGrid, Layer, LinearSystem};
+use crate::inversion::{
+    build_constraints, build_member_layers, Layer, LinearSystem, ObjectiveTerms,
+};
 use crate::products::{own_map_side, ProductOptions, Products};
+use crate::reconstruct::shear_set;
 use crate::reconstruct::{
-    check_memory, cross_validate, fitted_system_ids, map_geometry, product_options, reconstruct,
-    reconstruct_with_choice, strength_candidates, strength_folds, ConvergenceRecord,
+    check_memory, cross_validate, fitted_system_ids, grid_of, map_geometry, product_options,
+    reconstruct, reconstruct_with_choice, strength_candidates, strength_folds, ConvergenceRecord,
     CrossValidation, Dataset, DatasetError, Ensemble, Inputs, MemoryLimit, ReconstructConfig,
     ReconstructError, Reconstruction, RunSize, RunStatus, SourceReport, StageTimings,
     StrengthCandidate, StrengthChoice, DEFAULT_FOLDS,
@@ -345,9 +348,10 @@ impl Session {
             .collect();
         let constraints = build_constraints(source, &config.constraints, &self.settings.holdout)
             .map_err(|e| run(&e))?;
-        let positions: Vec<DVec2> = constraints.pixels.iter().map(|p| p.position).collect();
-        let grid = CellGrid::from_config(&config.grid, &positions).map_err(|e| run(&e))?;
+        let (shear, shear_warning) = shear_set(parsed.shear.as_ref(), &config, &plane);
+        let grid = grid_of(&constraints, &shear, &config).map_err(|e| run(&e))?;
         let mut warnings = parsed.warnings.clone();
+        warnings.extend(shear_warning);
         warnings.extend(unfitted);
         let layers: Vec<Layer> = match &parsed.members {
             None => Vec::new(),
@@ -358,8 +362,16 @@ impl Session {
                 model.layers
             }
         };
-        let system = LinearSystem::build(&grid, &layers, &constraints, &plane, &config.system)
-            .map_err(|e| run(&e))?;
+        let system = LinearSystem::build_with_shear(
+            &grid,
+            &layers,
+            &constraints,
+            &shear,
+            &plane,
+            &config.system,
+            ObjectiveTerms::default(),
+        )
+        .map_err(|e| run(&e))?;
         warnings.extend(system.measurability_warnings());
         let lens = system.reconstructed_lens(&x).map_err(|e| run(&e))?;
         let opts = product_options(&config, &grid);

@@ -1,4 +1,5 @@
-//! Lenstool catalogues: multiple images and cluster members ([method §7]).
+//! Lenstool catalogues: multiple images, cluster members and weak-lensing arclets
+//! ([method §7]).
 //!
 //! Positions are brought into the arcsec frame of one sky reference (+x West, +y North).
 //! [`parse_image_catalog`] and [`parse_member_catalog`] read Lenstool's text formats; the
@@ -12,12 +13,14 @@ use serde::{Deserialize, Serialize};
 
 use crate::sky::SkyReference;
 
+mod arclets;
 mod error;
 mod frame;
 mod lenstool;
 mod rows;
 mod units;
 
+pub use arclets::{arclet_ellipticity, parse_arclet_catalog, Arclet, ArcletCatalog};
 pub use error::{CatalogError, CatalogWarning};
 pub(crate) use frame::{mean_position, sexagesimal};
 pub use lenstool::{

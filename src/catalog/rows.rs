@@ -98,7 +98,7 @@ pub(super) struct Fields<'r, 'a> {
 }
 
 impl Fields<'_, '_> {
-    fn bad(&self, i: usize, reason: impl Into<String>) -> CatalogError {
+    pub(super) fn bad(&self, i: usize, reason: impl Into<String>) -> CatalogError {
         CatalogError::BadValue {
             source_name: self.source_name.into(),
             line: self.row.line,

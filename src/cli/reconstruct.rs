@@ -22,7 +22,7 @@ use super::maps::write_products;
 /// images, offsets; held-out systems marked), images.reg (DS9 circles: observed images green,
 /// predicted ones magenta), convergence.json (objective, grid mass and C per report) and
 /// summary.json (settings, C per layer, grid mass, enclosed masses, Einstein
-/// radius, image-plane rms, timings); with --folds also crossval.json and the folds' convergence
+/// radius, image-plane rms, the weak-lensing fit with --shear, timings); with --folds also crossval.json and the folds' convergence
 /// (crossval-kappa-mean.fits, crossval-kappa-spread.fits, crossval-kappa-spread.png).
 #[derive(Debug, Args)]
 #[command(group(
@@ -45,6 +45,15 @@ pub struct ReconstructArgs {
     /// Lenstool member catalogue (potfile: id x y a b theta mag lum).
     #[arg(long, value_name = "MEMBERS.cat")]
     members: Option<PathBuf>,
+    /// Lenstool arclet catalogue (id x y a b theta z) of weakly lensed background galaxies:
+    /// each galaxy's ellipticity (a - b)/(a + b) exp(2i theta) adds two reduced-shear rows,
+    /// and a ring of coarser cells around the grid reaches the farthest galaxy.
+    #[arg(long, value_name = "ARCLETS.cat")]
+    shear: Option<PathBuf>,
+    /// Shape noise of the arclets: the scatter of each ellipticity component (default 0.3;
+    /// overrides shear.shape_noise of the configuration).
+    #[arg(long, value_name = "SIGMA", requires = "shear")]
+    shape_noise: Option<f64>,
     /// Lens redshift.
     #[arg(long)]
     z_lens: f64,
@@ -145,11 +154,18 @@ pub fn run(args: &ReconstructArgs) -> Result<(), String> {
     if args.default_z.is_some() {
         config.constraints.default_z = args.default_z;
     }
+    if let Some(sigma) = args.shape_noise {
+        config.shear.shape_noise = sigma;
+    }
     let option = |flag: &str, e: &dyn std::fmt::Display| format!("{flag}: {e}");
     config
         .solver_settings()
         .validate()
         .map_err(|e| option("--iterations", &e))?;
+    config
+        .shear
+        .validate()
+        .map_err(|e| option("--shape-noise", &e))?;
     config.constraints.validate().map_err(|e| {
         match e.to_string().contains("free_z_prior") && args.z_prior.is_some() {
             true => option("--z-prior", &e),
@@ -170,7 +186,7 @@ pub fn run(args: &ReconstructArgs) -> Result<(), String> {
             },
         );
     }
-    let texts = [&args.images, &args.members, &args.arcs].map(|path| {
+    let texts = [&args.images, &args.members, &args.arcs, &args.shear].map(|path| {
         let kind = if path == &args.arcs {
             InputKind::Arcs
         } else {
@@ -180,8 +196,8 @@ pub fn run(args: &ReconstructArgs) -> Result<(), String> {
             .map(|p| Ok::<_, String>((name(p), read_text(p, kind)?)))
             .transpose()
     });
-    let [images, members, arcs] = texts;
-    let (images, members, arcs) = (images?, members?, arcs?);
+    let [images, members, arcs, shear] = texts;
+    let (images, members, arcs, shear) = (images?, members?, arcs?, shear?);
     fn text(f: &Option<(String, String)>) -> Option<InputText<'_>> {
         f.as_ref().map(|(name, text)| InputText { name, text })
     }
@@ -189,6 +205,7 @@ pub fn run(args: &ReconstructArgs) -> Result<(), String> {
         images: text(&images),
         members: text(&members),
         arcs: text(&arcs),
+        shear: text(&shear),
     };
     let data = Dataset::read(&files, config.constraints.pixel_arcsec).map_err(|e| e.to_string())?;
     let unfitted = data.unfitted_arcs(config.constraints.mode);

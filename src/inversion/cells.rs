@@ -282,6 +282,20 @@ impl CellGrid {
         d.x <= half && d.y <= half
     }
 
+    /// Side in arcsec of the square about the centre that holds every cell: the field's width,
+    /// or wider when cells lie outside it (the weak-lensing ring, [`super::with_ring`]).
+    pub fn extent_arcsec(&self) -> f64 {
+        if self.cells.iter().all(|c| self.contains(c.center, 0.0)) {
+            return self.width_arcsec;
+        }
+        let half = self
+            .cells
+            .iter()
+            .map(|c| (c.center - self.center).abs().max_element() + 0.5 * c.size_arcsec)
+            .fold(0.5 * self.width_arcsec, f64::max);
+        2.0 * half
+    }
+
     /// A multi-resolution grid: the `ceil(fraction * len)` cells of highest mass density
     /// `masses[j] / size_j^2` (masses in any unit, one per cell) are each split into 4
     /// sub-cells of half the size and half the width; the others are kept. Children replace

@@ -1,5 +1,6 @@
 //! The WSLAP+ inversion between the catalogues and the solver ([method §3] and [§4]):
-//! the cell grid, the member-galaxy layers, the constraint pixels and the linear system
+//! the cell grid, the member-galaxy layers, the constraint pixels, the weak-lensing rows and
+//! the linear system
 //! `Theta = Gamma X` with its normal equations.
 //!
 //! [method §3]: crate::method#3-the-linear-system
@@ -11,6 +12,7 @@ mod constraints;
 mod members;
 mod npy;
 mod regularise;
+mod shear;
 mod system;
 
 pub use cells::{Cell, CellGrid, GridConfig, GridError, GridMass};
@@ -29,6 +31,7 @@ pub use npy::{export_system, npy_header, write_f64s, write_npy, NpyError};
 pub use regularise::{
     capped_inverse_jacobian, cell_penalty, AutoWord, ObjectiveConfig, Regulariser, Strength,
 };
+pub use shear::{kappa_gamma, with_ring, ShearConfig, ShearPoint, ShearSet, MIN_ONE_MINUS_KAPPA};
 pub use system::{
     ColumnInfo, LinearSystem, ObjectiveTerms, RowBlock, ScaledLens, SystemConfig, SystemError,
     LAYER_SHARE_WARN,

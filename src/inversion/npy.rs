@@ -150,6 +150,16 @@ pub fn export_system(system: &LinearSystem, dir: &Path) -> Result<(), NpyError> 
         weights.extend_from_slice(&block.weights);
         start = end;
     }
+    let n_gal = system.shear.len();
+    let mut start = 0;
+    while start < n_gal {
+        let end = (start + system.pixels_per_block()).min(n_gal);
+        system.shear_rows(start..end, &mut block)?;
+        write_f64s(&mut w, &block.gamma).map_err(&io)?;
+        theta.extend_from_slice(&block.theta);
+        weights.extend_from_slice(&block.weights);
+        start = end;
+    }
     let prior = system.prior_rows();
     write_f64s(&mut w, &prior.gamma).map_err(&io)?;
     theta.extend_from_slice(&prior.theta);
@@ -161,7 +171,9 @@ pub fn export_system(system: &LinearSystem, dir: &Path) -> Result<(), NpyError> 
         n_rows: system.n_rows,
         n_columns: system.n_columns(),
         rows: "row 2i is theta_x + shift of pixel i, row 2i+1 theta_y + shift; \
-               weights in 1/arcsec^2; then one row C_l = 1 (weight 1/sigma^2) per layer with \
+               weights in 1/arcsec^2; then rows 2g and 2g+1 of weak-lensing galaxy g \
+               (gamma_1 + e_1 kappa = e_1, gamma_2 + e_2 kappa = e_2, weight 1/sigma_e^2); \
+               then one row C_l = 1 (weight 1/sigma^2) per layer with \
                a prior on its factor",
         theta_shift_arcsec: system.theta_shift_arcsec,
         mass_unit_msun: system.mass_unit_msun,

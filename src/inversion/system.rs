@@ -43,8 +43,9 @@ use super::cells::{CellGrid, GridError, GridMass};
 use super::constraints::ConstraintSet;
 use super::members::Layer;
 use super::regularise::{cell_penalty, Regulariser};
+use super::shear::{kappa_gamma, ShearSet};
 use crate::cosmology::{CosmologyError, LensPlane};
-use crate::profiles::cell_unit_deflection;
+use crate::profiles::{cell_unit_deflection, gaussian_unit_hessian};
 use crate::profiles::{Lens, MassComponent};
 use crate::solver::{NormalEquations, SolverError};
 use crate::units::point_mass_deflection_arcsec2;
@@ -191,7 +192,8 @@ pub struct ObjectiveTerms {
 #[derive(Debug, Clone)]
 pub struct LinearSystem {
     pub columns: Vec<ColumnInfo>,
-    /// Rows of `Gamma`: `2 x` number of pixels, then one per layer with a prior on `C_l`.
+    /// Rows of `Gamma`: `2 x` number of pixels, `2 x` number of weak-lensing galaxies, then
+    /// one per layer with a prior on `C_l`.
     pub n_rows: usize,
     /// Frame shift `S` in arcsec.
     pub theta_shift_arcsec: f64,
@@ -206,6 +208,8 @@ pub struct LinearSystem {
     pub grid: CellGrid,
     pub layers: Vec<Layer>,
     pub constraints: ConstraintSet,
+    /// The weak-lensing galaxies (empty without an arclet catalogue; the `shear` module).
+    pub shear: ShearSet,
     /// `f(z_s) = D_ls / D_s` per system.
     pub distance_ratios: Vec<f64>,
     /// `D_l` in Mpc.
@@ -216,6 +220,8 @@ pub struct LinearSystem {
     layer_independence: std::sync::OnceLock<Vec<Option<f64>>>,
     /// `a_l(theta_i)` for pixel `i`, layer `l` at `[i * L + l]`.
     layer_deflections: Vec<DVec2>,
+    /// Hessian of layer `l` at galaxy `g` at `[g * L + l]` (`D_ls/D_s = 1`).
+    shear_layer_hessians: Vec<[f64; 3]>,
     threads: usize,
     rows_per_block: usize,
 }
@@ -267,6 +273,21 @@ impl LinearSystem {
         config: &SystemConfig,
         terms: ObjectiveTerms,
     ) -> Result<Self, SystemError> {
+        let no_shear = ShearSet::default();
+        Self::build_with_shear(grid, layers, constraints, &no_shear, plane, config, terms)
+    }
+
+    /// As [`Self::build_with`], with the weak-lensing rows of `shear` after the pixels' rows
+    /// (the `shear` module).
+    pub fn build_with_shear(
+        grid: &CellGrid,
+        layers: &[Layer],
+        constraints: &ConstraintSet,
+        shear: &ShearSet,
+        plane: &LensPlane,
+        config: &SystemConfig,
+        terms: ObjectiveTerms,
+    ) -> Result<Self, SystemError> {
         config.validate()?;
         if !terms.pixel_transforms.is_empty()
             && terms.pixel_transforms.len() != constraints.pixels.len()
@@ -301,12 +322,14 @@ impl LinearSystem {
         });
         let threads = crate::threads::count(config.threads, constraints.pixels.len(), 1);
         let layer_deflections = layer_deflections(layers, constraints, threads)?;
+        let shear_layer_hessians = layer_hessians(layers, shear)?;
         let bytes_per_pixel = 2.0 * n_cols as f64 * 8.0;
         let rows_per_block =
             ((config.block_mbytes * 1e6 / bytes_per_pixel).floor() as usize).max(1);
         let mut system = Self {
             columns,
             n_rows: 2 * constraints.pixels.len()
+                + 2 * shear.len()
                 + layers.iter().filter(|l| l.prior_sigma.is_some()).count(),
             theta_shift_arcsec,
             mass_unit_msun: config.mass_unit_msun,
@@ -316,11 +339,13 @@ impl LinearSystem {
             grid: grid.clone(),
             layers: layers.to_vec(),
             constraints: constraints.clone(),
+            shear: shear.clone(),
             distance_ratios,
             d_l_mpc: plane.d_l_mpc,
             terms,
             layer_independence: std::sync::OnceLock::new(),
             layer_deflections,
+            shear_layer_hessians,
             threads,
             rows_per_block,
         };
@@ -558,6 +583,63 @@ impl LinearSystem {
         Ok(())
     }
 
+    /// Rows `2 g0 .. 2 g1` of the weak-lensing block for galaxies `g0..g1` into `out` (resized;
+    /// see [`RowBlock`]): `gamma_i = e_i (1 - kappa_0)`, the cells' and layers' shear at the
+    /// galaxy times its `D_ls/D_s`, zeros in the beta columns, weight
+    /// `1 / (sigma_e (1 - kappa_0))^2` (the `shear` module; [`ShearPoint::row_target`]).
+    ///
+    /// [`ShearPoint::row_target`]: super::ShearPoint::row_target
+    pub fn shear_rows(
+        &self,
+        galaxies: Range<usize>,
+        out: &mut RowBlock,
+    ) -> Result<(), SystemError> {
+        let n_gal = self.shear.len();
+        if galaxies.start > galaxies.end || galaxies.end > n_gal {
+            return Err(SystemError::Length {
+                what: "galaxy range end",
+                expected: n_gal,
+                got: galaxies.end,
+            });
+        }
+        let n_cols = self.n_columns();
+        out.gamma.clear();
+        out.gamma.resize(2 * galaxies.len() * n_cols, 0.0);
+        out.theta.clear();
+        out.weights.clear();
+        let cells = &self.grid.cells;
+        let (n_cells, n_layers) = (self.grid.len(), self.layers.len());
+        let first = galaxies.start;
+        parallel_fill(&mut out.gamma, 2 * n_cols, self.threads, |k0, chunk| {
+            for (k, two_rows) in chunk.chunks_exact_mut(2 * n_cols).enumerate() {
+                let g = first + k0 + k;
+                let point = &self.shear.points[g];
+                let f = point.distance_ratio;
+                let scale = self.cell_scale(f);
+                let (row_1, row_2) = two_rows.split_at_mut(n_cols);
+                let p = point.position;
+                for (j, cell) in cells.iter().enumerate() {
+                    let d = p - cell.center;
+                    let h = gaussian_unit_hessian(d.x, d.y, cell.sigma_arcsec);
+                    let [_, g1, g2] = kappa_gamma(h);
+                    row_1[j] = scale * g1;
+                    row_2[j] = scale * g2;
+                }
+                for l in 0..n_layers {
+                    let [_, g1, g2] = kappa_gamma(self.shear_layer_hessians[g * n_layers + l]);
+                    row_1[n_cells + l] = f * g1;
+                    row_2[n_cells + l] = f * g2;
+                }
+            }
+        });
+        for point in &self.shear.points[galaxies] {
+            let (target, weight) = point.row_target();
+            out.theta.extend([target.x, target.y]);
+            out.weights.extend([weight, weight]);
+        }
+        Ok(())
+    }
+
     /// The rows after the pixels' rows: `C_l = 1` with weight `1 / sigma_l^2` for each layer
     /// `l` that has a prior (`Layer::prior_sigma`), in layer order.
     pub fn prior_rows(&self) -> RowBlock {
@@ -586,6 +668,20 @@ impl LinearSystem {
         while start < n_pix {
             let end = (start + self.rows_per_block).min(n_pix);
             self.rows(start..end, &mut block)?;
+            acc.add_rows(&block.gamma, &block.weights, &block.theta)?;
+            theta_w_theta += block
+                .theta
+                .iter()
+                .zip(&block.weights)
+                .map(|(t, w)| w * t * t)
+                .sum::<f64>();
+            start = end;
+        }
+        let n_gal = self.shear.len();
+        let mut start = 0;
+        while start < n_gal {
+            let end = (start + self.rows_per_block).min(n_gal);
+            self.shear_rows(start..end, &mut block)?;
             acc.add_rows(&block.gamma, &block.weights, &block.theta)?;
             theta_w_theta += block
                 .theta
@@ -748,6 +844,25 @@ fn column_layout(
         id: s.id.clone(),
     }));
     columns
+}
+
+/// The Hessian of every layer at every weak-lensing galaxy (`[g * L + l]`), checked finite.
+fn layer_hessians(layers: &[Layer], shear: &ShearSet) -> Result<Vec<[f64; 3]>, SystemError> {
+    let mut out = Vec::with_capacity(layers.len() * shear.len());
+    for point in &shear.points {
+        for layer in layers {
+            let h = layer.lens.hessian(point.position);
+            if !h.iter().all(|v| v.is_finite()) {
+                return Err(SystemError::LayerNotFinite {
+                    layer: layer.name.clone(),
+                    x: point.position.x,
+                    y: point.position.y,
+                });
+            }
+            out.push(h);
+        }
+    }
+    Ok(out)
 }
 
 /// `a_l(theta_i)` for every pixel and layer (`[i * L + l]`), checked finite.

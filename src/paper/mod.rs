@@ -604,6 +604,7 @@ fn run_one(
         reference: None,
         holdout: &[],
         catalog: None,
+        shear: None,
     };
     let mut quiet = |_: &ConvergenceRecord| Control::Continue;
     reconstruct(&inputs, config, &mut quiet).map_err(|e| PaperError::Reconstruct {

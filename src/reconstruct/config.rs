@@ -5,7 +5,8 @@ use serde::{Deserialize, Serialize};
 
 use crate::error::BadFieldValue;
 use crate::inversion::{
-    ConstraintConfig, GridConfig, MemberConfig, ObjectiveConfig, Regulariser, SystemConfig,
+    ConstraintConfig, GridConfig, MemberConfig, ObjectiveConfig, Regulariser, ShearConfig,
+    SystemConfig,
 };
 use crate::limits::{json_error_message, InputKind, TooLarge};
 use crate::solver::SolverSettings;
@@ -31,6 +32,9 @@ pub struct ReconstructConfig {
     pub solver: SolverConfig,
     /// The maps and curves of the result.
     pub products: ProductConfig,
+    /// Weak lensing: the shape noise of the arclets and the ring of coarser cells (used only
+    /// with an arclet catalogue).
+    pub shear: ShearConfig,
 }
 
 /// Which solver minimises the objective.
@@ -149,6 +153,7 @@ impl ReconstructConfig {
         self.constraints.validate()?;
         self.system.validate()?;
         self.objective.validate()?;
+        self.shear.validate()?;
         self.solver_settings().validate()?;
         if self.solver.method == SolverMethod::Exact {
             let o = &self.objective;

@@ -6,6 +6,8 @@
 //!   in it (or sets it when there is no image catalogue); DS9 region arcs are read in that frame,
 //!   or, with no catalogue at all, in a frame centred on the regions' mean position (a warning
 //!   says so).
+//! - **Weak lensing.** An arclet catalogue is read in the frame of the others (or sets it when
+//!   it is the only catalogue).
 //! - **Redshifts of region arcs.** A region labelled without `z=` takes the redshift of the
 //!   system of the same id in the image catalogue.
 //! - **Which constraints.** With an image catalogue and arcs, the setting
@@ -20,7 +22,8 @@ use crate::arcs::{
     arcs_from_regions, is_region_file, parse_arcs, ArcCatalog, ArcsError, RegionArcs,
 };
 use crate::catalog::{
-    parse_image_catalog, parse_member_catalog, CatalogError, ImageCatalog, MemberCatalog,
+    parse_arclet_catalog, parse_image_catalog, parse_member_catalog, ArcletCatalog, CatalogError,
+    ImageCatalog, MemberCatalog,
 };
 use crate::cosmology::LensPlane;
 use crate::inversion::{ConstraintMode, ConstraintSource};
@@ -42,6 +45,8 @@ pub struct InputTexts<'a> {
     pub members: Option<InputText<'a>>,
     /// Arc pixels: a JSON arcs file or a DS9 region file.
     pub arcs: Option<InputText<'a>>,
+    /// Lenstool arclet catalogue (weak lensing).
+    pub shear: Option<InputText<'a>>,
 }
 
 /// What went wrong reading the files (each message names the file and, where there is one,
@@ -62,6 +67,8 @@ pub struct Dataset {
     pub images: Option<ImageCatalog>,
     pub arcs: Option<ArcCatalog>,
     pub members: Option<MemberCatalog>,
+    /// Weak-lensing galaxies.
+    pub shear: Option<ArcletCatalog>,
     /// The frame of arcs read from a DS9 region file without a catalogue to give one (the
     /// regions' mean position).
     pub arcs_reference: Option<SkyReference>,
@@ -84,6 +91,12 @@ impl Dataset {
             out.warnings.extend(w.iter().map(ToString::to_string));
             out.members = Some(m);
         }
+        if let Some(f) = files.shear {
+            let frame = out.reference();
+            let (a, w) = parse_arclet_catalog(f.text, f.name, frame)?;
+            out.warnings.extend(w.iter().map(ToString::to_string));
+            out.shear = Some(a);
+        }
         if let Some(f) = files.arcs {
             out.arcs = Some(if is_region_file(f.text) {
                 let frame = out.reference();
@@ -104,11 +117,12 @@ impl Dataset {
     }
 
     /// The frame's sky reference: the image catalogue's, else the member catalogue's, else the
-    /// region file's mean position.
+    /// arclet catalogue's, else the region file's mean position.
     pub fn reference(&self) -> Option<SkyReference> {
         let images = self.images.as_ref().and_then(|c| c.reference);
         let members = self.members.as_ref().and_then(|m| m.reference);
-        images.or(members).or(self.arcs_reference)
+        let shear = self.shear.as_ref().and_then(|a| a.reference);
+        images.or(members).or(shear).or(self.arcs_reference)
     }
 
     /// The constraints fitted under `mode` and the mode they are fitted with (see the module
@@ -162,6 +176,7 @@ impl Dataset {
             reference: self.reference(),
             holdout,
             catalog: self.images.as_ref(),
+            shear: self.shear.as_ref(),
         };
         Ok(inputs)
     }
@@ -207,6 +222,7 @@ mod tests {
                 text: IMAGES,
             }),
             members: None,
+            shear: None,
             arcs: arcs.then_some(InputText {
                 name: "arcs.reg",
                 text: REGIONS,

@@ -4,6 +4,9 @@
 
 use serde::Serialize;
 
+use crate::inversion::kappa_gamma;
+use crate::profiles::MassComponent;
+
 use super::{FreeZSummary, ReconstructConfig, SourceReport, StageTimings, StrengthChoice, Verdict};
 use crate::inversion::LinearSystem;
 use crate::products::Summary;
@@ -60,6 +63,27 @@ impl<'a> Solved<'a> {
         median_arcsec(self.image_offsets_arcsec(held_out))
     }
 
+    /// How the map fits the weak-lensing galaxies (`None` without any).
+    pub fn weak_lensing(&self) -> Option<WeakLensingFit> {
+        let s = self.system;
+        if s.shear.is_empty() {
+            return None;
+        }
+        let lens = s.reconstructed_lens(self.x).ok()?;
+        let chi2 = s.shear.chi2_per_galaxy(|p| kappa_gamma(lens.hessian(p)))?;
+        let field = |c: &&crate::inversion::Cell| s.grid.contains(c.center, 0.0);
+        let ring: Vec<_> = s.grid.cells.iter().filter(|c| !field(c)).collect();
+        Some(WeakLensingFit {
+            catalogue: s.shear.source_name.clone(),
+            arclets: s.shear.len(),
+            shape_noise: self.config.shear.shape_noise,
+            chi2_per_arclet: chi2,
+            ring_cells: ring.len(),
+            ring_cell_arcsec: ring.first().map(|c| c.size_arcsec),
+            ring_extent_arcsec: s.grid.extent_arcsec(),
+        })
+    }
+
     /// `summary.json`, with `status` as written ("Completed", "Cancelled", ...), the map
     /// summary of the products and the verdict on them.
     pub fn summary(
@@ -106,6 +130,7 @@ impl<'a> Solved<'a> {
             regulariser_weight: s.terms.penalty_weight,
             strength_choice: self.strength_choice,
             free_redshifts: self.free_z,
+            weak_lensing: self.weak_lensing(),
             warnings: self.warnings,
             maps,
             timings_ms: self.timings,
@@ -154,9 +179,32 @@ pub struct ReconstructSummary<'a> {
     /// The systems whose redshift was estimated (`sources.json` has each estimate), and the
     /// fitted median offset of the others without and with them.
     pub free_redshifts: Option<&'a FreeZSummary>,
+    /// The weak-lensing fit, with an arclet catalogue (absent otherwise).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub weak_lensing: Option<WeakLensingFit>,
     pub warnings: &'a [String],
     pub maps: Summary,
     pub timings_ms: StageTimings,
+}
+
+/// How a map fits the weak-lensing galaxies (`summary.json`'s `weak_lensing`).
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct WeakLensingFit {
+    /// The arclet catalogue's file name.
+    pub catalogue: String,
+    /// Galaxies fitted (those behind the lens).
+    pub arclets: usize,
+    /// The shape noise `sigma_e` of the rows' weights.
+    pub shape_noise: f64,
+    /// `chi^2` of the reduced shear per galaxy, `sum |g - e|^2 / sigma_e^2 / N`
+    /// ([`crate::ShearSet::chi2_per_galaxy`]): about 2 when the map fits the ellipticities to
+    /// their shape noise.
+    pub chi2_per_arclet: f64,
+    /// Cells of the ring of coarser cells around the grid's field, their side (arcsec) and
+    /// the side of the square the grid and ring cover (arcsec).
+    pub ring_cells: usize,
+    pub ring_cell_arcsec: Option<f64>,
+    pub ring_extent_arcsec: f64,
 }
 
 /// The offsets (arcsec) of the observed images of `sources` from their nearest predicted

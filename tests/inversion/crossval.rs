@@ -47,6 +47,7 @@ fn inputs<'a>(cat: &'a ImageCatalog, holdout: &'a [String]) -> Inputs<'a> {
         reference: cat.reference,
         holdout,
         catalog: Some(cat),
+        shear: None,
     }
 }
 
@@ -96,6 +97,7 @@ fn held_out_arc_systems_are_predicted_from_their_pixels() {
         reference: cat.reference,
         holdout: &holdout,
         catalog: None,
+        shear: None,
     };
     let r = reconstruct(&inputs, &config, &mut quiet).unwrap();
     let held: Vec<_> = r.sources.iter().filter(|s| s.held_out).collect();

@@ -15,5 +15,6 @@ mod objective;
 mod reconstruct;
 mod regions;
 mod settings;
+mod shear;
 mod solver;
 mod system;

@@ -92,6 +92,7 @@ fn point_inputs<'a>(
         reference: None,
         holdout: &[],
         catalog: Some(catalog),
+        shear: None,
     }
 }
 

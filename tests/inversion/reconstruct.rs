@@ -161,6 +161,7 @@ fn reconstruct_synthetic(
         reference: None,
         holdout: &[],
         catalog: Some(catalog),
+        shear: None,
     };
     let r = reconstruct(&inputs, &config, &mut quiet).unwrap();
     let true_lens = truth.lens();
@@ -286,6 +287,7 @@ fn a_system_with_fewer_rows_than_unknowns_is_flagged() {
             reference: None,
             holdout: &[],
             catalog: Some(&catalog),
+            shear: None,
         };
         reconstruct(&inputs, config, &mut quiet).unwrap()
     };
@@ -335,6 +337,7 @@ fn system_threads_limits_every_parallel_section_of_the_run() {
             reference: None,
             holdout: &[],
             catalog: Some(&catalog),
+            shear: None,
         };
         let mut seen = Vec::new();
         reconstruct(&inputs, &config, &mut |_| {
@@ -397,6 +400,7 @@ fn the_accelerated_gradient_goes_further_than_qadp() {
         reference: None,
         holdout: &[],
         catalog: Some(&catalog),
+        shear: None,
     };
     let chi2 = |r: &wslap::Reconstruction| {
         2.0 * wslap::quadratic_objective(&r.system.a, &r.system.b, &r.x) + r.system.theta_w_theta
@@ -434,6 +438,7 @@ fn a_reconstruction_keeps_its_iterates_when_asked() {
         reference: None,
         holdout: &[],
         catalog: Some(&catalog),
+        shear: None,
     };
     let mut config = ReconstructConfig::paper();
     config.grid.cells = 12;
@@ -494,6 +499,7 @@ fn c_smooth_inputs(catalog: &ImageCatalog) -> Inputs<'_> {
         reference: catalog.reference,
         holdout: &[],
         catalog: Some(catalog),
+        shear: None,
     }
 }
 
@@ -664,6 +670,7 @@ pub(crate) mod real {
             reference: catalog.reference,
             holdout,
             catalog: Some(&catalog),
+            shear: None,
         };
         let r = reconstruct(&inputs, config, &mut quiet).unwrap();
         (r, catalog)
