@@ -190,12 +190,16 @@ function caption(info) {
   const offsets = offsetText('image offsets', sum.image_offset_median_arcsec, sum.image_plane_rms_arcsec);
   const held = offsetText('held-out images:', sum.holdout_image_offset_median_arcsec,
     sum.holdout_image_plane_rms_arcsec);
+  // Weak lensing: the arclets fitted and their reduced-shear chi^2 (about 2 per arclet at the
+  // shape noise).
+  const wl = sum.weak_lensing;
+  const shear = wl ? `${wl.arclets} arclets, χ² ${wl.chi2_per_arclet.toFixed(2)} per arclet; ` : '';
   // A loaded model file that is not drawn next to a reconstruction says why.
   const note = info.model_note ? ` ${info.model_note}.` : '';
   const stale = [...rejected.values()].map(({ file, kept }) => ` Made with ${kept}: ${file} had errors and was not loaded.`).join('')
     + ($('sky-warning').hidden ? '' : ' Made with files of different parts of the sky (see the warning above).');
   $('summary').textContent = `${status}Einstein radius ${bound}${s.einstein_radius_arcsec.toFixed(1)}″ at ` +
-    `z_s = ${s.z_source}; ${factors}${offsets}${held}${s.tangential_curves} tangential and ${s.radial_curves} radial critical curves.${ensembleCaption(sum)}${note}${stale}`;
+    `z_s = ${s.z_source}; ${factors}${offsets}${held}${shear}${s.tangential_curves} tangential and ${s.radial_curves} radial critical curves.${ensembleCaption(sum)}${note}${stale}`;
 }
 
 /** Under the views: the systems a run left out of the fit and its warnings (collapsed: a

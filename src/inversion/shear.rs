@@ -2,8 +2,8 @@
 //! catalogue, [`crate::catalog::parse_arclet_catalog`]) as rows of the linear system, and the
 //! ring of coarser cells that carries the mass they see outside the strong-lensing field.
 //!
-//! Diego et al. (2007, the weak-lensing extension the WSLAP+ paper cites in its sections 3 and
-//! 7.4) add the shear to the same linear system as the strong-lensing rows. The reduced shear
+//! Diego et al. (2007; the WSLAP+ paper's "Extension to weak lensing analysis" points to it) add
+//! the shear to the same linear system as the strong-lensing rows. The reduced shear
 //! `g = gamma / (1 - kappa)` is linear in the mass once multiplied out, `gamma = g (1 - kappa)`,
 //! and each galaxy at `theta` with distance ratio `f = D_ls / D_s` and measured ellipticity
 //! `e` (the estimator of `g`) gives two rows, zeros in the source-position columns (a galaxy's

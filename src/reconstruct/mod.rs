@@ -677,15 +677,17 @@ fn reconstruct_limited(
             model.layers
         }
     };
-    // The system's true sizes (the layers built, the systems kept), before it is built.
-    RunSize::of(
+    // The system's true sizes (the layers built, the systems kept, the weak-lensing ring's
+    // cells), before it is built.
+    let mut size = RunSize::of(
         config,
         constraints.pixels.len(),
         constraints.systems.len(),
         layers.len(),
-    )
-    .memory(config)
-    .check(MemoryLimit::here())?;
+    );
+    let ring = grid.len().saturating_sub(size.cells_per_side.pow(2));
+    size.cells = size.cells.saturating_add(ring);
+    size.memory(config).check(MemoryLimit::here())?;
     let mut convergence = Vec::new();
     let mut timings = StageTimings::default();
     let mut level = 0;

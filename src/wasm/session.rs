@@ -119,7 +119,8 @@ impl AppSession {
         self.inner.name = name.to_string();
     }
 
-    /// Loads a text file as `role` (images, members, arcs, model); returns its `LoadReport`.
+    /// Loads a text file as `role` (images, members, arcs, shear, model); returns its
+    /// `LoadReport`.
     /// On an error (naming the file, line and reason) nothing loaded changes.
     pub fn load_text(&mut self, role: &str, name: &str, text: &str) -> Result<JsValue, JsError> {
         let role = DataRole::parse(role).map_err(err)?;
@@ -451,7 +452,8 @@ impl AppSession {
         let fits = |k: usize| d.deflection[k].as_ref().map(|x| x.name.clone());
         to_js(&serde_json::json!({
             "images": name(&d.images), "members": name(&d.members), "arcs": name(&d.arcs),
-            "model": name(&d.model), "deflection_x": fits(0), "deflection_y": fits(1),
+            "model": name(&d.model), "shear": name(&d.shear),
+            "deflection_x": fits(0), "deflection_y": fits(1),
             "sky_warnings": self.inner.sky_warnings(),
         }))
     }

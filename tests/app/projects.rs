@@ -158,3 +158,65 @@ fn a_project_with_a_broken_or_oversized_fits_is_refused_and_changes_nothing() {
     assert_eq!(report.result, "recomputed", "{}", report.message);
     assert!(s.data.deflection[0].is_none());
 }
+
+/// The weak-lensing synthetic of tests/inversion/shear.rs in the app: the arclets load as their
+/// own file (a bad one is refused with its line and keeps the good one), the run fits them, and
+/// the project keeps them and rebuilds the same map from X.
+#[cfg_attr(not(target_arch = "wasm32"), test)]
+#[cfg_attr(target_arch = "wasm32", wasm_bindgen_test::wasm_bindgen_test)]
+fn a_project_keeps_its_arclets() {
+    use wslap::app::DataRole;
+    let mut s = Session::new();
+    let images = include_str!("../data/weak_lensing/images.cat");
+    let arclets = include_str!("../data/weak_lensing/arclets.cat");
+    s.load_text(DataRole::Images, "images.cat", images).unwrap();
+    let report = s
+        .load_text(DataRole::Shear, "arclets.cat", arclets)
+        .unwrap();
+    assert_eq!(report.summary, "3000 arclets (weak lensing)");
+    let bad = arclets.replacen(
+        "1 166.2124 139.8925 0.5000 0.20041",
+        "1 166.2124 139.8925 0.5000 -0.2",
+        1,
+    );
+    let err = s.load_text(DataRole::Shear, "bad.cat", &bad).unwrap_err();
+    assert_eq!(
+        err.to_string(),
+        "bad.cat: line 4, column 5 (b): '-0.2' is negative: ellipse semi-axes must be >= 0 arcsec"
+    );
+    assert_eq!(s.data.shear.as_ref().unwrap().name, "arclets.cat");
+    for (path, value) in [
+        ("z_lens", json!(0.32)),
+        ("reconstruct.grid.cells", json!(16)),
+        ("reconstruct.products.pixels", json!(64)),
+        ("reconstruct.objective.regulariser", json!("density")),
+        ("reconstruct.objective.strength", json!(0.01)),
+        ("reconstruct.shear.shape_noise", json!(0.3)),
+    ] {
+        s.set_field(path, value).unwrap();
+    }
+    s.run(RunKind::Reconstruct, &mut |_| Control::Continue)
+        .unwrap();
+    let summary: serde_json::Value =
+        serde_json::from_str(&s.result().unwrap().summary_json().unwrap()).unwrap();
+    assert_eq!(summary["weak_lensing"]["arclets"], 3000);
+    let text = s.project_json().unwrap();
+    let mut t = Session::new();
+    let report = t.open_project(&text, "wl.json").unwrap();
+    assert_eq!(report.result, "restored", "{}", report.message);
+    assert_eq!(t.data.shear, s.data.shear);
+    let (a, b) = (s.result().unwrap(), t.result().unwrap());
+    let worst = a
+        .products()
+        .maps
+        .kappa
+        .data
+        .iter()
+        .zip(&b.products().maps.kappa.data)
+        .map(|(p, q)| (p - q).abs() / p.abs().max(1e-12))
+        .fold(0.0, f64::max);
+    assert!(worst <= 1e-9, "kappa differs by {worst:e} (relative)");
+    let restored: serde_json::Value =
+        serde_json::from_str(&t.result().unwrap().summary_json().unwrap()).unwrap();
+    assert_eq!(restored["weak_lensing"]["arclets"], 3000);
+}

@@ -171,6 +171,39 @@ test('a malformed catalogue shows its line and keeps the previous data', async (
   }
 });
 
+test('arclets load as their own file and the run fits them', async () => {
+  const app = await openApp();
+  try {
+    const { page } = app;
+    await waitStatus(page, /^Ready/);
+    const wl = join(ROOT, 'tests', 'data', 'weak_lensing');
+    await page.setInputFiles('#file-images', join(wl, 'images.cat'));
+    await page.waitForFunction(() => /6 systems, 24 images/.test(document.getElementById('status-images').textContent));
+    await page.setInputFiles('#file-shear', join(wl, 'arclets.cat'));
+    await page.waitForFunction(() => /3000 arclets/.test(document.getElementById('status-shear').textContent));
+    // A bad arclet row is refused with its file, line and value; the good file stays.
+    const dir = await mkdtemp(join(tmpdir(), 'wslap-e2e-'));
+    const bad = join(dir, 'bad-arclets.cat');
+    await writeFile(bad, '#REFERENCE 3 342.1832 -44.5309\n1 60.0 10.0 0.5 0.3 20 1.5\n2 70.0 -5.0 0.5 0.3 20 0\n');
+    await page.setInputFiles('#file-shear', bad);
+    await page.waitForSelector('#status-shear.bad');
+    const message = await page.textContent('#status-shear');
+    assert.match(message, /bad-arclets\.cat: line 3, column 7 \(z\): '0' is 0 \(unknown\)/);
+    assert.match(message, /arclets\.cat/);
+    await setField(page, '#set-z_lens', 0.32);
+    await setField(page, '#set-reconstruct-objective-regulariser', 'density');
+    await setField(page, '#set-reconstruct-objective-strength', '0.01');
+    await setField(page, '#set-reconstruct-products-pixels', 256);
+    await runToMap(page, '#reconstruct', 120_000);
+    const caption = await page.textContent('#summary');
+    assert.match(caption, /3000 arclets, χ² [\d.]+ per arclet/);
+    await page.screenshot({ path: join(ARTIFACTS, 'app-arclets.png'), fullPage: true });
+    assert.deepEqual(app.consoleErrors, []);
+  } finally {
+    await app.close();
+  }
+});
+
 test('Cancel stops a run at once and the page keeps working', async () => {
   const app = await openApp();
   try {

@@ -5,6 +5,7 @@ export const ROLES = [
   { role: 'images', label: 'Image catalogue (Lenstool)', accept: '.cat,.txt,.dat' },
   { role: 'members', label: 'Member catalogue (Lenstool)', accept: '.cat,.txt,.dat' },
   { role: 'arcs', label: 'Arcs (JSON, or DS9 regions in fk5)', accept: '.json,.reg' },
+  { role: 'shear', label: 'Arclets for weak lensing (Lenstool: id x y a b theta z)', accept: '.cat,.txt,.dat' },
   { role: 'model', label: 'Model file (JSON, or a Lenstool .par; forward mode)', accept: '.json,.par' },
   { role: 'deflection_x', label: 'Deflection x (FITS)', accept: '.fits,.fit' },
   { role: 'deflection_y', label: 'Deflection y (FITS)', accept: '.fits,.fit' },
@@ -23,6 +24,7 @@ export async function guessRole(file) {
     if (head.includes('"components"')) return 'model';
     return 'arcs';
   }
+  if (/arclet|shear|weak|(^|[-_.])wl([-_.]|$)/.test(name)) return 'shear';
   if (/member|pot|gal|ref/.test(name)) return 'members';
   return 'images';
 }
