@@ -638,6 +638,53 @@ fn reconstruct_folds_writes_crossval_json() {
     );
 }
 
+#[test]
+fn shear_inputs_are_checked_before_the_run() {
+    let dir = temp_dir("shear-bad");
+    let images = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/tests/data/weak_lensing/images.cat"
+    );
+    // An arclet without a redshift: the file, line, column and value.
+    let bad = dir.join("arclets.cat");
+    fs::write(
+        &bad,
+        "#REFERENCE 3 342.1832 -44.5309\n1 60 10 0.5 0.3 20 1.5\n2 70 -5 0.5 0.3 20 0\n",
+    )
+    .unwrap();
+    let bad = bad.to_str().unwrap();
+    let args = ["--images", images, "--shear", bad, "--z-lens", "0.32"];
+    let err = refused(&dir, "reconstruct", &args);
+    assert!(
+        err.contains("arclets.cat: line 3, column 7 (z): '0' is 0 (unknown)"),
+        "{err}"
+    );
+    // A shape noise out of range names the option.
+    let args = [
+        "--images",
+        images,
+        "--shear",
+        bad,
+        "--shape-noise",
+        "0",
+        "--z-lens",
+        "0.32",
+    ];
+    let err = refused(&dir, "reconstruct", &args);
+    assert!(err.contains("--shape-noise: shear.shape_noise"), "{err}");
+    // --shape-noise needs --shear.
+    let args = [
+        "--images",
+        images,
+        "--shape-noise",
+        "0.2",
+        "--z-lens",
+        "0.32",
+    ];
+    let err = refused(&dir, "reconstruct", &args);
+    assert!(err.contains("--shear"), "{err}");
+}
+
 /// Runs `wslap <command>` with `args` (plus `--out`), expects failure and no output folder,
 /// returns stderr.
 fn refused(dir: &Path, command: &str, args: &[&str]) -> String {

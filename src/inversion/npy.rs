@@ -172,7 +172,7 @@ pub fn export_system(system: &LinearSystem, dir: &Path) -> Result<(), NpyError> 
         n_columns: system.n_columns(),
         rows: "row 2i is theta_x + shift of pixel i, row 2i+1 theta_y + shift; \
                weights in 1/arcsec^2; then rows 2g and 2g+1 of weak-lensing galaxy g \
-               (gamma_1 + e_1 kappa = e_1, gamma_2 + e_2 kappa = e_2, weight 1/sigma_e^2); \
+               (gamma_i = e_i (1 - kappa_0), weight 1/(sigma_e (1 - kappa_0))^2); \
                then one row C_l = 1 (weight 1/sigma^2) per layer with \
                a prior on its factor",
         theta_shift_arcsec: system.theta_shift_arcsec,

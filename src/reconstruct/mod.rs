@@ -882,7 +882,10 @@ fn sheet_warning(objective: &crate::inversion::ObjectiveConfig) -> Option<String
         Regulariser::None | Regulariser::Density => None,
     })?;
     Some(format!(
-        "weak lensing with the {} regulariser: reduced shear cannot see a uniform mass sheet and          this regulariser prefers one, so the mass at large radius comes out too high (3 times          at 3 arcmin on a synthetic cluster); objective.regulariser \"density\" (strength          0.01 there) does not",
+        "weak lensing with the {} regulariser: reduced shear cannot see a uniform mass sheet \
+         and this regulariser prefers one, so the mass at large radius comes out too high (3 \
+         times at 3 arcmin on a synthetic cluster); objective.regulariser \"density\" \
+         (strength 0.01 there) does not",
         sheet
     ))
 }
@@ -1210,5 +1213,25 @@ mod tests {
     fn a_choice_without_per_system_offsets_is_not_remade() {
         let choice = choice(vec![candidate(Regulariser::Gradient, 0.01, &[])]);
         assert_eq!(choice.best_for(|_| 1), None);
+    }
+
+    use crate::inversion::ObjectiveConfig;
+
+    #[test]
+    fn the_sheet_warning_names_a_sheet_loving_regulariser() {
+        let mut objective = ObjectiveConfig::default();
+        // "auto" over gradient and curvature: the first is named.
+        let text = sheet_warning(&objective).unwrap();
+        assert!(
+            text.starts_with("weak lensing with the gradient regulariser: reduced shear cannot see a uniform mass sheet and this"),
+            "{text}"
+        );
+        objective.strength = Strength::Value(0.01);
+        objective.regulariser = Regulariser::Density;
+        assert_eq!(sheet_warning(&objective), None);
+        objective.regulariser = Regulariser::Curvature;
+        assert!(sheet_warning(&objective)
+            .unwrap()
+            .contains("the curvature regulariser"));
     }
 }
