@@ -4,10 +4,14 @@
 //!
 //! Each galaxy's complex ellipticity is `e = (a - b) / (a + b) exp(2 i theta)`, with `theta`
 //! in degrees counter-clockwise from +x, the convention of the image catalogues' ellipses
-//! (Lenstool writes `theta` from its x axis, which is this frame's +x, West, towards +y,
-//! North). For a source of random orientation its expectation is the reduced shear
-//! `g = gamma / (1 - kappa)` at the galaxy (for `|g| < 1`), so `e` is the estimator the
-//! weak-lensing rows of the linear system use (`crate::inversion`'s `shear` module).
+//! ([`super::Image::theta_deg`]). Lenstool's own code agrees on the angle: its `st_opt.c`
+//! (J.-P. Kneib) writes `E.theta * RTD` (degrees) and orients shapes by
+//! `(cos 2 theta, sin 2 theta)` in the frame of the positions (+x West, +y North here); there
+//! it measures ellipticity as `(a^2 - b^2) / (a^2 + b^2)`, whereas `(a - b) / (a + b)` is used
+//! here because for a source of random orientation its expectation is the reduced shear
+//! `g = gamma / (1 - kappa)` at the galaxy (for `|g| < 1`; Seitz & Schneider 1997), the
+//! estimator the weak-lensing rows of the linear system need (`crate::inversion`'s `shear`
+//! module).
 
 use std::collections::HashMap;
 

@@ -274,6 +274,30 @@ pub fn with_ring(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::catalog::parse_arclet_catalog;
+    use crate::cosmology::Cosmology;
+
+    #[test]
+    fn galaxies_in_front_of_the_lens_are_left_out_with_one_warning() {
+        let text = "#REFERENCE 3 150.0 2.0\n\
+                    1 60 10 0.5 0.3 20 1.5\n\
+                    2 70 -5 0.5 0.3 20 0.2\n\
+                    3 -40 5 0.5 0.3 20 0.25\n";
+        let (catalog, _) = parse_arclet_catalog(text, "wl.cat", None).unwrap();
+        let plane = LensPlane::new(Cosmology::default(), 0.3).unwrap();
+        let config = ShearConfig {
+            shape_noise: 0.25,
+            ..ShearConfig::default()
+        };
+        let (set, warning) = ShearSet::from_catalog(&catalog, &config, &plane);
+        assert_eq!(set.len(), 1);
+        assert_eq!(set.points[0].weight, 16.0);
+        assert_eq!(
+            warning.unwrap(),
+            "wl.cat: line 3: 2 arclet(s) at z <= z_lens = 0.3 (the first at z = 0.2) carry no \
+             shear and are left out"
+        );
+    }
 
     #[test]
     fn the_ring_continues_the_grid_lattice() {
