@@ -30,6 +30,7 @@ DATA = os.path.join(ROOT, "tests", "data", "weak_lensing")
 RUNS = [
     ("without arclets, density 0.01", False, {"regulariser": "density", "strength": 0.01}),
     ("without arclets, gradient 0.1", False, {"regulariser": "gradient", "strength": 0.1}),
+    ("arclets, defaults (\"auto\")", True, {}),
     ("arclets, density 0.01", True, {"regulariser": "density", "strength": 0.01}),
     ("arclets, density 0.003", True, {"regulariser": "density", "strength": 0.003}),
     ("arclets, density 0.03", True, {"regulariser": "density", "strength": 0.03}),

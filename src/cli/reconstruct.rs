@@ -47,7 +47,8 @@ pub struct ReconstructArgs {
     members: Option<PathBuf>,
     /// Lenstool arclet catalogue (id x y a b theta z) of weakly lensed background galaxies:
     /// each galaxy's ellipticity (a - b)/(a + b) exp(2i theta) adds two reduced-shear rows,
-    /// and a ring of coarser cells around the grid reaches the farthest galaxy.
+    /// and a ring of coarser cells around the grid reaches the median galaxy (the outer half,
+    /// beyond the grid, weigh the mass inside it).
     #[arg(long, value_name = "ARCLETS.cat")]
     shear: Option<PathBuf>,
     /// Shape noise of the arclets: the scatter of each ellipticity component (default 0.3;

@@ -47,8 +47,9 @@ pub struct ShearConfig {
     pub shape_noise: f64,
     /// Most cells in the ring of coarser cells around the grid (default 400). Its cells are
     /// `k` grid cells wide, `k` the smallest divisor of `grid.cells` that keeps the ring within
-    /// this count (so the ring's lattice continues the grid's); the ring reaches the farthest
-    /// galaxy. Allowed 1..=10000.
+    /// this count (so the ring's lattice continues the grid's); the ring reaches the median
+    /// galaxy (the outer half lie beyond the grid and weigh it: `reconstruct::grid_of`).
+    /// Allowed 1..=10000.
     pub ring_cells_max: usize,
     /// Solves after the first with each row's `kappa_0` updated to the previous solution's
     /// convergence (default 3; 0: the rows stay `gamma = e`, the weak-shear approximation).

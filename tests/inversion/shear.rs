@@ -199,13 +199,13 @@ fn enclosed_masses(r: &Reconstruction, truth: &Truth) -> Vec<f64> {
         .collect()
 }
 
-/// The settings of the measurement (BENCHMARKS.md): the density regulariser at 0.01. The
-/// gradient and curvature regularisers favour a mass sheet that reduced shear cannot see (the
-/// run's warning), and with them the mass at 3 arcmin comes out ~3 times the truth.
+/// The default regulariser (gradient) at 0.1, one of the default "auto" candidates (the
+/// full "auto" choice is in BENCHMARKS.md: it runs the cross-validation). The grid ends at
+/// the median galaxy, so the outer galaxies weigh it and no sheet fits them.
 fn shear_config() -> ReconstructConfig {
     let mut config = ReconstructConfig::default();
-    config.objective.regulariser = Regulariser::Density;
-    config.objective.strength = Strength::Value(0.01);
+    config.objective.regulariser = Regulariser::Gradient;
+    config.objective.strength = Strength::Value(0.1);
     // The maps must reach 3 arcmin without the arclets too.
     config.products.size_arcsec = Some(540.0);
     config.products.pixels = 360;
@@ -254,10 +254,4 @@ fn shear_rows_recover_the_mass_at_large_radius() {
     // Without the arclets the map stops at the strong-lensing field: at 3 arcmin it lacks
     // more than half of the mass.
     assert!(m_without[2] < 0.5 * truth.mass_within_msun[2]);
-    // The density regulariser gets no warning about the sheet.
-    assert!(
-        !with.warnings.iter().any(|w| w.contains("mass sheet")),
-        "{:?}",
-        with.warnings
-    );
 }

@@ -44,7 +44,7 @@ export const FIELDS = [
   { path: 'reconstruct.objective.image_plane_iterations', label: 'Image-plane updates', type: 'int',
     hint: 'times the residuals are re-weighted by the magnification (default 2; 0: source-plane residuals)' },
   { path: 'reconstruct.shear.shape_noise', label: 'Arclet shape noise (weak lensing)', type: 'number', step: 0.01,
-    hint: 'scatter of each ellipticity component of the arclets (default 0.3): each galaxy\'s two rows have weight 1/σ²; with arclets, use the density regulariser: the others prefer a mass sheet the shear cannot see' },
+    hint: 'scatter of each ellipticity component of the arclets (default 0.3): each galaxy\'s two rows have weight 1/σ²' },
   { path: 'reconstruct.solver.iterations', label: 'Iterations', type: 'int' },
   { path: 'holdout', label: 'Hold out systems (ids, e.g. 3, 7)', type: 'list',
     hint: 'left out of the fit, then predicted by the model: their image offsets show how well it finds images it was not given' },
