@@ -59,6 +59,15 @@ put("image_catalog", "no_header.cat",
 put("image_catalog", "sexagesimal.cat",
     "#REFERENCE 1 22:48:43.97 -44:31:51.2\n14c.1 -3.2 10.5 0.2 0.1 45 1.0\n14c.2 4.1 -8.8 0.2 0.1 45 1.0\n")
 
+# Arclet catalogues (weak lensing): the head of the synthetic one, and header variants.
+put("arclet_catalog", "weak_lensing.cat", first_lines(read("tests/data/weak_lensing/arclets.cat"), 14))
+put("arclet_catalog", "absolute.cat",
+    "#REFERENCE 0\n1 342.1901 -44.5268 0.5 0.3 12 1.2\n2 342.1755 -44.5351 0.4 0.4 0 1.9\n"
+    "g3 342.1838 -44.5211 0.3 0.2 -40 0.9 extra\n")
+put("arclet_catalog", "round_and_edge_on.cat",
+    "#REFERENCE 3 342.1832 -44.5309\n1 60.0 10.0 0.5 0.5 20 1.5\n2 -70.0 5.0 0.5 0 135 2.5\n"
+    "3 0.0 0.0 1e-3 0 -90 3\n")
+
 # Member catalogues.
 put("member_catalog", "fidelity_d.cat", first_lines(read("tests/data/fidelity/d_few_systems/members.cat"), 14))
 put("member_catalog", "a1689.cat", first_lines(read("www/examples/a1689-sim/members.cat"), 14))

@@ -15,6 +15,7 @@ use wslap::MassComponent;
 use wslap::ModelFile;
 use wslap::ReconstructConfig;
 use wslap::SkyReference;
+use wslap::{arclet_ellipticity, parse_arclet_catalog};
 use wslap::{arcs_from_regions, parse_arcs, ArcCatalog};
 use wslap::{parse_image_catalog, parse_member_catalog, ImageCatalog, MemberCatalog};
 use wslap::{read_image, write_image, FitsWriteOptions};
@@ -28,6 +29,7 @@ pub type Target = fn(&[u8]);
 pub const TARGETS: &[(&str, Target)] = &[
     ("image_catalog", image_catalog),
     ("member_catalog", member_catalog),
+    ("arclet_catalog", arclet_catalog),
     ("arcs_json", arcs_json),
     ("ds9_regions", ds9_regions),
     ("lenstool_par", lenstool_par),
@@ -153,6 +155,51 @@ pub fn image_catalog(data: &[u8]) {
             !relative_header(text),
             "a relative catalogue that parsed does not parse again: {e}\nwritten:\n{written}"
         ),
+    }
+}
+
+/// Lenstool arclet catalogue (`wslap reconstruct --shear`, the app's "Arclets" file): what
+/// parses is usable as weak-lensing rows (finite positions, `z > 0`, an ellipticity that is
+/// the catalogue's `a`, `b`, `theta` and at most 1 in size), and the same rows parse again
+/// from a catalogue written back in the header's frame.
+pub fn arclet_catalog(data: &[u8]) {
+    let Some(text) = text(data) else { return };
+    let Ok((cat, _)) = parse_arclet_catalog(text, "arclets.cat", None) else {
+        return;
+    };
+    assert!(!cat.arclets.is_empty());
+    for a in &cat.arclets {
+        assert!(a.position.is_finite(), "{a:?}");
+        assert!(a.z > 0.0 && a.z.is_finite(), "{a:?}");
+        assert!(
+            a.ellipticity.is_finite() && a.ellipticity.length() <= 1.0 + 1e-12,
+            "{a:?}"
+        );
+        assert_eq!(
+            a.ellipticity,
+            arclet_ellipticity(a.a_arcsec, a.b_arcsec, a.theta_deg),
+            "{a:?}"
+        );
+    }
+    if relative_header(text) {
+        let mut written = String::new();
+        if let Some(r) = cat.reference {
+            let _ = writeln!(written, "#REFERENCE 3 {:?} {:?}", r.ra_deg, r.dec_deg);
+        }
+        for a in &cat.arclets {
+            let _ = writeln!(
+                written,
+                "{} {:?} {:?} {:?} {:?} {:?} {:?}",
+                a.id, a.position.x, a.position.y, a.a_arcsec, a.b_arcsec, a.theta_deg, a.z
+            );
+        }
+        if let Ok((again, _)) = parse_arclet_catalog(&written, "arclets.cat", None) {
+            let same = again.arclets.len() == cat.arclets.len()
+                && again.arclets.iter().zip(&cat.arclets).all(|(p, q)| {
+                    p.position == q.position && p.ellipticity == q.ellipticity && p.z == q.z
+                });
+            assert!(same, "rows changed on a round trip:\nwritten:\n{written}");
+        }
     }
 }
 
