@@ -361,13 +361,7 @@ fn image_offsets2(lensing: &[(DVec2, DVec2, [f64; 3])], f: f64, max_stretch: f64
         })
         .collect();
     let beta = super::sources::image_plane_source(&terms);
-    terms
-        .iter()
-        .map(|(b, m)| {
-            let d = *b - beta;
-            DVec2::new(m[0] * d.x + m[1] * d.y, m[2] * d.x + m[3] * d.y).length_squared()
-        })
-        .sum()
+    super::sources::image_plane_offsets2(&terms, beta)
 }
 
 /// The quantiles of the distribution with density `weights` on the even grid `zs` (linear

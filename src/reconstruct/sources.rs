@@ -359,6 +359,18 @@ pub(super) fn image_plane_source(terms: &[(DVec2, [f64; 4])]) -> DVec2 {
     }
 }
 
+/// `sum_k |M_k (beta_k - beta)|^2` (arcsec^2): to first order, the summed squared image-plane
+/// offsets of a source at `beta` from a system's images (terms as in [`image_plane_source`]).
+pub(super) fn image_plane_offsets2(terms: &[(DVec2, [f64; 4])], beta: DVec2) -> f64 {
+    terms
+        .iter()
+        .map(|(b, m)| {
+            let d = *b - beta;
+            DVec2::new(m[0] * d.x + m[1] * d.y, m[2] * d.x + m[3] * d.y).length_squared()
+        })
+        .sum()
+}
+
 /// Arrival times on a lens's product maps: its potential map, made once.
 pub struct ArrivalTimes<'a> {
     psi: Map,
@@ -516,16 +528,7 @@ fn finish(
 mod tests {
     use super::*;
 
-    /// `sum_k |M_k (beta_k - beta)|^2`.
-    fn cost(terms: &[(DVec2, [f64; 4])], beta: DVec2) -> f64 {
-        terms
-            .iter()
-            .map(|(b, m)| {
-                let d = *b - beta;
-                DVec2::new(m[0] * d.x + m[1] * d.y, m[2] * d.x + m[3] * d.y).length_squared()
-            })
-            .sum()
-    }
+    use super::image_plane_offsets2 as cost;
 
     #[test]
     fn the_image_plane_source_is_the_minimiser_of_the_image_plane_offsets() {
