@@ -663,33 +663,25 @@ impl LinearSystem {
         let mut acc = NormalEquations::new(n)?;
         let mut theta_w_theta = 0.0;
         let mut block = RowBlock::default();
-        let n_pix = self.constraints.pixels.len();
-        let mut start = 0;
-        while start < n_pix {
-            let end = (start + self.rows_per_block).min(n_pix);
-            self.rows(start..end, &mut block)?;
+        // Adds a block of rows to the normal equations; returns its `theta^T W theta`.
+        let mut add = |block: &RowBlock| -> Result<f64, SystemError> {
             acc.add_rows(&block.gamma, &block.weights, &block.theta)?;
-            theta_w_theta += block
+            Ok(block
                 .theta
                 .iter()
                 .zip(&block.weights)
                 .map(|(t, w)| w * t * t)
-                .sum::<f64>();
-            start = end;
+                .sum::<f64>())
+        };
+        let per = self.rows_per_block;
+        let blocks = |len: usize| (0..len).step_by(per).map(move |s| s..(s + per).min(len));
+        for range in blocks(self.constraints.pixels.len()) {
+            self.rows(range, &mut block)?;
+            theta_w_theta += add(&block)?;
         }
-        let n_gal = self.shear.len();
-        let mut start = 0;
-        while start < n_gal {
-            let end = (start + self.rows_per_block).min(n_gal);
-            self.shear_rows(start..end, &mut block)?;
-            acc.add_rows(&block.gamma, &block.weights, &block.theta)?;
-            theta_w_theta += block
-                .theta
-                .iter()
-                .zip(&block.weights)
-                .map(|(t, w)| w * t * t)
-                .sum::<f64>();
-            start = end;
+        for range in blocks(self.shear.len()) {
+            self.shear_rows(range, &mut block)?;
+            theta_w_theta += add(&block)?;
         }
         let prior = self.prior_rows();
         acc.add_rows(&prior.gamma, &prior.weights, &prior.theta)?;
