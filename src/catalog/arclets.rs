@@ -19,7 +19,7 @@ use glam::DVec2;
 use serde::{Deserialize, Serialize};
 
 use super::frame;
-use super::rows::{read_table, warn_extra_columns, Fields};
+use super::rows::{read_table, warn_extra_columns, warn_repeated_id, Fields};
 use super::units::{check_field, RowPosition};
 use super::{reframe_pair, CatalogError, CatalogWarning};
 use crate::sky::SkyReference;
@@ -104,14 +104,14 @@ pub fn parse_arclet_catalog(
         };
         f.require(ARCLET_LAYOUT, &mut extra_lines)?;
         let id = row.fields[0];
-        if let Some(&first_line) = seen.get(id) {
-            warnings.push(CatalogWarning {
-                source_name: source_name.into(),
-                line: row.line,
-                message: format!("arclet id '{id}' is already used on line {first_line}"),
-            });
-        }
-        seen.insert(id, row.line);
+        warn_repeated_id(
+            &mut seen,
+            id,
+            row.line,
+            "arclet",
+            source_name,
+            &mut warnings,
+        );
         let shape = f.shape(table.coords)?;
         if shape.a + shape.b <= 0.0 {
             return Err(f.bad(4, "is 0 as is a: an arclet needs a shape (a + b > 0)"));

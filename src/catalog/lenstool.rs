@@ -10,7 +10,7 @@ use std::collections::HashMap;
 use glam::DVec2;
 
 use super::frame;
-use super::rows::{read_table, warn_extra_columns, Fields};
+use super::rows::{read_table, warn_extra_columns, warn_repeated_id, Fields};
 use super::units::{check_field, RowPosition};
 use super::{
     CatalogError, CatalogWarning, Image, ImageCatalog, ImageSystem, Member, MemberCatalog,
@@ -136,14 +136,14 @@ pub fn parse_member_catalog(
         };
         f.require(MEMBER_LAYOUT, &mut extra_lines)?;
         let id = row.fields[0];
-        if let Some(&first_line) = seen.get(id) {
-            warnings.push(CatalogWarning {
-                source_name: source_name.into(),
-                line: row.line,
-                message: format!("member id '{id}' is already used on line {first_line}"),
-            });
-        }
-        seen.insert(id, row.line);
+        warn_repeated_id(
+            &mut seen,
+            id,
+            row.line,
+            "member",
+            source_name,
+            &mut warnings,
+        );
         let shape = f.shape(table.coords)?;
         let mag_text = row.fields[6];
         let mag = if mag_text.eq_ignore_ascii_case("nan") {

@@ -1,6 +1,8 @@
 //! Rows of a Lenstool catalogue: splitting the text into rows after the `#REFERENCE` header,
 //! and reading fields with errors that name the file, line, column and value.
 
+use std::collections::HashMap;
+
 use glam::DVec2;
 
 use super::frame::{self, Coords};
@@ -199,6 +201,25 @@ impl Fields<'_, '_> {
             Some((_, "")) => Err(self.bad(0, "has no image part after the '.'")),
             Some((system, _)) => Ok(system.into()),
         }
+    }
+}
+
+/// Records `id` as seen on `line`; a warning when an earlier row used it (`what`: "member",
+/// "arclet", the kind of row).
+pub(super) fn warn_repeated_id<'t>(
+    seen: &mut HashMap<&'t str, usize>,
+    id: &'t str,
+    line: usize,
+    what: &str,
+    source_name: &str,
+    warnings: &mut Vec<CatalogWarning>,
+) {
+    if let Some(first_line) = seen.insert(id, line) {
+        warnings.push(CatalogWarning {
+            source_name: source_name.into(),
+            line,
+            message: format!("{what} id '{id}' is already used on line {first_line}"),
+        });
     }
 }
 
