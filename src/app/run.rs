@@ -276,7 +276,8 @@ impl Session {
 
     /// K-fold cross-validation of the settings on the loaded data
     /// ([`crate::reconstruct::cross_validate`], `wslap reconstruct --folds`), with the folds'
-    /// convergence on the maps a reconstruction with these settings makes. The session's
+    /// convergence on the maps a reconstruction with these settings makes; systems whose
+    /// redshift the session's result estimated are fitted in every fold at it. The session's
     /// result is not touched. `progress` sees the fold (1-based) and every QADP report, and
     /// may cancel.
     pub fn cross_validate(
@@ -284,9 +285,21 @@ impl Session {
         folds: usize,
         progress: &mut dyn FnMut(usize, &ConvergenceRecord) -> Control,
     ) -> Result<CrossValidation, AppError> {
-        self.with_inputs(|inputs, config, _| {
+        self.with_inputs(|inputs, config, parsed| {
             let geometry = map_geometry(inputs, config).map_err(run_error)?;
-            cross_validate(inputs, config, folds, Some(geometry), progress).map_err(run_error)
+            // Systems whose redshift the result estimated are fitted in every fold at it, when
+            // the result was made from these images.
+            let observed = parsed.marks().observed;
+            let estimates = self
+                .result()
+                .ok()
+                .filter(|r| r.marks.observed == observed)
+                .and_then(|r| r.reconstruction())
+                .map(|r| r.z_estimates())
+                .unwrap_or_default();
+            let mut config = config.clone();
+            config.constraints.z_estimates = estimates;
+            cross_validate(inputs, &config, folds, Some(geometry), progress).map_err(run_error)
         })
     }
 

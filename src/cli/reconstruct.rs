@@ -272,11 +272,12 @@ fn write_ensemble(
     result: &Reconstruction,
     out: &Path,
 ) -> Result<(), String> {
-    let mut last = 0;
+    // Members run side by side, their reports interleaved: a line when each starts.
+    let mut started = vec![false; members + 1];
     let mut progress = |member: usize, _: &ConvergenceRecord| {
-        if member != last {
+        if let Some(seen @ false) = started.get_mut(member) {
+            *seen = true;
             eprintln!("ensemble member {member}/{members}");
-            last = member;
         }
         Control::Continue
     };
@@ -331,7 +332,10 @@ fn run_crossval(
         Control::Continue
     };
     let geometry = result.products.maps.geometry();
-    let cv = cross_validate(inputs, config, folds, Some(geometry), &mut progress)
+    // Systems whose redshift the run estimated are fitted in every fold at it.
+    let mut config = config.clone();
+    config.constraints.z_estimates = result.z_estimates();
+    let cv = cross_validate(inputs, &config, folds, Some(geometry), &mut progress)
         .map_err(|e| e.to_string())?;
     let write = |file: &str, bytes: &[u8]| -> Result<(), String> {
         let path = out.join(file);

@@ -262,14 +262,17 @@ pub fn fitted_system_ids(
 }
 
 /// The groups of system ids that [`cross_validate`] holds out in turn: the systems `inputs`
-/// fits ([`fitted_system_ids`]), the k-th to group `k mod folds`. Needs
-/// `2 <= folds <=` the number of fitted systems.
+/// fits ([`fitted_system_ids`]) but those fitted at an estimated redshift
+/// (`constraints.z_estimates`), the k-th to group `k mod folds`. Needs `2 <= folds <=` the
+/// number of such systems.
 pub fn fold_groups(
     inputs: &Inputs<'_>,
     config: &ReconstructConfig,
     folds: usize,
 ) -> Result<Vec<Vec<String>>, ReconstructError> {
-    let ids = fitted_system_ids(inputs, config)?;
+    let mut own_redshifts = config.clone();
+    own_redshifts.constraints.z_estimates.clear();
+    let ids = fitted_system_ids(inputs, &own_redshifts)?;
     if folds < 2 || folds > ids.len() {
         return Err(ReconstructError::Folds {
             folds,
@@ -285,10 +288,17 @@ pub fn fold_groups(
 
 /// Reconstructs the lens `folds` times, each time without one group of [`fold_groups`], and
 /// predicts the images of the group left out. Systems in `inputs.holdout` stay out of every
-/// fit and of the result. With `kappa_on`, also the mean and spread of the folds' convergence
-/// on that map ([`KappaSpread`]; the map of the reconstruction from all the systems, say).
-/// `progress` sees the fold number (1-based) and every QADP report, and may cancel: the result
-/// then holds the folds completed before, with status "Cancelled".
+/// fit and of the result. Systems without a redshift are left out of every fold, unless
+/// `constraints.z_estimates` gives them one (a reconstruction's
+/// [`Reconstruction::z_estimates`]): then every fold fits them at it, and none holds them out
+/// (their redshift was found with the other systems' help, so predicting them would not be a
+/// test). On a catalogue with many such systems (MACS1931: 4 of 10) the folds then have the
+/// constraints the reconstruction had, less the group. With `kappa_on`, also the mean and
+/// spread of the folds' convergence on that map ([`KappaSpread`]; the map of the
+/// reconstruction from all the systems, say). `progress` sees the fold number (1-based) and
+/// every QADP report, and may cancel: the result then holds the folds that finished, with
+/// status "Cancelled". Natively the folds run side by side, one thread each, as many as the
+/// memory allows; `progress` is called on this thread, the folds' reports interleaved.
 pub fn cross_validate(
     inputs: &Inputs<'_>,
     config: &ReconstructConfig,
@@ -297,60 +307,38 @@ pub fn cross_validate(
     progress: &mut dyn FnMut(usize, &ConvergenceRecord) -> Control,
 ) -> Result<CrossValidation, ReconstructError> {
     let groups = fold_groups(inputs, config, folds)?;
+    let threads = super::side_by_side(inputs, config, groups.len())?;
+    let jobs: Vec<(usize, &Vec<String>)> = (1..).zip(&groups).collect();
+    let outcomes = crate::threads::map_reporting(
+        &jobs,
+        threads,
+        |&(fold, group), report| {
+            run_fold(inputs, config, fold, group, kappa_on, &mut |record| {
+                Control::from(report(record.clone()))
+            })
+        },
+        &mut |k, record| progress(k + 1, &record).into(),
+    );
     let mut spread = kappa_on.map(SpreadSum::new);
     let mut runs = Vec::new();
     let mut systems = Vec::new();
     let mut fitted = Vec::new();
     let mut status = "Completed";
-    for (k, group) in groups.iter().enumerate() {
-        let fold = k + 1;
-        let clock = crate::products::Clock::start();
-        let holdout: Vec<String> = inputs.holdout.iter().chain(group).cloned().collect();
-        let fold_inputs = Inputs {
-            holdout: &holdout,
-            ..*inputs
-        };
-        let r = reconstruct_free_z(&fold_inputs, config, false, &mut |record| {
-            progress(fold, record)
-        })?;
-        if r.status == SolveStatus::Cancelled {
+    for outcome in outcomes {
+        let Some(fold) = outcome.transpose()?.flatten() else {
+            // Cancelled, or not started after a cancel.
             status = "Cancelled";
-            break;
+            continue;
+        };
+        fitted.extend(fold.fitted_offsets);
+        if let (Some(sum), Some(kappa)) = (&mut spread, &fold.kappa) {
+            sum.add(kappa);
         }
-        let predicted: Vec<SourceReport> = r
-            .sources
-            .iter()
-            .filter(|s| s.held_out && group.contains(&s.id))
-            .cloned()
-            .collect();
-        fitted.extend(image_offsets_arcsec(
-            r.sources.iter().filter(|s| !s.held_out),
-        ));
-        if let Some(sum) = &mut spread {
-            sum.add(&fold_kappa(&r, sum.geometry)?);
-        }
-        let summary = r.products.summary();
-        runs.push(FoldRun {
-            fold,
-            held_out: group.clone(),
-            status: r.status.name().to_string(),
-            iterations: r.iterations,
-            c: r.layer_factors(),
-            grid_mass_msun: r.grid_mass_msun(),
-            einstein_radius_arcsec: summary.einstein_radius_arcsec,
-            einstein_radius_z_source: r.products.curves.z_source,
-            mass_within_arcsec: summary.mass_within_arcsec,
-            fit_image_offset_median_arcsec: r.image_offset_median_arcsec(false),
-            holdout_image_offset_median_arcsec: median_arcsec(image_offsets_arcsec(
-                predicted.iter(),
-            )),
-            elapsed_ms: clock.ms(),
-        });
-        systems.extend(
-            predicted
-                .into_iter()
-                .map(|report| PredictedSystem { fold, report }),
-        );
+        systems.extend(fold.predicted.into_iter().map(|report| PredictedSystem {
+            fold: fold.run.fold,
+            report,
+        }));
+        runs.push(fold.run);
     }
     let offsets = image_offsets_arcsec(systems.iter().map(|s| &s.report));
     let holdout_images = systems.iter().map(|s| s.report.observed.len()).sum();
@@ -366,4 +354,70 @@ pub fn cross_validate(
         systems,
         kappa: spread.and_then(SpreadSum::finish),
     })
+}
+
+/// What one fold of [`cross_validate`] gives.
+struct FoldOutcome {
+    run: FoldRun,
+    /// The held-out group's systems, predicted.
+    predicted: Vec<SourceReport>,
+    /// The fold's own fitted image offsets (arcsec).
+    fitted_offsets: Vec<f64>,
+    /// Its convergence on the map asked for.
+    kappa: Option<Vec<f64>>,
+}
+
+/// Fold `fold` (1-based) of [`cross_validate`]: the lens reconstructed without `group`, and
+/// the group predicted. `None` when `progress` cancelled it.
+fn run_fold(
+    inputs: &Inputs<'_>,
+    config: &ReconstructConfig,
+    fold: usize,
+    group: &[String],
+    kappa_on: Option<MapGeometry>,
+    progress: &mut dyn FnMut(&ConvergenceRecord) -> Control,
+) -> Result<Option<FoldOutcome>, ReconstructError> {
+    let clock = crate::products::Clock::start();
+    let holdout: Vec<String> = inputs.holdout.iter().chain(group).cloned().collect();
+    let fold_inputs = Inputs {
+        holdout: &holdout,
+        ..*inputs
+    };
+    // A fold cancelled while an "auto" strength chose its candidate has no result at all.
+    let r = match reconstruct_free_z(&fold_inputs, config, false, progress) {
+        Err(ReconstructError::Cancelled) => return Ok(None),
+        r => r?,
+    };
+    if r.status == SolveStatus::Cancelled {
+        return Ok(None);
+    }
+    let predicted: Vec<SourceReport> = r
+        .sources
+        .iter()
+        .filter(|s| s.held_out && group.contains(&s.id))
+        .cloned()
+        .collect();
+    let fitted_offsets = image_offsets_arcsec(r.sources.iter().filter(|s| !s.held_out));
+    let kappa = kappa_on.map(|g| fold_kappa(&r, g)).transpose()?;
+    let summary = r.products.summary();
+    let run = FoldRun {
+        fold,
+        held_out: group.to_vec(),
+        status: r.status.name().to_string(),
+        iterations: r.iterations,
+        c: r.layer_factors(),
+        grid_mass_msun: r.grid_mass_msun(),
+        einstein_radius_arcsec: summary.einstein_radius_arcsec,
+        einstein_radius_z_source: r.products.curves.z_source,
+        mass_within_arcsec: summary.mass_within_arcsec,
+        fit_image_offset_median_arcsec: r.image_offset_median_arcsec(false),
+        holdout_image_offset_median_arcsec: median_arcsec(image_offsets_arcsec(predicted.iter())),
+        elapsed_ms: clock.ms(),
+    };
+    Ok(Some(FoldOutcome {
+        run,
+        predicted,
+        fitted_offsets,
+        kappa,
+    }))
 }

@@ -290,8 +290,11 @@ pub fn check_ensemble_size(members: usize) -> Result<(), ReconstructError> {
 /// settings, sampled on `main`'s maps. `progress` sees the member number (1-based) and every
 /// solver report, and may cancel.
 ///
-/// The same as [`EnsemblePlan::new`], [`EnsemblePlan::run_member`] for every member in turn
-/// and [`EnsemblePlan::combine`]: the app runs the members in web workers that way.
+/// The same as [`EnsemblePlan::new`], [`EnsemblePlan::run_member`] for every member and
+/// [`EnsemblePlan::combine`]: the app runs the members in web workers that way. Natively the
+/// members run side by side, one thread each, as many as the memory allows; `progress` is called
+/// on this thread, the members' reports interleaved. After a cancel the ensemble holds the
+/// members that finished.
 pub fn run_ensemble(
     inputs: &Inputs<'_>,
     config: &ReconstructConfig,
@@ -301,16 +304,26 @@ pub fn run_ensemble(
     progress: &mut dyn FnMut(usize, &ConvergenceRecord) -> Control,
 ) -> Result<Ensemble, ReconstructError> {
     let plan = EnsemblePlan::new(inputs, config, main, members, seed)?;
+    let threads = super::side_by_side(inputs, config, members)?;
+    let numbers: Vec<usize> = (1..=members).collect();
+    let outcomes = crate::threads::map_reporting(
+        &numbers,
+        threads,
+        |&member, report| {
+            plan.run_member(inputs, config, member, &mut |rec| {
+                Control::from(report(rec.clone()))
+            })
+        },
+        &mut |k, rec| progress(numbers[k], &rec).into(),
+    );
     let mut runs = Vec::new();
     let mut complete = true;
-    for member in 1..=members {
-        let mut report = |rec: &ConvergenceRecord| progress(member, rec);
-        match plan.run_member(inputs, config, member, &mut report)? {
-            Some(run) => runs.push(run),
-            None => {
-                complete = false;
-                break;
-            }
+    for outcome in outcomes {
+        match outcome {
+            Some(Ok(Some(run))) => runs.push(run),
+            Some(Err(e)) if !matches!(e, ReconstructError::Cancelled) => return Err(e),
+            // Cancelled, or not started after a cancel.
+            _ => complete = false,
         }
     }
     plan.combine(runs, complete)

@@ -311,6 +311,13 @@ impl Reconstruction {
         self.solved().image_offset_median_arcsec(held_out)
     }
 
+    /// The systems whose redshift this run estimated, each with its most probable redshift,
+    /// as `constraints.z_estimates` takes them: a cross-validation of the same data given
+    /// these fits those systems in every fold ([`cross_validate`]).
+    pub fn z_estimates(&self) -> Vec<(String, f64)> {
+        free_z::most_probable_of(&free_z::estimates_of(&self.sources))
+    }
+
     /// The verdict on the map ([`Verdict::assess`]), with the curves at the products'
     /// source redshift.
     pub fn verdict(&self) -> Verdict {
@@ -339,7 +346,8 @@ impl Reconstruction {
 /// Runs the reconstruction. `progress` sees every QADP report and may cancel; a cancelled run
 /// still returns the products of the last iterate (its status says `Cancelled`). Every
 /// parallel section of the run (rows, normal equations, QADP passes, maps, image search) uses
-/// at most `system.threads` threads (0: all cores).
+/// at most `system.threads` threads (0: all cores), and no more than a limit set around it
+/// ([`crate::threads::with_limit`]).
 ///
 /// Systems without a redshift are first left out, then have it estimated on the lens of the
 /// others and are fitted at it (the `free_z` module).
@@ -407,6 +415,27 @@ pub fn check_memory(
     }
     estimate.check(MemoryLimit::here())?;
     Ok(estimate)
+}
+
+/// How many of `runs` independent reconstructions of `inputs` with `config` (ensemble
+/// members, cross-validation folds) may run side by side here: one per thread the run may use
+/// ([`crate::threads::available`] within `system.threads`), and no more than fit in the
+/// memory one of them needs ([`check_memory`] of a one-thread run, against
+/// [`MemoryLimit::here`]). Side by side, each run keeps one thread busy in every stage with
+/// no barriers, where one run on two threads gains less than twice (BENCHMARKS.md).
+pub(crate) fn side_by_side(
+    inputs: &Inputs<'_>,
+    config: &ReconstructConfig,
+    runs: usize,
+) -> Result<usize, ReconstructError> {
+    let threads =
+        crate::threads::with_limit(config.system.threads, crate::threads::available).min(runs);
+    if threads <= 1 {
+        return Ok(1);
+    }
+    let one = crate::threads::with_limit(1, || check_memory(inputs, config))?;
+    let fit = MemoryLimit::here().bytes / one.bytes.max(1);
+    Ok(threads.min(fit.max(1) as usize))
 }
 
 /// For an "auto" strength, the cross-validation of every candidate and the one chosen

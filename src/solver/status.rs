@@ -20,6 +20,26 @@ pub enum Control {
     Cancel,
 }
 
+/// `Cancel` is a break: the standard library's way of saying "stop" to a loop, used by code
+/// that does not know the solver (`threads::map_reporting`).
+impl From<std::ops::ControlFlow<()>> for Control {
+    fn from(flow: std::ops::ControlFlow<()>) -> Self {
+        match flow {
+            std::ops::ControlFlow::Continue(()) => Control::Continue,
+            std::ops::ControlFlow::Break(()) => Control::Cancel,
+        }
+    }
+}
+
+impl From<Control> for std::ops::ControlFlow<()> {
+    fn from(control: Control) -> Self {
+        match control {
+            Control::Continue => std::ops::ControlFlow::Continue(()),
+            Control::Cancel => std::ops::ControlFlow::Break(()),
+        }
+    }
+}
+
 /// How a run ended (a run is not an error).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum SolveStatus {

@@ -210,19 +210,22 @@ fn each_fold_is_a_hold_out_run_and_every_system_is_predicted_once() {
     assert!(cv.fit_image_offset_median_arcsec.unwrap() < median);
 }
 
-/// Cancelling in the second fold keeps the first fold's result and says "Cancelled".
+/// One fold after another (one thread), cancelling in the second fold keeps the first fold's
+/// result and says "Cancelled".
 #[test]
 fn cancel_keeps_the_folds_before_it() {
     let cat = catalog();
     let none: Vec<String> = Vec::new();
     let mut seen = Vec::new();
-    let cv = cross_validate(&inputs(&cat, &none), &config(), 2, None, &mut |fold, _| {
-        seen.push(fold);
-        if fold == 2 {
-            Control::Cancel
-        } else {
-            Control::Continue
-        }
+    let cv = wslap::with_thread_limit(1, || {
+        cross_validate(&inputs(&cat, &none), &config(), 2, None, &mut |fold, _| {
+            seen.push(fold);
+            if fold == 2 {
+                Control::Cancel
+            } else {
+                Control::Continue
+            }
+        })
     })
     .unwrap();
     assert_eq!(cv.status, "Cancelled");
@@ -230,6 +233,126 @@ fn cancel_keeps_the_folds_before_it() {
     assert!(cv.systems.iter().all(|s| s.fold == 1));
     assert_eq!(cv.systems.len(), 2);
     assert!(seen.contains(&1) && seen.contains(&2));
+}
+
+/// Side by side (two threads), the folds give exactly what they give one after another, the
+/// caller sees every fold's reports, and a cancel in one fold stops the other too (it keeps
+/// only a fold that had already finished).
+#[test]
+fn folds_side_by_side_agree_with_one_after_another_and_cancel_together() {
+    let cat = catalog();
+    let none: Vec<String> = Vec::new();
+    let run = |threads| {
+        let mut seen = Vec::new();
+        let cv = wslap::with_thread_limit(threads, || {
+            cross_validate(&inputs(&cat, &none), &config(), 2, None, &mut |fold, _| {
+                seen.push(fold);
+                Control::Continue
+            })
+        })
+        .unwrap();
+        (cv, seen)
+    };
+    let (one, seen_one) = run(1);
+    let (two, seen_two) = run(2);
+    assert_eq!(two.status, "Completed");
+    assert_eq!(
+        serde_json::to_value(&one.systems).unwrap(),
+        serde_json::to_value(&two.systems).unwrap()
+    );
+    assert_eq!(
+        one.holdout_image_offset_median_arcsec,
+        two.holdout_image_offset_median_arcsec
+    );
+    assert_eq!(
+        one.runs.iter().map(|r| r.c.clone()).collect::<Vec<_>>(),
+        two.runs.iter().map(|r| r.c.clone()).collect::<Vec<_>>()
+    );
+    let count = |seen: &[usize], f| seen.iter().filter(|&&s| s == f).count();
+    for fold in [1, 2] {
+        assert_eq!(
+            count(&seen_one, fold),
+            count(&seen_two, fold),
+            "fold {fold}"
+        );
+    }
+
+    let cv = wslap::with_thread_limit(2, || {
+        cross_validate(&inputs(&cat, &none), &config(), 2, None, &mut |fold, _| {
+            if fold == 2 {
+                Control::Cancel
+            } else {
+                Control::Continue
+            }
+        })
+    })
+    .unwrap();
+    assert_eq!(cv.status, "Cancelled");
+    assert!(cv
+        .runs
+        .iter()
+        .all(|r| r.fold == 1 && r.status == "Completed"));
+    assert!(cv.systems.iter().all(|s| s.fold == 1));
+}
+
+/// A system without a redshift is never held out. Without an estimate it is left out of every
+/// fold; given one (`constraints.z_estimates`, as a reconstruction that estimated it gives
+/// them) every fold fits it there: each fold is then exactly `reconstruct` with its group held
+/// out and the estimate given.
+#[test]
+fn systems_at_an_estimated_redshift_are_fitted_in_every_fold_and_never_held_out() {
+    let mut cat = catalog();
+    let z3 = cat.systems[2].z.take().unwrap();
+    assert_eq!(cat.systems[2].id, "3");
+    let none: Vec<String> = Vec::new();
+    let mut config = config();
+    config.objective.strength = wslap::Strength::Value(0.1);
+    let mut estimated = config.clone();
+    estimated.constraints.z_estimates = vec![("3".to_string(), z3)];
+    for c in [&config, &estimated] {
+        let groups = fold_groups(&inputs(&cat, &none), c, 3).unwrap();
+        assert_eq!(groups, [ids(&["1"]), ids(&["2"]), ids(&["4"])]);
+    }
+    let without = cross_validate(&inputs(&cat, &none), &config, 3, None, &mut |_, _| {
+        Control::Continue
+    })
+    .unwrap();
+    let with = cross_validate(&inputs(&cat, &none), &estimated, 3, None, &mut |_, _| {
+        Control::Continue
+    })
+    .unwrap();
+    for cv in [&without, &with] {
+        let held: Vec<&str> = cv.systems.iter().map(|s| s.report.id.as_str()).collect();
+        assert_eq!(held, ["1", "2", "4"]);
+    }
+    for (k, id) in ["1", "2", "4"].iter().enumerate() {
+        let holdout = ids(&[id]);
+        let alone = reconstruct(&inputs(&cat, &holdout), &estimated, &mut quiet).unwrap();
+        let fitted: Vec<&str> = alone
+            .sources
+            .iter()
+            .filter(|s| !s.held_out)
+            .map(|s| s.id.as_str())
+            .collect();
+        assert!(fitted.contains(&"3"), "{fitted:?}");
+        let predicted = |r: &wslap::SourceReport| {
+            r.observed
+                .iter()
+                .map(|o| o.offset_arcsec)
+                .collect::<Vec<_>>()
+        };
+        let report = alone.sources.iter().find(|s| s.id == *id).unwrap();
+        assert_eq!(
+            predicted(&with.systems[k].report),
+            predicted(report),
+            "system {id}"
+        );
+        assert_ne!(
+            predicted(&without.systems[k].report),
+            predicted(report),
+            "system {id}"
+        );
+    }
 }
 
 /// The folds' convergence on a given map: at every pixel the mean and the standard deviation
