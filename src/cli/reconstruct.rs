@@ -366,8 +366,15 @@ fn crossval_line(cv: &CrossValidation, path: &Path) -> String {
             values.last().copied().unwrap_or(f64::NAN)
         )
     });
+    let always = match cv.always_fitted.as_slice() {
+        [] => String::new(),
+        ids => format!(
+            "; fitted in every fold at their estimated redshift: {}",
+            ids.join(", ")
+        ),
+    };
     format!(
-        "wrote {} ({} folds: held-out images median {}, rms {}, {} of {} without a predicted image; fitted images median {}{spread})",
+        "wrote {} ({} folds: held-out images median {}, rms {}, {} of {} without a predicted image; fitted images median {}{spread}{always})",
         path.display(),
         cv.folds,
         arcsec(cv.holdout_image_offset_median_arcsec),

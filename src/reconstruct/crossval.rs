@@ -79,9 +79,14 @@ pub struct PredictedSystem {
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct CrossValidation {
     pub folds: usize,
-    /// "Completed", or "Cancelled" when a fold was cancelled (the folds before it are kept).
+    /// "Completed", or "Cancelled" when a fold was cancelled (the folds that finished are
+    /// kept).
     pub status: String,
     pub runs: Vec<FoldRun>,
+    /// The systems every fold fits and none holds out: those at an estimated redshift
+    /// (`constraints.z_estimates`).
+    #[serde(default)]
+    pub always_fitted: Vec<String>,
     /// Every predicted system once, in catalogue order within each fold.
     pub systems: Vec<PredictedSystem>,
     /// Observed images of the predicted systems, and how many of them had no predicted image
@@ -307,6 +312,8 @@ pub fn cross_validate(
     progress: &mut dyn FnMut(usize, &ConvergenceRecord) -> Control,
 ) -> Result<CrossValidation, ReconstructError> {
     let groups = fold_groups(inputs, config, folds)?;
+    let mut always_fitted = fitted_system_ids(inputs, config)?;
+    always_fitted.retain(|id| !groups.iter().flatten().any(|g| g == id));
     let threads = super::side_by_side(inputs, config, groups.len())?;
     let jobs: Vec<(usize, &Vec<String>)> = (1..).zip(&groups).collect();
     let outcomes = crate::threads::map_reporting(
@@ -346,6 +353,7 @@ pub fn cross_validate(
         folds,
         status: status.to_string(),
         runs,
+        always_fitted,
         holdout_images,
         holdout_images_unmatched: holdout_images - offsets.len(),
         holdout_image_plane_rms_arcsec: rms_arcsec(&offsets),

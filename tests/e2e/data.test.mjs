@@ -125,6 +125,20 @@ test('systems without a redshift have it estimated, or take the one the settings
     assert.equal(free.estimated.length, found.length, free.estimated.join(' | '));
     for (const cell of free.estimated) assert.match(cell, /^[\d.]+ est\.[\d.]+–[\d.]+$/);
     assert.deepEqual(free.warnings.filter((t) => /not used/.test(t)), []);
+    // The cross-validation fits those systems in every fold at their estimate and predicts
+    // the others (a fixed strength keeps it quick).
+    const ids = found.map((t) => t.match(/^system (\S+):/)[1]);
+    await setField(page, '#set-reconstruct-objective-strength', 0.1);
+    await page.click('#crossval');
+    await waitStatus(page, /^Cross-validated in [\d.]+ s \(\d folds\)\.$/);
+    const summary = (await page.textContent('#crossval-summary')).replace(/\s+/g, ' ');
+    const always = summary.match(/Systems? (.+?), whose redshift the reconstruction estimated, (is|are) fitted in every fold at that redshift and not predicted\./);
+    assert.ok(always, summary);
+    assert.deepEqual(always[1].split(', ').sort(), [...ids].sort(), summary);
+    await page.click('#crossval-systems summary');
+    const predicted = await page.$$eval('#crossval-box tbody th', (ths) => ths.map((th) => th.textContent));
+    assert.ok(predicted.length >= 2 && predicted.every((id) => !ids.includes(id)), predicted.join(' '));
+    await setField(page, '#set-reconstruct-objective-strength', 'auto');
     // A redshift at or in front of the lens is refused and the field keeps its value.
     await page.fill('#set-reconstruct-constraints-default_z', '0.3');
     await page.dispatchEvent('#set-reconstruct-constraints-default_z', 'change');

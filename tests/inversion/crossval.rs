@@ -325,6 +325,8 @@ fn systems_at_an_estimated_redshift_are_fitted_in_every_fold_and_never_held_out(
         let held: Vec<&str> = cv.systems.iter().map(|s| s.report.id.as_str()).collect();
         assert_eq!(held, ["1", "2", "4"]);
     }
+    assert!(without.always_fitted.is_empty());
+    assert_eq!(with.always_fitted, ids(&["3"]));
     for (k, id) in ["1", "2", "4"].iter().enumerate() {
         let holdout = ids(&[id]);
         let alone = reconstruct(&inputs(&cat, &holdout), &estimated, &mut quiet).unwrap();

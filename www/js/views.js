@@ -220,6 +220,10 @@ export function showCrossval(cv, onDownload, files = []) {
     return;
   }
   const cancelled = cv.status === 'Cancelled' ? ` Cancelled after ${cv.runs.length} of ${cv.folds} folds.` : '';
+  const fixed = cv.always_fitted ?? [];
+  const always = fixed.length
+    ? ` ${fixed.length === 1 ? 'System' : 'Systems'} ${fixed.map(esc).join(', ')}, whose redshift the reconstruction estimated,
+      ${fixed.length === 1 ? 'is' : 'are'} fitted in every fold at that redshift and not predicted.` : '';
   const unmatched = cv.holdout_images_unmatched
     ? ` ${cv.holdout_images_unmatched} of ${cv.holdout_images} held-out images had no predicted image.` : '';
   const span = (values, d) => {
@@ -251,7 +255,7 @@ export function showCrossval(cv, onDownload, files = []) {
     that group's images, so every system is predicted once by a lens that never saw it. Held-out images lie ${fmt(cv.holdout_image_offset_median_arcsec)}″ from
     their predictions (median; rms ${fmt(cv.holdout_image_plane_rms_arcsec)}″), the fitted ones
     ${fmt(cv.fit_image_offset_median_arcsec)}″: the first says how well these settings find images the model
-    was not given.${spread}${unmatched}${cancelled}</p>
+    was not given.${spread}${always}${unmatched}${cancelled}</p>
     <details id="crossval-systems"><summary>Per system (${cv.systems.length})</summary>
     <div class="table-scroll"><table><caption>Per held-out system: the fold that left it out, its redshift, each
     observed image's offset from the nearest predicted image (arcsec) with the fold's magnification there, and their rms</caption>
