@@ -210,14 +210,12 @@ fn each_fold_is_a_hold_out_run_and_every_system_is_predicted_once() {
     assert!(cv.fit_image_offset_median_arcsec.unwrap() < median);
 }
 
-/// One fold after another (one thread), cancelling in the second fold keeps the first fold's
-/// result and says "Cancelled".
-#[test]
-fn cancel_keeps_the_folds_before_it() {
+/// Two folds of the teaching example on `threads` threads, cancelled at the second fold's
+/// first report; `seen` gets the fold of every report.
+fn cancelled_in_fold_two(threads: usize, seen: &mut Vec<usize>) -> wslap::CrossValidation {
     let cat = catalog();
     let none: Vec<String> = Vec::new();
-    let mut seen = Vec::new();
-    let cv = wslap::with_thread_limit(1, || {
+    wslap::with_thread_limit(threads, || {
         cross_validate(&inputs(&cat, &none), &config(), 2, None, &mut |fold, _| {
             seen.push(fold);
             if fold == 2 {
@@ -227,7 +225,15 @@ fn cancel_keeps_the_folds_before_it() {
             }
         })
     })
-    .unwrap();
+    .unwrap()
+}
+
+/// One fold after another (one thread), cancelling in the second fold keeps the first fold's
+/// result and says "Cancelled".
+#[test]
+fn cancel_keeps_the_folds_before_it() {
+    let mut seen = Vec::new();
+    let cv = cancelled_in_fold_two(1, &mut seen);
     assert_eq!(cv.status, "Cancelled");
     assert_eq!(cv.runs.len(), 1);
     assert!(cv.systems.iter().all(|s| s.fold == 1));
@@ -277,16 +283,7 @@ fn folds_side_by_side_agree_with_one_after_another_and_cancel_together() {
         );
     }
 
-    let cv = wslap::with_thread_limit(2, || {
-        cross_validate(&inputs(&cat, &none), &config(), 2, None, &mut |fold, _| {
-            if fold == 2 {
-                Control::Cancel
-            } else {
-                Control::Continue
-            }
-        })
-    })
-    .unwrap();
+    let cv = cancelled_in_fold_two(2, &mut Vec::new());
     assert_eq!(cv.status, "Cancelled");
     assert!(cv
         .runs
