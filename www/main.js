@@ -240,7 +240,7 @@ async function showResult(info) {
   showDownloads(info.kind, app);
   showIterates(info.kind === 'reconstruct' ? (await ask('iterates')).iterates : null);
   showEnsemble(info.summary?.ensemble_members ? await ask('ensembleInfo') : null, app);
-  if (currentView() === 'spread' && !info.summary?.ensemble_members) $('tab-kappa').click();
+  if (currentView() === 'spread' && $('tab-spread').hidden) $('tab-kappa').click();
 }
 
 function showProgress(on) {
@@ -320,6 +320,8 @@ async function ensemble(mainMs) {
   setStatus(`Done in ${(mainMs / 1000).toFixed(2)} s; ensemble of ${info.summary.ensemble_members} members in ${
     (info.ensemble_ms / 1000).toFixed(2)} s.`);
   await showResult(info);
+  // The project keeps the ensemble: a reload or a restarted worker shows it again.
+  await persist();
   await render();
 }
 

@@ -4,20 +4,23 @@
 //! share them: [`Session::ensemble_plan`] draws every member from the seed, any session with
 //! the same data and settings runs a member ([`Session::ensemble_member`]), and
 //! [`Session::set_ensemble`] combines them into the result's ensemble: its spread view, its
-//! files and the interval of the read-out.
+//! files and the interval of the read-out. A project keeps it ([`StoredEnsemble`]): its record
+//! and its five statistics maps, not the members' own maps.
 
 use glam::DVec2;
 use serde::{Deserialize, Serialize};
 
 use crate::error::BadFieldValue;
-use crate::map::Map;
+use crate::map::{Map, MapGeometry};
 use crate::reconstruct::{
-    check_ensemble_size, ConvergenceRecord, Ensemble, EnsembleMember, EnsemblePlan, MemberRun,
-    MemoryLimit, MAX_ENSEMBLE_MEMBERS,
+    check_ensemble_size, ConvergenceRecord, Ensemble, EnsembleMaps, EnsembleMember, EnsemblePlan,
+    MemberRun, MemoryLimit, MAX_ENSEMBLE_MEMBERS,
 };
 use crate::render::{KappaPlotOptions, Overlay};
 use crate::solver::Control;
+use base64::Engine as _;
 
+use super::data::MAX_STORED_FITS_BYTES;
 use super::outputs::pretty;
 use super::views::{points, ViewOptions, ViewPng, OBSERVED_RGB};
 use super::{AppError, Session};
@@ -285,4 +288,126 @@ pub fn member_run(
             data: magnif,
         },
     })
+}
+
+/// Most bytes of an ensemble's statistics maps a project keeps, as of a deflection FITS
+/// ([`MAX_STORED_FITS_BYTES`]): the five maps as `f32` up to 1024 x 1024 pixels. The app's
+/// 256 x 256 maps take 5 x 256² x 4 = 1 310 720 bytes, 1 747 628 characters of base64 (with
+/// the members' records, about 1.76 MB for 20 members); a larger ensemble keeps its record
+/// and intervals without the maps.
+pub const MAX_STORED_ENSEMBLE_MAP_BYTES: usize = MAX_STORED_FITS_BYTES;
+
+/// The statistics maps a project keeps, in the order of [`StoredEnsemble::maps_f32_base64`].
+const STORED_MAPS: usize = 5;
+
+/// An ensemble in a project file: its record (`ensemble.json`: members, intervals, note) and
+/// its statistics maps, `kappa_mean`, `kappa_std`, `magnif_p16`, `magnif_p50` and
+/// `magnif_p84` as little-endian `f32` in base64 (the read-out and the spread view need no
+/// more). The members' own maps (`range/`) are not kept: the app drops them once combined.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct StoredEnsemble {
+    pub record: Ensemble,
+    /// The maps' geometry: the reconstruction's map.
+    pub geometry: MapGeometry,
+    /// `5 x pixels²` values, map after map; `None` above [`MAX_STORED_ENSEMBLE_MAP_BYTES`].
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub maps_f32_base64: Option<String>,
+}
+
+impl StoredEnsemble {
+    /// `e` for a project file; `None` without its statistics maps (none to show again).
+    pub fn from_ensemble(e: &Ensemble) -> Option<Self> {
+        let maps = e.maps.as_ref()?;
+        let all = [
+            &maps.kappa_mean,
+            &maps.kappa_std,
+            &maps.magnif_p16,
+            &maps.magnif_p50,
+            &maps.magnif_p84,
+        ];
+        let bytes = all.iter().map(|m| m.data.len() * 4).sum::<usize>();
+        let maps_f32_base64 = (bytes <= MAX_STORED_ENSEMBLE_MAP_BYTES).then(|| {
+            let raw: Vec<u8> = all
+                .iter()
+                .flat_map(|m| m.data.iter().flat_map(|v| (*v as f32).to_le_bytes()))
+                .collect();
+            base64::engine::general_purpose::STANDARD.encode(raw)
+        });
+        Some(Self {
+            record: Ensemble {
+                maps: None,
+                ..e.clone()
+            },
+            geometry: maps.kappa_std.geometry,
+            maps_f32_base64,
+        })
+    }
+
+    /// The ensemble again, its maps checked against `geometry` (the restored result's map);
+    /// the error says what does not fit. Without stored maps, the record alone (the caption's
+    /// intervals; no spread view or read-out).
+    pub fn to_ensemble(&self, geometry: MapGeometry) -> Result<Ensemble, String> {
+        if self.record.members.is_empty() {
+            return Err("it has no members".to_string());
+        }
+        let mut e = Ensemble {
+            maps: None,
+            ..self.record.clone()
+        };
+        let Some(text) = &self.maps_f32_base64 else {
+            return Ok(e);
+        };
+        if self.geometry != geometry {
+            return Err(format!(
+                "its maps are of {}, the result's of {geometry}",
+                self.geometry
+            ));
+        }
+        let n = geometry.pixels.saturating_mul(geometry.pixels);
+        let want = n.saturating_mul(STORED_MAPS * 4);
+        if want > MAX_STORED_ENSEMBLE_MAP_BYTES || text.len() / 4 * 3 > want + 3 {
+            return Err(format!(
+                "its maps take more than the {MAX_STORED_ENSEMBLE_MAP_BYTES} bytes a project keeps"
+            ));
+        }
+        let bytes = base64::engine::general_purpose::STANDARD
+            .decode(text)
+            .map_err(|err| format!("its maps are not base64: {err}"))?;
+        if bytes.len() != want {
+            return Err(format!(
+                "its maps have {} bytes, not the {want} of five {p} x {p} maps",
+                bytes.len(),
+                p = geometry.pixels
+            ));
+        }
+        let values: Vec<f64> = bytes
+            .chunks_exact(4)
+            .map(|b| f64::from(f32::from_le_bytes([b[0], b[1], b[2], b[3]])))
+            .collect();
+        if values.iter().any(|v| !v.is_finite()) {
+            return Err("a value of its maps is not a finite number".to_string());
+        }
+        let maps: Vec<Map> = values
+            .chunks_exact(n.max(1))
+            .map(|data| Map {
+                geometry,
+                data: data.to_vec(),
+            })
+            .collect();
+        let Ok([kappa_mean, kappa_std, magnif_p16, magnif_p50, magnif_p84]) =
+            <[Map; STORED_MAPS]>::try_from(maps)
+        else {
+            return Err("its maps are not five maps".to_string());
+        };
+        e.maps = Some(EnsembleMaps {
+            kappa_mean,
+            kappa_std,
+            magnif_p16,
+            magnif_p50,
+            magnif_p84,
+            member_kappa: Vec::new(),
+            member_magnif: Vec::new(),
+        });
+        Ok(e)
+    }
 }

@@ -26,7 +26,9 @@ pub use data::{
     ArcPixels, DataMarks, DataRole, DataViews, LoadReport, LoadedData, ModelLens, NamedMap,
     NamedText, MAX_STORED_FITS_BYTES,
 };
-pub use ensemble::{member_run, EnsembleReadout, EnsembleSettings};
+pub use ensemble::{
+    member_run, EnsembleReadout, EnsembleSettings, StoredEnsemble, MAX_STORED_ENSEMBLE_MAP_BYTES,
+};
 pub use iterates::{
     IterateList, IterateStep, StoredIterates, APP_KEPT_ITERATES, MAX_STORED_ITERATE_VALUES,
 };

@@ -11,13 +11,20 @@
 //!  "result": {"kind": "reconstruct", "summary": {...}, "x": [...], "iterations": 8000,
 //!             "sources": [...], "convergence": [...],
 //!             "iterates": {"unknowns": 580, "steps": [{"iteration": 0, "objective": 1.2}, ...],
-//!                          "x_f32_base64": "..."}}}
+//!                          "x_f32_base64": "..."},
+//!             "ensemble": {"record": {...ensemble.json...}, "geometry": {...},
+//!                          "maps_f32_base64": "..."}}}
 //! ```
 //! The iterates are kept as `f32`, at most [`super::MAX_STORED_ITERATE_VALUES`] values (a run
 //! with more keeps every other one, [`StoredIterates::from_iterates`]).
 //! Deflection FITS files (look-up mode) are stored as base64 up to
 //! [`MAX_STORED_FITS_BYTES`] each; a larger one is left out (the app says so when it is
 //! loaded) and must be loaded again. Files without the deflection fields still read.
+//! A reconstruction's ensemble is kept with its five statistics maps as `f32`
+//! ([`StoredEnsemble`], at most [`super::MAX_STORED_ENSEMBLE_MAP_BYTES`]; 1.7 MB of base64 for
+//! the app's 256 x 256 maps), not the members' own maps. Files written before ensembles were
+//! kept read without one; a stored ensemble that does not read or fit the result is dropped and
+//! the reopen message says so, the rest of the project opens.
 //! `format` and `version` are read first: a file of another format, or of a version this build
 //! does not read (one saved by a newer wslap says so), is refused before its other fields are.
 
@@ -27,6 +34,7 @@ use crate::limits::json_error_message;
 use crate::reconstruct::{ConvergenceRecord, SourceReport};
 
 use super::data::{NamedText, MAX_STORED_FITS_BYTES};
+use super::ensemble::StoredEnsemble;
 use super::iterates::StoredIterates;
 use super::outputs::pretty;
 use super::run::RunKind;
@@ -129,6 +137,11 @@ pub struct ProjectResult {
     /// files written before them, and for other results).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub iterates: Option<StoredIterates>,
+    /// The ensemble run after a reconstruction ([`StoredEnsemble`]), absent in files written
+    /// before projects kept it and without one. Read as any JSON here, so that one that does
+    /// not read drops the ensemble, not the project.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub ensemble: Option<serde_json::Value>,
 }
 
 /// A saved session.
@@ -157,6 +170,37 @@ pub struct ReopenReport {
 }
 
 impl Session {
+    /// Puts the `stored` ensemble (a project's, as JSON) on the restored reconstruction; what
+    /// the reopen message adds: "" without one, else whether it was restored or dropped and why.
+    fn restore_ensemble(&mut self, stored: Option<serde_json::Value>) -> String {
+        let Some(value) = stored else {
+            return String::new();
+        };
+        let Some(result) = self.result.as_mut() else {
+            return String::new();
+        };
+        let geometry = result.products().maps.geometry();
+        let restored = serde_json::from_value::<StoredEnsemble>(value)
+            .map_err(|e| format!("it does not read: {e}"))
+            .and_then(|s| s.to_ensemble(geometry));
+        match restored {
+            Ok(e) => {
+                let n = e.members.len();
+                let without = if e.maps.is_none() {
+                    " (its intervals only: its maps were too large to keep, run it again for \
+                     the spread view)"
+                } else {
+                    ""
+                };
+                result.ensemble = Some(Box::new(e));
+                format!("; its ensemble of {n} members restored{without}")
+            }
+            Err(e) => format!(
+                "; its stored ensemble was dropped ({e}): press Reconstruct to run it again"
+            ),
+        }
+    }
+
     /// The project of this session (pretty JSON).
     pub fn project_json(&self) -> Result<String, AppError> {
         let d = &self.data;
@@ -186,6 +230,16 @@ impl Session {
                 iterates: r
                     .reconstruction()
                     .and_then(|x| StoredIterates::from_iterates(&x.iterates)),
+                ensemble: match r
+                    .ensemble
+                    .as_deref()
+                    .and_then(StoredEnsemble::from_ensemble)
+                {
+                    None => None,
+                    Some(e) => {
+                        Some(serde_json::to_value(e).map_err(|e| AppError::Run(e.to_string()))?)
+                    }
+                },
             }),
         };
         pretty(&Project {
@@ -270,10 +324,15 @@ impl Session {
                         r.sources,
                         iterates,
                     ) {
-                        Ok(()) => (
-                            "restored",
-                            format!("maps rebuilt from the stored solution X{dropped}"),
-                        ),
+                        Ok(()) => {
+                            let ensemble = next.restore_ensemble(r.ensemble);
+                            (
+                                "restored",
+                                format!(
+                                    "maps rebuilt from the stored solution X{dropped}{ensemble}"
+                                ),
+                            )
+                        }
                         Err(e) => (
                             "solve_needed",
                             format!("the stored solution was not used ({e}): reconstruct again"),

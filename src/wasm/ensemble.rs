@@ -97,10 +97,15 @@ impl AppSession {
         self.result_info()
     }
 
-    /// The result's ensemble (`ensemble.json` as an object), or `null`.
+    /// The result's ensemble (`ensemble.json` as an object, with `maps`: whether its
+    /// statistics maps are at hand, for the spread view, the read-out and the FITS), or `null`.
     pub fn ensemble_info(&self) -> Result<JsValue, JsError> {
         match self.inner.ensemble() {
-            Some(e) => to_js(e),
+            Some(e) => {
+                let mut info = serde_json::to_value(e).map_err(|e| JsError::new(&e.to_string()))?;
+                info["maps"] = serde_json::Value::Bool(e.maps.is_some());
+                to_js(&info)
+            }
             None => Ok(JsValue::NULL),
         }
     }

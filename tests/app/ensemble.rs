@@ -218,3 +218,193 @@ fn the_ensemble_shows_in_the_summary_files_view_and_read_out() {
         .ensemble
         .is_none());
 }
+
+/// The teaching session with a combined ensemble of `members` (seed 7) on maps of `pixels`,
+/// as the app makes it.
+fn with_ensemble(members: usize, pixels: usize) -> Session {
+    let mut s = teaching_session();
+    s.set_field("reconstruct.products.pixels", json!(pixels))
+        .unwrap();
+    s.set_field("ensemble.members", json!(members)).unwrap();
+    s.set_field("ensemble.seed", json!(7)).unwrap();
+    s.run(RunKind::Reconstruct, &mut |_| Control::Continue)
+        .unwrap();
+    let plan = s.ensemble_plan().unwrap().unwrap();
+    let runs = (1..=members)
+        .map(|k| {
+            s.ensemble_member(&plan, k, &mut |_| Control::Continue)
+                .unwrap()
+        })
+        .collect();
+    s.set_ensemble(&plan, runs, true).unwrap();
+    s
+}
+
+/// Largest difference of two maps relative to `f32` rounding of the first's values.
+fn worst_in_f32_steps(a: &wslap::Map, b: &wslap::Map) -> f64 {
+    assert_eq!(a.geometry, b.geometry);
+    a.data
+        .iter()
+        .zip(&b.data)
+        .map(|(p, q)| (p - q).abs() / (p.abs() * f64::from(f32::EPSILON)).max(f64::MIN_POSITIVE))
+        .fold(0.0, f64::max)
+}
+
+/// A project keeps the ensemble: after save and open, the same record (members, intervals,
+/// note), the statistics maps to `f32` precision, the same read-out, spread view and files.
+#[cfg_attr(not(target_arch = "wasm32"), test)]
+#[cfg_attr(target_arch = "wasm32", wasm_bindgen_test::wasm_bindgen_test)]
+fn an_ensemble_survives_save_and_open() {
+    // The app's maps (APP_MAP_PIXELS), to measure what a project stores for them.
+    let s = with_ensemble(3, wslap::app::APP_MAP_PIXELS);
+    let text = s.project_json().unwrap();
+    let mut t = Session::new();
+    let report = t.open_project(&text, "p.json").unwrap();
+    assert_eq!(report.result, "restored", "{}", report.message);
+    assert!(
+        report.message.contains("ensemble of 3 members restored"),
+        "{}",
+        report.message
+    );
+    let (a, b) = (s.ensemble().unwrap(), t.ensemble().expect("the ensemble"));
+    assert_eq!(a.members, b.members);
+    assert_eq!(
+        a.einstein_radius_interval_arcsec,
+        b.einstein_radius_interval_arcsec
+    );
+    assert_eq!(a.mass_within_interval_msun, b.mass_within_interval_msun);
+    assert_eq!((&a.note, &a.status, a.seed), (&b.note, &b.status, b.seed));
+    let (ma, mb) = (a.maps.as_ref().unwrap(), b.maps.as_ref().unwrap());
+    // Stored as f32: each value within one f32 rounding (half an epsilon, relative).
+    const F32_STEPS: f64 = 0.5;
+    for (what, p, q) in [
+        ("kappa_mean", &ma.kappa_mean, &mb.kappa_mean),
+        ("kappa_std", &ma.kappa_std, &mb.kappa_std),
+        ("magnif_p16", &ma.magnif_p16, &mb.magnif_p16),
+        ("magnif_p50", &ma.magnif_p50, &mb.magnif_p50),
+        ("magnif_p84", &ma.magnif_p84, &mb.magnif_p84),
+    ] {
+        let worst = worst_in_f32_steps(p, q);
+        assert!(worst <= F32_STEPS, "{what}: {worst} f32 epsilons off");
+    }
+    // The stored size of the app's 256 x 256 maps: five maps of f32 in base64.
+    let p: serde_json::Value = serde_json::from_str(&text).unwrap();
+    let stored = &p["result"]["ensemble"];
+    assert_eq!(stored["geometry"]["pixels"], 256);
+    let maps_chars = stored["maps_f32_base64"].as_str().unwrap().len();
+    assert_eq!(maps_chars, (5 * 256 * 256 * 4_usize).div_ceil(3) * 4);
+    eprintln!(
+        "stored ensemble of 3 members: {} bytes of JSON, {maps_chars} of them the maps; \
+         project {} bytes",
+        stored.to_string().len(),
+        text.len()
+    );
+    // What the page shows of it: caption intervals, read-out, spread view, files.
+    let sum = |s: &Session| -> serde_json::Value {
+        serde_json::from_str(&s.result().unwrap().summary_json().unwrap()).unwrap()
+    };
+    let (sa, sb) = (sum(&s), sum(&t));
+    for key in [
+        "einstein_radius_interval_arcsec",
+        "mass_within_interval_msun",
+        "ensemble_members",
+    ] {
+        assert_eq!(sa[key], sb[key], "{key}");
+    }
+    let at = |s: &Session| {
+        s.hover(&ViewOptions::default(), 300.0, 300.0)
+            .unwrap()
+            .unwrap()
+            .ensemble
+            .expect("the ensemble's values")
+    };
+    let (ea, eb) = (at(&s), at(&t));
+    assert_eq!(ea.members, eb.members);
+    const READOUT_RTOL: f64 = 1e-6;
+    for (p, q) in [
+        (ea.magnification_p16, eb.magnification_p16),
+        (ea.magnification_p50, eb.magnification_p50),
+        (ea.magnification_p84, eb.magnification_p84),
+        (ea.kappa_std, eb.kappa_std),
+    ] {
+        assert!((p - q).abs() <= READOUT_RTOL * p.abs().max(1e-6), "{p} {q}");
+    }
+    assert!(t
+        .spread_view(&ViewOptions::default())
+        .unwrap()
+        .png
+        .starts_with(PNG_MAGIC));
+    let names = |s: &Session| -> Vec<String> {
+        s.ensemble_files()
+            .unwrap()
+            .into_iter()
+            .map(|(n, _)| n)
+            .collect()
+    };
+    assert_eq!(names(&s), names(&t));
+    // Saved again, the reopened project keeps it as it was read.
+    let again: serde_json::Value = serde_json::from_str(&t.project_json().unwrap()).unwrap();
+    assert_eq!(again["result"]["ensemble"], *stored);
+}
+
+/// A project saved before projects kept ensembles opens without one; a stored ensemble that
+/// does not read or does not fit the result is dropped with a message, the project opens.
+#[cfg_attr(not(target_arch = "wasm32"), test)]
+#[cfg_attr(target_arch = "wasm32", wasm_bindgen_test::wasm_bindgen_test)]
+fn an_old_or_corrupt_stored_ensemble_still_opens_the_project() {
+    let s = with_ensemble(2, 64);
+    let p: serde_json::Value = serde_json::from_str(&s.project_json().unwrap()).unwrap();
+    let open = |p: &serde_json::Value| {
+        let mut t = Session::new();
+        let report = t.open_project(&p.to_string(), "p.json").unwrap();
+        assert_eq!(report.result, "restored", "{}", report.message);
+        (t, report.message)
+    };
+    let mut old = p.clone();
+    old["result"].as_object_mut().unwrap().remove("ensemble");
+    let (t, message) = open(&old);
+    assert!(t.ensemble().is_none());
+    assert!(!message.contains("ensemble"), "{message}");
+    let corrupt = |path: &[&str], value: serde_json::Value| {
+        let mut q = p.clone();
+        let mut at = &mut q["result"]["ensemble"];
+        for key in path {
+            at = &mut at[*key];
+        }
+        *at = value;
+        q
+    };
+    let maps = p["result"]["ensemble"]["maps_f32_base64"].as_str().unwrap();
+    for (case, q, why) in [
+        ("not an object", corrupt(&[], json!("x")), "does not read"),
+        (
+            "no members",
+            corrupt(&["record", "members"], json!([])),
+            "no members",
+        ),
+        (
+            "not base64",
+            corrupt(&["maps_f32_base64"], json!("!!!!")),
+            "not base64",
+        ),
+        (
+            "cut short",
+            corrupt(&["maps_f32_base64"], json!(&maps[..maps.len() / 8 * 4])),
+            "bytes, not the",
+        ),
+        (
+            "another map",
+            corrupt(&["geometry", "pixels"], json!(128)),
+            "the result's of",
+        ),
+    ] {
+        let (t, message) = open(&q);
+        assert!(t.ensemble().is_none(), "{case}");
+        assert!(
+            message.contains("stored ensemble was dropped") && message.contains(why),
+            "{case}: {message}"
+        );
+        // The rest of the result is there.
+        assert!(t.result().unwrap().reconstruction().is_some(), "{case}");
+    }
+}

@@ -2,7 +2,7 @@
 // Reconstruct, spread over a pool of workers (www/js/ensemble.js) with one progress bar; the
 // result gains the spread view, the ensemble's downloads, its intervals in the caption and its
 // values in the read-out. Cancel during the members stops every worker and leaves the app
-// usable.
+// usable. The project kept in the browser keeps the ensemble: a reload shows it again.
 import { test } from 'node:test';
 import assert from 'node:assert/strict';
 import { readFile } from 'node:fs/promises';
@@ -124,6 +124,93 @@ test('Cancel during the members stops every worker and the app stays usable', as
     await waitStatus(page, ENSEMBLE_DONE, 300_000);
     assert.equal(Number((await page.textContent('#status')).match(ENSEMBLE_DONE)[1]), 2);
     assert.equal(poolWorkers(page).length, 0);
+    assert.deepEqual(app.consoleErrors, []);
+  } finally {
+    await app.close();
+  }
+});
+
+test('a reload shows the ensemble again: caption interval, spread view, read-out, downloads', async () => {
+  const app = await openApp({ query: '?app&workers=2', height: 720 });
+  try {
+    const { page } = app;
+    await waitStatus(page, /^Ready/);
+    await setField(page, '#set-ensemble-members', 2);
+    await page.click('#reconstruct');
+    await waitStatus(page, ENSEMBLE_DONE, 300_000);
+    const interval = (await page.textContent('#summary')).match(/Ensemble of 2 members \(16th – 84th percentile\): Einstein radius \d+\.\d – \d+\.\d″/);
+    assert.ok(interval, await page.textContent('#summary'));
+    // The project in IndexedDB has the ensemble once it is saved after the members.
+    await page.waitForFunction(() => new Promise((resolve) => {
+      const open = indexedDB.open('wslap', 1);
+      open.onsuccess = () => {
+        const db = open.result;
+        const req = db.transaction('projects', 'readonly').objectStore('projects').get('current');
+        req.onsuccess = () => { db.close(); resolve(/"maps_f32_base64"/.test(req.result ?? '')); };
+      };
+    }), null, { timeout: 30_000 });
+
+    await page.reload();
+    await waitStatus(page, /^Restored your project from this browser/, 120_000);
+    assert.ok((await page.textContent('#summary')).includes(interval[0]), `${await page.textContent('#summary')} / ${await page.textContent('#project-description')}`);
+    assert.match(await page.textContent('#project-description'), /its ensemble of 2 members restored/);
+    assert.match(await page.innerText('#ensemble-summary'), /Einstein radius at z_s = 3, 16th – 84th percentile/);
+    assert.equal(await page.isVisible('#tab-spread'), true);
+    const before = await renderCount(page);
+    await page.click('#tab-spread');
+    await waitView(page, 'spread', before);
+    const stats = await imageStats(page, '#view-image');
+    assert.ok(stats.distinctColours > 50, `spread figure has ${stats.distinctColours} colours`);
+    await page.screenshot({ path: join(ARTIFACTS, 'app-ensemble-reloaded.png') });
+    const back = await renderCount(page);
+    await page.click('#tab-kappa');
+    await waitView(page, 'kappa', back);
+    const box = await page.locator('#view-image').boundingBox();
+    await page.mouse.click(box.x + box.width * 0.45, box.y + box.height * 0.4);
+    await page.waitForFunction(() => /^Clicked: .*ensemble of 2: κ std \d\.\d{3}, μ 16–84% -?\d+\.\d\d to -?\d+\.\d\d/
+      .test(document.getElementById('readout').textContent), null, { timeout: 30_000 });
+    // The downloads made from what the project keeps, and what it does not keep said there.
+    await page.click('#downloads-panel summary');
+    const f = await download(page, 'dl-magnif-p84-fits-panel');
+    assert.deepEqual(fitsAxes(f.bytes), [256, 256]);
+    assert.match(f.bytes.subarray(0, 2880 * 2).toString('latin1'), /NMEMBERS= +2/);
+    assert.match(await page.innerText('#ensemble-downloads'), /members' own maps \(range\/.*\) are not kept by the app/);
+    await page.click('#downloads-panel summary');
+    await page.locator('#ensemble-box').scrollIntoViewIfNeeded();
+    await page.screenshot({ path: join(ARTIFACTS, 'app-ensemble-reloaded-box.png') });
+    await page.setViewportSize({ width: 390, height: 844 });
+    const overflow = await page.evaluate(() => document.documentElement.scrollWidth - window.innerWidth);
+    assert.ok(overflow <= 0, `page is ${overflow}px wider than a phone`);
+    await page.locator('#ensemble-box').screenshot({ path: join(ARTIFACTS, 'app-ensemble-reloaded-phone.png') });
+
+    // A project that kept the intervals only (maps above the size a project keeps): the caption
+    // and the intervals, no spread view, and the page says why and what to do.
+    await page.setViewportSize({ width: 1280, height: 720 });
+    await page.evaluate(() => new Promise((resolve, reject) => {
+      const open = indexedDB.open('wslap', 1);
+      open.onsuccess = () => {
+        const db = open.result;
+        const tx = db.transaction('projects', 'readwrite');
+        const store = tx.objectStore('projects');
+        const req = store.get('current');
+        req.onsuccess = () => {
+          const p = JSON.parse(req.result);
+          delete p.result.ensemble.maps_f32_base64;
+          store.put(JSON.stringify(p), 'current');
+        };
+        tx.oncomplete = () => { db.close(); resolve(); };
+        tx.onerror = () => reject(tx.error);
+      };
+    }));
+    await page.reload();
+    await waitStatus(page, /^Restored your project from this browser/, 120_000);
+    assert.ok((await page.textContent('#summary')).includes(interval[0]));
+    assert.match(await page.textContent('#project-description'), /its ensemble of 2 members restored \(its intervals only/);
+    assert.equal(await page.isHidden('#tab-spread'), true);
+    assert.match(await page.innerText('#ensemble-box'), /kept its intervals only .* press Reconstruct to run it again/);
+    assert.equal(await page.locator('#dl-kappa-std-fits').count(), 0);
+    assert.equal(await page.locator('#dl-ensemble-json').count(), 1);
+    await page.locator('#ensemble-box').screenshot({ path: join(ARTIFACTS, 'app-ensemble-intervals-only.png') });
     assert.deepEqual(app.consoleErrors, []);
   } finally {
     await app.close();

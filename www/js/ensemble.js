@@ -151,15 +151,18 @@ export function ensembleReadout(h) {
 
 const FITS = ['kappa-mean.fits', 'kappa-std.fits', 'magnif-p16.fits', 'magnif-p50.fits', 'magnif-p84.fits'];
 
-/** Shows the result's ensemble (`ensemble`: ensemble.json as the worker gives it, or null)
- * under the views, with its downloads; adds them to the downloads panel and shows or hides
- * the spread tab. `app` gives the files (`ensembleFiles`, `textFile`) and shows errors. */
+/** Shows the result's ensemble (`ensemble`: ensemble.json as the worker gives it, with `maps`
+ * false when a reopened project kept its intervals only, or null) under the views, with its
+ * downloads; adds them to the downloads panel and shows or hides the spread tab. `app` gives
+ * the files (`ensembleFiles`, `textFile`) and shows errors. */
 export function showEnsemble(ensemble, app) {
   const box = document.getElementById('ensemble-box');
   const tab = document.getElementById('tab-spread');
   document.getElementById('ensemble-downloads')?.remove();
   shown = ensemble;
-  tab.hidden = !ensemble;
+  // A project keeps the ensemble's statistics maps up to a size: without them, no spread.
+  const maps = ensemble?.maps !== false;
+  tab.hidden = !ensemble || !maps;
   if (!ensemble) {
     box.replaceChildren();
     box.hidden = true;
@@ -173,10 +176,23 @@ export function showEnsemble(ensemble, app) {
   const json = () => app.textFile('ensemble.json')
     .then((t) => save('ensemble.json', new Blob([t], { type: 'application/json' })), fail);
   const buttons = () => [
-    ...FITS.map((name) => button(name, `dl-${name.replaceAll('.', '-')}`, file(name))),
+    ...(maps ? FITS.map((name) => button(name, `dl-${name.replaceAll('.', '-')}`, file(name))) : []),
     button('ensemble.json', 'dl-ensemble-json', json),
-    button('kappa-std.png', 'dl-kappa-std-png', file('kappa-std.png')),
+    ...(maps ? [button('kappa-std.png', 'dl-kappa-std-png', file('kappa-std.png'))] : []),
   ];
+  // What is not offered, said where the downloads are.
+  const missing = () => {
+    const p = document.createElement('p');
+    p.className = 'hint ensemble-missing';
+    const cli = document.createElement('code');
+    cli.textContent = `wslap reconstruct --ensemble ${n} --seed ${ensemble.seed}`;
+    cli.style.whiteSpace = 'nowrap';
+    p.append(`${maps ? '' : 'This ensemble was reopened from a project that kept its intervals only '
+      + '(its maps were too large to keep): press Reconstruct to run it again for its maps, the spread and the '
+      + 'magnification intervals. '}The members' own maps (range/, one κ and one μ map per member) are not kept by `
+      + 'the app; ', cli, ' writes them.');
+    return p;
+  };
   const r = ensemble.einstein_radius_interval_arcsec;
   const radii = ensemble.members.map((m) => m.einstein_radius_arcsec).filter(Number.isFinite);
   const masses = (ensemble.mass_within_interval_msun ?? []).map(([within, m]) =>
@@ -187,9 +203,9 @@ export function showEnsemble(ensemble, app) {
     percentile: <b>${r ? `${fixed(r[0], 2)} – ${fixed(r[1], 2)}″` : 'none'}</b>${radii.length ? ` (members
     ${fixed(Math.min(...radii), 2)} – ${fixed(Math.max(...radii), 2)}″)` : ''}. Projected mass:</p>
     <ul id="ensemble-masses">${masses}</ul>
-    <p class="hint">${ensemble.note} The tab "Ensemble spread" shows the standard deviation of κ; a click on the
-    mass map reads out the magnification's interval.</p>`;
-  box.append(...buttons());
+    <p class="hint">${ensemble.note}${maps ? ` The tab "Ensemble spread" shows the standard deviation of κ; a click
+    on the mass map reads out the magnification's interval.` : ''}</p>`;
+  box.append(...buttons(), missing());
   box.hidden = false;
   const group = document.createElement('div');
   group.className = 'download-group';
@@ -200,6 +216,7 @@ export function showEnsemble(ensemble, app) {
     b.id = `${b.id}-panel`;
     group.append(b);
   }
+  group.append(missing());
   const downloads = document.getElementById('downloads');
   downloads.insertBefore(group, downloads.lastElementChild);
 }
