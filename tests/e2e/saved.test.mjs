@@ -27,16 +27,15 @@ function idb(page, op, key, value) {
 /** The project text the app saved, once it matches `pattern`. */
 async function savedText(page, pattern = /wslap-project/) {
   await waitStatus(page, /^Ready/);
-  await page.waitForFunction((src) => new Promise((resolve) => {
-    const open = indexedDB.open('wslap', 1);
-    open.onsuccess = () => {
-      const db = open.result;
-      const tx = db.transaction('projects', 'readonly');
-      const req = tx.objectStore('projects').get('current');
-      tx.oncomplete = () => { db.close(); resolve(new RegExp(src).test(req.result ?? '')); };
-    };
-  }), pattern.source);
-  return idb(page, 'get', 'current');
+  // Polled here: `waitForFunction` takes a returned promise as a truthy value and does not
+  // wait for it.
+  const deadline = Date.now() + 30000;
+  for (;;) {
+    const text = await idb(page, 'get', 'current');
+    if (pattern.test(text ?? '')) return text;
+    assert.ok(Date.now() < deadline, `no saved project matching ${pattern} after 30 s`);
+    await new Promise((r) => setTimeout(r, 200));
+  }
 }
 
 test('a corrupt and a too-new saved project are set aside, downloadable, and the app opens', async () => {
