@@ -11,7 +11,7 @@ import { wireFigureDownload } from './js/figure-download.js';
 import { StrengthPool, poolSize, projectForTrials } from './js/pool.js';
 import { wireIterates, showIterates, syncIterates, iterateOption } from './js/iterates.js';
 import { showVerdict } from './js/verdict.js';
-import { wireLocate } from './js/coords.js';
+import { wireLocate, locateExamples } from './js/coords.js';
 import { runEnsemble, showEnsemble, ensembleCaption } from './js/ensemble.js';
 
 // Offline use once loaded (sw.js), for the lessons and the playground too. Without it (an old
@@ -241,6 +241,8 @@ async function showResult(info) {
   showIterates(info.kind === 'reconstruct' ? (await ask('iterates')).iterates : null);
   showEnsemble(info.summary?.ensemble_members ? await ask('ensembleInfo') : null, app);
   if (currentView() === 'spread' && $('tab-spread').hidden) $('tab-kappa').click();
+  // The position box's examples at these data's sky reference.
+  locateExamples(await app.pointReadout([0, 0]).catch(() => null));
 }
 
 function showProgress(on) {

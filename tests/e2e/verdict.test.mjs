@@ -137,6 +137,10 @@ test('a typed coordinate reads out κ, μ and the counter-images without the mou
     const { page } = app;
     // The example's frame: offsets from its sky reference (members.cat's #REFERENCE).
     const [ra0, dec0] = [197.872917, -1.341111];
+    // The box's examples are this cluster's reference, not another's.
+    await page.waitForFunction((deg) => document.getElementById('locate-help').textContent.includes(deg),
+      `(${ra0.toFixed(4)} ${dec0.toFixed(4)})`);
+    assert.match(await page.getAttribute('#locate-input', 'placeholder'), /^13:11:29\.\d\d -01:20:28\.\d$/);
     const [x, y] = [-40.0, -20.0];
     const ra = ra0 - x / 3600 / Math.cos(dec0 * Math.PI / 180);
     const dec = dec0 + y / 3600;

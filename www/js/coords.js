@@ -59,6 +59,29 @@ export function counterImagesText(c) {
     `${items.join('; ')}. ${atPoint}; ${found}.`;
 }
 
+/** The box's help, its examples at the data's sky reference (`h`: the read-out at the frame's
+ * origin, or null before any result). */
+function locateHelp(h) {
+  const what = 'κ, μ and the images of the source behind it.';
+  if (!h) {
+    return `RA Dec in degrees (342.1832 -44.5309) or sexagesimal (22:48:43.97 -44:31:51.2), or x y in
+      arcsec from the reference (12.5 -3.2 arcsec): ${what}`;
+  }
+  if (!h.radec_sexagesimal) return `x y in arcsec from the frame's origin (12.5 -3.2; these data give no sky reference): ${what}`;
+  return `RA Dec in degrees (${fmt(h.radec_deg[0], 4)} ${fmt(h.radec_deg[1], 4)}) or sexagesimal
+    (${h.radec_sexagesimal}), or x y in arcsec from the reference (12.5 -3.2 arcsec): ${what}`;
+}
+
+/** Gives the position box examples at the loaded data's sky reference: `h` is the read-out at
+ * the frame's origin (0, 0). */
+export function locateExamples(h) {
+  const help = document.getElementById('locate-help');
+  const input = document.getElementById('locate-input');
+  if (!help || !input) return;
+  help.textContent = locateHelp(h).replace(/\s+/g, ' ');
+  input.placeholder = h?.radec_sexagesimal ?? '12.5 -3.2';
+}
+
 /** Adds the box for a typed position after the read-out. `locate(text)` resolves to the point
  * (`{x_arcsec, y_arcsec, form_words}`) or rejects with the core's message; `pinAt(point)` pins
  * it as a click on the map would. */
@@ -71,9 +94,7 @@ export function wireLocate({ locate, pinAt }) {
     <span class="locate-row"><input id="locate-input" type="text" autocomplete="off" spellcheck="false"
       placeholder="22:48:43.97 -44:31:51.2" aria-describedby="locate-help locate-error">
     <button type="submit" id="locate-go" class="secondary">Show</button></span>
-    <span id="locate-help" class="hint">RA Dec in degrees (342.1832 -44.5309) or sexagesimal
-      (22:48:43.97 -44:31:51.2), or x y in arcsec from the reference (12.5 -3.2 arcsec): κ, μ and the
-      images of the source behind it.</span>
+    <span id="locate-help" class="hint">${locateHelp(null)}</span>
     <span id="locate-error" class="field-error" role="alert"></span>`;
   const input = form.querySelector('#locate-input');
   const error = form.querySelector('#locate-error');
