@@ -384,8 +384,10 @@ impl StoredEnsemble {
             .chunks_exact(4)
             .map(|b| f64::from(f32::from_le_bytes([b[0], b[1], b[2], b[3]])))
             .collect();
-        if values.iter().any(|v| !v.is_finite()) {
-            return Err("a value of its maps is not a finite number".to_string());
+        // kappa is finite wherever there is a map; a magnification may not be (at a critical
+        // curve, or beyond f32's range), and is kept as stored.
+        if values[..2 * n].iter().any(|v| !v.is_finite()) {
+            return Err("a value of its kappa maps is not a finite number".to_string());
         }
         let maps: Vec<Map> = values
             .chunks_exact(n.max(1))

@@ -375,7 +375,30 @@ fn an_old_or_corrupt_stored_ensemble_still_opens_the_project() {
         q
     };
     let maps = p["result"]["ensemble"]["maps_f32_base64"].as_str().unwrap();
+    // The stored maps with a NaN as value `index` (map after map).
+    let nan_at = |index: usize| {
+        use base64::Engine as _;
+        let b64 = base64::engine::general_purpose::STANDARD;
+        let mut raw = b64.decode(maps).unwrap();
+        raw[4 * index..4 * index + 4].copy_from_slice(&f32::NAN.to_le_bytes());
+        corrupt(&["maps_f32_base64"], json!(b64.encode(raw)))
+    };
+    let pixels = p["result"]["ensemble"]["geometry"]["pixels"]
+        .as_u64()
+        .unwrap() as usize;
+    // A magnification need not be finite (at a critical curve): the ensemble is kept.
+    let (t, message) = open(&nan_at(3 * pixels * pixels + 5));
+    assert!(t.ensemble().is_some(), "{message}");
+    assert!(
+        message.contains("ensemble of 2 members restored"),
+        "{message}"
+    );
     for (case, q, why) in [
+        (
+            "kappa not finite",
+            nan_at(7),
+            "kappa maps is not a finite number",
+        ),
         ("not an object", corrupt(&[], json!("x")), "does not read"),
         (
             "no members",
