@@ -97,26 +97,13 @@ pub fn for_each<T: Send>(jobs: Vec<T>, threads: usize, f: impl Fn(T) + Sync) {
 /// running `f` with a limit of one thread (so that the whole stays within the caller's
 /// limit); in order. On one thread (and on wasm32) the items run here, one after another.
 pub fn map_items<T: Sync, R: Send>(items: &[T], f: impl Fn(&T) -> R + Sync) -> Vec<R> {
-    let threads = available().min(items.len());
-    if threads <= 1 {
-        return items.iter().map(f).collect();
-    }
-    let next = AtomicUsize::new(0);
-    let mut out: Vec<Option<R>> = (0..items.len()).map(|_| None).collect();
-    let done = Mutex::new(&mut out);
-    std::thread::scope(|scope| {
-        for _ in 0..threads {
-            scope.spawn(|| loop {
-                let i = next.fetch_add(1, Ordering::Relaxed);
-                let Some(item) = items.get(i) else { break };
-                let r = with_limit(1, || f(item));
-                done.lock().unwrap_or_else(|e| e.into_inner())[i] = Some(r);
-            });
-        }
-    });
-    out.into_iter()
-        .map(|r| r.expect("every item was run"))
-        .collect()
+    // Nothing reported, nothing to stop: every item runs.
+    map_reporting(items, available(), |item, _| f(item), &mut |_, ()| {
+        ControlFlow::Continue(())
+    })
+    .into_iter()
+    .map(|r| r.expect("every item was run"))
+    .collect()
 }
 
 /// `run` of every item, side by side as in [`map_items`] on at most `threads` threads, each
