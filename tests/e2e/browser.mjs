@@ -192,6 +192,35 @@ export async function waitStatus(page, pattern, timeout = 60_000) {
   }
 }
 
+/** Runs `op` ('get', 'put', 'keys') on the app's IndexedDB store from the page. */
+export function idb(page, op, key, value) {
+  return page.evaluate(([op, key, value]) => new Promise((resolve, reject) => {
+    const open = indexedDB.open('wslap', 1);
+    open.onupgradeneeded = () => open.result.createObjectStore('projects');
+    open.onerror = () => reject(open.error);
+    open.onsuccess = () => {
+      const db = open.result;
+      const tx = db.transaction('projects', op === 'put' ? 'readwrite' : 'readonly');
+      const s = tx.objectStore('projects');
+      const req = op === 'put' ? s.put(value, key) : op === 'get' ? s.get(key) : s.getAllKeys();
+      tx.oncomplete = () => { db.close(); resolve(req.result); };
+      tx.onerror = () => reject(tx.error);
+    };
+  }), [op, key, value]);
+}
+
+/** The project text the app keeps in IndexedDB, once it matches `pattern` (polled: Playwright's
+ * `waitForFunction` takes a returned promise as a true value and does not wait for it). */
+export async function savedProject(page, pattern = /wslap-project/, timeout = 30_000) {
+  const deadline = Date.now() + timeout;
+  for (;;) {
+    const text = await idb(page, 'get', 'current');
+    if (pattern.test(text ?? '')) return text;
+    if (Date.now() >= deadline) throw new Error(`no saved project matching ${pattern} after ${timeout / 1000} s`);
+    await new Promise((r) => setTimeout(r, 200));
+  }
+}
+
 /** [NAXIS1, NAXIS2] of a FITS file's primary header. */
 export function fitsAxes(bytes) {
   const header = bytes.subarray(0, 2880 * 4).toString('latin1');

@@ -7,7 +7,7 @@ import { test } from 'node:test';
 import assert from 'node:assert/strict';
 import { readFile } from 'node:fs/promises';
 import { join } from 'node:path';
-import { openApp, ARTIFACTS, fitsAxes, imageStats, renderCount, setField, waitStatus, waitView } from './browser.mjs';
+import { idb, openApp, ARTIFACTS, fitsAxes, imageStats, renderCount, savedProject, setField, waitStatus, waitView } from './browser.mjs';
 
 // The pool workers' URLs carry `worker=pool-N` (lens-client.js).
 const POOL = /[?&]worker=pool-\d+/;
@@ -130,21 +130,6 @@ test('Cancel during the members stops every worker and the app stays usable', as
   }
 });
 
-/** The project text the page keeps in IndexedDB ('' before any). `page.evaluate` awaits the
- * promise (`waitForFunction` would take the promise itself for a true value). */
-function savedProject(page) {
-  return page.evaluate(() => new Promise((resolve, reject) => {
-    const open = indexedDB.open('wslap', 1);
-    open.onerror = () => reject(open.error);
-    open.onsuccess = () => {
-      const db = open.result;
-      const req = db.transaction('projects', 'readonly').objectStore('projects').get('current');
-      req.onsuccess = () => { db.close(); resolve(req.result ?? ''); };
-      req.onerror = () => reject(req.error);
-    };
-  }));
-}
-
 test('a restarted worker and a reload show the ensemble again: caption, spread view, read-out, downloads', async () => {
   const app = await openApp({ query: '?app&workers=2', height: 720 });
   try {
@@ -156,11 +141,7 @@ test('a restarted worker and a reload show the ensemble again: caption, spread v
     const interval = (await page.textContent('#summary')).match(/Ensemble of 2 members \(16th – 84th percentile\): Einstein radius \d+\.\d – \d+\.\d″/);
     assert.ok(interval, await page.textContent('#summary'));
     // The project in IndexedDB has the ensemble once it is saved after the members.
-    const t0 = Date.now();
-    while (!/"maps_f32_base64"/.test(await savedProject(page))) {
-      assert.ok(Date.now() - t0 < 30_000, 'the project with the ensemble was not saved');
-      await new Promise((r) => setTimeout(r, 200));
-    }
+    await savedProject(page, /"maps_f32_base64"/);
 
     // The main worker dies: the page starts another one with the session, ensemble included.
     const main = page.workers().filter((w) => !POOL.test(w.url())).at(-1);
@@ -206,22 +187,9 @@ test('a restarted worker and a reload show the ensemble again: caption, spread v
     // A project that kept the intervals only (maps above the size a project keeps): the caption
     // and the intervals, no spread view, and the page says why and what to do.
     await page.setViewportSize({ width: 1280, height: 720 });
-    await page.evaluate(() => new Promise((resolve, reject) => {
-      const open = indexedDB.open('wslap', 1);
-      open.onsuccess = () => {
-        const db = open.result;
-        const tx = db.transaction('projects', 'readwrite');
-        const store = tx.objectStore('projects');
-        const req = store.get('current');
-        req.onsuccess = () => {
-          const p = JSON.parse(req.result);
-          delete p.result.ensemble.maps_f32_base64;
-          store.put(JSON.stringify(p), 'current');
-        };
-        tx.oncomplete = () => { db.close(); resolve(); };
-        tx.onerror = () => reject(tx.error);
-      };
-    }));
+    const kept = JSON.parse(await idb(page, 'get', 'current'));
+    delete kept.result.ensemble.maps_f32_base64;
+    await idb(page, 'put', 'current', JSON.stringify(kept));
     await page.reload();
     await waitStatus(page, /^Restored your project from this browser/, 120_000);
     assert.ok((await page.textContent('#summary')).includes(interval[0]));

@@ -5,37 +5,12 @@
 import { test } from 'node:test';
 import assert from 'node:assert/strict';
 import { readFile } from 'node:fs/promises';
-import { openApp, runToMap, setField, waitStatus } from './browser.mjs';
-
-/** Runs `op` ('get', 'put', 'keys') on the app's IndexedDB store from the page. */
-function idb(page, op, key, value) {
-  return page.evaluate(([op, key, value]) => new Promise((resolve, reject) => {
-    const open = indexedDB.open('wslap', 1);
-    open.onupgradeneeded = () => open.result.createObjectStore('projects');
-    open.onerror = () => reject(open.error);
-    open.onsuccess = () => {
-      const db = open.result;
-      const tx = db.transaction('projects', op === 'put' ? 'readwrite' : 'readonly');
-      const s = tx.objectStore('projects');
-      const req = op === 'put' ? s.put(value, key) : op === 'get' ? s.get(key) : s.getAllKeys();
-      tx.oncomplete = () => { db.close(); resolve(req.result); };
-      tx.onerror = () => reject(tx.error);
-    };
-  }), [op, key, value]);
-}
+import { idb, openApp, runToMap, savedProject, setField, waitStatus } from './browser.mjs';
 
 /** The project text the app saved, once it matches `pattern`. */
 async function savedText(page, pattern = /wslap-project/) {
   await waitStatus(page, /^Ready/);
-  // Polled here: `waitForFunction` takes a returned promise as a truthy value and does not
-  // wait for it.
-  const deadline = Date.now() + 30000;
-  for (;;) {
-    const text = await idb(page, 'get', 'current');
-    if (pattern.test(text ?? '')) return text;
-    assert.ok(Date.now() < deadline, `no saved project matching ${pattern} after 30 s`);
-    await new Promise((r) => setTimeout(r, 200));
-  }
+  return savedProject(page, pattern);
 }
 
 test('a corrupt and a too-new saved project are set aside, downloadable, and the app opens', async () => {
