@@ -62,6 +62,21 @@ pub struct NamedText {
 /// header fit). A larger map is used, but must be loaded again after the page is reloaded.
 pub const MAX_STORED_FITS_BYTES: usize = 20 * 1024 * 1024;
 
+/// `values` as a project file stores many numbers: little-endian `f32`, in base64.
+pub(super) fn f32_base64(values: impl Iterator<Item = f64>) -> String {
+    use base64::Engine as _;
+    let bytes: Vec<u8> = values.flat_map(|v| (v as f32).to_le_bytes()).collect();
+    base64::engine::general_purpose::STANDARD.encode(bytes)
+}
+
+/// The values of decoded [`f32_base64`] bytes (a last incomplete value is left out).
+pub(super) fn f32_values(bytes: &[u8]) -> Vec<f64> {
+    bytes
+        .chunks_exact(4)
+        .map(|b| f64::from(f32::from_le_bytes([b[0], b[1], b[2], b[3]])))
+        .collect()
+}
+
 /// A deflection map (HFF convention, arcsec at `D_ls/D_s = 1`) read from FITS.
 #[derive(Debug, Clone)]
 pub struct NamedMap {

@@ -20,7 +20,7 @@ use crate::render::{KappaPlotOptions, Overlay};
 use crate::solver::Control;
 use base64::Engine as _;
 
-use super::data::MAX_STORED_FITS_BYTES;
+use super::data::{f32_base64, f32_values, MAX_STORED_FITS_BYTES};
 use super::outputs::pretty;
 use super::views::{points, ViewOptions, ViewPng, OBSERVED_RGB};
 use super::{AppError, Session};
@@ -326,13 +326,8 @@ impl StoredEnsemble {
             &maps.magnif_p84,
         ];
         let bytes = all.iter().map(|m| m.data.len() * 4).sum::<usize>();
-        let maps_f32_base64 = (bytes <= MAX_STORED_ENSEMBLE_MAP_BYTES).then(|| {
-            let raw: Vec<u8> = all
-                .iter()
-                .flat_map(|m| m.data.iter().flat_map(|v| (*v as f32).to_le_bytes()))
-                .collect();
-            base64::engine::general_purpose::STANDARD.encode(raw)
-        });
+        let maps_f32_base64 = (bytes <= MAX_STORED_ENSEMBLE_MAP_BYTES)
+            .then(|| f32_base64(all.iter().flat_map(|m| m.data.iter().copied())));
         Some(Self {
             record: Ensemble {
                 maps: None,
@@ -380,10 +375,7 @@ impl StoredEnsemble {
                 p = geometry.pixels
             ));
         }
-        let values: Vec<f64> = bytes
-            .chunks_exact(4)
-            .map(|b| f64::from(f32::from_le_bytes([b[0], b[1], b[2], b[3]])))
-            .collect();
+        let values = f32_values(&bytes);
         // kappa is finite wherever there is a map; a magnification may not be (at a critical
         // curve, or beyond f32's range), and is kept as stored.
         if values[..2 * n].iter().any(|v| !v.is_finite()) {

@@ -19,6 +19,7 @@ use crate::reconstruct::{images_on_maps, Reconstruction};
 use crate::solver::Iterate;
 use base64::Engine as _;
 
+use super::data::{f32_base64, f32_values};
 use super::run::curves_at;
 use super::{AppError, SessionResult};
 
@@ -66,10 +67,6 @@ impl StoredIterates {
         if kept.len() < 2 || kept.len() * unknowns > MAX_STORED_ITERATE_VALUES {
             return None;
         }
-        let bytes: Vec<u8> = kept
-            .iter()
-            .flat_map(|i| i.x.iter().flat_map(|v| (*v as f32).to_le_bytes()))
-            .collect();
         Some(Self {
             unknowns,
             steps: kept
@@ -79,7 +76,7 @@ impl StoredIterates {
                     objective: i.objective,
                 })
                 .collect(),
-            x_f32_base64: base64::engine::general_purpose::STANDARD.encode(bytes),
+            x_f32_base64: f32_base64(kept.iter().flat_map(|i| i.x.iter().copied())),
         })
     }
 
@@ -109,10 +106,7 @@ impl StoredIterates {
                 values * 4
             ));
         }
-        let x: Vec<f64> = bytes
-            .chunks_exact(4)
-            .map(|b| f64::from(f32::from_le_bytes([b[0], b[1], b[2], b[3]])))
-            .collect();
+        let x = f32_values(&bytes);
         if x.iter().any(|v| !v.is_finite()) {
             return Err("a value is not a finite number".to_string());
         }
