@@ -315,27 +315,30 @@ pub struct StoredEnsemble {
 }
 
 impl StoredEnsemble {
-    /// `e` for a project file; `None` without its statistics maps (none to show again).
-    pub fn from_ensemble(e: &Ensemble) -> Option<Self> {
-        let maps = e.maps.as_ref()?;
-        let all = [
-            &maps.kappa_mean,
-            &maps.kappa_std,
-            &maps.magnif_p16,
-            &maps.magnif_p50,
-            &maps.magnif_p84,
-        ];
-        let bytes = all.iter().map(|m| m.data.len() * 4).sum::<usize>();
-        let maps_f32_base64 = (bytes <= MAX_STORED_ENSEMBLE_MAP_BYTES)
-            .then(|| f32_base64(all.iter().flat_map(|m| m.data.iter().copied())));
-        Some(Self {
+    /// `e`, the ensemble of a result on maps of `geometry`, for a project file: its record,
+    /// and its statistics maps when it has them within [`MAX_STORED_ENSEMBLE_MAP_BYTES`] (an
+    /// ensemble reopened with its intervals only is kept so again).
+    pub fn from_ensemble(e: &Ensemble, geometry: MapGeometry) -> Self {
+        let maps_f32_base64 = e.maps.as_ref().and_then(|maps| {
+            let all = [
+                &maps.kappa_mean,
+                &maps.kappa_std,
+                &maps.magnif_p16,
+                &maps.magnif_p50,
+                &maps.magnif_p84,
+            ];
+            let bytes = all.iter().map(|m| m.data.len() * 4).sum::<usize>();
+            (bytes <= MAX_STORED_ENSEMBLE_MAP_BYTES)
+                .then(|| f32_base64(all.iter().flat_map(|m| m.data.iter().copied())))
+        });
+        Self {
             record: Ensemble {
                 maps: None,
                 ..e.clone()
             },
-            geometry: maps.kappa_std.geometry,
+            geometry,
             maps_f32_base64,
-        })
+        }
     }
 
     /// The ensemble again, its maps checked against `geometry` (the restored result's map);

@@ -230,14 +230,14 @@ impl Session {
                 iterates: r
                     .reconstruction()
                     .and_then(|x| StoredIterates::from_iterates(&x.iterates)),
-                ensemble: match r
-                    .ensemble
-                    .as_deref()
-                    .and_then(StoredEnsemble::from_ensemble)
-                {
+                ensemble: match r.ensemble.as_deref() {
                     None => None,
                     Some(e) => {
-                        Some(serde_json::to_value(e).map_err(|e| AppError::Run(e.to_string()))?)
+                        let stored = StoredEnsemble::from_ensemble(e, r.products().maps.geometry());
+                        Some(
+                            serde_json::to_value(stored)
+                                .map_err(|e| AppError::Run(e.to_string()))?,
+                        )
                     }
                 },
             }),

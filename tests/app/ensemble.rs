@@ -386,6 +386,25 @@ fn an_old_or_corrupt_stored_ensemble_still_opens_the_project() {
     let pixels = p["result"]["ensemble"]["geometry"]["pixels"]
         .as_u64()
         .unwrap() as usize;
+    // Kept with its intervals only (maps too large to keep), it stays so when saved again.
+    let mut intervals_only = p.clone();
+    intervals_only["result"]["ensemble"]
+        .as_object_mut()
+        .unwrap()
+        .remove("maps_f32_base64");
+    let (t, message) = open(&intervals_only);
+    assert!(message.contains("(its intervals only"), "{message}");
+    let again: serde_json::Value = serde_json::from_str(&t.project_json().unwrap()).unwrap();
+    assert_eq!(
+        again["result"]["ensemble"],
+        intervals_only["result"]["ensemble"]
+    );
+    let (u, _) = open(&again);
+    assert_eq!(
+        u.ensemble().unwrap().einstein_radius_interval_arcsec,
+        t.ensemble().unwrap().einstein_radius_interval_arcsec
+    );
+    assert!(u.ensemble().unwrap().maps.is_none());
     // A magnification need not be finite (at a critical curve): the ensemble is kept.
     let (t, message) = open(&nan_at(3 * pixels * pixels + 5));
     assert!(t.ensemble().is_some(), "{message}");
