@@ -221,6 +221,22 @@ CLUSTERS = [
          n_members=65, member_rc=28.0,
          what="(f) elliptical NFW halo with a BCG, a massive dark clump 38 arcsec N "
               "(2.5e14 Msun), 65 members, 20 systems"),
+    # Members lighter than the catalogue law says (member_scale: the true mass over the
+    # law's, before the scatter). A Lenstool fit of a real cluster found its L* galaxy at a
+    # velocity dispersion of 100 km/s (CATS, AS1063: a third of the law's mass), so the
+    # reconstruction's member prior is then wrong by a factor 3, as it may be for any cluster.
+    dict(name="g_light_members", seed=707, z_l=0.36, ra0=322.3590, dec0=-7.6910, n_sys=24,
+         halos=[dict(m200=1.3e15, c=6.0, x=0.0, y=0.0, q=0.75, phi=20.0, bcg_l=7.0)],
+         clumps=[dict(m200=1.0e14, c=7.0, x=30.0, y=-30.0)],
+         n_members=70, member_rc=30.0, member_scale=1.0 / 3.0,
+         what="(g) elliptical NFW halo with a BCG, a dark clump 42 arcsec SW, 70 members "
+              "whose true masses are a third of the catalogue law's"),
+    dict(name="h_light_bimodal", seed=808, z_l=0.42, ra0=39.9710, dec0=-1.5820, n_sys=30,
+         halos=[dict(m200=7.5e14, c=6.5, x=-22.0, y=10.0, q=0.7, phi=-30.0, bcg_l=6.0),
+                dict(m200=6.5e14, c=6.5, x=22.0, y=-8.0, q=0.8, phi=40.0, bcg_l=5.0)],
+         clumps=[], n_members=75, member_rc=25.0, member_scale=1.0 / 3.0,
+         what="(h) bimodal: two elliptical NFW halos 47 arcsec apart, each with a BCG, "
+              "75 members whose true masses are a third of the catalogue law's"),
 ]
 
 
@@ -266,7 +282,7 @@ def build_lens(plane, spec, rng):
     members = []
     for k, (x, y, l) in enumerate(draw_members(rng, spec) if spec["n_members"] else []):
         m_cat = M_STAR * l
-        m_true = m_cat * 10 ** (MASS_SCATTER_DEX * rng.normal())
+        m_true = m_cat * spec.get("member_scale", 1.0) * 10 ** (MASS_SCATTER_DEX * rng.normal())
         q = rng.uniform(0.6, 1.0)
         theta = rng.uniform(-90, 90)
         a = 1.0 * (m_cat / 1e12) ** (1 / 3)
