@@ -150,7 +150,7 @@ pub use reconstruct::{
     check_ensemble_size, check_memory, cross_validate, estimate_redshift, fitted_system_ids,
     fold_groups, image_regions, layer_count, product_options, reconstruct, reconstruct_with_choice,
     run_ensemble, strength_candidates, strength_folds, strength_trial, ArrivalTimes, Bytes,
-    ConvergenceRecord, CrossValidation, Dataset, DatasetError, Ensemble, EnsembleMaps,
+    Candidate, ConvergenceRecord, CrossValidation, Dataset, DatasetError, Ensemble, EnsembleMaps,
     EnsembleMember, EnsemblePlan, FoldRun, FreeZSummary, Heap, ImageReport, InputText, InputTexts,
     Inputs, InterpolatedLens, KappaSpread, LayerSource, MemberDraw, MemberRun, MemoryEstimate,
     MemoryLimit, PredictedImage, PredictedSystem, ProductConfig, ReconstructConfig,

@@ -5,7 +5,6 @@ use glam::DVec2;
 use serde::{Deserialize, Serialize};
 
 use crate::curves::critical_curves;
-use crate::inversion::Regulariser;
 use crate::inversion::{
     build_constraints, build_member_layers, Layer, LinearSystem, ObjectiveTerms,
 };
@@ -13,10 +12,10 @@ use crate::products::{own_map_side, ProductOptions, Products};
 use crate::reconstruct::shear_set;
 use crate::reconstruct::{
     check_memory, cross_validate, fitted_system_ids, grid_of, map_geometry, product_options,
-    reconstruct, reconstruct_with_choice, strength_candidates, strength_folds, ConvergenceRecord,
-    CrossValidation, Dataset, DatasetError, Ensemble, Inputs, MemoryLimit, ReconstructConfig,
-    ReconstructError, Reconstruction, RunSize, RunStatus, SourceReport, StageTimings,
-    StrengthCandidate, StrengthChoice, DEFAULT_FOLDS,
+    reconstruct, reconstruct_with_choice, strength_candidates, strength_folds, Candidate,
+    ConvergenceRecord, CrossValidation, Dataset, DatasetError, Ensemble, Inputs, MemoryLimit,
+    ReconstructConfig, ReconstructError, Reconstruction, RunSize, RunStatus, SourceReport,
+    StageTimings, StrengthCandidate, StrengthChoice, DEFAULT_FOLDS,
 };
 use crate::solver::{Control, Iterate};
 
@@ -207,8 +206,7 @@ impl Session {
     /// cross-validated with (below 2: too few systems); `None` when the strength is a number.
     /// The app runs [`Self::strength_trial`] for the candidates in parallel workers, then
     /// [`Self::run_with_trials`].
-    #[allow(clippy::type_complexity)]
-    pub fn strength_plan(&self) -> Result<Option<(Vec<(Regulariser, f64)>, usize)>, AppError> {
+    pub fn strength_plan(&self) -> Result<Option<(Vec<Candidate>, usize)>, AppError> {
         self.with_inputs(|inputs, config, _| {
             if config.objective.strength.value().is_some() {
                 return Ok(None);
@@ -220,26 +218,17 @@ impl Session {
         })
     }
 
-    /// The cross-validation of one candidate (`regulariser` at `strength`) on the loaded data
-    /// and settings, as a reconstruction with "auto" runs it; the session's result is not
-    /// touched.
+    /// The cross-validation of one `candidate` on the loaded data and settings, as a
+    /// reconstruction with "auto" runs it; the session's result is not touched.
     pub fn strength_trial(
         &self,
-        regulariser: Regulariser,
-        strength: f64,
+        candidate: &Candidate,
         folds: usize,
         progress: &mut dyn FnMut(&ConvergenceRecord) -> Control,
     ) -> Result<StrengthCandidate, AppError> {
         self.with_inputs(|inputs, config, _| {
-            crate::reconstruct::strength_trial(
-                inputs,
-                config,
-                regulariser,
-                strength,
-                folds,
-                progress,
-            )
-            .map_err(run_error)
+            crate::reconstruct::strength_trial(inputs, config, candidate, folds, progress)
+                .map_err(run_error)
         })
     }
 

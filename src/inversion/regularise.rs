@@ -103,6 +103,13 @@ pub struct ObjectiveConfig {
     /// and curvature: each predicted better on some of those clusters). With a number for
     /// the strength, `regulariser` alone is used.
     pub auto_regularisers: Vec<Regulariser>,
+    /// The grids "auto" tries, each with every regulariser and strength, as fractions of
+    /// `grid.cells` a side: a grid of `round(scale * grid.cells)` cells a side (at least 1)
+    /// for each (default 0.5, 0.75 and 1: 16, 24 and 32 cells a side with the default grid;
+    /// on the eight synthetic clusters of tests/data/fidelity each grid predicted best on
+    /// some, BENCHMARKS.md). `[1]`: `grid.cells` alone. Allowed 1 to 4 scales, each in
+    /// (0, 1]. With a number for the strength, `grid.cells` is used.
+    pub auto_grid_scales: Vec<f64>,
     /// Folds of the cross-validation that chooses the strength (default 4). At least 2; fewer
     /// when there are fewer systems.
     pub folds: usize,
@@ -121,6 +128,7 @@ impl Default for ObjectiveConfig {
             strength: Strength::Auto(AutoWord::Auto),
             candidates: vec![1e-2, 1e-1, 1.0],
             auto_regularisers: vec![Regulariser::Gradient, Regulariser::Curvature],
+            auto_grid_scales: vec![0.5, 0.75, 1.0],
             folds: 4,
             image_plane_iterations: 2,
             max_stretch: 10.0,
@@ -165,6 +173,24 @@ impl ObjectiveConfig {
                 "objective.auto_regularisers",
                 self.auto_regularisers.len() as f64,
                 "give 1 to 4 regularisers",
+            );
+        }
+        if self.auto_grid_scales.is_empty() || self.auto_grid_scales.len() > 4 {
+            return bad(
+                "objective.auto_grid_scales",
+                self.auto_grid_scales.len() as f64,
+                "give 1 to 4 scales",
+            );
+        }
+        if let Some(&v) = self
+            .auto_grid_scales
+            .iter()
+            .find(|&&v| !(v.is_finite() && v > 0.0 && v <= 1.0))
+        {
+            return bad(
+                "objective.auto_grid_scales",
+                v,
+                "each must be in (0, 1]: a fraction of grid.cells",
             );
         }
         if !(2..=20).contains(&self.folds) {

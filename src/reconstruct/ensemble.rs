@@ -7,7 +7,7 @@
 //! - **the systems fitted drawn at random** (bootstrap over systems): as many draws with
 //!   replacement as there are fitted systems; the systems drawn at least once are fitted
 //!   (a system drawn twice counts once), the others (about a third) are left out;
-//! - **the regulariser and its strength chosen again on that draw**, when the main run's were
+//! - **the regulariser, its strength and the grid chosen again on that draw**, when the main run's were
 //!   "auto": the main run's cross-validation is not rerun, but its rule (fewest unmatched, then
 //!   smallest median held-out offset) is applied to the held-out offsets of the systems the
 //!   member drew, each counted as often as drawn ([`StrengthChoice::best_for`]). Candidates
@@ -38,7 +38,7 @@ use serde::{Deserialize, Serialize};
 
 use super::crossval::SpreadSum;
 use super::{
-    fitted_system_ids, reconstruct, reconstruct_with_choice, ConvergenceRecord, Inputs,
+    fitted_system_ids, reconstruct, reconstruct_with_choice, Candidate, ConvergenceRecord, Inputs,
     ReconstructConfig, ReconstructError, Reconstruction, Regulariser, StrengthChoice,
 };
 use crate::curves::CriticalCurves;
@@ -72,6 +72,9 @@ pub struct EnsembleMember {
     pub regulariser: Option<Regulariser>,
     #[serde(default)]
     pub strength: Option<f64>,
+    /// The grid's cells a side it used (`None`: the main run's).
+    #[serde(default)]
+    pub cells: Option<usize>,
     pub status: String,
     /// `C_l` per layer.
     pub c: Vec<f64>,
@@ -351,6 +354,9 @@ pub struct MemberDraw {
     pub regulariser: Option<Regulariser>,
     #[serde(default)]
     pub strength: Option<f64>,
+    /// The grid's cells a side it uses with them (`None`: the main run's choice or settings).
+    #[serde(default)]
+    pub cells: Option<usize>,
 }
 
 /// An ensemble before its members run: what they share, taken from the main run (its grid,
@@ -446,8 +452,9 @@ impl EnsemblePlan {
                     left_out: pick(false),
                     grid_shift_arcsec: shift,
                     redshifts: super::free_z::draw(&estimated, &mut z_rng),
-                    regulariser: choice.map(|c| c.0),
-                    strength: choice.map(|c| c.1),
+                    regulariser: choice.map(|c| c.regulariser),
+                    strength: choice.map(|c| c.strength),
+                    cells: choice.and_then(|c| c.cells),
                 }
             })
             .collect();
@@ -518,7 +525,11 @@ impl EnsemblePlan {
         let r = match &self.strength_choice {
             Some(c) => {
                 let choice = match (draw.regulariser, draw.strength) {
-                    (Some(kind), Some(strength)) => c.with_chosen(kind, strength),
+                    (Some(regulariser), Some(strength)) => c.with_chosen(Candidate {
+                        regulariser,
+                        strength,
+                        cells: draw.cells,
+                    }),
                     _ => c.clone(),
                 };
                 reconstruct_with_choice(&member_inputs, &member_config, choice, progress)?
@@ -537,6 +548,7 @@ impl EnsemblePlan {
             redshifts: draw.redshifts.clone(),
             regulariser: draw.regulariser,
             strength: draw.strength,
+            cells: draw.cells,
             status: r.status.name().to_string(),
             c: r.layer_factors(),
             einstein_radius_arcsec: summary.einstein_radius_arcsec,

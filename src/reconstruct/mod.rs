@@ -233,12 +233,41 @@ pub struct Reconstruction {
     pub member_positions_arcsec: Vec<DVec2>,
 }
 
-/// One candidate (regulariser and strength) of an "auto" strength and how well it predicted.
+/// What one candidate of an "auto" strength sets: the regulariser, its strength and the
+/// grid's cells a side.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct Candidate {
+    pub regulariser: Regulariser,
+    pub strength: f64,
+    /// Cells a side (`None`: `grid.cells` of the settings).
+    #[serde(default)]
+    pub cells: Option<usize>,
+}
+
+impl Candidate {
+    /// `config` with this candidate's regulariser, strength and grid.
+    pub fn apply(&self, config: &ReconstructConfig) -> ReconstructConfig {
+        let mut c = config.clone();
+        c.objective.strength = Strength::Value(self.strength);
+        c.objective.regulariser = self.regulariser;
+        if let Some(cells) = self.cells {
+            c.grid.cells = cells;
+        }
+        c
+    }
+}
+
+/// One candidate (regulariser, strength, grid) of an "auto" strength and how well it
+/// predicted.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct StrengthCandidate {
     #[serde(default)]
     pub regulariser: Regulariser,
     pub strength: f64,
+    /// The grid's cells a side (`None` in results saved before grids were candidates: the
+    /// settings' `grid.cells`).
+    #[serde(default)]
+    pub cells: Option<usize>,
     /// Median and rms offset of the held-out images from their predictions (arcsec) over the
     /// folds of the cross-validation (`None` when none was matched).
     pub holdout_median_arcsec: Option<f64>,
@@ -270,6 +299,9 @@ pub struct StrengthChoice {
     pub chosen: f64,
     /// The regulariser used with it.
     pub chosen_regulariser: Regulariser,
+    /// The grid's cells a side used with it (`None`: the settings' `grid.cells`).
+    #[serde(default)]
+    pub chosen_cells: Option<usize>,
     /// Why it was chosen, in words.
     pub rule: String,
 }
@@ -457,27 +489,43 @@ fn choose_strength(
         return Ok(Some(StrengthChoice::from_trials(config, folds, Vec::new())));
     }
     let rows: Vec<StrengthCandidate> = if crate::threads::available() > 1 {
-        crate::threads::map_items(&candidates, |&(kind, s)| {
-            strength_trial(inputs, config, kind, s, folds, &mut |_| Control::Continue)
+        crate::threads::map_items(&candidates, |c| {
+            strength_trial(inputs, config, c, folds, &mut |_| Control::Continue)
         })
         .into_iter()
         .collect::<Result<_, _>>()?
     } else {
         candidates
             .iter()
-            .map(|&(kind, s)| strength_trial(inputs, config, kind, s, folds, progress))
+            .map(|c| strength_trial(inputs, config, c, folds, progress))
             .collect::<Result<_, _>>()?
     };
     Ok(Some(StrengthChoice::from_trials(config, folds, rows)))
 }
 
-/// The (regulariser, strength) pairs an "auto" strength tries: every one of
-/// `objective.auto_regularisers` with every one of `objective.candidates`.
-pub fn strength_candidates(config: &ReconstructConfig) -> Vec<(Regulariser, f64)> {
+/// The candidates an "auto" strength tries: every grid of `objective.auto_grid_scales`
+/// (the distinct cell counts, coarsest first) with every one of `objective.auto_regularisers`
+/// and every one of `objective.candidates`.
+pub fn strength_candidates(config: &ReconstructConfig) -> Vec<Candidate> {
     let o = &config.objective;
-    o.auto_regularisers
+    let mut grids: Vec<usize> = o
+        .auto_grid_scales
         .iter()
-        .flat_map(|&kind| o.candidates.iter().map(move |&s| (kind, s)))
+        .map(|&scale| ((scale * config.grid.cells as f64).round() as usize).max(1))
+        .collect();
+    grids.sort_unstable();
+    grids.dedup();
+    grids
+        .iter()
+        .flat_map(|&cells| {
+            o.auto_regularisers.iter().flat_map(move |&regulariser| {
+                o.candidates.iter().map(move |&strength| Candidate {
+                    regulariser,
+                    strength,
+                    cells: Some(cells),
+                })
+            })
+        })
         .collect()
 }
 
@@ -491,19 +539,16 @@ pub fn strength_folds(
     Ok(config.objective.folds.min(fitted))
 }
 
-/// The cross-validation of one candidate `regulariser` and `strength` over `folds` folds (maps of at most
+/// The cross-validation of one `candidate` over `folds` folds (maps of at most
 /// [`CHOICE_MAP_PIXELS`] and no curves: they only serve to predict the held-out images).
 pub fn strength_trial(
     inputs: &Inputs<'_>,
     config: &ReconstructConfig,
-    regulariser: Regulariser,
-    strength: f64,
+    candidate: &Candidate,
     folds: usize,
     progress: &mut dyn FnMut(&ConvergenceRecord) -> Control,
 ) -> Result<StrengthCandidate, ReconstructError> {
-    let mut trial = config.clone();
-    trial.objective.strength = Strength::Value(strength);
-    trial.objective.regulariser = regulariser;
+    let mut trial = candidate.apply(config);
     trial.products.pixels = trial.products.pixels.min(CHOICE_MAP_PIXELS);
     trial.products.maps_only = true;
     let mut cancelled = false;
@@ -516,8 +561,9 @@ pub fn strength_trial(
         return Err(ReconstructError::Cancelled);
     }
     Ok(StrengthCandidate {
-        regulariser,
-        strength,
+        regulariser: candidate.regulariser,
+        strength: candidate.strength,
+        cells: candidate.cells,
         holdout_median_arcsec: cv.holdout_image_offset_median_arcsec,
         holdout_rms_arcsec: cv.holdout_image_plane_rms_arcsec,
         holdout_unmatched: cv.holdout_images_unmatched,
@@ -539,15 +585,28 @@ impl StrengthChoice {
     /// inflate: for offsets with a Gaussian error `s` per axis the median offset is
     /// `s sqrt(2 ln 2)` and the rms `s sqrt(2)`. `None` without trials.
     pub fn holdout_sigma_arcsec(&self) -> Option<f64> {
-        let chosen = self
-            .candidates
-            .iter()
-            .find(|c| c.regulariser == self.chosen_regulariser && c.strength == self.chosen)?;
+        let chosen = self.candidates.iter().find(|c| self.is_chosen(c))?;
         let median = chosen.holdout_median_arcsec?;
         Some(median * (2.0 / (2.0 * std::f64::consts::LN_2)).sqrt())
     }
 
-    /// The candidate (regulariser, strength) this choice's rule picks when the held-out
+    /// Whether `c` is the chosen candidate.
+    pub fn is_chosen(&self, c: &StrengthCandidate) -> bool {
+        c.regulariser == self.chosen_regulariser
+            && c.strength == self.chosen
+            && (c.cells.is_none() || self.chosen_cells.is_none() || c.cells == self.chosen_cells)
+    }
+
+    /// The chosen candidate: what the reconstruction uses.
+    pub fn chosen_candidate(&self) -> Candidate {
+        Candidate {
+            regulariser: self.chosen_regulariser,
+            strength: self.chosen,
+            cells: self.chosen_cells,
+        }
+    }
+
+    /// The candidate (regulariser, strength, grid) this choice's rule picks when the held-out
     /// systems count `weight(id)` times each (a bootstrap draw: 0 for a system not drawn, 2
     /// for one drawn twice): the fewest unmatched images, then the smallest median offset,
     /// both over the drawn systems' images. `None` without the candidates' per-system
@@ -556,7 +615,7 @@ impl StrengthChoice {
     /// An ensemble member re-makes the choice this way on its own draw, so that the
     /// uncertainty of the choice itself (which candidates the data cannot tell apart) enters
     /// the ensemble's spread without running the cross-validation again.
-    pub fn best_for(&self, weight: impl Fn(&str) -> usize) -> Option<(Regulariser, f64)> {
+    pub fn best_for(&self, weight: impl Fn(&str) -> usize) -> Option<Candidate> {
         let score = |c: &StrengthCandidate| {
             let mut unmatched = 0;
             let mut offsets = Vec::new();
@@ -583,15 +642,20 @@ impl StrengthChoice {
             .iter()
             .filter_map(|c| Some((score(c)?, c)))
             .min_by(|(a, _), (b, _)| a.0.cmp(&b.0).then(a.1.total_cmp(&b.1)))
-            .map(|(_, c)| (c.regulariser, c.strength))
+            .map(|(_, c)| Candidate {
+                regulariser: c.regulariser,
+                strength: c.strength,
+                cells: c.cells,
+            })
     }
 
-    /// The same choice with `regulariser` and `strength` used instead of the chosen ones
-    /// (an ensemble member's own choice), its candidates kept.
-    pub fn with_chosen(&self, regulariser: Regulariser, strength: f64) -> Self {
+    /// The same choice with `chosen` used instead of the chosen candidate (an ensemble
+    /// member's own choice), its candidates kept.
+    pub fn with_chosen(&self, chosen: Candidate) -> Self {
         Self {
-            chosen: strength,
-            chosen_regulariser: regulariser,
+            chosen: chosen.strength,
+            chosen_regulariser: chosen.regulariser,
+            chosen_cells: chosen.cells,
             ..self.clone()
         }
     }
@@ -611,6 +675,7 @@ impl StrengthChoice {
                 candidates: Vec::new(),
                 chosen: candidates[candidates.len() / 2],
                 chosen_regulariser: config.objective.regulariser,
+                chosen_cells: None,
                 rule: "too few fitted systems to hold any out, so the middle candidate".to_string(),
             };
         }
@@ -624,15 +689,16 @@ impl StrengthChoice {
             let (a, b) = (score(p), score(q));
             a.0.cmp(&b.0).then(a.1.total_cmp(&b.1))
         });
-        let (chosen_regulariser, chosen) = best
-            .map_or((config.objective.regulariser, candidates[0]), |c| {
-                (c.regulariser, c.strength)
+        let (chosen_regulariser, chosen, chosen_cells) = best
+            .map_or((config.objective.regulariser, candidates[0], None), |c| {
+                (c.regulariser, c.strength, c.cells)
             });
         Self {
             folds,
             candidates: trials,
             chosen,
             chosen_regulariser,
+            chosen_cells,
             rule: format!(
                 "the fewest unmatched, then the smallest median offset of held-out images \
                  over {folds} folds"
@@ -660,9 +726,7 @@ fn with_choice(
     progress: &mut dyn FnMut(&ConvergenceRecord) -> Control,
 ) -> Result<Reconstruction, ReconstructError> {
     crate::threads::with_limit(config.system.threads, || {
-        let mut fixed = config.clone();
-        fixed.objective.strength = Strength::Value(choice.chosen);
-        fixed.objective.regulariser = choice.chosen_regulariser;
+        let fixed = choice.chosen_candidate().apply(config);
         let mut r = reconstruct_limited(inputs, &fixed, progress)?;
         if free_z {
             let sigma = choice.holdout_sigma_arcsec();
@@ -1143,6 +1207,12 @@ mod tests {
         StrengthCandidate {
             regulariser: kind,
             strength,
+            // A grid of its own per regulariser, so that the choice is seen to carry it.
+            cells: Some(if kind == Regulariser::Gradient {
+                24
+            } else {
+                32
+            }),
             holdout_median_arcsec: None,
             holdout_rms_arcsec: None,
             holdout_unmatched: 0,
@@ -1157,12 +1227,21 @@ mod tests {
         }
     }
 
+    fn pick(regulariser: Regulariser, strength: f64, cells: usize) -> Candidate {
+        Candidate {
+            regulariser,
+            strength,
+            cells: Some(cells),
+        }
+    }
+
     fn choice(candidates: Vec<StrengthCandidate>) -> StrengthChoice {
         StrengthChoice {
             folds: 2,
             candidates,
             chosen: 1.0,
             chosen_regulariser: Regulariser::Gradient,
+            chosen_cells: None,
             rule: String::new(),
         }
     }
@@ -1190,16 +1269,16 @@ mod tests {
             ),
         ]);
         // Both once: medians 0.55 against 0.25.
-        assert_eq!(choice.best_for(|_| 1), Some((c, 0.1)));
+        assert_eq!(choice.best_for(|_| 1), Some(pick(c, 0.1, 32)));
         // System 1 alone: 0.1 against 0.3.
         assert_eq!(
             choice.best_for(|id| usize::from(id == "1")),
-            Some((g, 0.01))
+            Some(pick(g, 0.01, 24))
         );
         // System 1 drawn twice, 2 once: medians 0.1 against 0.3 (a draw counts its repeats).
         assert_eq!(
             choice.best_for(|id| if id == "1" { 2 } else { 1 }),
-            Some((g, 0.01))
+            Some(pick(g, 0.01, 24))
         );
         // Nothing drawn that was predicted: no choice.
         assert_eq!(choice.best_for(|_| 0), None);
@@ -1217,10 +1296,10 @@ mod tests {
                 &[("1", &[Some(0.5)]), ("2", &[Some(0.5), Some(0.5)])],
             ),
         ]);
-        assert_eq!(choice.best_for(|_| 1), Some((c, 0.1)));
+        assert_eq!(choice.best_for(|_| 1), Some(pick(c, 0.1, 32)));
         assert_eq!(
             choice.best_for(|id| usize::from(id == "1")),
-            Some((g, 0.01))
+            Some(pick(g, 0.01, 24))
         );
     }
 

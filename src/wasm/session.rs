@@ -186,21 +186,15 @@ impl AppSession {
     pub fn strength_plan(&self) -> Result<JsValue, JsError> {
         match self.inner.strength_plan().map_err(err)? {
             Some((candidates, folds)) if folds >= 2 => {
-                let candidates: Vec<serde_json::Value> = candidates
-                    .iter()
-                    .map(|(regulariser, strength)| {
-                        serde_json::json!({"regulariser": regulariser, "strength": strength})
-                    })
-                    .collect();
                 to_js(&serde_json::json!({"candidates": candidates, "folds": folds}))
             }
             _ => Ok(JsValue::NULL),
         }
     }
 
-    /// The cross-validation of one candidate of the plan, `{regulariser, strength}` (or a bare
-    /// strength with the settings' regulariser): a row of `strength_choice`, `{regulariser,
-    /// strength, holdout_median_arcsec, holdout_rms_arcsec, holdout_unmatched,
+    /// The cross-validation of one candidate of the plan, `{regulariser, strength, cells}`
+    /// (`cells` optional: the settings' grid; or a bare strength with the settings' regulariser
+    /// and grid): a row of `strength_choice`, `{regulariser, strength, cells, holdout_median_arcsec, holdout_rms_arcsec, holdout_unmatched,
     /// fit_median_arcsec, holdout_by_system}`. `progress` gets the reports as [`AppSession::run`]'s, with
     /// `strength`. The session's result is not touched.
     pub fn strength_trial(
@@ -211,30 +205,28 @@ impl AppSession {
     ) -> Result<JsValue, JsError> {
         #[derive(serde::Deserialize)]
         #[serde(untagged)]
-        enum Candidate {
+        enum Given {
             Strength(f64),
-            Pair {
-                regulariser: crate::inversion::Regulariser,
-                strength: f64,
-            },
+            Candidate(crate::reconstruct::Candidate),
         }
-        let candidate: Candidate = serde_wasm_bindgen::from_value(candidate)
+        let given: Given = serde_wasm_bindgen::from_value(candidate)
             .map_err(|e| JsError::new(&format!("candidate: {e}")))?;
-        let (regulariser, strength) = match candidate {
-            Candidate::Strength(s) => (self.inner.settings.reconstruct.objective.regulariser, s),
-            Candidate::Pair {
-                regulariser,
+        let candidate = match given {
+            Given::Strength(strength) => crate::reconstruct::Candidate {
+                regulariser: self.inner.settings.reconstruct.objective.regulariser,
                 strength,
-            } => (regulariser, strength),
+                cells: None,
+            },
+            Given::Candidate(c) => c,
         };
         let mut throttle = Throttle::new(progress);
         let mut report = |r: &ConvergenceRecord| {
-            throttle.report(r, &[("strength", strength)]);
+            throttle.report(r, &[("strength", candidate.strength)]);
             Control::Continue
         };
         let row = self
             .inner
-            .strength_trial(regulariser, strength, folds, &mut report)
+            .strength_trial(&candidate, folds, &mut report)
             .map_err(err)?;
         to_js(&row)
     }

@@ -345,21 +345,33 @@ fn auto_strength_in_pieces_equals_one_auto_run() {
     s.set_field("reconstruct.objective.candidates", json!([0.01, 1.0]))
         .unwrap();
     let (candidates, folds) = s.strength_plan().unwrap().expect("auto has a plan");
-    use wslap::{Regulariser::Curvature, Regulariser::Gradient};
-    assert_eq!(
-        candidates,
-        vec![
-            (Gradient, 0.01),
-            (Gradient, 1.0),
-            (Curvature, 0.01),
-            (Curvature, 1.0)
-        ]
-    );
+    use wslap::{Candidate, Regulariser::Curvature, Regulariser::Gradient};
+    // Each grid (the default scales 0.5, 0.75 and 1 of grid.cells, coarsest first) with each
+    // regulariser and strength.
+    let n = s.settings.reconstruct.grid.cells;
+    let grids = [0.5, 0.75, 1.0].map(|f: f64| (f * n as f64).round() as usize);
+    let expected: Vec<Candidate> = grids
+        .iter()
+        .flat_map(|&cells| {
+            [
+                (Gradient, 0.01),
+                (Gradient, 1.0),
+                (Curvature, 0.01),
+                (Curvature, 1.0),
+            ]
+            .map(|(regulariser, strength)| Candidate {
+                regulariser,
+                strength,
+                cells: Some(cells),
+            })
+        })
+        .collect();
+    assert_eq!(candidates, expected);
     assert!(folds >= 2, "{folds} folds");
     let trials: Vec<_> = candidates
         .iter()
-        .map(|&(kind, c)| {
-            s.strength_trial(kind, c, folds, &mut |_| Control::Continue)
+        .map(|c| {
+            s.strength_trial(c, folds, &mut |_| Control::Continue)
                 .unwrap()
         })
         .collect();
@@ -374,6 +386,10 @@ fn auto_strength_in_pieces_equals_one_auto_run() {
     assert_eq!(pieces["strength_choice"], whole["strength_choice"]);
     assert_eq!(pieces["grid_mass_msun"], whole["grid_mass_msun"]);
     assert_eq!(pieces["settings"]["objective"]["strength"], "auto");
+    // The reconstruction is made on the chosen grid.
+    let cells = whole["strength_choice"]["chosen_cells"].as_u64().unwrap();
+    assert!(grids.contains(&(cells as usize)), "{cells}");
+    assert_eq!(whole["grid_cells"].as_u64().unwrap(), cells * cells);
     // A number needs no plan.
     s.set_field("reconstruct.objective.strength", json!(0.1))
         .unwrap();

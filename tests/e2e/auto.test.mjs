@@ -38,7 +38,7 @@ test('AS1063 gold with the strength "auto": the candidates run in workers and th
     const t0 = Date.now();
     await page.click('#reconstruct');
     // One progress bar: the candidates done, and those being tried at their iteration.
-    await page.waitForFunction(() => /^Choosing the regulariser: \d+ of \d+ candidates done; \d workers? trying [\w. ]+ \(iteration \d+\)/
+    await page.waitForFunction(() => /^Choosing the regulariser: \d+ of \d+ candidates done; \d workers? trying [\w. ×,]+ \(iteration \d+\)/
       .test(document.getElementById('progress-text').textContent), null, { timeout: 60_000 });
     const candidates = Number((await page.textContent('#progress-text')).match(/of (\d+) candidates/)[1]);
     const workers = Math.min(await page.evaluate(() => navigator.hardwareConcurrency), 4, candidates);
@@ -56,6 +56,7 @@ test('AS1063 gold with the strength "auto": the candidates run in workers and th
     assert.match(chosen, /✓ chosen/);
     assert.match(await page.innerText('#strength-summary'), /whose held-out images were predicted best/);
     const strengths = (await page.$$eval('#strength-table tbody tr', (trs) => trs.map((tr) => Number(tr.dataset.strength))));
+    const cells = (await page.$$eval('#strength-table tbody tr', (trs) => trs.map((tr) => Number(tr.dataset.cells))));
     const chosenRow = await page.$eval('#strength-table tr.chosen', (tr) => ({ ...tr.dataset }));
 
     await page.click('#downloads-panel summary');
@@ -64,20 +65,28 @@ test('AS1063 gold with the strength "auto": the candidates run in workers and th
     const choice = summary.strength_choice;
     assert.ok(choice, 'summary.json has strength_choice');
     assert.equal(summary.settings.objective.strength, 'auto');
-    // Every candidate strength of the settings (with each regulariser "auto" tries, if several).
+    // Every candidate strength of the settings with each regulariser and each grid "auto" tries.
     const o = summary.settings.objective;
-    assert.equal(choice.candidates.length, o.candidates.length * (o.auto_regularisers?.length ?? 1));
+    const grids = [...new Set(o.auto_grid_scales.map((s) => Math.max(1, Math.round(s * summary.settings.grid.cells))))];
+    assert.equal(grids.length, 3, 'the default tries three grids');
+    assert.equal(choice.candidates.length, o.candidates.length * o.auto_regularisers.length * grids.length);
     assert.deepEqual(choice.candidates.map((c) => c.strength), strengths);
+    assert.deepEqual(choice.candidates.map((c) => c.cells), cells);
+    assert.deepEqual([...new Set(cells)].sort((a, b) => a - b), grids.sort((a, b) => a - b));
     assert.deepEqual([...new Set(strengths)].sort((a, b) => a - b), [...o.candidates].sort((a, b) => a - b));
     assert.equal(choice.folds, o.folds);
     assert.ok(choice.candidates.every((c) => Number.isFinite(c.holdout_median_arcsec)), JSON.stringify(choice));
     assert.equal(Number(chosenRow.strength), choice.chosen);
     if (choice.chosen_regulariser !== undefined) assert.equal(chosenRow.regulariser, choice.chosen_regulariser);
+    assert.equal(Number(chosenRow.cells), choice.chosen_cells);
+    // The reconstruction was made on the chosen grid.
+    assert.equal(summary.grid_cells, choice.chosen_cells ** 2);
     // The rule: the fewest unmatched held-out images, then the smallest held-out median.
     const best = [...choice.candidates].sort((a, b) => a.holdout_unmatched - b.holdout_unmatched
       || a.holdout_median_arcsec - b.holdout_median_arcsec)[0];
     assert.equal(choice.chosen, best.strength);
     if (choice.chosen_regulariser !== undefined) assert.equal(choice.chosen_regulariser, best.regulariser);
+    assert.equal(choice.chosen_cells, best.cells);
     // One main tangential curve: the largest holds most of the area inside them.
     assert.ok(summary.maps.tangential_main_area_share > 0.8,
       `main tangential curve holds ${summary.maps.tangential_main_area_share} of the area`);

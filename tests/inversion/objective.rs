@@ -217,9 +217,9 @@ fn an_unmeasured_member_factor_is_held_near_one() {
     assert!(c_free > c + 0.2, "free C = {c_free}, held C = {c}");
 }
 
-/// "auto" takes the candidate whose cross-validation (run here on its own) predicts the
-/// held-out images best (fewest without a predicted image, then the smallest median), and
-/// writes the curve it chose from.
+/// "auto" takes the candidate (regulariser, strength, grid) whose cross-validation (run here
+/// on its own) predicts the held-out images best (fewest without a predicted image, then the
+/// smallest median), writes the curve it chose from and makes the map on the chosen grid.
 #[test]
 fn auto_strength_takes_the_best_predicting_candidate() {
     let cluster = Cluster::new();
@@ -230,18 +230,23 @@ fn auto_strength_takes_the_best_predicting_candidate() {
     config.objective.folds = 3;
     let r = reconstruct(&inputs, &config, &mut quiet).unwrap();
     let choice = r.strength_choice.as_ref().expect("auto writes its choice");
-    // Every regulariser of the list with every strength.
+    // Every regulariser of the list with every strength on every grid: 6, 9 and 12 cells a
+    // side (the default scales 0.5, 0.75 and 1 of 12).
+    let grids = [6, 9, 12];
     assert_eq!(
         choice.candidates.len(),
-        3 * config.objective.auto_regularisers.len()
+        3 * config.objective.auto_regularisers.len() * grids.len()
     );
-    let mut best = (usize::MAX, f64::INFINITY, (Regulariser::None, 0.0));
+    let mut best = (usize::MAX, f64::INFINITY, (Regulariser::None, 0.0, 0));
     for row in &choice.candidates {
         let strength = row.strength;
         assert!(config.objective.candidates.contains(&strength));
+        let cells = row.cells.expect("each candidate has its grid");
+        assert!(grids.contains(&cells), "{cells} cells");
         let mut fixed = config.clone();
         fixed.objective.strength = Strength::Value(strength);
         fixed.objective.regulariser = row.regulariser;
+        fixed.grid.cells = cells;
         fixed.products.pixels = 96;
         let cv = cross_validate(&inputs, &fixed, 3, None, &mut |_, _| Control::Continue).unwrap();
         assert_eq!(
@@ -252,10 +257,15 @@ fn auto_strength_takes_the_best_predicting_candidate() {
         let m = cv.holdout_image_offset_median_arcsec.unwrap();
         let u = cv.holdout_images_unmatched;
         if u < best.0 || (u == best.0 && m < best.1) {
-            best = (u, m, (row.regulariser, strength));
+            best = (u, m, (row.regulariser, strength, cells));
         }
     }
-    assert_eq!((choice.chosen_regulariser, choice.chosen), best.2);
+    let chosen_cells = choice.chosen_cells.expect("the chosen grid");
+    assert_eq!(
+        (choice.chosen_regulariser, choice.chosen, chosen_cells),
+        best.2
+    );
+    assert_eq!(r.system.grid.cells_per_side, chosen_cells);
     // The heaviest smoothing predicts worst here: the halo's cusp is real.
     assert_ne!(choice.chosen, 1e3);
     let summary = serde_json::to_value(r.summary()).unwrap();

@@ -16,9 +16,10 @@ export function poolSize(candidates) {
 }
 
 /** A candidate of the plan in words: a strength (`0.1`), or a regulariser with its strength
- * (`curvature 0.1`) when the plan pairs them. */
+ * and grid (`curvature 0.1 on 24×24`) when the plan pairs them. */
 export function candidateLabel(c) {
-  return typeof c === 'number' ? String(c) : `${c.regulariser} ${c.strength}`;
+  if (typeof c === 'number') return String(c);
+  return `${c.regulariser} ${c.strength}${c.cells != null ? ` on ${c.cells}×${c.cells}` : ''}`;
 }
 
 /** The project text `project` (the main worker's project.json) without its result: a pool

@@ -170,34 +170,40 @@ export function showStrengthChoice(choice) {
   const medians = rows.map((r) => r.holdout_median_arcsec).filter((v) => v != null);
   const top = Math.max(...medians, 1e-9);
   const unmatched = rows.some((r) => r.holdout_unmatched > 0);
-  // A regulariser column when the candidates pair several regularisers with the strengths.
+  // The regulariser and the grid in the candidate's name when several were tried.
   const kinds = new Set(rows.map((r) => r.regulariser).filter((k) => k != null));
   const byKind = kinds.size > 1;
+  const grids = new Set(rows.map((r) => r.cells).filter((c) => c != null));
+  const byGrid = grids.size > 1;
   const isChosen = (r) => r.strength === choice.chosen
-    && (choice.chosen_regulariser == null || r.regulariser == null || r.regulariser === choice.chosen_regulariser);
+    && (choice.chosen_regulariser == null || r.regulariser == null || r.regulariser === choice.chosen_regulariser)
+    && (choice.chosen_cells == null || r.cells == null || r.cells === choice.chosen_cells);
+  const grid = (cells) => `${esc(cells)} × ${esc(cells)} cells`;
   const bar = (v) => `<span class="bar-track" aria-hidden="true">${v == null ? ''
     : `<span class="bar" style="width:${(100 * v / top).toFixed(1)}%"></span>`}</span>`;
   const mark = ' <span class="mark">✓ chosen</span>';
   const body = rows.map((r) => {
     const chosen = isChosen(r);
-    // The candidate: its strength, after its regulariser when several were tried.
-    const name = byKind ? `${esc(r.regulariser)} ${esc(r.strength)}` : esc(r.strength);
-    return `<tr${chosen ? ' class="chosen"' : ''} data-strength="${esc(r.strength)}" data-regulariser="${esc(r.regulariser ?? '')}">
+    // The candidate: its strength, after its regulariser and before its grid when several were tried.
+    const name = `${byKind ? `${esc(r.regulariser)} ` : ''}${esc(r.strength)}${byGrid && r.cells != null ? `, ${grid(r.cells)}` : ''}`;
+    return `<tr${chosen ? ' class="chosen"' : ''} data-strength="${esc(r.strength)}" data-regulariser="${esc(r.regulariser ?? '')}" data-cells="${esc(r.cells ?? '')}">
       <th scope="row">${name}${chosen ? mark : ''}</th>
       <td><span class="bar-cell"><span class="value">${fmt(r.holdout_median_arcsec)}</span>${bar(r.holdout_median_arcsec)}</span></td>
       <td>${fmt(r.holdout_rms_arcsec)}</td><td>${fmt(r.fit_median_arcsec)}</td>${
   unmatched ? `<td>${r.holdout_unmatched}</td>` : ''}</tr>`;
   }).join('');
-  const what = byKind && choice.chosen_regulariser != null
-    ? `${esc(choice.chosen_regulariser)} at strength ${esc(choice.chosen)}` : `strength ${esc(choice.chosen)}`;
+  const what = (byKind && choice.chosen_regulariser != null
+    ? `${esc(choice.chosen_regulariser)} at strength ${esc(choice.chosen)}` : `strength ${esc(choice.chosen)}`)
+    + (byGrid && choice.chosen_cells != null ? ` on ${grid(choice.chosen_cells)}` : '');
+  const tried = [byKind && 'regulariser', 'strength', byGrid && 'grid'].filter(Boolean);
   box.innerHTML = `<h3>Regulariser ${what}, chosen by cross-validation</h3>
-    <p id="strength-summary">The ${byKind ? 'regulariser and strength' : 'strength'} whose held-out images were
+    <p id="strength-summary">The ${tried.length > 1 ? `${tried.slice(0, -1).join(', ')} and ${tried.at(-1)}` : 'strength'} whose held-out images were
     predicted best. Each candidate was tried over ${choice.folds} folds: every fold fits the lens without some of
     the systems and predicts their images, so the held-out offsets say how well the map finds images it was not
     given (smaller is better), while the fitted median says how closely it reproduces those it was given.
     Offsets from the predictions in arcsec${unmatched ? '; unmatched: held-out images with no predicted image, which count first' : ''}.</p>
     <div class="table-scroll"><table id="strength-table">
-    <thead><tr><th scope="col">${byKind ? 'candidate' : 'strength'}</th><th scope="col">held-out median</th>
+    <thead><tr><th scope="col">${byKind || byGrid ? 'candidate' : 'strength'}</th><th scope="col">held-out median</th>
     <th scope="col">held-out rms</th><th scope="col">fitted median</th>${unmatched ? '<th scope="col">unmatched</th>' : ''}</tr></thead>
     <tbody>${body}</tbody></table></div>`;
   box.hidden = false;
