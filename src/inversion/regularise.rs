@@ -285,6 +285,29 @@ pub fn capped_inverse_jacobian(h: [f64; 3], f: f64, max_stretch: f64) -> [f64; 4
 mod tests {
     use super::*;
 
+    /// The grids "auto" tries are fractions of `grid.cells` in (0, 1], one to four of them;
+    /// a bad one is refused with the field's name and the value.
+    #[test]
+    fn grid_scales_are_checked() {
+        let mut o = ObjectiveConfig::default();
+        assert_eq!(o.auto_grid_scales, vec![0.5, 0.75, 1.0]);
+        assert!(o.validate().is_ok());
+        for (scales, value) in [
+            (vec![0.5, 0.0], "0"),
+            (vec![1.5], "1.5"),
+            (vec![f64::NAN], "NaN"),
+            (vec![], "0"),
+            (vec![0.2, 0.4, 0.6, 0.8, 1.0], "5"),
+        ] {
+            o.auto_grid_scales = scales.clone();
+            let message = o.validate().unwrap_err().to_string();
+            assert!(
+                message.starts_with(&format!("objective.auto_grid_scales = {value}")),
+                "{scales:?}: {message}"
+            );
+        }
+    }
+
     /// The penalty of two unit Gaussians against a numerical integral on a fine grid.
     #[test]
     fn penalties_match_a_numerical_integral() {

@@ -1303,6 +1303,44 @@ mod tests {
         );
     }
 
+    /// Each grid once (scales that round to the same cells give one grid), coarsest first,
+    /// with every regulariser and strength.
+    #[test]
+    fn candidates_pair_every_grid_with_every_regulariser_and_strength() {
+        let mut config = ReconstructConfig::default();
+        config.grid.cells = 10;
+        config.objective.auto_grid_scales = vec![1.0, 0.74, 0.75, 0.05];
+        config.objective.auto_regularisers = vec![Regulariser::Curvature];
+        config.objective.candidates = vec![0.1, 1.0];
+        let grids: Vec<Option<usize>> = strength_candidates(&config)
+            .iter()
+            .map(|c| c.cells)
+            .collect();
+        // 0.05 of 10 is 0.5: one cell; 7.4 rounds to 7 and 7.5 to 8.
+        assert_eq!(
+            grids,
+            [1, 1, 7, 7, 8, 8, 10, 10].map(Some).to_vec(),
+            "{grids:?}"
+        );
+        // 7.5 and 7.6 both round to 8: one grid.
+        config.objective.auto_grid_scales = vec![0.75, 0.76];
+        let grids: Vec<Option<usize>> = strength_candidates(&config)
+            .iter()
+            .map(|c| c.cells)
+            .collect();
+        assert_eq!(grids, [8, 8].map(Some).to_vec());
+        // The chosen candidate sets the grid of the run.
+        let c = Candidate {
+            regulariser: Regulariser::Curvature,
+            strength: 0.1,
+            cells: Some(7),
+        };
+        let applied = c.apply(&config);
+        assert_eq!(applied.grid.cells, 7);
+        assert_eq!(applied.objective.strength, Strength::Value(0.1));
+        assert_eq!(applied.objective.regulariser, Regulariser::Curvature);
+    }
+
     #[test]
     fn a_choice_without_per_system_offsets_is_not_remade() {
         let choice = choice(vec![candidate(Regulariser::Gradient, 0.01, &[])]);
