@@ -405,8 +405,12 @@ pub(super) fn write_reconstruction(r: &Reconstruction, dir: &Path) -> Result<(),
 }
 
 fn one_line(r: &Reconstruction, out: &Path) -> String {
+    let choice = r
+        .strength_choice
+        .as_ref()
+        .map_or(String::new(), |c| format!("; regulariser {}", c.describe()));
     format!(
-        "wrote {} ({} systems, {} constraint pixels, {} iterations; C = {:?}; grid mass {:.3e} Msun; Einstein radius at z_s = {}: {}; image offsets: rms {}, median {})",
+        "wrote {} ({} systems, {} constraint pixels, {} iterations; C = {:?}; grid mass {:.3e} Msun; Einstein radius at z_s = {}: {}; image offsets: rms {}, median {}{choice})",
         out.display(),
         r.system.constraints.systems.len(),
         r.system.constraints.pixels.len(),

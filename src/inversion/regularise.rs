@@ -60,6 +60,18 @@ pub enum Regulariser {
     Curvature,
 }
 
+impl Regulariser {
+    /// Its name in the settings (`"gradient"`, ...).
+    pub fn name(self) -> &'static str {
+        match self {
+            Regulariser::None => "none",
+            Regulariser::Density => "density",
+            Regulariser::Gradient => "gradient",
+            Regulariser::Curvature => "curvature",
+        }
+    }
+}
+
 /// The strength of the regulariser: a number, or "auto" (chosen by cross-validation).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 #[serde(untagged)]
@@ -284,6 +296,19 @@ pub fn capped_inverse_jacobian(h: [f64; 3], f: f64, max_stretch: f64) -> [f64; 4
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// A regulariser's name is the one the settings use.
+    #[test]
+    fn names_are_the_settings_words() {
+        for r in [
+            Regulariser::None,
+            Regulariser::Density,
+            Regulariser::Gradient,
+            Regulariser::Curvature,
+        ] {
+            assert_eq!(serde_json::to_value(r).unwrap(), r.name());
+        }
+    }
 
     /// The grids "auto" tries are fractions of `grid.cells` in (0, 1], one to four of them;
     /// a bad one is refused with the field's name and the value.

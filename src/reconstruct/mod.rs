@@ -590,6 +590,26 @@ impl StrengthChoice {
         Some(median * (2.0 / (2.0 * std::f64::consts::LN_2)).sqrt())
     }
 
+    /// The choice in words, e.g. "curvature at strength 0.1 on 24 x 24 cells, chosen by
+    /// 4-fold cross-validation of 18 candidates".
+    pub fn describe(&self) -> String {
+        let grid = self
+            .chosen_cells
+            .map_or(String::new(), |n| format!(" on {n} x {n} cells"));
+        let what = format!(
+            "{} at strength {}{grid}",
+            self.chosen_regulariser.name(),
+            self.chosen
+        );
+        match self.candidates.len() {
+            0 => format!("{what} ({})", self.rule),
+            n => format!(
+                "{what}, chosen by {}-fold cross-validation of {n} candidates",
+                self.folds
+            ),
+        }
+    }
+
     /// Whether `c` is the chosen candidate.
     pub fn is_chosen(&self, c: &StrengthCandidate) -> bool {
         c.regulariser == self.chosen_regulariser
@@ -1339,6 +1359,27 @@ mod tests {
         assert_eq!(applied.grid.cells, 7);
         assert_eq!(applied.objective.strength, Strength::Value(0.1));
         assert_eq!(applied.objective.regulariser, Regulariser::Curvature);
+    }
+
+    /// The choice in words, as the CLI prints it.
+    #[test]
+    fn a_choice_says_what_was_chosen_and_how() {
+        let mut c = choice(vec![candidate(Regulariser::Gradient, 0.01, &[])]);
+        c.chosen_regulariser = Regulariser::Curvature;
+        c.chosen = 0.1;
+        c.chosen_cells = Some(24);
+        assert_eq!(
+            c.describe(),
+            "curvature at strength 0.1 on 24 x 24 cells, chosen by 2-fold cross-validation \
+             of 1 candidates"
+        );
+        let config = ReconstructConfig::default();
+        let none = StrengthChoice::from_trials(&config, 1, Vec::new());
+        assert_eq!(
+            none.describe(),
+            "gradient at strength 0.1 (too few fitted systems to hold any out, so the middle \
+             candidate)"
+        );
     }
 
     #[test]
