@@ -283,6 +283,17 @@ pub struct StrengthCandidate {
     pub holdout_by_system: Vec<SystemOffsets>,
 }
 
+impl StrengthCandidate {
+    /// What this candidate sets (its regulariser, strength and grid).
+    pub fn candidate(&self) -> Candidate {
+        Candidate {
+            regulariser: self.regulariser,
+            strength: self.strength,
+            cells: self.cells,
+        }
+    }
+}
+
 /// The held-out images of one system and their offsets (arcsec; `None`: no predicted image).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct SystemOffsets {
@@ -662,11 +673,7 @@ impl StrengthChoice {
             .iter()
             .filter_map(|c| Some((score(c)?, c)))
             .min_by(|(a, _), (b, _)| a.0.cmp(&b.0).then(a.1.total_cmp(&b.1)))
-            .map(|(_, c)| Candidate {
-                regulariser: c.regulariser,
-                strength: c.strength,
-                cells: c.cells,
-            })
+            .map(|(_, c)| c.candidate())
     }
 
     /// The same choice with `chosen` used instead of the chosen candidate (an ensemble
@@ -709,16 +716,20 @@ impl StrengthChoice {
             let (a, b) = (score(p), score(q));
             a.0.cmp(&b.0).then(a.1.total_cmp(&b.1))
         });
-        let (chosen_regulariser, chosen, chosen_cells) = best
-            .map_or((config.objective.regulariser, candidates[0], None), |c| {
-                (c.regulariser, c.strength, c.cells)
-            });
+        let chosen = best.map_or(
+            Candidate {
+                regulariser: config.objective.regulariser,
+                strength: candidates[0],
+                cells: None,
+            },
+            StrengthCandidate::candidate,
+        );
         Self {
             folds,
             candidates: trials,
-            chosen,
-            chosen_regulariser,
-            chosen_cells,
+            chosen: chosen.strength,
+            chosen_regulariser: chosen.regulariser,
+            chosen_cells: chosen.cells,
             rule: format!(
                 "the fewest unmatched, then the smallest median offset of held-out images \
                  over {folds} folds"
