@@ -527,8 +527,8 @@
 //! on each grid of `objective.auto_grid_scales` (default a half, three quarters and all of
 //! `grid.cells` a side: 16, 24 and 32 cells, the same field; a coarser grid is a stronger
 //! prior of smoothness on scales the regulariser does not reach, and the data say which they
-//! support), over `objective.folds` (default 4) folds of the systems, keeping the one whose held-out
-//! images land closest to their predictions (first fewest held-out images without any
+//! support), over `objective.folds` (default 4) folds of the systems, keeping the one whose
+//! held-out images land closest to their predictions (first fewest held-out images without any
 //! prediction, then the smallest median offset). A held-out system is predicted from the
 //! source `beta = (sum_k W_k)^-1 sum_k W_k beta_k`, its images `theta_k` back-projected to
 //! `beta_k` and weighted by `W_k = M_k^T M_k` (`M_k` the capped inverse Jacobian above): to

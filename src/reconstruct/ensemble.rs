@@ -7,13 +7,14 @@
 //! - **the systems fitted drawn at random** (bootstrap over systems): as many draws with
 //!   replacement as there are fitted systems; the systems drawn at least once are fitted
 //!   (a system drawn twice counts once), the others (about a third) are left out;
-//! - **the regulariser, its strength and the grid chosen again on that draw**, when the main run's were
-//!   "auto": the main run's cross-validation is not rerun, but its rule (fewest unmatched, then
-//!   smallest median held-out offset) is applied to the held-out offsets of the systems the
-//!   member drew, each counted as often as drawn ([`StrengthChoice::best_for`]). Candidates
-//!   the data cannot tell apart then share the members, so the choice's own uncertainty is in
-//!   the spread (on the six synthetic clusters of `tests/data/fidelity`, 20 members: the main
-//!   run's choice in 3 to 16 of them);
+//! - **the regulariser, its strength and the grid chosen again on that draw**, when the main
+//!   run's were "auto": the main run's cross-validation is not rerun, but its rule (fewest
+//!   unmatched, then smallest median held-out offset) is applied to the held-out offsets of
+//!   the systems the member drew, each counted as often as drawn
+//!   ([`StrengthChoice::best_for`]). Candidates the data cannot tell apart then share the
+//!   members, so the choice's own uncertainty is in the spread (on the six synthetic
+//!   clusters of `tests/data/fidelity`, 20 members: the main run's choice in 3 to 16 of
+//!   them);
 //! - **the grid moved** by up to half a cell in x and y (uniform), so that where the cells fall
 //!   is not mistaken for structure.
 //!
