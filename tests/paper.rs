@@ -265,3 +265,48 @@ fn markdown_has_tables(md: &str) -> bool {
     md.contains("## Case (iii) from several starts")
         && md.contains("## The open defaults, measured")
 }
+
+/// `--cases ii --no-convergence --no-studies`: one case alone, its checks only, no convergence
+/// study and no convergence figure; the studies refuse to run without cases ii and iii.
+#[test]
+fn one_case_alone_runs_without_the_others() {
+    let mut config = PaperConfig {
+        iterations: 300,
+        map_pixels: 96,
+        studies: false,
+        convergence: false,
+        cases: vec![Case::GalaxyModel],
+        ..PaperConfig::default()
+    };
+    config.simulation.pixel_arcsec = 1.0;
+    let mut lines = Vec::new();
+    let run = run_paper(&config, &mut |l| lines.push(l.to_string())).unwrap();
+    let r = &run.report;
+    assert_eq!(
+        r.cases.keys().collect::<Vec<_>>(),
+        ["galaxy_model"],
+        "{lines:#?}"
+    );
+    assert!(r.convergence.iterations.is_empty());
+    assert!(r.convergence.reasonable.grid_mass_msun.is_empty());
+    assert!(!r.checks.is_empty());
+    assert!(
+        r.checks.iter().all(|c| c.name.starts_with("(ii)")),
+        "{:#?}",
+        r.checks
+    );
+    let names: Vec<&str> = wslap::paper::render_figures(&run)
+        .unwrap()
+        .iter()
+        .map(|f| f.file_name)
+        .collect();
+    assert!(!names.contains(&"convergence.png"), "{names:?}");
+    assert!(names.contains(&"maps.png"), "{names:?}");
+
+    config.studies = true;
+    let err = run_paper(&config, &mut |_| {}).unwrap_err().to_string();
+    assert!(err.contains("cases ii and iii"), "{err}");
+    assert_eq!(Case::parse("ii"), Some(Case::GalaxyModel));
+    assert_eq!(Case::parse("galaxy_true"), Some(Case::GalaxyTrue));
+    assert_eq!(Case::parse("iv"), None);
+}

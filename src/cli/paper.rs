@@ -5,8 +5,8 @@ use std::fs;
 use std::path::{Path, PathBuf};
 
 use clap::Args;
+use wslap::paper::{render_figures, report_markdown, run_paper, Case, PaperConfig};
 use wslap::write_simulation;
-use wslap::{paper::render_figures, paper::report_markdown, paper::run_paper, paper::PaperConfig};
 
 use super::reconstruct::write_reconstruction;
 
@@ -55,6 +55,13 @@ pub struct PaperArgs {
     /// regulariser chosen by cross-validation, the exact minimiser) instead of the paper's QADP.
     #[arg(long)]
     default_objective: bool,
+    /// The cases to run, comma-separated: i (no galaxies), ii (galaxy-model), iii
+    /// (galaxy-true). The studies need ii and iii.
+    #[arg(long, value_delimiter = ',', default_value = "i,ii,iii")]
+    cases: Vec<String>,
+    /// Skip the convergence study (three runs of --long iterations).
+    #[arg(long)]
+    no_convergence: bool,
 }
 
 pub fn run(args: &PaperArgs) -> Result<(), String> {
@@ -67,6 +74,16 @@ pub fn run(args: &PaperArgs) -> Result<(), String> {
     config.simulation.seed = args.seed;
     config.studies = !args.no_studies;
     config.default_objective = args.default_objective;
+    config.convergence = !args.no_convergence;
+    config.cases = args
+        .cases
+        .iter()
+        .map(|name| {
+            Case::parse(name.trim()).ok_or_else(|| {
+                format!("--cases: \"{name}\" is not a case: give i, ii or iii, comma-separated")
+            })
+        })
+        .collect::<Result<_, _>>()?;
     if let Some(m) = args.start_cell_mass {
         config.reasonable_start_cell_mass_msun = m;
     }

@@ -39,9 +39,9 @@ fn fig_err(figure: &'static str) -> impl Fn(crate::render::RenderError) -> Paper
     }
 }
 
-/// Every figure of a paper run.
+/// Every figure of a paper run (`convergence.png` only when the convergence study ran).
 pub fn render_figures(run: &PaperRun) -> Result<Vec<Figure>, PaperError> {
-    Ok(vec![
+    let mut figures = vec![
         Figure {
             file_name: "maps.png",
             png: mass_maps(run)?,
@@ -55,14 +55,17 @@ pub fn render_figures(run: &PaperRun) -> Result<Vec<Figure>, PaperError> {
             png: soft_component(run)?,
         },
         Figure {
-            file_name: "convergence.png",
-            png: convergence(run)?,
-        },
-        Figure {
             file_name: "deflection-error.png",
             png: deflection_error(run)?,
         },
-    ])
+    ];
+    if run.config.convergence {
+        figures.push(Figure {
+            file_name: "convergence.png",
+            png: convergence(run)?,
+        });
+    }
+    Ok(figures)
 }
 
 /// Kappa (log) with the critical curves at z_s = 3, per case (with the truth's curves dashed)

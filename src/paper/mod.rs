@@ -95,6 +95,11 @@ pub enum PaperError {
     BadFieldValue(#[from] crate::error::BadFieldValue),
     #[error("simulated member catalogue: {0}")]
     Members(Box<crate::catalog::CatalogError>),
+    #[error(
+        "the studies need cases ii and iii, and only {0} were asked for: add them, or skip the \
+         studies (--no-studies)"
+    )]
+    StudiesNeedCases(String),
     #[error("figure {figure}: {message}")]
     Figure {
         figure: &'static str,
@@ -142,6 +147,11 @@ pub struct PaperConfig {
     ///
     /// [method §9]: crate::method#9-the-default-objective
     pub default_objective: bool,
+    /// The cases to run (default all three, in the paper's order). The studies need cases
+    /// (ii) and (iii); the checks that compare cases are made where their cases ran.
+    pub cases: Vec<Case>,
+    /// Also run the convergence study (three long runs; default true).
+    pub convergence: bool,
 }
 
 impl Default for PaperConfig {
@@ -163,6 +173,8 @@ impl Default for PaperConfig {
             studies: true,
             best_fit_iterations: 10_000,
             default_objective: false,
+            cases: Case::ALL.to_vec(),
+            convergence: true,
         }
     }
 }
@@ -193,6 +205,22 @@ impl Case {
             Case::NoGalaxies => "case-no-galaxies",
             Case::GalaxyModel => "case-galaxy-model",
             Case::GalaxyTrue => "case-galaxy-true",
+        }
+    }
+
+    /// The case of its roman numeral (`"i"`, `"ii"`, `"iii"`) or its key in `report.json`.
+    pub fn parse(name: &str) -> Option<Case> {
+        Case::ALL
+            .into_iter()
+            .find(|c| c.key() == name || c.numeral() == name)
+    }
+
+    /// Its roman numeral: `"i"`, `"ii"`, `"iii"`.
+    pub fn numeral(self) -> &'static str {
+        match self {
+            Case::NoGalaxies => "i",
+            Case::GalaxyModel => "ii",
+            Case::GalaxyTrue => "iii",
         }
     }
 
@@ -249,6 +277,14 @@ impl PaperConfig {
         }
         if self.report_every == 0 {
             return Err(bad("report_every", 0.0, "must be at least 1"));
+        }
+        if self.cases.is_empty() {
+            return Err(bad("cases", 0.0, "name at least one case"));
+        }
+        let has = |c| self.cases.contains(&c);
+        if self.studies && !(has(Case::GalaxyModel) && has(Case::GalaxyTrue)) {
+            let asked: Vec<&str> = self.cases.iter().map(|c| c.numeral()).collect();
+            return Err(PaperError::StudiesNeedCases(asked.join(", ")));
         }
         if !(self.bad_start_cell_factor.is_finite() && self.bad_start_cell_factor > 0.0) {
             return Err(bad(
@@ -501,6 +537,7 @@ fn plan_batch<'a>(config: &PaperConfig, setup: &'a Setup) -> Vec<(Run, Option<Jo
     ];
     let mut plan: Vec<(Run, Option<Job>)> = Case::ALL
         .iter()
+        .filter(|case| config.cases.contains(case))
         .map(|&case| {
             let job = Job {
                 layers: given(case_layers(case)),
@@ -510,7 +547,12 @@ fn plan_batch<'a>(config: &PaperConfig, setup: &'a Setup) -> Vec<(Run, Option<Jo
             (Run::Case(case), Some(job))
         })
         .collect();
-    for (name, layers, start_mass, start_c) in long_runs {
+    let long_runs = if config.convergence {
+        &long_runs[..]
+    } else {
+        &[]
+    };
+    for &(name, layers, start_mass, start_c) in long_runs {
         let mut rc = config.reconstruct_config(field, config.long_iterations);
         rc.solver.start_cell_mass_msun = start_mass;
         rc.solver.start_c = start_c;
