@@ -541,12 +541,16 @@ pub fn strength_candidates(config: &ReconstructConfig) -> Vec<Candidate> {
 }
 
 /// The folds an "auto" strength is cross-validated with: `objective.folds`, at most one per
-/// fitted system (below 2: too few systems to hold any out).
+/// system a fold can hold out (below 2: too few systems to hold any out). Systems fitted at
+/// an estimated redshift (`constraints.z_estimates`) are fitted by every fold and count for
+/// none ([`fold_groups`]).
 pub fn strength_folds(
     inputs: &Inputs<'_>,
     config: &ReconstructConfig,
 ) -> Result<usize, ReconstructError> {
-    let fitted = fitted_system_ids(inputs, config)?.len();
+    let mut own_redshifts = config.clone();
+    own_redshifts.constraints.z_estimates.clear();
+    let fitted = fitted_system_ids(inputs, &own_redshifts)?.len();
     Ok(config.objective.folds.min(fitted))
 }
 

@@ -421,3 +421,36 @@ fn the_folds_kappa_maps_give_their_mean_and_spread() {
     .unwrap();
     assert!(cv.kappa.is_none());
 }
+
+/// The "auto" choice inside a fold counts only the systems it can hold out: one at an
+/// estimated redshift is fitted by every inner fold too. Here each fold of 3 fits two systems
+/// with a redshift and the estimated one, so its choice has 2 folds (it asked for 3 of the 3
+/// fitted systems before, one more than fold_groups could make, and the fold failed).
+#[test]
+fn an_auto_choice_inside_a_fold_counts_only_the_systems_it_can_hold_out() {
+    let mut cat = catalog();
+    let z3 = cat.systems[2].z.take().unwrap();
+    let none: Vec<String> = Vec::new();
+    let mut config = config();
+    config.objective.strength = wslap::Strength::Auto(wslap::AutoWord::Auto);
+    config.objective.candidates = vec![0.1];
+    config.objective.auto_regularisers = vec![wslap::Regulariser::Gradient];
+    config.objective.auto_grid_scales = vec![1.0];
+    config.objective.folds = 4;
+    config.constraints.z_estimates = vec![("3".to_string(), z3)];
+    assert_eq!(
+        wslap::strength_folds(&inputs(&cat, &none), &config).unwrap(),
+        3
+    );
+    let holdout = ids(&["1"]);
+    assert_eq!(
+        wslap::strength_folds(&inputs(&cat, &holdout), &config).unwrap(),
+        2
+    );
+    let cv = cross_validate(&inputs(&cat, &none), &config, 3, None, &mut |_, _| {
+        Control::Continue
+    })
+    .unwrap();
+    assert_eq!(cv.runs.len(), 3);
+    assert_eq!(cv.always_fitted, ids(&["3"]));
+}
