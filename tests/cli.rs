@@ -1337,12 +1337,27 @@ fn reconstruct_ensemble_writes_its_statistics() {
         .collect();
     let mean = read(out_dir.join("kappa-mean.fits"));
     let std = read(out_dir.join("kappa-std.fits"));
-    // FITS stores float32: compare to its precision.
+    let main = read(out_dir.join("kappa.fits"));
+    let ensemble: serde_json::Value =
+        serde_json::from_str(&fs::read_to_string(out_dir.join("ensemble.json")).unwrap()).unwrap();
+    // The factor the spreads were widened by: at least 1, 1 without a calibration.
+    let factor = ensemble["calibration"]["factor"].as_f64().unwrap_or(1.0);
+    assert!(factor >= 1.0, "{}", ensemble["calibration"]);
+    // FITS stores float32: compare to its precision. kappa-std is the members' rms deviation
+    // from the main map (kappa.fits), widened by the factor.
     for i in 0..mean.len() {
         let m = members.iter().map(|k| k[i]).sum::<f64>() / 4.0;
-        let s = (members.iter().map(|k| (k[i] - m).powi(2)).sum::<f64>() / 4.0).sqrt();
+        let s = (members
+            .iter()
+            .map(|k| (k[i] - main[i]).powi(2))
+            .sum::<f64>()
+            / 4.0)
+            .sqrt();
         assert!((mean[i] - m).abs() <= 1e-6 * m.abs().max(1.0), "pixel {i}");
-        assert!((std[i] - s).abs() <= 1e-6 * m.abs().max(1.0), "pixel {i}");
+        assert!(
+            (std[i] - factor * s).abs() <= 1e-6 * m.abs().max(1.0) * factor,
+            "pixel {i}"
+        );
     }
     assert!(std.iter().any(|&s| s > 0.0), "the members differ");
     let (p16, p50, p84) = (
@@ -1351,9 +1366,7 @@ fn reconstruct_ensemble_writes_its_statistics() {
         read(out_dir.join("magnif-p84.fits")),
     );
     assert!((0..p50.len()).all(|i| p16[i] <= p50[i] && p50[i] <= p84[i]));
-    let ensemble: serde_json::Value =
-        serde_json::from_str(&fs::read_to_string(out_dir.join("ensemble.json")).unwrap()).unwrap();
-    let radii: Vec<f64> = ensemble["members"]
+    let mut radii: Vec<f64> = ensemble["members"]
         .as_array()
         .unwrap()
         .iter()
@@ -1363,10 +1376,25 @@ fn reconstruct_ensemble_writes_its_statistics() {
     let s = summary(&out_dir);
     let range = &s["einstein_radius_interval_arcsec"];
     let (lo, hi) = (range[0].as_f64().unwrap(), range[1].as_f64().unwrap());
-    let (min, max) = radii
-        .iter()
-        .fold((f64::MAX, f64::MIN), |(a, b), &r| (a.min(r), b.max(r)));
-    assert!(min <= lo && lo <= hi && hi <= max, "{lo} {hi} of {radii:?}");
+    // The members' 16th and 84th percentiles' distances from their median (four values:
+    // linear interpolation between the sorted ones), times the factor, about the main run's
+    // Einstein radius.
+    radii.sort_by(f64::total_cmp);
+    let at = |q: f64| {
+        let pos = q * 3.0;
+        let (i, t) = (pos.floor() as usize, pos.fract());
+        radii[i] + t * (radii[(i + 1).min(3)] - radii[i])
+    };
+    let theta = s["einstein_radius_arcsec"].as_f64().unwrap();
+    let want = [
+        theta - factor * (at(0.5) - at(0.16)),
+        theta + factor * (at(0.84) - at(0.5)),
+    ];
+    assert!(
+        (lo - want[0]).abs() < 1e-9 && (hi - want[1]).abs() < 1e-9,
+        "{lo} {hi}, want {want:?} from {radii:?} about {theta}"
+    );
+    assert!(lo <= theta && theta <= hi);
     assert_eq!(s["mass_within_interval_msun"].as_array().unwrap().len(), 3);
     // `wslap lookup` gives the ensemble's interval at its redshift, and says why not at another.
     let lookup = |z: &str| -> serde_json::Value {

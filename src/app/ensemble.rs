@@ -163,18 +163,18 @@ impl Session {
             .result
             .as_mut()
             .ok_or_else(|| AppError::Missing("nothing has been computed yet".to_string()))?;
-        let same = result.reconstruction().is_some_and(|r| {
+        let main = result.reconstruction().filter(|r| {
             r.products.maps.geometry() == plan.geometry
                 && r.system.grid.center == plan.grid_center_arcsec
                 && r.system.grid.width_arcsec == plan.grid_width_arcsec
         });
-        if !same {
+        let Some(main) = main else {
             return Err(AppError::Run(
                 "the reconstruction changed while its ensemble ran: press Reconstruct again"
                     .to_string(),
             ));
-        }
-        let mut ensemble = plan.combine(runs, complete).map_err(run_error)?;
+        };
+        let mut ensemble = plan.combine(main, runs, complete).map_err(run_error)?;
         if let Some(maps) = &mut ensemble.maps {
             maps.member_kappa = Vec::new();
             maps.member_magnif = Vec::new();

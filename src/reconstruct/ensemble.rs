@@ -24,20 +24,31 @@
 //! redshift drawn from that estimate (a normal of the interval's width on each side of the
 //! most probable value, not below the interval).
 //!
-//! Every member's maps are sampled on the main run's map. Per pixel, the ensemble gives the
-//! mean and standard deviation of kappa and the 16th, 50th and 84th percentiles of the
-//! magnification (HFF `kappa-mean`, `kappa-std`, `magnif-p16/p50/p84`), and over the members
-//! the 16th - 84th percentile range of the Einstein radius and of the masses inside 10, 20 and
-//! 50 arcsec. The spread says how much the answer depends on which systems are fitted and on
-//! the grid; it does not include errors common to every member (the members' mass-to-light
-//! law, the cosmology, a wrong redshift, mass outside the grid that no image constrains).
+//! Every member's maps are sampled on the main run's map. The ensemble describes that map,
+//! the one the run reports:
+//!
+//! - per pixel, `kappa-std` is the members' rms deviation from the main run's kappa (their
+//!   standard deviation when they centre on it), `kappa-mean` their mean, and
+//!   `magnif-p16/p50/p84` the percentiles of their magnifications (HFF names);
+//! - the Einstein radius and the masses inside 10, 20 and 50 arcsec get a 68% interval about
+//!   the main run's value: the members' 16th and 84th percentiles lie that far below and above
+//!   their median. A member fits about two thirds of the systems and its map is not centred on
+//!   the main run's (on the synthetic clusters of `tests/data/fidelity` the members' Einstein
+//!   radii lie 0.5 - 1.5% above it); the members' own percentile range then misses the value
+//!   it should describe, while the distances keep what the spread measures.
+//!
+//! Both are widened by the [`Calibration`] factor when the members' predictions of the
+//! images they left out miss by more than their spread says (never narrowed). The spread
+//! says how much the answer depends on which systems are fitted and on the grid; it does not
+//! include errors common to every member (the members' mass-to-light law, the cosmology, a
+//! wrong redshift, mass outside the grid that no image constrains), except as far as the
+//! calibration sees them at the images.
 //!
 //! [method §9]: crate::method#9-the-default-objective
 
 use glam::DVec2;
 use serde::{Deserialize, Serialize};
 
-use super::crossval::SpreadSum;
 use super::{
     fitted_system_ids, reconstruct, reconstruct_with_choice, Candidate, ConvergenceRecord, Inputs,
     ReconstructConfig, ReconstructError, Reconstruction, Regulariser, StrengthChoice,
@@ -85,7 +96,23 @@ pub struct EnsembleMember {
     pub mass_within_arcsec: Vec<(f64, Option<f64>)>,
     /// Median offset of the images it did not fit from their predictions (arcsec).
     pub left_out_image_offset_median_arcsec: Option<f64>,
+    /// The images of the systems its draw left out, each with the position it predicts for
+    /// it (the nearest predicted image; absent where it found none). They measure how far the
+    /// members' spread is from the model's actual error (`Ensemble::calibration`).
+    #[serde(default)]
+    pub left_out_images: Vec<LeftOutImage>,
     pub elapsed_ms: f64,
+}
+
+/// An image of a system a member did not fit, and where the member predicts it.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct LeftOutImage {
+    /// The catalogue id of the image.
+    pub id: String,
+    /// Its observed position (arcsec).
+    pub observed_arcsec: DVec2,
+    /// The member's nearest predicted image (arcsec), `None` when it predicts none.
+    pub predicted_arcsec: Option<DVec2>,
 }
 
 /// The result of [`run_ensemble`] (`ensemble.json`, and the maps as FITS).
@@ -96,21 +123,113 @@ pub struct Ensemble {
     pub seed: u64,
     pub z_source: f64,
     pub members: Vec<EnsembleMember>,
-    /// 16th and 84th percentiles over the members (arcsec).
+    /// The 68% interval of the main run's Einstein radius (arcsec): the members' 16th and
+    /// 84th percentiles' distances from their median, times the calibration factor, about the
+    /// main run's value (the module documentation says why).
     pub einstein_radius_interval_arcsec: Option<[f64; 2]>,
-    /// Per radius of `summary.json` (10, 20, 50 arcsec): the 16th and 84th percentiles of the
-    /// enclosed mass over the members (Msun; `null` where a member's circle left its map).
+    /// Per radius of `summary.json` (10, 20, 50 arcsec): the same interval of the enclosed
+    /// mass (Msun; `null` where a member's circle left its map).
     pub mass_within_interval_msun: Vec<(f64, Option<[f64; 2]>)>,
+    /// How the members' spread compares with the model's actual error at the images of the
+    /// systems they left out, and the factor every spread above was widened by (`None` when
+    /// too few such images were predicted, e.g. in ensembles saved before it was measured).
+    #[serde(default)]
+    pub calibration: Option<Calibration>,
     /// What the spread includes and what it does not.
     pub note: String,
     #[serde(skip)]
     pub maps: Option<EnsembleMaps>,
 }
 
+/// The members' spread against the model's error where the data can tell: at the images of
+/// the systems a member left out (its bootstrap draw did not include them), which it predicts
+/// as a model that never saw them.
+///
+/// For each such image `j`, the `n_j` members that left its system out and predicted it give
+/// predictions `p_mj`: their mean `p_j`, their spread `s_j` (rms distance from `p_j`, over
+/// `n_j - 1`) and the miss `e_j = |p_j - observed_j|`. If the observed image were one more
+/// draw from the members' distribution (an isotropic normal), `e_j` would have the spread
+/// `s_j sqrt(1 + 1/n_j)`, and the median of `e_j` would be `sqrt(ln 2)` times the median of
+/// that spread. `ratio` is the measured median miss over that: about 1 when the members'
+/// spread is as large as the error, above 1 when the error is larger than the spread.
+/// Every spread of the ensemble (the Einstein radius and mass intervals, `kappa-std`) is
+/// widened by `factor = max(1, ratio)`: never narrowed, since the members' own spread is
+/// the least the data leave open.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Calibration {
+    /// Images predicted by at least [`CALIBRATION_MIN_PREDICTIONS`] members.
+    pub images: usize,
+    /// Median of the misses `e_j` (arcsec).
+    pub miss_median_arcsec: f64,
+    /// Median of the spreads `s_j sqrt(1 + 1/n_j)` (arcsec).
+    pub spread_median_arcsec: f64,
+    /// `miss_median / (sqrt(ln 2) spread_median)`.
+    pub ratio: f64,
+    /// `max(1, ratio)`: what the spreads were widened by.
+    pub factor: f64,
+}
+
+/// Fewest members that must predict an image for it to count in [`Calibration`].
+pub const CALIBRATION_MIN_PREDICTIONS: usize = 3;
+/// Fewest such images for a [`Calibration`] (below it the spreads are not widened).
+pub const CALIBRATION_MIN_IMAGES: usize = 5;
+
+impl Calibration {
+    /// The calibration of `members`' predictions of the images they left out; `None` with
+    /// fewer than [`CALIBRATION_MIN_IMAGES`] images predicted by at least
+    /// [`CALIBRATION_MIN_PREDICTIONS`] members each.
+    pub fn of(members: &[&EnsembleMember]) -> Option<Self> {
+        let mut by_image: Vec<(&str, DVec2, Vec<DVec2>)> = Vec::new();
+        for image in members.iter().flat_map(|m| &m.left_out_images) {
+            let Some(p) = image.predicted_arcsec else {
+                continue;
+            };
+            match by_image.iter_mut().find(|(id, _, _)| *id == image.id) {
+                Some((_, _, predictions)) => predictions.push(p),
+                None => by_image.push((&image.id, image.observed_arcsec, vec![p])),
+            }
+        }
+        let mut misses = Vec::new();
+        let mut spreads = Vec::new();
+        for (_, observed, predictions) in &by_image {
+            let n = predictions.len();
+            if n < CALIBRATION_MIN_PREDICTIONS {
+                continue;
+            }
+            let mean = predictions.iter().copied().sum::<DVec2>() / n as f64;
+            let ss: f64 = predictions.iter().map(|p| p.distance_squared(mean)).sum();
+            let spread = (ss / (n - 1) as f64).sqrt() * (1.0 + 1.0 / n as f64).sqrt();
+            misses.push(mean.distance(*observed));
+            spreads.push(spread);
+        }
+        if misses.len() < CALIBRATION_MIN_IMAGES {
+            return None;
+        }
+        let median = |mut v: Vec<f64>| {
+            v.sort_by(f64::total_cmp);
+            quantile(&v, 0.5)
+        };
+        let images = misses.len();
+        let miss = median(misses);
+        let spread = median(spreads);
+        let ratio = miss / (std::f64::consts::LN_2.sqrt() * spread);
+        // Members that all predict the same point (spread 0) say nothing about the error.
+        let ratio = if ratio.is_finite() { ratio } else { 1.0 };
+        Some(Self {
+            images,
+            miss_median_arcsec: miss,
+            spread_median_arcsec: spread,
+            ratio,
+            factor: ratio.max(1.0),
+        })
+    }
+}
+
 /// Per-pixel statistics of the members, on the main run's map, and each member's own maps.
 #[derive(Debug, Clone, PartialEq)]
 pub struct EnsembleMaps {
     pub kappa_mean: Map,
+    /// The members' rms deviation from the main run's kappa, times the calibration factor.
     pub kappa_std: Map,
     /// Magnification at the products' z_s: 16th, 50th and 84th percentiles.
     pub magnif_p16: Map,
@@ -124,8 +243,11 @@ pub struct EnsembleMaps {
 const NOTE: &str = "Members differ in the systems fitted (bootstrap over systems), in the \
      regulariser and strength an \"auto\" choice makes on those systems, in the grid's \
      placement (up to half a cell) and in the redshifts of the systems whose redshift was \
-     estimated (drawn from the estimate). Not included: the members' mass-to-light law, the \
-     cosmology, errors of catalogue redshifts, and mass that no image constrains.";
+     estimated (drawn from the estimate). The intervals and kappa-std describe the main map: \
+     they are the members' deviations from it, widened by the calibration factor where the \
+     members' predictions of the images they did not fit miss by more than their spread. \
+     Not included: the members' mass-to-light law, the cosmology, errors of catalogue \
+     redshifts, and mass that no image constrains.";
 
 impl Ensemble {
     /// The files of `wslap reconstruct --ensemble`: `kappa-mean.fits`, `kappa-std.fits`,
@@ -264,17 +386,28 @@ impl Ensemble {
                 "ensemble_members".to_string(),
                 serde_json::json!(self.members.len()),
             );
+            s.insert(
+                "ensemble_calibration".to_string(),
+                serde_json::json!(self.calibration),
+            );
         }
     }
 }
 
-fn interval(mut values: Vec<f64>) -> Option<[f64; 2]> {
+/// The interval of the main run's `value` from the members' `values`: the distances of the
+/// members' 16th and 84th percentiles from their median, times `factor`, on either side of
+/// `value` (of the members' median when the main run has none). The members fit about two
+/// thirds of the systems each and may centre away from the main run; the interval is about
+/// the map the run reports, and always holds it.
+fn interval(value: Option<f64>, mut values: Vec<f64>, factor: f64) -> Option<[f64; 2]> {
     values.retain(|v| v.is_finite());
     if values.is_empty() {
         return None;
     }
     values.sort_by(f64::total_cmp);
-    Some([quantile(&values, 0.16), quantile(&values, 0.84)])
+    let [q16, q50, q84] = [0.16, 0.5, 0.84].map(|q| quantile(&values, q));
+    let centre = value.filter(|v| v.is_finite()).unwrap_or(q50);
+    Some([centre - factor * (q50 - q16), centre + factor * (q84 - q50)])
 }
 
 /// Checks the number of members.
@@ -330,7 +463,7 @@ pub fn run_ensemble(
             _ => complete = false,
         }
     }
-    plan.combine(runs, complete)
+    plan.combine(main, runs, complete)
 }
 
 /// How one member differs from the main run: the systems it fits and its grid's shift.
@@ -555,6 +688,17 @@ impl EnsemblePlan {
             einstein_radius_arcsec: summary.einstein_radius_arcsec,
             mass_within_arcsec: summary.mass_within_arcsec,
             left_out_image_offset_median_arcsec: r.image_offset_median_arcsec(true),
+            left_out_images: r
+                .sources
+                .iter()
+                .filter(|s| s.held_out && draw.left_out.contains(&s.id))
+                .flat_map(|s| &s.observed)
+                .map(|o| LeftOutImage {
+                    id: o.id.clone(),
+                    observed_arcsec: o.position_arcsec,
+                    predicted_arcsec: o.predicted_arcsec,
+                })
+                .collect(),
             elapsed_ms: clock.ms(),
         };
         Ok(Some(MemberRun {
@@ -564,14 +708,25 @@ impl EnsemblePlan {
         }))
     }
 
-    /// The ensemble of `runs` (members of this plan, in any order, each once), "Completed"
-    /// when `complete`, else "Cancelled". Fails when a run is not of this plan (its number or
-    /// its maps) or comes twice.
+    /// The ensemble of `runs` (members of this plan, in any order, each once) about `main`,
+    /// the reconstruction the plan was made from: "Completed" when `complete`, else
+    /// "Cancelled". Its intervals and `kappa-std` describe `main`'s map ([`Calibration`] says
+    /// by how much they were widened). Fails when a run is not of this plan (its number or its
+    /// maps) or comes twice, or when `main`'s map is not the plan's.
     pub fn combine(
         &self,
+        main: &Reconstruction,
         mut runs: Vec<MemberRun>,
         complete: bool,
     ) -> Result<Ensemble, ReconstructError> {
+        if main.products.maps.geometry() != self.geometry {
+            return Err(BadFieldValue::new(
+                "ensemble",
+                self.members() as f64,
+                "the reconstruction is not the one its members were planned from",
+            )
+            .into());
+        }
         runs.sort_by_key(|r| r.record.member);
         for (k, run) in runs.iter().enumerate() {
             let m = run.record.member;
@@ -596,6 +751,9 @@ impl EnsemblePlan {
             }
         }
         let records: Vec<&EnsembleMember> = runs.iter().map(|r| &r.record).collect();
+        let calibration = Calibration::of(&records);
+        let factor = calibration.as_ref().map_or(1.0, |c| c.factor);
+        let main_summary = main.products.summary();
         let mass_within_interval_msun = self
             .radii_arcsec
             .iter()
@@ -605,11 +763,19 @@ impl EnsemblePlan {
                     .iter()
                     .map(|m| m.mass_within_arcsec.get(i).and_then(|(_, v)| *v))
                     .collect();
-                (r, values.and_then(interval))
+                let value = main_summary
+                    .mass_within_arcsec
+                    .iter()
+                    .find(|(radius, _)| *radius == r)
+                    .and_then(|(_, v)| *v);
+                (r, values.and_then(|v| interval(value, v, factor)))
             })
             .collect();
-        let einstein_radius_interval_arcsec =
-            interval(records.iter().map(|m| m.einstein_radius_arcsec).collect());
+        let einstein_radius_interval_arcsec = interval(
+            Some(main_summary.einstein_radius_arcsec),
+            records.iter().map(|m| m.einstein_radius_arcsec).collect(),
+            factor,
+        );
         let mut members = Vec::with_capacity(runs.len());
         let mut kappas = Vec::with_capacity(runs.len());
         let mut magnifs = Vec::with_capacity(runs.len());
@@ -618,6 +784,8 @@ impl EnsemblePlan {
             kappas.push(run.kappa);
             magnifs.push(run.magnif);
         }
+        let maps = (!kappas.is_empty())
+            .then(|| statistics(&main.products.maps.kappa, factor, kappas, magnifs));
         Ok(Ensemble {
             status: if complete { "Completed" } else { "Cancelled" }.to_string(),
             seed: self.seed,
@@ -625,8 +793,9 @@ impl EnsemblePlan {
             members,
             einstein_radius_interval_arcsec,
             mass_within_interval_msun,
+            calibration,
             note: NOTE.to_string(),
-            maps: (!kappas.is_empty()).then(|| statistics(self.geometry, kappas, magnifs)),
+            maps,
         })
     }
 }
@@ -651,13 +820,24 @@ fn sampled_maps(r: &Reconstruction, geometry: MapGeometry) -> (Map, Map) {
     (kappa, magnif)
 }
 
-fn statistics(geometry: MapGeometry, kappas: Vec<Map>, magnifs: Vec<Map>) -> EnsembleMaps {
-    let mut kappa = SpreadSum::new(geometry);
-    for k in &kappas {
-        kappa.add(&k.data);
-    }
-    let kappa = kappa.finish().expect("an ensemble has members");
+/// The ensemble's maps: `kappa_mean` the members' mean; `kappa_std` their rms deviation
+/// from `main_kappa` (the map the run reports; equal to their standard deviation when they
+/// centre on it) times `factor`; the magnification's percentiles over the members.
+fn statistics(main_kappa: &Map, factor: f64, kappas: Vec<Map>, magnifs: Vec<Map>) -> EnsembleMaps {
+    let geometry = main_kappa.geometry;
     let n = geometry.pixels * geometry.pixels;
+    let count = kappas.len().max(1) as f64;
+    let mut mean = vec![0.0; n];
+    let mut about_main = vec![0.0; n];
+    for k in &kappas {
+        for (i, &v) in k.data.iter().enumerate() {
+            mean[i] += v / count;
+            about_main[i] += (v - main_kappa.data[i]).powi(2) / count;
+        }
+    }
+    for v in &mut about_main {
+        *v = factor * v.sqrt();
+    }
     let mut p = [vec![0.0; n], vec![0.0; n], vec![0.0; n]];
     let mut column = Vec::with_capacity(magnifs.len());
     for i in 0..n {
@@ -671,8 +851,8 @@ fn statistics(geometry: MapGeometry, kappas: Vec<Map>, magnifs: Vec<Map>) -> Ens
     let map = |data| Map { geometry, data };
     let [p16, p50, p84] = p;
     EnsembleMaps {
-        kappa_mean: kappa.mean,
-        kappa_std: kappa.spread,
+        kappa_mean: map(mean),
+        kappa_std: map(about_main),
         magnif_p16: map(p16),
         magnif_p50: map(p50),
         magnif_p84: map(p84),
@@ -686,10 +866,85 @@ mod tests {
     use super::*;
 
     #[test]
-    fn interval_is_the_16th_to_84th_percentile_of_the_finite_values() {
+    fn interval_is_the_members_percentile_spread_about_the_main_value() {
+        // Percentiles of 1..5: 16th 1.64, median 3, 84th 4.36.
         let v = vec![5.0, 1.0, f64::NAN, 3.0, 2.0, 4.0];
-        let [lo, hi] = interval(v).unwrap();
-        assert!((lo - 1.64).abs() < 1e-12 && (hi - 4.36).abs() < 1e-12);
-        assert_eq!(interval(vec![f64::NAN]), None);
+        let close =
+            |a: [f64; 2], b: [f64; 2]| (a[0] - b[0]).abs() < 1e-12 && (a[1] - b[1]).abs() < 1e-12;
+        assert!(close(interval(None, v.clone(), 1.0).unwrap(), [1.64, 4.36]));
+        assert!(close(
+            interval(Some(2.0), v.clone(), 1.0).unwrap(),
+            [0.64, 3.36]
+        ));
+        assert!(close(
+            interval(Some(2.0), v.clone(), 2.0).unwrap(),
+            [-0.72, 4.72]
+        ));
+        assert!(close(
+            interval(Some(f64::NAN), v, 1.0).unwrap(),
+            [1.64, 4.36]
+        ));
+        assert_eq!(interval(Some(1.0), vec![f64::NAN], 1.0), None);
+    }
+
+    fn member(images: Vec<LeftOutImage>) -> EnsembleMember {
+        EnsembleMember {
+            member: 1,
+            fitted: Vec::new(),
+            grid_shift_arcsec: DVec2::ZERO,
+            redshifts: Vec::new(),
+            regulariser: None,
+            strength: None,
+            cells: None,
+            status: "Converged".to_string(),
+            c: Vec::new(),
+            einstein_radius_arcsec: 30.0,
+            mass_within_arcsec: Vec::new(),
+            left_out_image_offset_median_arcsec: None,
+            left_out_images: images,
+            elapsed_ms: 0.0,
+        }
+    }
+
+    /// Six images, each predicted by four members at the corners of a square of side 2 about
+    /// a point 3 arcsec from the observed image: spread sqrt(8/3) sqrt(5/4), miss 3.
+    #[test]
+    fn calibration_compares_the_miss_with_the_spread_of_the_predictions() {
+        let corners = [(1.0, 1.0), (-1.0, 1.0), (1.0, -1.0), (-1.0, -1.0)];
+        let members: Vec<EnsembleMember> = corners
+            .iter()
+            .map(|&(dx, dy)| {
+                member(
+                    (0..6)
+                        .map(|j| LeftOutImage {
+                            id: format!("{j}.1"),
+                            observed_arcsec: DVec2::new(10.0 * j as f64, 0.0),
+                            predicted_arcsec: Some(DVec2::new(10.0 * j as f64 + dx, 3.0 + dy)),
+                        })
+                        .collect(),
+                )
+            })
+            .collect();
+        let refs: Vec<&EnsembleMember> = members.iter().collect();
+        let c = Calibration::of(&refs).unwrap();
+        let spread = (8.0f64 / 3.0).sqrt() * 1.25f64.sqrt();
+        assert_eq!(c.images, 6);
+        assert!((c.miss_median_arcsec - 3.0).abs() < 1e-12);
+        assert!((c.spread_median_arcsec - spread).abs() < 1e-12);
+        let ratio = 3.0 / (std::f64::consts::LN_2.sqrt() * spread);
+        assert!((c.ratio - ratio).abs() < 1e-12 && (c.factor - ratio).abs() < 1e-12);
+        // Predictions on the observed image: nothing to widen, the factor stays 1.
+        let mut on = members.clone();
+        for m in &mut on {
+            for im in &mut m.left_out_images {
+                im.observed_arcsec.y = 3.0;
+            }
+        }
+        let refs: Vec<&EnsembleMember> = on.iter().collect();
+        let c = Calibration::of(&refs).unwrap();
+        assert!(c.ratio < 1e-12 && c.factor == 1.0);
+        // Images predicted by fewer than three members do not count; too few images, none.
+        let refs: Vec<&EnsembleMember> = members.iter().take(2).collect();
+        assert_eq!(Calibration::of(&refs), None);
     }
 }

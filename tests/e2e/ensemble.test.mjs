@@ -39,8 +39,8 @@ test('an ensemble of the built-in example gives the spread view, the downloads a
 
     // The intervals: in the caption and under the views.
     const caption = await page.textContent('#summary');
-    assert.match(caption, /Ensemble of 3 members \(16th – 84th percentile\): Einstein radius \d+\.\d – \d+\.\d″/);
-    assert.match(await page.innerText('#ensemble-summary'), /Einstein radius at z_s = 3, 16th – 84th percentile/);
+    assert.match(caption, /Ensemble of 3 members \(68% intervals about this map(, widened ×\d+\.\d\d)?\): Einstein radius \d+\.\d – \d+\.\d″/);
+    assert.match(await page.innerText('#ensemble-summary'), /Einstein radius at z_s = 3, 68% interval\s+about this map/);
     assert.equal(await page.locator('#ensemble-masses li').count(), 3);
 
     // The spread view.
@@ -80,6 +80,18 @@ test('an ensemble of the built-in example gives the spread view, the downloads a
     assert.equal(summary.ensemble_members, 3);
     assert.deepEqual(summary.einstein_radius_interval_arcsec, ensemble.einstein_radius_interval_arcsec);
     assert.equal(summary.mass_within_interval_msun.length, 3);
+    assert.deepEqual(summary.ensemble_calibration, ensemble.calibration ?? null);
+    // The interval is about the map the caption gives: it holds its Einstein radius.
+    const [lo, hi] = ensemble.einstein_radius_interval_arcsec;
+    assert.ok(lo <= summary.einstein_radius_arcsec && summary.einstein_radius_arcsec <= hi,
+      `${lo} - ${hi} against ${summary.einstein_radius_arcsec}`);
+    // Every member says where it predicts the images of the systems it left out; where three
+    // of them predict one image, the box says how their misses compare with their spread.
+    assert.ok(ensemble.members.every((m) => Array.isArray(m.left_out_images)));
+    assert.equal(await page.isVisible('#ensemble-calibration'), ensemble.calibration != null);
+    if (ensemble.calibration) {
+      assert.match(await page.innerText('#ensemble-calibration'), /miss by a median of \d+\.\d\d″ for a spread of/);
+    }
     await page.click('#downloads-panel summary');
 
     await page.locator('#ensemble-box').scrollIntoViewIfNeeded();
@@ -138,7 +150,7 @@ test('a restarted worker and a reload show the ensemble again: caption, spread v
     await setField(page, '#set-ensemble-members', 2);
     await page.click('#reconstruct');
     await waitStatus(page, ENSEMBLE_DONE, 300_000);
-    const interval = (await page.textContent('#summary')).match(/Ensemble of 2 members \(16th – 84th percentile\): Einstein radius \d+\.\d – \d+\.\d″/);
+    const interval = (await page.textContent('#summary')).match(/Ensemble of 2 members \(68% intervals about this map(, widened ×\d+\.\d\d)?\): Einstein radius \d+\.\d – \d+\.\d″/);
     assert.ok(interval, await page.textContent('#summary'));
     // The project in IndexedDB has the ensemble once it is saved after the members.
     await savedProject(page, /"maps_f32_base64"/);
@@ -155,7 +167,7 @@ test('a restarted worker and a reload show the ensemble again: caption, spread v
     await waitStatus(page, /^Restored your project from this browser/, 120_000);
     assert.ok((await page.textContent('#summary')).includes(interval[0]), `${await page.textContent('#summary')} / ${await page.textContent('#project-description')}`);
     assert.match(await page.textContent('#project-description'), /its ensemble of 2 members restored/);
-    assert.match(await page.innerText('#ensemble-summary'), /Einstein radius at z_s = 3, 16th – 84th percentile/);
+    assert.match(await page.innerText('#ensemble-summary'), /Einstein radius at z_s = 3, 68% interval\s+about this map/);
     assert.equal(await page.isVisible('#tab-spread'), true);
     const before = await renderCount(page);
     await page.click('#tab-spread');

@@ -137,7 +137,9 @@ export function ensembleCaption(summary) {
   const radius = r ? `Einstein radius${z} ${fixed(r[0], 1)} – ${fixed(r[1], 1)}″` : 'no Einstein radius';
   const masses = (summary.mass_within_interval_msun ?? []).filter(([, m]) => m)
     .map(([within, [lo, hi]]) => `${mass(lo)} – ${mass(hi)} M☉ within ${fixed(within, 0)}″`);
-  return ` Ensemble of ${n} members (16th – 84th percentile): ${radius}${masses.length ? `; ${masses.join(', ')}` : ''}.`;
+  const widened = summary.ensemble_calibration?.factor > 1
+    ? `, widened ×${fixed(summary.ensemble_calibration.factor, 2)}` : '';
+  return ` Ensemble of ${n} members (68% intervals about this map${widened}): ${radius}${masses.length ? `; ${masses.join(', ')}` : ''}.`;
 }
 
 /** The ensemble's values in the map's read-out (`h.ensemble` of a hover answer), '' without. */
@@ -197,14 +199,19 @@ export function showEnsemble(ensemble, app) {
   const radii = ensemble.members.map((m) => m.einstein_radius_arcsec).filter(Number.isFinite);
   const masses = (ensemble.mass_within_interval_msun ?? []).map(([within, m]) =>
     `<li>within ${fixed(within, 0)}″: ${m ? `${mass(m[0])} – ${mass(m[1])} M☉` : 'not on every member\'s map'}</li>`).join('');
+  const c = ensemble.calibration;
+  const calibration = c ? `<p id="ensemble-calibration">At the ${c.images} images of the systems they left out,
+    the members' predictions miss by a median of ${fixed(c.miss_median_arcsec, 2)}″ for a spread of
+    ${fixed(c.spread_median_arcsec, 2)}″ (ratio ${fixed(c.ratio, 2)}, 1 when the spread is the error): ${c.factor > 1
+    ? `the intervals and κ's spread are widened ×${fixed(c.factor, 2)}` : 'the intervals are the members\' own spread'}.</p>` : '';
   box.innerHTML = `<h3>Ensemble of ${n} members (seed ${ensemble.seed})</h3>
     <p id="ensemble-summary">How sure the map is: ${n} more reconstructions, each fitting a bootstrap draw of the
-    systems on a grid moved by up to half a cell. Einstein radius at z_s = ${ensemble.z_source}, 16th – 84th
-    percentile: <b>${r ? `${fixed(r[0], 2)} – ${fixed(r[1], 2)}″` : 'none'}</b>${radii.length ? ` (members
+    systems on a grid moved by up to half a cell. Einstein radius at z_s = ${ensemble.z_source}, 68% interval
+    about this map: <b>${r ? `${fixed(r[0], 2)} – ${fixed(r[1], 2)}″` : 'none'}</b>${radii.length ? ` (members
     ${fixed(Math.min(...radii), 2)} – ${fixed(Math.max(...radii), 2)}″)` : ''}. Projected mass:</p>
-    <ul id="ensemble-masses">${masses}</ul>
-    <p class="hint">${ensemble.note}${maps ? ` The tab "Ensemble spread" shows the standard deviation of κ; a click
-    on the mass map reads out the magnification's interval.` : ''}</p>`;
+    <ul id="ensemble-masses">${masses}</ul>${calibration}
+    <p class="hint">${ensemble.note}${maps ? ` The tab "Ensemble spread" shows κ's spread about this map; a click
+    on the mass map reads out the magnification's 16th – 84th percentiles over the members.` : ''}</p>`;
   box.append(...buttons(), missing());
   box.hidden = false;
   const group = document.createElement('div');
