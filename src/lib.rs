@@ -157,8 +157,9 @@ pub use reconstruct::{
     ProductConfig, ReconstructConfig, ReconstructError, ReconstructSummary, Reconstruction,
     RedshiftEstimate, RunSize, RunStatus, Solved, SolverConfig, SolverMethod, SourceReport,
     StrengthCandidate, StrengthChoice, SystemCheck, TooMuchMemory, Trust, Verdict, VerdictInputs,
-    WeakLensingFit, CHOICE_MAP_PIXELS, DEFAULT_FOLDS, FALLBACK_MEMORY_LIMIT_BYTES,
-    FALLBACK_SIGMA_ARCSEC, MAX_ENSEMBLE_MEMBERS, SHOWN_MIN_MAGNIFICATION, WASM_MEMORY_LIMIT_BYTES,
+    WeakLensingFit, CALIBRATION_MIN_IMAGES, CALIBRATION_MIN_PREDICTIONS, CHOICE_MAP_PIXELS,
+    DEFAULT_FOLDS, FALLBACK_MEMORY_LIMIT_BYTES, FALLBACK_SIGMA_ARCSEC, MAX_ENSEMBLE_MEMBERS,
+    SHOWN_MIN_MAGNIFICATION, WASM_MEMORY_LIMIT_BYTES,
 };
 
 // The verdict on a reconstruction and its thresholds.

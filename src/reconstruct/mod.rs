@@ -29,7 +29,8 @@ pub use crossval::{
 pub use dataset::{Dataset, DatasetError, InputText, InputTexts};
 pub use ensemble::{
     check_ensemble_size, run_ensemble, Calibration, Ensemble, EnsembleMaps, EnsembleMember,
-    EnsemblePlan, LeftOutImage, MemberDraw, MemberRun, MAX_ENSEMBLE_MEMBERS,
+    EnsemblePlan, LeftOutImage, MemberDraw, MemberRun, CALIBRATION_MIN_IMAGES,
+    CALIBRATION_MIN_PREDICTIONS, MAX_ENSEMBLE_MEMBERS,
 };
 pub use free_z::{estimate_redshift, FreeZSummary, RedshiftEstimate, FALLBACK_SIGMA_ARCSEC};
 pub use memory::{
