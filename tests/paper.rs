@@ -9,10 +9,10 @@
 #![cfg(not(target_arch = "wasm32"))]
 
 use wslap::paper::metrics::lens_equation_chi2;
+use wslap::paper::{run_paper, Case, CaseSettings, PaperConfig};
 use wslap::quadratic_objective as objective;
 use wslap::MassComponent;
 use wslap::LAYER_SHARE_WARN;
-use wslap::{paper::run_paper, paper::Case, paper::PaperConfig};
 
 /// Iterations of the reduced run: enough for the galaxy layer to matter (the paper's solutions
 /// are good after a few thousand).
@@ -267,7 +267,8 @@ fn markdown_has_tables(md: &str) -> bool {
 }
 
 /// `--cases ii --no-convergence --no-studies`: one case alone, its checks only, no convergence
-/// study and no convergence figure; the studies refuse to run without cases ii and iii.
+/// study and no convergence figure; `--config` settings laid over the case's; the studies
+/// refuse to run without cases ii and iii.
 #[test]
 fn one_case_alone_runs_without_the_others() {
     let mut config = PaperConfig {
@@ -302,6 +303,27 @@ fn one_case_alone_runs_without_the_others() {
         .collect();
     assert!(!names.contains(&"convergence.png"), "{names:?}");
     assert!(names.contains(&"maps.png"), "{names:?}");
+
+    // Settings laid over the case's: here a fixed strength for the default objective.
+    let mut laid = config.clone();
+    laid.default_objective = true;
+    laid.case_settings = Some(CaseSettings {
+        source_name: "strength.json".to_string(),
+        value: serde_json::json!({"objective": {"strength": 0.1}, "grid": {"cells": 12}}),
+    });
+    let run = run_paper(&laid, &mut |_| {}).unwrap();
+    let c = &run.cases[0].reconstruction.config;
+    assert_eq!(c.objective.strength, wslap::Strength::Value(0.1));
+    assert_eq!(c.grid.cells, 12);
+    assert_eq!(c.solver.method, wslap::SolverMethod::Exact);
+    assert!(run.cases[0].reconstruction.strength_choice.is_none());
+    // Settings that do not read are refused before the simulation, naming their file.
+    laid.case_settings = Some(CaseSettings {
+        source_name: "strength.json".to_string(),
+        value: serde_json::json!({"grid": {"cells": 100000}}),
+    });
+    let err = run_paper(&laid, &mut |_| {}).unwrap_err().to_string();
+    assert!(err.starts_with("strength.json: grid.cells"), "{err}");
 
     config.studies = true;
     let err = run_paper(&config, &mut |_| {}).unwrap_err().to_string();

@@ -5,9 +5,10 @@ use std::fs;
 use std::path::{Path, PathBuf};
 
 use clap::Args;
-use wslap::paper::{render_figures, report_markdown, run_paper, Case, PaperConfig};
-use wslap::write_simulation;
+use wslap::paper::{render_figures, report_markdown, run_paper, Case, CaseSettings, PaperConfig};
+use wslap::{write_simulation, InputKind};
 
+use super::input::read_text;
 use super::reconstruct::write_reconstruction;
 
 /// Reproduces the WSLAP+ paper's test: simulates the cluster and its arcs (as `wslap simulate`),
@@ -62,6 +63,10 @@ pub struct PaperArgs {
     /// Skip the convergence study (three runs of --long iterations).
     #[arg(long)]
     no_convergence: bool,
+    /// Settings (JSON, as `wslap reconstruct --config` reads) laid over each case's: e.g.
+    /// `{"objective": {"strength": 0.1}}` with --default-objective to try one strength.
+    #[arg(long, value_name = "FILE")]
+    config: Option<PathBuf>,
 }
 
 pub fn run(args: &PaperArgs) -> Result<(), String> {
@@ -75,6 +80,21 @@ pub fn run(args: &PaperArgs) -> Result<(), String> {
     config.studies = !args.no_studies;
     config.default_objective = args.default_objective;
     config.convergence = !args.no_convergence;
+    if let Some(path) = &args.config {
+        let name = path.display().to_string();
+        let text = read_text(path, InputKind::Config)?;
+        let value: serde_json::Value =
+            serde_json::from_str(&text).map_err(|e| format!("{name}: not JSON: {e}"))?;
+        if !value.is_object() {
+            return Err(format!(
+                "{name}: settings are a JSON object, e.g. {{\"objective\": {{\"strength\": 0.1}}}}"
+            ));
+        }
+        config.case_settings = Some(CaseSettings {
+            source_name: name,
+            value,
+        });
+    }
     config.cases = args
         .cases
         .iter()

@@ -100,6 +100,11 @@ pub enum PaperError {
          studies (--no-studies)"
     )]
     StudiesNeedCases(String),
+    #[error("{message}")]
+    CaseSettings {
+        source_name: String,
+        message: String,
+    },
     #[error("figure {figure}: {message}")]
     Figure {
         figure: &'static str,
@@ -152,6 +157,51 @@ pub struct PaperConfig {
     pub cases: Vec<Case>,
     /// Also run the convergence study (three long runs; default true).
     pub convergence: bool,
+    /// Settings laid over each case's reconstruction settings (`wslap paper --config`): a
+    /// JSON object in the form `wslap reconstruct --config` reads, whose fields replace the
+    /// case's (objects field by field); `None` (default) for the cases as they are.
+    pub case_settings: Option<CaseSettings>,
+}
+
+/// Settings laid over the cases' reconstruction settings, and the file they came from.
+#[derive(Debug, Clone, PartialEq)]
+pub struct CaseSettings {
+    /// Where they came from, for messages (a file name).
+    pub source_name: String,
+    pub value: serde_json::Value,
+}
+
+impl CaseSettings {
+    /// `config` with these settings laid over it, checked as `wslap reconstruct --config`
+    /// checks a file.
+    pub fn apply(&self, config: &ReconstructConfig) -> Result<ReconstructConfig, PaperError> {
+        fn lay(base: &mut serde_json::Value, over: &serde_json::Value) {
+            match (base, over) {
+                (serde_json::Value::Object(base), serde_json::Value::Object(over)) => {
+                    for (key, value) in over {
+                        lay(
+                            base.entry(key.clone()).or_insert(serde_json::Value::Null),
+                            value,
+                        );
+                    }
+                }
+                (base, over) => *base = over.clone(),
+            }
+        }
+        let mut value = serde_json::to_value(config).map_err(|e| PaperError::CaseSettings {
+            source_name: self.source_name.clone(),
+            message: e.to_string(),
+        })?;
+        lay(&mut value, &self.value);
+        let fail = |message: String| PaperError::CaseSettings {
+            source_name: self.source_name.clone(),
+            message: format!("{}: {message}", self.source_name),
+        };
+        let config: ReconstructConfig =
+            serde_json::from_value(value).map_err(|e| fail(e.to_string()))?;
+        config.validate().map_err(|e| fail(e.to_string()))?;
+        Ok(config)
+    }
 }
 
 impl Default for PaperConfig {
@@ -175,6 +225,7 @@ impl Default for PaperConfig {
             default_objective: false,
             cases: Case::ALL.to_vec(),
             convergence: true,
+            case_settings: None,
         }
     }
 }
@@ -324,6 +375,18 @@ impl PaperConfig {
     }
 }
 
+impl PaperConfig {
+    /// The reconstruction settings of the cases: [`Self::reconstruct_config`] with
+    /// `case_settings` laid over it.
+    fn case_config(&self, field_arcsec: f64) -> Result<ReconstructConfig, PaperError> {
+        let c = self.reconstruct_config(field_arcsec, self.iterations);
+        match &self.case_settings {
+            Some(settings) => settings.apply(&c),
+            None => Ok(c),
+        }
+    }
+}
+
 /// Runs the simulation, the three cases and the convergence study, and scores them.
 /// `say` receives one line per stage.
 ///
@@ -332,23 +395,29 @@ impl PaperConfig {
 /// each (`collect_batch`).
 pub fn run_paper(config: &PaperConfig, say: &mut dyn FnMut(&str)) -> Result<PaperRun, PaperError> {
     config.validate()?;
+    // Settings that do not read fail here, before the simulation.
+    config.case_config(config.simulation.field_arcsec)?;
     let t_all = Clock::start();
     let setup = Setup::new(config, say)?;
     let scorer = setup.scorer();
-    let done = run_plan(&setup.simulation, plan_batch(config, &setup), |run, rec| {
-        Ok(match *run {
-            Run::Case(case) => {
-                let scored = scorer.score(&rec, case.key())?;
-                Done::Case(case, Box::new(scored), Box::new(rec))
-            }
-            Run::Long(name) => Done::Long(
-                name,
-                RunSeries::from_records(&rec, &setup.truth_betas),
-                rec.convergence.clone(),
-                run_seconds(&rec),
-            ),
-        })
-    })?;
+    let done = run_plan(
+        &setup.simulation,
+        plan_batch(config, &setup)?,
+        |run, rec| {
+            Ok(match *run {
+                Run::Case(case) => {
+                    let scored = scorer.score(&rec, case.key())?;
+                    Done::Case(case, Box::new(scored), Box::new(rec))
+                }
+                Run::Long(name) => Done::Long(
+                    name,
+                    RunSeries::from_records(&rec, &setup.truth_betas),
+                    rec.convergence.clone(),
+                    run_seconds(&rec),
+                ),
+            })
+        },
+    )?;
     let done = done
         .into_iter()
         .map(|(_, done)| done.expect("every run has a job"));
@@ -503,7 +572,10 @@ enum Done {
 
 /// The three cases and the convergence study (the galaxy-true layer from the reasonable and
 /// the bad start, and the grid alone, each for `long_iterations`), run as one batch.
-fn plan_batch<'a>(config: &PaperConfig, setup: &'a Setup) -> Vec<(Run, Option<Job<'a>>)> {
+fn plan_batch<'a>(
+    config: &PaperConfig,
+    setup: &'a Setup,
+) -> Result<Vec<(Run, Option<Job<'a>>)>, PaperError> {
     let field = setup.simulation.config.field_arcsec;
     let layer_true = std::slice::from_ref(&setup.layer_true);
     let case_layers = |case: Case| -> &[Layer] {
@@ -535,13 +607,14 @@ fn plan_batch<'a>(config: &PaperConfig, setup: &'a Setup) -> Vec<(Run, Option<Jo
             config.reasonable_start_c,
         ),
     ];
+    let case_config = config.case_config(field)?;
     let mut plan: Vec<(Run, Option<Job>)> = Case::ALL
         .iter()
         .filter(|case| config.cases.contains(case))
         .map(|&case| {
             let job = Job {
                 layers: given(case_layers(case)),
-                config: config.reconstruct_config(field, config.iterations),
+                config: case_config.clone(),
                 name: case.key(),
             };
             (Run::Case(case), Some(job))
@@ -565,7 +638,7 @@ fn plan_batch<'a>(config: &PaperConfig, setup: &'a Setup) -> Vec<(Run, Option<Jo
         };
         plan.push((Run::Long(name), Some(job)));
     }
-    plan
+    Ok(plan)
 }
 
 /// The batch's cases and convergence-study series, in plan order, with one line each to `say`.
