@@ -523,7 +523,9 @@
 //! matrix, `A_cells`, so that `strength` means the same for any mass unit, field or number of
 //! images; it is fixed at the first solve. With `objective.strength = "auto"` (default) every
 //! candidate is cross-validated: each regulariser of `objective.auto_regularisers` (default
-//! gradient and curvature) at each strength of `objective.candidates` (default 0.01, 0.1, 1),
+//! gradient, curvature and density: the first two cost nothing for a uniform sheet of mass,
+//! which images at similar redshifts hardly measure; density, the least mass, does) at each
+//! strength of `objective.candidates` (default 0.01, 0.1, 1),
 //! on each grid of `objective.auto_grid_scales` (default a half, three quarters and all of
 //! `grid.cells` a side: 16, 24 and 32 cells, the same field; a coarser grid is a stronger
 //! prior of smoothness on scales the regulariser does not reach, and the data say which they

@@ -111,9 +111,12 @@ pub struct ObjectiveConfig {
     /// The strengths "auto" chooses from (default 0.01, 0.1 and 1: on the six synthetic
     /// clusters of tests/data/fidelity and AS1063, 0.001 and 10 were chosen once and never).
     pub candidates: Vec<f64>,
-    /// The regularisers "auto" tries, each with every candidate strength (default gradient
-    /// and curvature: each predicted better on some of those clusters). With a number for
-    /// the strength, `regulariser` alone is used.
+    /// The regularisers "auto" tries, each with every candidate strength (default gradient,
+    /// curvature and density: gradient and curvature each predicted better on some of the
+    /// synthetic clusters of tests/data/fidelity; neither costs a uniform sheet of mass, so
+    /// where the images leave the mass-sheet-like direction open only density, the least
+    /// mass, holds it, as on the simulated cluster of `wslap paper` (BENCHMARKS.md)). With a
+    /// number for the strength, `regulariser` alone is used.
     pub auto_regularisers: Vec<Regulariser>,
     /// The grids "auto" tries, each with every regulariser and strength, as fractions of
     /// `grid.cells` a side: a grid of `round(scale * grid.cells)` cells a side (at least 1)
@@ -139,7 +142,11 @@ impl Default for ObjectiveConfig {
             regulariser: Regulariser::Gradient,
             strength: Strength::Auto(AutoWord::Auto),
             candidates: vec![1e-2, 1e-1, 1.0],
-            auto_regularisers: vec![Regulariser::Gradient, Regulariser::Curvature],
+            auto_regularisers: vec![
+                Regulariser::Gradient,
+                Regulariser::Curvature,
+                Regulariser::Density,
+            ],
             auto_grid_scales: vec![0.5, 0.75, 1.0],
             folds: 4,
             image_plane_iterations: 2,

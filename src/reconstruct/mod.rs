@@ -607,7 +607,7 @@ impl StrengthChoice {
     }
 
     /// The choice in words, e.g. "curvature at strength 0.1 on 24 x 24 cells, chosen by
-    /// 4-fold cross-validation of 18 candidates".
+    /// 4-fold cross-validation of 27 candidates".
     pub fn describe(&self) -> String {
         let grid = self
             .chosen_cells
