@@ -148,18 +148,18 @@ pub use solver::{
 // A reconstruction: inputs, settings, the run, cross-validation.
 pub use reconstruct::{
     check_ensemble_size, check_memory, cross_validate, estimate_redshift, fitted_system_ids,
-    fold_groups, image_regions, layer_count, product_options, reconstruct, reconstruct_with_choice,
-    run_ensemble, strength_candidates, strength_folds, strength_trial, ArrivalTimes, Bytes,
-    Calibration, Candidate, ConvergenceRecord, CrossValidation, Dataset, DatasetError, Ensemble,
-    EnsembleMaps, EnsembleMember, EnsemblePlan, FoldRun, FreeZSummary, Heap, ImageReport,
-    InputText, InputTexts, Inputs, InterpolatedLens, KappaSpread, LayerSource, LeftOutImage,
-    MemberDraw, MemberRun, MemoryEstimate, MemoryLimit, PredictedImage, PredictedSystem,
-    ProductConfig, ReconstructConfig, ReconstructError, ReconstructSummary, Reconstruction,
-    RedshiftEstimate, RunSize, RunStatus, Solved, SolverConfig, SolverMethod, SourceReport,
-    StrengthCandidate, StrengthChoice, SystemCheck, TooMuchMemory, Trust, Verdict, VerdictInputs,
-    WeakLensingFit, CALIBRATION_MIN_IMAGES, CALIBRATION_MIN_PREDICTIONS, CHOICE_MAP_PIXELS,
-    DEFAULT_FOLDS, FALLBACK_MEMORY_LIMIT_BYTES, FALLBACK_SIGMA_ARCSEC, MAX_ENSEMBLE_MEMBERS,
-    SHOWN_MIN_MAGNIFICATION, WASM_MEMORY_LIMIT_BYTES,
+    fold_groups, holdable_system_ids, image_regions, layer_count, product_options, reconstruct,
+    reconstruct_with_choice, run_ensemble, strength_candidates, strength_folds, strength_trial,
+    ArrivalTimes, Bytes, Calibration, Candidate, ConvergenceRecord, CrossValidation, Dataset,
+    DatasetError, Ensemble, EnsembleMaps, EnsembleMember, EnsemblePlan, FoldRun, FreeZSummary,
+    Heap, ImageReport, InputText, InputTexts, Inputs, InterpolatedLens, KappaSpread, LayerSource,
+    LeftOutImage, MemberDraw, MemberRun, MemoryEstimate, MemoryLimit, PredictedImage,
+    PredictedSystem, ProductConfig, ReconstructConfig, ReconstructError, ReconstructSummary,
+    Reconstruction, RedshiftEstimate, RunSize, RunStatus, Solved, SolverConfig, SolverMethod,
+    SourceReport, StrengthCandidate, StrengthChoice, SystemCheck, TooMuchMemory, Trust, Verdict,
+    VerdictInputs, WeakLensingFit, CALIBRATION_MIN_IMAGES, CALIBRATION_MIN_PREDICTIONS,
+    CHOICE_MAP_PIXELS, DEFAULT_FOLDS, FALLBACK_MEMORY_LIMIT_BYTES, FALLBACK_SIGMA_ARCSEC,
+    MAX_ENSEMBLE_MEMBERS, SHOWN_MIN_MAGNIFICATION, WASM_MEMORY_LIMIT_BYTES,
 };
 
 // The verdict on a reconstruction and its thresholds.

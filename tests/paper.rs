@@ -303,6 +303,11 @@ fn one_case_alone_runs_without_the_others() {
         .collect();
     assert!(!names.contains(&"convergence.png"), "{names:?}");
     assert!(names.contains(&"maps.png"), "{names:?}");
+    // report.json says which cases ran and that no settings were laid over them.
+    assert_eq!(r.settings["cases"], serde_json::json!(["ii"]));
+    assert_eq!(r.settings["convergence"], false);
+    assert_eq!(r.settings["studies"], false);
+    assert_eq!(r.settings["case_settings"], serde_json::Value::Null);
 
     // Settings laid over the case's: here a fixed strength for the default objective.
     let mut laid = config.clone();
@@ -317,6 +322,10 @@ fn one_case_alone_runs_without_the_others() {
     assert_eq!(c.grid.cells, 12);
     assert_eq!(c.solver.method, wslap::SolverMethod::Exact);
     assert!(run.cases[0].reconstruction.strength_choice.is_none());
+    assert_eq!(
+        run.report.settings["case_settings"],
+        serde_json::json!({"file": "strength.json", "settings": laid.case_settings.as_ref().unwrap().value})
+    );
     // Settings that do not read are refused before the simulation, naming their file.
     laid.case_settings = Some(CaseSettings {
         source_name: "strength.json".to_string(),

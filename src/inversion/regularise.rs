@@ -73,7 +73,9 @@ impl Regulariser {
 }
 
 /// The strength of the regulariser: a number, or "auto" (chosen by cross-validation).
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+/// Read by hand, not by serde's untagged enum, whose error ("data did not match any variant")
+/// would tell a person nothing.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
 #[serde(untagged)]
 pub enum Strength {
     /// `strength` of the module documentation.
@@ -88,6 +90,42 @@ pub enum Strength {
 #[serde(rename_all = "snake_case")]
 pub enum AutoWord {
     Auto,
+}
+
+impl<'de> Deserialize<'de> for Strength {
+    fn deserialize<D: serde::Deserializer<'de>>(deserializer: D) -> Result<Self, D::Error> {
+        struct StrengthVisitor;
+
+        impl serde::de::Visitor<'_> for StrengthVisitor {
+            type Value = Strength;
+
+            fn expecting(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
+                f.write_str("a number (0 to 1e6) or \"auto\"")
+            }
+
+            fn visit_f64<E: serde::de::Error>(self, v: f64) -> Result<Strength, E> {
+                Ok(Strength::Value(v))
+            }
+
+            fn visit_i64<E: serde::de::Error>(self, v: i64) -> Result<Strength, E> {
+                Ok(Strength::Value(v as f64))
+            }
+
+            fn visit_u64<E: serde::de::Error>(self, v: u64) -> Result<Strength, E> {
+                Ok(Strength::Value(v as f64))
+            }
+
+            fn visit_str<E: serde::de::Error>(self, v: &str) -> Result<Strength, E> {
+                if v == "auto" {
+                    Ok(Strength::Auto(AutoWord::Auto))
+                } else {
+                    Err(E::invalid_value(serde::de::Unexpected::Str(v), &self))
+                }
+            }
+        }
+
+        deserializer.deserialize_any(StrengthVisitor)
+    }
 }
 
 impl Strength {
@@ -314,6 +352,38 @@ mod tests {
             Regulariser::Curvature,
         ] {
             assert_eq!(serde_json::to_value(r).unwrap(), r.name());
+        }
+    }
+
+    /// A strength is a number or the word "auto", and reads back as it was written; anything
+    /// else is refused with the value and what is expected, not with serde's "did not match
+    /// any variant of untagged enum".
+    #[test]
+    fn strength_reads_a_number_or_auto() {
+        for (text, strength) in [
+            ("0.1", Strength::Value(0.1)),
+            ("3", Strength::Value(3.0)),
+            ("-2", Strength::Value(-2.0)),
+            ("\"auto\"", Strength::Auto(AutoWord::Auto)),
+        ] {
+            let read: Strength = serde_json::from_str(text).unwrap();
+            assert_eq!(read, strength, "{text}");
+            let written = serde_json::to_string(&read).unwrap();
+            assert_eq!(serde_json::from_str::<Strength>(&written).unwrap(), read);
+        }
+        for (text, shown) in [
+            ("\"fast\"", "string \"fast\""),
+            ("true", "boolean `true`"),
+            ("[1]", "sequence"),
+            ("null", "null"),
+        ] {
+            let message = serde_json::from_str::<Strength>(text)
+                .unwrap_err()
+                .to_string();
+            assert!(
+                message.contains(shown) && message.contains("a number (0 to 1e6) or \"auto\""),
+                "{text}: {message}"
+            );
         }
     }
 

@@ -188,15 +188,12 @@ impl CaseSettings {
                 (base, over) => *base = over.clone(),
             }
         }
-        let mut value = serde_json::to_value(config).map_err(|e| PaperError::CaseSettings {
-            source_name: self.source_name.clone(),
-            message: e.to_string(),
-        })?;
-        lay(&mut value, &self.value);
         let fail = |message: String| PaperError::CaseSettings {
             source_name: self.source_name.clone(),
             message: format!("{}: {message}", self.source_name),
         };
+        let mut value = serde_json::to_value(config).map_err(|e| fail(e.to_string()))?;
+        lay(&mut value, &self.value);
         let config: ReconstructConfig =
             serde_json::from_value(value).map_err(|e| fail(e.to_string()))?;
         config.validate().map_err(|e| fail(e.to_string()))?;

@@ -412,6 +412,19 @@ impl PaperReport {
                 config.reasonable_start_c.into(),
             ),
             ("z_source_curves".to_string(), super::Z_SOURCE_CURVES.into()),
+            (
+                "cases".to_string(),
+                config.cases.iter().map(|c| c.numeral()).collect(),
+            ),
+            ("convergence".to_string(), config.convergence.into()),
+            ("studies".to_string(), config.studies.into()),
+            (
+                "case_settings".to_string(),
+                config.case_settings.as_ref().map_or(
+                    serde_json::Value::Null,
+                    |s| serde_json::json!({ "file": s.source_name, "settings": s.value }),
+                ),
+            ),
         ]);
         let mut timings_ms = BTreeMap::from([
             ("simulate".to_string(), simulate_ms),

@@ -266,6 +266,18 @@ pub fn fitted_system_ids(
     Ok(constraints.systems.into_iter().map(|s| s.id).collect())
 }
 
+/// The systems a fold may hold out: those `inputs` fits ([`fitted_system_ids`]) at a
+/// redshift of their own, not at an estimate (`constraints.z_estimates`: such a redshift was
+/// found with the other systems' help, so predicting the system would not be a test).
+pub fn holdable_system_ids(
+    inputs: &Inputs<'_>,
+    config: &ReconstructConfig,
+) -> Result<Vec<String>, ReconstructError> {
+    let mut own_redshifts = config.clone();
+    own_redshifts.constraints.z_estimates.clear();
+    fitted_system_ids(inputs, &own_redshifts)
+}
+
 /// The groups of system ids that [`cross_validate`] holds out in turn: the systems `inputs`
 /// fits ([`fitted_system_ids`]) but those fitted at an estimated redshift
 /// (`constraints.z_estimates`), the k-th to group `k mod folds`. Needs `2 <= folds <=` the
@@ -275,9 +287,7 @@ pub fn fold_groups(
     config: &ReconstructConfig,
     folds: usize,
 ) -> Result<Vec<Vec<String>>, ReconstructError> {
-    let mut own_redshifts = config.clone();
-    own_redshifts.constraints.z_estimates.clear();
-    let ids = fitted_system_ids(inputs, &own_redshifts)?;
+    let ids = holdable_system_ids(inputs, config)?;
     if folds < 2 || folds > ids.len() {
         return Err(ReconstructError::Folds {
             folds,

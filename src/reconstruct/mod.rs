@@ -23,8 +23,8 @@ use thiserror::Error;
 
 pub use config::{ProductConfig, ReconstructConfig, SolverConfig, SolverMethod};
 pub use crossval::{
-    cross_validate, fitted_system_ids, fold_groups, CrossValidation, FoldRun, KappaSpread,
-    PredictedSystem, DEFAULT_FOLDS,
+    cross_validate, fitted_system_ids, fold_groups, holdable_system_ids, CrossValidation, FoldRun,
+    KappaSpread, PredictedSystem, DEFAULT_FOLDS,
 };
 pub use dataset::{Dataset, DatasetError, InputText, InputTexts};
 pub use ensemble::{
@@ -544,15 +544,13 @@ pub fn strength_candidates(config: &ReconstructConfig) -> Vec<Candidate> {
 /// The folds an "auto" strength is cross-validated with: `objective.folds`, at most one per
 /// system a fold can hold out (below 2: too few systems to hold any out). Systems fitted at
 /// an estimated redshift (`constraints.z_estimates`) are fitted by every fold and count for
-/// none ([`fold_groups`]).
+/// none ([`holdable_system_ids`]).
 pub fn strength_folds(
     inputs: &Inputs<'_>,
     config: &ReconstructConfig,
 ) -> Result<usize, ReconstructError> {
-    let mut own_redshifts = config.clone();
-    own_redshifts.constraints.z_estimates.clear();
-    let fitted = fitted_system_ids(inputs, &own_redshifts)?.len();
-    Ok(config.objective.folds.min(fitted))
+    let holdable = holdable_system_ids(inputs, config)?.len();
+    Ok(config.objective.folds.min(holdable))
 }
 
 /// The cross-validation of one `candidate` over `folds` folds (maps of at most
