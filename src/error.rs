@@ -26,6 +26,15 @@ impl BadFieldValue {
     }
 }
 
+/// The reason of a value outside `[lo, hi]` (`(lo, hi]` when `lo_open`), as a person reads
+/// it: "must be between 0 and 2", "must be above 0 and at most 1e4".
+pub fn range_reason(lo: f64, hi: f64, lo_open: bool) -> String {
+    match lo_open {
+        true => format!("must be above {} and at most {}", number(lo), number(hi)),
+        false => format!("must be between {} and {}", number(lo), number(hi)),
+    }
+}
+
 /// `value` as a person would write it in a settings file: whole numbers up to 10^7 in full,
 /// larger and smaller magnitudes in exponent form (`1e15`, not `1000000000000000`).
 fn number(value: f64) -> String {
@@ -40,6 +49,19 @@ fn number(value: f64) -> String {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn ranges_are_stated() {
+        assert_eq!(range_reason(0.0, 2.0, false), "must be between 0 and 2");
+        assert_eq!(
+            range_reason(0.0, 1e4, true),
+            "must be above 0 and at most 10000"
+        );
+        assert_eq!(
+            range_reason(1e-9, 1e13, true),
+            "must be above 1e-9 and at most 1e13"
+        );
+    }
 
     #[test]
     fn values_are_written_as_in_a_settings_file() {

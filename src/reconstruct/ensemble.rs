@@ -16,7 +16,12 @@
 //!   clusters of `tests/data/fidelity`, 20 members: the main run's choice in 3 to 16 of
 //!   them);
 //! - **the grid moved** by up to half a cell in x and y (uniform), so that where the cells fall
-//!   is not mistaken for structure.
+//!   is not mistaken for structure;
+//! - **the members' mass-to-light law drawn**, when the run has a member catalogue: a factor
+//!   `10^(s n)` on `members.mass_to_light` (`n` standard normal, `s` =
+//!   `members.mass_to_light_scatter_dex`, default 0.3 dex). Point images hardly measure the
+//!   members' mass (their factor `C` then stays at its prior about the law), so without the
+//!   draw every member would share the law's error.
 //!
 //! The start is not varied: the default objective has one minimiser, which the exact solver
 //! finds from any start ([method §9]). Catalogue redshifts are not drawn (they carry no
@@ -39,10 +44,10 @@
 //!
 //! Both are widened by the [`Calibration`] factor when the members' predictions of the
 //! images they left out miss by more than their spread says (never narrowed). The spread
-//! says how much the answer depends on which systems are fitted and on the grid; it does not
-//! include errors common to every member (the members' mass-to-light law, the cosmology, a
-//! wrong redshift, mass outside the grid that no image constrains), except as far as the
-//! calibration sees them at the images.
+//! says how much the answer depends on which systems are fitted, on the grid and on the
+//! members' law; it does not include errors common to every member (the cosmology, a wrong
+//! catalogue redshift, the members' profile shape, mass outside the grid that no image
+//! constrains), except as far as the calibration sees them at the images.
 //!
 //! [method §9]: crate::method#9-the-default-objective
 
@@ -51,7 +56,7 @@ use serde::{Deserialize, Serialize};
 
 use super::{
     fitted_system_ids, reconstruct, reconstruct_with_choice, Candidate, ConvergenceRecord, Inputs,
-    ReconstructConfig, ReconstructError, Reconstruction, Regulariser, StrengthChoice,
+    LayerSource, ReconstructConfig, ReconstructError, Reconstruction, Regulariser, StrengthChoice,
 };
 use crate::curves::CriticalCurves;
 use crate::error::BadFieldValue;
@@ -87,6 +92,10 @@ pub struct EnsembleMember {
     /// The grid's cells a side it used (`None`: the main run's).
     #[serde(default)]
     pub cells: Option<usize>,
+    /// The factor on the members' mass-to-light law it used (drawn from
+    /// `members.mass_to_light_scatter_dex`; 1 without member galaxies).
+    #[serde(default = "unit_factor")]
+    pub member_mass_factor: f64,
     pub status: String,
     /// `C_l` per layer.
     pub c: Vec<f64>,
@@ -102,6 +111,10 @@ pub struct EnsembleMember {
     #[serde(default)]
     pub left_out_images: Vec<LeftOutImage>,
     pub elapsed_ms: f64,
+}
+
+fn unit_factor() -> f64 {
+    1.0
 }
 
 /// An image of a system a member did not fit, and where the member predicts it.
@@ -242,12 +255,13 @@ pub struct EnsembleMaps {
 
 const NOTE: &str = "Members differ in the systems fitted (bootstrap over systems), in the \
      regulariser and strength an \"auto\" choice makes on those systems, in the grid's \
-     placement (up to half a cell) and in the redshifts of the systems whose redshift was \
-     estimated (drawn from the estimate). The intervals and kappa-std describe the main map: \
-     they are the members' deviations from it, widened by the calibration factor where the \
-     members' predictions of the images they did not fit miss by more than their spread. \
-     Not included: the members' mass-to-light law, the cosmology, errors of catalogue \
-     redshifts, and mass that no image constrains.";
+     placement (up to half a cell), in the redshifts of the systems whose redshift was \
+     estimated (drawn from the estimate) and in the member galaxies' mass-to-light law \
+     (drawn from members.mass_to_light_scatter_dex). The intervals and kappa-std describe \
+     the main map: they are the members' deviations from it, widened by the calibration \
+     factor where the members' predictions of the images they did not fit miss by more than \
+     their spread. Not included: the cosmology, errors of catalogue redshifts, the member \
+     halos' shape, and mass that no image constrains.";
 
 impl Ensemble {
     /// The files of `wslap reconstruct --ensemble`: `kappa-mean.fits`, `kappa-std.fits`,
@@ -491,6 +505,11 @@ pub struct MemberDraw {
     /// The grid's cells a side it uses with them (`None`: the main run's choice or settings).
     #[serde(default)]
     pub cells: Option<usize>,
+    /// The factor on the members' mass-to-light law it fits with: `10^(s n)`, `n` a
+    /// standard normal and `s` = `members.mass_to_light_scatter_dex` (1 when the run has no
+    /// member catalogue).
+    #[serde(default = "unit_factor")]
+    pub member_mass_factor: f64,
 }
 
 /// An ensemble before its members run: what they share, taken from the main run (its grid,
@@ -557,6 +576,12 @@ impl EnsemblePlan {
         let cell = grid.width_arcsec / grid.cells_per_side.max(1) as f64;
         let mut rng = Rng::stream(seed, 0xE25E);
         let mut z_rng = Rng::stream(seed, 0x2ED5);
+        // The members' law from a stream of its own too.
+        let mut law_rng = Rng::stream(seed, 0x3A5E);
+        let law_scatter = match inputs.layers {
+            LayerSource::Members(_) => config.members.mass_to_light_scatter_dex,
+            _ => 0.0,
+        };
         let draws = (1..=members)
             .map(|member| {
                 // How many times each system was drawn.
@@ -589,6 +614,7 @@ impl EnsemblePlan {
                     regulariser: choice.map(|c| c.regulariser),
                     strength: choice.map(|c| c.strength),
                     cells: choice.and_then(|c| c.cells),
+                    member_mass_factor: 10f64.powf(law_scatter * law_rng.normal()),
                 }
             })
             .collect();
@@ -646,6 +672,9 @@ impl EnsemblePlan {
             .constraints
             .z_estimates
             .clone_from(&draw.redshifts);
+        // Within the law's allowed range (a draw far in the tail of a wide scatter).
+        member_config.members.mass_to_light =
+            (config.members.mass_to_light * draw.member_mass_factor).clamp(1e-6, 1e4);
         let left_out: Vec<String> = inputs
             .holdout
             .iter()
@@ -683,6 +712,7 @@ impl EnsemblePlan {
             regulariser: draw.regulariser,
             strength: draw.strength,
             cells: draw.cells,
+            member_mass_factor: draw.member_mass_factor,
             status: r.status.name().to_string(),
             c: r.layer_factors(),
             einstein_radius_arcsec: summary.einstein_radius_arcsec,
@@ -896,6 +926,7 @@ mod tests {
             regulariser: None,
             strength: None,
             cells: None,
+            member_mass_factor: 1.0,
             status: "Converged".to_string(),
             c: Vec::new(),
             einstein_radius_arcsec: 30.0,

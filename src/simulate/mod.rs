@@ -130,7 +130,7 @@ impl SimulationConfig {
                 return Err(crate::error::BadFieldValue::new(
                     format!("simulation.{field}"),
                     value,
-                    "outside the range given in its documentation",
+                    crate::error::range_reason(lo, hi, false),
                 )
                 .into());
             }

@@ -602,6 +602,83 @@ fn ensemble_members_draw_estimated_redshifts() {
     }
 }
 
+/// An ensemble of a catalogue with member galaxies draws each member's mass-to-light law
+/// (`members.mass_to_light_scatter_dex`, log-normal, from a stream of its own: the other draws
+/// are those of an ensemble without it), and a member fits with the law it drew
+/// (d_few_systems of tests/data/fidelity, 15 systems and 60 members, small maps).
+#[cfg(not(target_arch = "wasm32"))]
+#[test]
+fn ensemble_members_draw_the_member_law() {
+    let dir = "tests/data/fidelity/d_few_systems";
+    let read = |f: &str| std::fs::read_to_string(format!("{dir}/{f}")).unwrap();
+    let (catalog, _) = wslap::parse_image_catalog(&read("images.cat"), "images.cat", None).unwrap();
+    let (members, _) =
+        wslap::parse_member_catalog(&read("members.cat"), "members.cat", catalog.reference)
+            .unwrap();
+    let inputs = Inputs {
+        images: ConstraintSource::Catalog(&catalog),
+        layers: LayerSource::Members(&members),
+        plane: LensPlane::new(Cosmology::default(), 0.3).unwrap(),
+        reference: catalog.reference,
+        holdout: &[],
+        catalog: Some(&catalog),
+        shear: None,
+    };
+    let mut config = ReconstructConfig::default();
+    config.objective.strength = wslap::Strength::Value(0.01);
+    config.grid.cells = 16;
+    config.products.pixels = 64;
+    let main = reconstruct(&inputs, &config, &mut quiet).unwrap();
+
+    let plan = wslap::EnsemblePlan::new(&inputs, &config, &main, 200, 3).unwrap();
+    let logs: Vec<f64> = plan
+        .draws
+        .iter()
+        .map(|d| d.member_mass_factor.log10())
+        .collect();
+    let mean = logs.iter().sum::<f64>() / logs.len() as f64;
+    let sd = (logs.iter().map(|l| (l - mean).powi(2)).sum::<f64>() / logs.len() as f64).sqrt();
+    assert!(
+        mean.abs() < 0.06 && (sd - 0.3).abs() < 0.05,
+        "mean {mean}, sd {sd}"
+    );
+    let mut fixed = config.clone();
+    fixed.members.mass_to_light_scatter_dex = 0.0;
+    let unscattered = wslap::EnsemblePlan::new(&inputs, &fixed, &main, 200, 3).unwrap();
+    for (a, b) in plan.draws.iter().zip(&unscattered.draws) {
+        assert_eq!(b.member_mass_factor, 1.0);
+        assert_eq!(
+            (&a.fitted, a.grid_shift_arcsec),
+            (&b.fitted, b.grid_shift_arcsec)
+        );
+    }
+
+    // Member 1 with a law four times heavier and with the law as set: the members' own peaks
+    // of kappa grow with it (their factor C stays at its prior: point images do not measure it).
+    let mut heavy = plan.clone();
+    heavy.draws[0].member_mass_factor = 4.0;
+    let mut as_set = plan.clone();
+    as_set.draws[0].member_mass_factor = 1.0;
+    let run = |p: &wslap::EnsemblePlan| {
+        p.run_member(&inputs, &config, 1, &mut |_| Control::Continue)
+            .unwrap()
+            .unwrap()
+    };
+    let (h, s) = (run(&heavy), run(&as_set));
+    assert_eq!(h.record.member_mass_factor, 4.0);
+    let brightest = members
+        .members
+        .iter()
+        .min_by(|a, b| a.mag.total_cmp(&b.mag))
+        .unwrap()
+        .position;
+    let (kh, ks) = (h.kappa.sample(brightest), s.kappa.sample(brightest));
+    assert!(
+        kh > 1.5 * ks,
+        "kappa at the brightest member: {kh} (x4 law) against {ks}"
+    );
+}
+
 #[cfg(not(target_arch = "wasm32"))]
 pub(crate) mod real {
     //! The two real clusters of ../shared/data, end to end.
