@@ -16,7 +16,10 @@ and scored:
   - deflection error: x/y-arcsec-deflect.fits (D_ls/D_s = 1, arcsec) bilinearly interpolated at
     the truth grid points (2 arcsec lattice inside the image region), minus the truth; the
     component-wise median difference vector (a constant deflection only shifts every source
-    plane) is removed and the median of the remaining norms reported;
+    plane) is removed and the median of the remaining norms reported; also (JSON, and the
+    column "λ (sheet)") the map fitted by a mass-sheet transform of the truth,
+    alpha - theta = lambda (alpha_true - theta) + c (benches/deflection_vs_truth.py), with the
+    error left after it: lambda near 1 means the map keeps the truth's mass scale;
   - fitted: median offset between observed and nearest predicted image over the fitted systems
     (sources.json, full run); held-out: the same over the held-out systems of the holdout run.
     Images with no predicted counterpart (offset null) are left out of the medians and counted;
@@ -44,6 +47,9 @@ import numpy as np
 from astropy.io import fits
 from scipy import ndimage
 from scipy.spatial import ConvexHull
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from deflection_vs_truth import mass_sheet_fit  # noqa: E402
 
 TARGETS = dict(theta_e_pct=5.0, deflection_arcsec=1.0, fitted_arcsec=0.5, held_out_arcsec=1.0)
 
@@ -227,6 +233,9 @@ def score(cdir, truth, full_dir, hold_dir):
     dx, dy = ax[ok] - g[ok, 2], ay[ok] - g[ok, 3]
     shift = np.array([np.median(dx), np.median(dy)])
     err = np.hypot(dx - shift[0], dy - shift[1])
+    lam, left = mass_sheet_fit(g[ok, 0], g[ok, 1], ax[ok], ay[ok], g[ok, 2], g[ok, 3])
+    r.update(deflection_sheet_lambda=float(lam),
+             deflection_err_after_sheet_median=float(np.median(left)))
     r.update(deflection_points=int(ok.sum()), deflection_points_outside_map=int((~ok).sum()),
              deflection_err_median=float(np.median(err)),
              deflection_err_p90=float(np.percentile(err, 90)),
@@ -310,6 +319,7 @@ COLUMNS = [
     ("ΔM(region) %", lambda r: _pct(r.get("mass_region_rel_err")), "+.1f", None),
     ("defl. err (\")", lambda r: r.get("deflection_err_median"), ".2f",
      lambda v: v < TARGETS["deflection_arcsec"]),
+    ("λ (sheet)", lambda r: r.get("deflection_sheet_lambda"), ".3f", None),
     ("fitted (\")", lambda r: r.get("fitted_median"), ".2f",
      lambda v: v < TARGETS["fitted_arcsec"]),
     ("held-out (\")", lambda r: r.get("held_out_median"), ".2f",
