@@ -69,7 +69,7 @@ test('a panic in the core is reported and the session comes back with its data',
   }
 });
 
-test('a grid the browser cannot hold is refused when it is set, with the memory it needs', async () => {
+test('settings a run cannot use are refused when set: a grid the browser cannot hold with the memory it needs, a value with its range', async () => {
   const app = await openApp({ height: 720 });
   try {
     const { page } = app;
@@ -86,6 +86,14 @@ test('a grid the browser cannot hold is refused when it is set, with the memory 
     assert.equal(await page.inputValue(cells), '32', 'the accepted value comes back');
     await page.locator(`${cells}-error`).scrollIntoViewIfNeeded();
     await page.screenshot({ path: join(ARTIFACTS, 'cells-128-refused.png') });
+    // A value out of its range is refused with the range, not the setting's path.
+    const scatter = '#set-reconstruct-members-mass_to_light_scatter_dex';
+    await page.locator(scatter).fill('5');
+    await page.locator(scatter).dispatchEvent('change');
+    await page.waitForFunction((sel) => document.getElementById(`${document.querySelector(sel).id}-error`).textContent,
+      scatter, { timeout: SETTLE_TIMEOUT_MS });
+    assert.equal(await page.textContent(`${scatter}-error`), '5 is not allowed (must be between 0 and 2)');
+    assert.equal(await page.inputValue(scatter), '0.3', 'the accepted value comes back');
     // Nothing else is touched: the example still reconstructs.
     await setField(page, '#set-reconstruct-solver-iterations', QUICK_ITERATIONS);
     await runToMap(page, '#reconstruct');

@@ -132,8 +132,10 @@ export function buildSettings(form, apply) {
       // A cancel restarts the worker and then shows the restored settings.
       if (problem?.cancelled) return;
       if (problem) {
-        // Shown next to the labelled field: without the setting's path the core puts first.
-        err.textContent = problem.message.replace(`${f.path}: `, '');
+        // Shown next to the labelled field: without the setting's path the core puts first,
+        // nor the path a range check names its value by ("members.x = 5 is not allowed").
+        const inBlock = f.path.replace(/^reconstruct\./, '');
+        err.textContent = problem.message.replace(`${f.path}: `, '').replace(`${inBlock} = `, '');
         if (!state.edited) input.value = input.dataset.good ?? '';
         return;
       }
