@@ -188,6 +188,9 @@ pub struct MemberConfig {
     pub mass_to_light_scatter_dex: f64,
 }
 
+/// Largest `MemberConfig::mass_to_light` a run accepts (Msun/Lsun).
+pub(crate) const MAX_MASS_TO_LIGHT: f64 = 1e4;
+
 /// Bisection steps for the parent concentration (`log c` over [1e-3, 1e3]: 2^-100 of that
 /// interval is far below double precision).
 const C200_BISECTIONS: usize = 100;
@@ -235,7 +238,13 @@ impl MemberConfig {
             check("mag_star", m, -50.0, 50.0, false)?;
         }
         check("abs_mag_star", self.abs_mag_star, -50.0, 50.0, false)?;
-        check("mass_to_light", self.mass_to_light, 0.0, 1e4, true)?;
+        check(
+            "mass_to_light",
+            self.mass_to_light,
+            0.0,
+            MAX_MASS_TO_LIGHT,
+            true,
+        )?;
         check(
             "mass_to_light_scatter_dex",
             self.mass_to_light_scatter_dex,

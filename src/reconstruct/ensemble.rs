@@ -673,8 +673,9 @@ impl EnsemblePlan {
             .z_estimates
             .clone_from(&draw.redshifts);
         // Within the law's allowed range (a draw far in the tail of a wide scatter).
-        member_config.members.mass_to_light =
-            (config.members.mass_to_light * draw.member_mass_factor).clamp(1e-6, 1e4);
+        member_config.members.mass_to_light = (config.members.mass_to_light
+            * draw.member_mass_factor)
+            .clamp(1e-6, crate::inversion::MAX_MASS_TO_LIGHT);
         let left_out: Vec<String> = inputs
             .holdout
             .iter()
