@@ -37,7 +37,7 @@ pub fn range_reason(lo: f64, hi: f64, lo_open: bool) -> String {
 
 /// `value` as a person would write it in a settings file: whole numbers up to 10^7 in full,
 /// larger and smaller magnitudes in exponent form (`1e15`, not `1000000000000000`).
-fn number(value: f64) -> String {
+pub(crate) fn number(value: f64) -> String {
     let magnitude = value.abs();
     if magnitude != 0.0 && magnitude.is_finite() && !(1e-4..1e7).contains(&magnitude) {
         format!("{value:e}")

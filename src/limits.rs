@@ -114,7 +114,15 @@ pub fn json_error_parts(text: &str, e: &serde_json::Error) -> (usize, usize, Str
     let (line, column) = (e.line(), e.column());
     let full = e.to_string();
     let suffix = format!(" at line {line} column {column}");
-    let mut reason = full.strip_suffix(&suffix).unwrap_or(&full).to_string();
+    let mut reason = json_words(full.strip_suffix(&suffix).unwrap_or(&full));
+    if reason.starts_with("must be ") {
+        if let Some(key) = key_before(text, line, column) {
+            reason = format!("'{key}' {reason}");
+        }
+    }
+    if reason == "expected value" && comment_at(text, line, column) {
+        reason.push_str(": JSON has no comments (// or /* */); remove them");
+    }
     if let Some(word) = non_json_number(text, line, column) {
         reason.push_str(&format!(
             ": '{word}' is not a number in JSON (Python's json.dump writes NaN and Infinity \
@@ -122,6 +130,151 @@ pub fn json_error_parts(text: &str, e: &serde_json::Error) -> (usize, usize, Str
         ));
     }
     (line, column, reason)
+}
+
+/// A `serde_json` error's reason (without its place) in words for a person: "invalid type:
+/// string \"abc\", expected usize" becomes "must be a whole number of 0 or more (got the text
+/// \"abc\")", "EOF while parsing a list" "ends too early, inside a list", and so on; a
+/// reason it does not know is returned as it is.
+pub fn json_words(reason: &str) -> String {
+    let kind = |expected: &str| match expected {
+        "usize" | "u64" | "u32" | "u16" | "u8" => "a whole number of 0 or more".to_string(),
+        "i64" | "i32" => "a whole number".to_string(),
+        "f64" | "f32" => "a number".to_string(),
+        "a boolean" => "true or false".to_string(),
+        "a string" => "text in quotes".to_string(),
+        "a sequence" => "a list in brackets [ ]".to_string(),
+        "a map" => "an object in braces { }".to_string(),
+        other if other.starts_with("struct ") || other.starts_with("a map") => {
+            "an object in braces { }".to_string()
+        }
+        other if other.starts_with("a sequence of ") => format!(
+            "a list of {} in brackets [ ]",
+            other
+                .trim_start_matches("a sequence of ")
+                .replace(" f64 values", " numbers")
+                .replace('`', "")
+        ),
+        other => other.replace('`', ""),
+    };
+    let got = |found: &str| match found {
+        "map" => "an object".to_string(),
+        "sequence" => "a list".to_string(),
+        "unit value" => "null".to_string(),
+        other => other
+            .replacen("string ", "the text ", 1)
+            .replace('`', "")
+            .replacen("floating point ", "", 1),
+    };
+    if let Some(rest) = reason
+        .strip_prefix("invalid type: ")
+        .or_else(|| reason.strip_prefix("invalid value: "))
+    {
+        if let Some((found, expected)) = rest.split_once(", expected ") {
+            return format!("must be {} (got {})", kind(expected), got(found));
+        }
+    }
+    if let Some(rest) = reason.strip_prefix("invalid length ") {
+        if let Some((found, expected)) = rest.split_once(", expected ") {
+            if expected.starts_with("struct ") {
+                return "must be an object in braces { } (got a list)".to_string();
+            }
+            let values = if found == "1" { "value" } else { "values" };
+            return format!("must be {} (got {found} {values})", kind(expected));
+        }
+    }
+    if let Some(rest) = reason.strip_prefix("duplicate field ") {
+        return format!("the field '{}' is given twice", rest.trim_matches('`'));
+    }
+    if let Some(rest) = reason.strip_prefix("unknown field ") {
+        if let Some((found, expected)) = rest.split_once(", expected ") {
+            let known = expected.trim_start_matches("one of ").replace('`', "");
+            return format!(
+                "unknown field '{}' (the fields here: {known})",
+                found.trim_matches('`')
+            );
+        }
+        if let Some((found, _)) = rest.split_once(", there are no fields") {
+            return format!(
+                "unknown field '{}' (nothing is expected here)",
+                found.trim_matches('`')
+            );
+        }
+    }
+    if let Some(rest) = reason.strip_prefix("missing field ") {
+        return format!("the field '{}' is missing", rest.trim_matches('`'));
+    }
+    if let Some(rest) = reason.strip_prefix("unknown variant ") {
+        if let Some((found, expected)) = rest.split_once(", expected ") {
+            let options = expected.trim_start_matches("one of ").replace('`', "");
+            return format!("must be one of {options} (got {})", found.replace('`', ""));
+        }
+    }
+    if let Some(what) = reason.strip_prefix("EOF while parsing ") {
+        let inside = match what {
+            "a value" => "where a value should be".to_string(),
+            "a list" => "inside a list [ ] that is not closed".to_string(),
+            "an object" => "inside an object { } that is not closed".to_string(),
+            "a string" => "inside text in quotes that is not closed".to_string(),
+            other => format!("inside {other}"),
+        };
+        return format!("ends too early, {inside}");
+    }
+    match reason {
+        "trailing comma" => {
+            "a comma before a closing bracket or brace (JSON allows none there)".to_string()
+        }
+        "trailing characters" => {
+            "more text after the end of the JSON (a file holds one value)".to_string()
+        }
+        "key must be a string" => "a name in an object must be in double quotes".to_string(),
+        "recursion limit exceeded" => {
+            "nested too deeply (more than 128 levels of [ ] and { })".to_string()
+        }
+        "number out of range" => "a number too large for a computer (above 1.8e308)".to_string(),
+        "control character (\\u0000-\\u001F) found while parsing a string" => {
+            "a control character (a tab, line break or NUL byte) inside text in quotes; JSON \
+             needs it written as an escape"
+                .to_string()
+        }
+        other => other.to_string(),
+    }
+}
+
+/// Whether a `//` or `/*` comment starts at (or just before) 1-based `line` and `column`.
+fn comment_at(text: &str, line: usize, column: usize) -> bool {
+    let Some(row) = line.checked_sub(1).and_then(|l| text.lines().nth(l)) else {
+        return false;
+    };
+    let mut at = column.saturating_sub(1).min(row.len());
+    while !row.is_char_boundary(at) {
+        at -= 1;
+    }
+    let from = row[..at].char_indices().next_back().map_or(0, |(i, _)| i);
+    row.get(from..).is_some_and(|rest| {
+        rest.trim_start().starts_with("//") || rest.trim_start().starts_with("/*")
+    })
+}
+
+/// The name of the JSON key whose value ends at 1-based `line` and `column` of `text` (the
+/// last `"name":` before it), for a message about that value.
+fn key_before(text: &str, line: usize, column: usize) -> Option<&str> {
+    let start: usize = text
+        .split_inclusive('\n')
+        .take(line.checked_sub(1)?)
+        .map(str::len)
+        .sum();
+    let mut end = (start + column).min(text.len());
+    while !text.is_char_boundary(end) {
+        end -= 1;
+    }
+    let before = &text[..end];
+    let colon = before.rfind(':')?;
+    let name_end = before[..colon].trim_end();
+    let name = name_end.strip_suffix('"')?;
+    let open = name.rfind('"')?;
+    let key = &name[open + 1..];
+    (!key.is_empty() && key.len() <= 64 && !key.contains(['{', '}', '[', ']', ','])).then_some(key)
 }
 
 /// The word at 1-based `line` and `column` of `text` (serde_json stops on it or just after
@@ -146,6 +299,31 @@ fn non_json_number(text: &str, line: usize, column: usize) -> Option<&str> {
     let word = &row[start..end];
     let bare = word.trim_start_matches(['-', '+']).to_ascii_lowercase();
     matches!(bare.as_str(), "nan" | "inf" | "infinity").then_some(word)
+}
+
+/// Line, column and reason (as [`json_error_parts`]) when `text` is JSON whose first value is
+/// not an object: a file of settings or a model must be `{ ... }`, and serde would read a
+/// list as the object's fields in order and blame its first field.
+pub fn not_an_object(text: &str) -> Option<(usize, usize, String)> {
+    let trimmed = text.trim_start();
+    let first = trimmed.chars().next()?;
+    if first == '{' {
+        return None;
+    }
+    let before = &text[..text.len() - trimmed.len()];
+    let line = 1 + before.matches('\n').count();
+    let column = 1 + before.rsplit('\n').next().map_or(0, |l| l.len());
+    let what = match first {
+        '[' => "a list [ ]".to_string(),
+        '"' => "text in quotes".to_string(),
+        c if c == '-' || c.is_ascii_digit() => "a number".to_string(),
+        _ => return None, // not JSON at all: serde says where
+    };
+    Some((
+        line,
+        column,
+        format!("the file must be an object in braces {{ }}, not {what}"),
+    ))
 }
 
 /// `"line L, column C: reason"` for a `serde_json` error in `text` (only the reason when
@@ -195,6 +373,48 @@ mod tests {
                 !json_error_message(text, &e).contains("not a number"),
                 "{text}"
             );
+        }
+    }
+
+    /// The key before a place is found in any text at any place without cutting a character.
+    #[test]
+    fn the_key_of_a_value_is_found_anywhere() {
+        let text = "{\"μμ\": {\"cells\": 1.5},\n \"b\": [1, \"x\"]}";
+        assert_eq!(key_before(text, 1, 19), Some("cells"));
+        assert_eq!(key_before(text, 2, 13), Some("b"));
+        for line in 0..4 {
+            for column in 0..40 {
+                let _ = key_before(text, line, column);
+                let _ = comment_at(text, line, column);
+            }
+        }
+        assert_eq!(key_before("[1, 2]", 1, 3), None);
+    }
+
+    /// serde's words become a person's; what it does not know passes unchanged.
+    #[test]
+    fn serde_words_become_a_persons() {
+        for (serde, person) in [
+            (
+                "invalid type: floating point `2.5`, expected usize",
+                "must be a whole number of 0 or more (got 2.5)",
+            ),
+            (
+                "invalid type: map, expected a sequence",
+                "must be a list in brackets [ ] (got an object)",
+            ),
+            (
+                "invalid type: sequence, expected struct ModelFile",
+                "must be an object in braces { } (got a list)",
+            ),
+            ("missing field `type`", "the field 'type' is missing"),
+            (
+                "EOF while parsing a list",
+                "ends too early, inside a list [ ] that is not closed",
+            ),
+            ("something new", "something new"),
+        ] {
+            assert_eq!(json_words(serde), person);
         }
     }
 

@@ -63,7 +63,7 @@ pub enum ModelError {
     },
     /// A component parameter out of range.
     #[error(
-        "{source_name}: component {index} ({kind}): {field} = {value} is not allowed ({reason})"
+        "{source_name}: component {index} ({kind}): {field} = {} is not allowed ({reason})", crate::error::number(*.value)
     )]
     BadComponent {
         source_name: String,
@@ -81,7 +81,7 @@ pub enum ModelError {
         source: CosmologyError,
     },
     /// A bad sky reference position.
-    #[error("{source_name}: reference: {field} = {value} is not allowed ({reason})")]
+    #[error("{source_name}: reference: {field} = {} is not allowed ({reason})", crate::error::number(*.value))]
     BadReference {
         source_name: String,
         field: &'static str,
@@ -260,6 +260,14 @@ impl ModelFile {
     /// error message; JSON errors carry line and column, component errors the component index.
     pub fn from_json_str(text: &str, source_name: &str) -> Result<Self, ModelError> {
         TooLarge::check_bytes(source_name, InputKind::Model, text.len() as u64)?;
+        if let Some((line, column, message)) = crate::limits::not_an_object(text) {
+            return Err(ModelError::Syntax {
+                source_name: source_name.to_string(),
+                line,
+                column,
+                message,
+            });
+        }
         let mut model: Self =
             serde_json::from_str(text).map_err(|e| syntax_error(text, source_name, &e))?;
         model.source_name = source_name.to_string();
@@ -364,14 +372,18 @@ fn syntax_error(text: &str, source_name: &str, e: &serde_json::Error) -> ModelEr
     // Attribute the error to a component only if that component fails on its own with the
     // same message (so a bad top-level field before it is not blamed on it).
     match failing_component(text) {
-        Some((index, kind, inner)) if inner.to_string() == message => ModelError::ComponentSyntax {
-            source_name: source_name.to_string(),
-            line,
-            column,
-            index,
-            kind,
-            message,
-        },
+        Some((index, kind, inner))
+            if message.ends_with(&crate::limits::json_words(&inner.to_string())) =>
+        {
+            ModelError::ComponentSyntax {
+                source_name: source_name.to_string(),
+                line,
+                column,
+                index,
+                kind,
+                message,
+            }
+        }
         _ => ModelError::Syntax {
             source_name: source_name.to_string(),
             line,

@@ -392,6 +392,17 @@ impl Products {
             points: Vec::new(),
             labels: Vec::new(),
         };
+        // A map without mass (e.g. a solve stopped at its start) has no log scale: drawn linear.
+        let massless = !self
+            .maps
+            .kappa
+            .data
+            .iter()
+            .any(|v| v.is_finite() && *v > 0.0);
+        let scale = match scale {
+            ColorScale::Log if massless => ColorScale::Linear,
+            other => other,
+        };
         let opts = KappaPlotOptions {
             scale,
             title: Some(format!(

@@ -714,14 +714,15 @@ fn config_errors_say_file_line_and_column_once() {
     };
     let err = with_config("{\n  \"grid\": {\"cells\": 12,}\n}");
     let expected = format!(
-        "error: {}: line 2, column 24: trailing comma\n",
+        "error: {}: line 2, column 24: a comma before a closing bracket or brace (JSON allows \
+         none there)\n",
         config.display()
     );
     assert_eq!(err, expected);
     // A number beyond f64 (JSON has no NaN or inf).
     let err = with_config("{\"products\": {\"z_source\": 1e999}}");
     assert!(
-        err.contains("config.json: line 1, column 31: number out of range"),
+        err.contains("config.json: line 1, column 31: a number too large for a computer"),
         "{err}"
     );
     assert_eq!(err.matches("line").count(), 1, "{err}");
@@ -731,6 +732,59 @@ fn config_errors_say_file_line_and_column_once() {
     let err = refused(&dir, "maps", &["--model", model.to_str().unwrap()]);
     assert!(err.contains("model.json: line 2, column 17: "), "{err}");
     assert_eq!(err.matches("line").count(), 1, "{err}");
+}
+
+/// Files saved with a byte-order mark (as Windows editors do) read as without one; the forms
+/// of `--z-prior` that the help gives are taken, a third is refused in words.
+#[test]
+fn byte_order_marks_and_option_forms_as_people_write_them() {
+    let dir = temp_dir("bom");
+    let images = shared("AS1063/lenstool_cats/cats_gold_mul_gold.cat");
+    let config = dir.join("config.json");
+    // Past the mark, the file is read: the error is about its value, not its first byte.
+    fs::write(&config, "\u{feff}{\"grid\": {\"cells\": 0}}").unwrap();
+    let path = config.to_str().unwrap();
+    let err = refused(
+        &dir,
+        "reconstruct",
+        &["--images", &images, "--z-lens", "0.348", "--config", path],
+    );
+    assert!(err.contains("grid.cells = 0 is not allowed"), "{err}");
+    fs::write(
+        &config,
+        r#"{"objective": {"strength": 0.1}, "products": {"pixels": 32}}"#,
+    )
+    .unwrap();
+    for prior in [&["0.5,7"][..], &["0.5", "7"][..]] {
+        let out = dir.join("out");
+        let mut args = vec!["reconstruct", "--images", &images, "--z-lens", "0.348"];
+        args.extend([
+            "--config",
+            path,
+            "--out",
+            out.to_str().unwrap(),
+            "--z-prior",
+        ]);
+        args.extend(prior);
+        let run = wslap(&args);
+        assert!(
+            run.status.success(),
+            "{}",
+            String::from_utf8_lossy(&run.stderr)
+        );
+        let s = summary(&out);
+        let given = s["settings"]["constraints"]["free_z_prior"].clone();
+        assert_eq!(given, serde_json::json!([0.5, 7.0]), "{prior:?}");
+    }
+    for prior in [&["1,2", "3,4"][..], &["1"][..]] {
+        let mut args = vec!["--images", &images, "--z-lens", "0.348", "--z-prior"];
+        args.extend(prior);
+        let err = refused(&dir, "reconstruct", &args);
+        assert!(
+            err.contains("--z-prior needs two redshifts, LOW,HIGH (e.g. --z-prior 0.5,8)"),
+            "{err}"
+        );
+    }
 }
 
 /// Settings that cannot run are refused before any work, naming the file (or the option) and
@@ -1637,4 +1691,32 @@ fn lookup_matches_an_sis() {
     assert!(!out.status.success());
     let err = String::from_utf8_lossy(&out.stderr);
     assert!(err.contains("positions.txt: line 1"), "{err}");
+}
+
+/// `--out` naming an existing file is refused before any work, not after a whole run.
+#[test]
+fn out_naming_a_file_is_refused_first() {
+    let dir = temp_dir("out-file");
+    let file = dir.join("results.txt");
+    fs::write(&file, "keep me").unwrap();
+    let images = shared("AS1063/lenstool_cats/cats_gold_mul_gold.cat");
+    let out = file.to_str().unwrap();
+    let t = std::time::Instant::now();
+    let run = wslap(&[
+        "reconstruct",
+        "--images",
+        &images,
+        "--z-lens",
+        "0.348",
+        "--out",
+        out,
+    ]);
+    assert!(!run.status.success());
+    let err = String::from_utf8_lossy(&run.stderr);
+    assert!(err.contains("--out names an existing file"), "{err}");
+    assert!(
+        t.elapsed().as_secs_f64() < 5.0,
+        "refused only after the run"
+    );
+    assert_eq!(fs::read_to_string(&file).unwrap(), "keep me");
 }

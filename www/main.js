@@ -580,6 +580,8 @@ async function onFile(role, file) {
       await render();
       setStatus(readyText(loaded) + skyNote());
     } else if (skyNote()) setStatus(skyNote().trim().replace(/^But t/, 'T'));
+    // A result stays on screen; the line no longer speaks of a file refused before this one.
+    else setStatus(`Loaded ${reportText(report)}; the map shown was made before it.`);
   } catch (err) {
     // The file before it (if any) stays loaded: said next to the file, at the top of the
     // results and in the next run's caption, so that nobody takes a run on it for one on theirs.
@@ -776,7 +778,7 @@ async function showSetAside() {
     const head = document.createElement('strong');
     head.textContent = 'A project saved in this browser could not be opened';
     // A copy cut short (a crash in the middle of a save, in an older version) says so first.
-    const cut = /EOF while parsing/.test(e.reason) ? 'it ends too early, cut short while it was saved: ' : '';
+    const cut = /EOF while parsing|ends too early/.test(e.reason) ? 'it was cut short while it was saved: ' : '';
     const why = cut + e.reason.replace(/^saved project: /, '');
     text.append(head, ` (found on ${day}): ${why}. It was set aside, not deleted: download it to keep it (e.g. to open it with the version that saved it, or to send it with a bug report), or delete it.`);
     const name = `wslap-project-set-aside-${e.at.replace(/[:.]/g, '-')}.json`;

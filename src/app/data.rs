@@ -118,9 +118,13 @@ pub struct ModelLens {
     pub reference: Option<SkyReference>,
 }
 
-/// Whether a model file's text is a Lenstool parameter file rather than a JSON model file.
-fn is_lenstool_par(text: &str) -> bool {
-    !text.trim_start().starts_with('{')
+/// Whether a model file's text is a Lenstool parameter file rather than a JSON model file: a
+/// `.json` name or JSON's first character (`{`, or `[` / `"` of a file that is JSON but not a
+/// model, which must be told so, not read as a `.par` without its blocks) says JSON.
+fn is_lenstool_par(name: &str, text: &str) -> bool {
+    let json_name = name.to_ascii_lowercase().ends_with(".json");
+    let json_start = text.trim_start().starts_with(['{', '[', '"']);
+    !(json_name || json_start)
 }
 
 /// Arc pixel side assumed when it cannot be measured (milliarcsec).
@@ -282,7 +286,7 @@ impl LoadedData {
             return Ok(None);
         };
         let err = |e: &dyn std::fmt::Display| AppError::File(e.to_string());
-        if !is_lenstool_par(&file.text) {
+        if !is_lenstool_par(&file.name, &file.text) {
             let model = ModelFile::from_json_str(&file.text, &file.name).map_err(|e| err(&e))?;
             return Ok(Some(ModelLens {
                 lens: model.build_lens().map_err(|e| err(&e))?,
@@ -361,7 +365,7 @@ impl LoadedData {
                     Vec::new(),
                 )
             }
-            DataRole::Model if is_lenstool_par(text) => {
+            DataRole::Model if is_lenstool_par(name, text) => {
                 let par = parse_par_with(text, name, par_options).map_err(|e| file(&e))?;
                 let members = match par.potfiles.len() {
                     0 => String::new(),

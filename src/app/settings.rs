@@ -157,6 +157,12 @@ impl AppSettings {
 
     /// Parses settings JSON (missing fields take their defaults); errors name the line.
     pub fn from_json_str(text: &str, source_name: &str) -> Result<Self, AppError> {
+        if let Some((line, column, reason)) = crate::limits::not_an_object(text) {
+            let place = format!("line {line}, column {column}");
+            return Err(AppError::Setting(format!(
+                "{source_name}: {place}: {reason}"
+            )));
+        }
         let s: Self = serde_json::from_str(text).map_err(|e| {
             AppError::Setting(format!("{source_name}: {}", json_error_message(text, &e)))
         })?;
@@ -165,38 +171,11 @@ impl AppSettings {
     }
 }
 
-/// A setting's type error in words for a person: serde's "invalid type: string \"abc\",
-/// expected usize" becomes "must be a whole number (got the text \"abc\")".
+/// A setting's type error in words for a person ([`crate::limits::json_words`]): serde's
+/// "invalid type: string \"abc\", expected usize" becomes "must be a whole number of 0 or more
+/// (got the text \"abc\")".
 fn value_error_words(e: &serde_json::Error) -> String {
     let text = e.to_string();
     // serde_json adds " at line L column C" to errors of JSON text; a value has none.
-    let text = text.split(" at line ").next().unwrap_or(&text);
-    let kind = |expected: &str| match expected {
-        "usize" | "u64" | "u32" | "u16" | "u8" => "a whole number of 0 or more".to_string(),
-        "i64" | "i32" => "a whole number".to_string(),
-        "f64" | "f32" => "a number".to_string(),
-        "a boolean" => "true or false".to_string(),
-        other => other.replace('`', ""),
-    };
-    let got = |found: &str| {
-        found
-            .replacen("string ", "the text ", 1)
-            .replace('`', "")
-            .replacen("floating point ", "", 1)
-    };
-    if let Some(rest) = text
-        .strip_prefix("invalid type: ")
-        .or_else(|| text.strip_prefix("invalid value: "))
-    {
-        if let Some((found, expected)) = rest.split_once(", expected ") {
-            return format!("must be {} (got {})", kind(expected), got(found));
-        }
-    }
-    if let Some(rest) = text.strip_prefix("unknown variant ") {
-        if let Some((found, expected)) = rest.split_once(", expected ") {
-            let options = expected.trim_start_matches("one of ").replace('`', "");
-            return format!("must be one of {options} (got {})", found.replace('`', ""));
-        }
-    }
-    text.to_string()
+    crate::limits::json_words(text.split(" at line ").next().unwrap_or(&text))
 }

@@ -57,7 +57,10 @@ impl Coords {
                 if dec.abs() >= 90.0 {
                     return Err((
                         1,
-                        format!("puts the declination at {dec} deg, outside (-90, 90)"),
+                        format!(
+                            "puts the declination at {} deg, outside (-90, 90)",
+                            crate::error::number(dec)
+                        ),
                     ));
                 }
             }

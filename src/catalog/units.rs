@@ -83,7 +83,7 @@ pub(super) fn check_field(
     }
     let (distance_deg, centre): (Box<dyn Fn(DVec2) -> f64>, String) = match coords {
         Coords::RelativeArcsec { .. } => (
-            Box::new(|p: DVec2| p.length() / 3600.0),
+            Box::new(|p: DVec2| p.x.hypot(p.y) / 3600.0),
             "the header's reference point (ra0, dec0)".into(),
         ),
         Coords::AbsoluteDeg { header } => {
@@ -115,8 +115,12 @@ pub(super) fn check_field(
         }
         Coords::RelativeArcsec { .. } => "positions under '#REFERENCE 1' or '3' are arcsec",
     };
+    let distance = match d < 1e6 {
+        true => format!("{d:.3}"),
+        false => format!("{d:.3e}"),
+    };
     let reason = format!(
-        "(with {} '{}') is {d:.3} deg from {centre}; one lensing field spans well under \
+        "(with {} '{}') is {distance} deg from {centre}; one lensing field spans well under \
          {FIELD_WARN_DEG} deg ({hint})",
         names[1], far.text[1]
     );

@@ -42,7 +42,7 @@ pub struct ImagesArgs {
     #[arg(long, value_name = "DIR")]
     maps: Option<PathBuf>,
     /// Lens redshift for --maps (default: the ZLENS card of the deflection maps).
-    #[arg(long)]
+    #[arg(long, allow_negative_numbers = true)]
     z_lens: Option<f64>,
     /// Source position in arcsec in the lens's frame (+x West, +y North).
     #[arg(long, num_args = 2, value_names = ["X", "Y"], allow_negative_numbers = true)]
@@ -295,13 +295,20 @@ pub(super) fn read_maps_dir(
     let y = dir.join("y-arcsec-deflect.fits");
     let (ax, reference, card_z) = read_map(&x)?;
     let (ay, _, _) = read_map(&y)?;
-    let z_lens = z_lens.or(card_z).ok_or_else(|| {
-        format!(
-            "{}: no ZLENS card says the lens redshift; give --z-lens",
-            x.display()
-        )
+    let given = z_lens.is_some();
+    let z_lens = match z_lens {
+        Some(z) => z,
+        None => card_z?.ok_or_else(|| {
+            format!(
+                "{}: no ZLENS card says the lens redshift; give --z-lens",
+                x.display()
+            )
+        })?,
+    };
+    let plane = LensPlane::new(Cosmology::default(), z_lens).map_err(|e| match given {
+        true => e.to_string(),
+        false => format!("{}: its ZLENS card: {e}", x.display()),
     })?;
-    let plane = LensPlane::new(Cosmology::default(), z_lens).map_err(|e| e.to_string())?;
     let maps = LensMaps::from_deflection(ax, ay).map_err(|e| e.to_string())?;
     Ok((maps, plane, reference))
 }

@@ -23,8 +23,70 @@ pub fn read_bytes(path: &Path, kind: InputKind) -> Result<Vec<u8>, String> {
     Ok(bytes)
 }
 
-/// The text of `path` (UTF-8), within the limit of `kind`.
+/// Refuses an `--out` that names an existing file (not a folder) before any work, so that a run
+/// of minutes does not end in "File exists".
+pub fn check_out_dir(out: &Path) -> Result<(), String> {
+    if out.exists() && !out.is_dir() {
+        return Err(format!(
+            "{}: --out names an existing file; give a folder for the results (it is created if \
+             missing)",
+            out.display()
+        ));
+    }
+    Ok(())
+}
+
+/// The text of `path` (UTF-8, a leading byte-order mark dropped, as a browser drops it),
+/// within the limit of `kind`. Text in another encoding is refused with the line of its first
+/// byte that is not UTF-8.
 pub fn read_text(path: &Path, kind: InputKind) -> Result<String, String> {
-    String::from_utf8(read_bytes(path, kind)?)
-        .map_err(|e| format!("{}: not UTF-8 text: {e}", path.display()))
+    let bytes = read_bytes(path, kind)?;
+    text_of(&path.display().to_string(), bytes)
+}
+
+/// `bytes` as UTF-8 text for [`read_text`]; `name` is the file's name for the message.
+fn text_of(name: &str, bytes: Vec<u8>) -> Result<String, String> {
+    if bytes.starts_with(&[0xff, 0xfe]) || bytes.starts_with(&[0xfe, 0xff]) {
+        return Err(format!(
+            "{name}: the file is UTF-16 text; save it as UTF-8 (or plain ASCII) and load it again"
+        ));
+    }
+    match String::from_utf8(bytes) {
+        Ok(text) => Ok(match text.strip_prefix('\u{feff}') {
+            Some(rest) => rest.to_string(),
+            None => text,
+        }),
+        Err(e) => {
+            let at = e.utf8_error().valid_up_to();
+            let bytes = e.as_bytes();
+            let line = 1 + bytes[..at].iter().filter(|&&b| b == b'\n').count();
+            Err(format!(
+                "{name}: line {line}: byte 0x{:02X} is not UTF-8 text (the file is in another \
+                 encoding, e.g. Latin-1, or is not text); save it as UTF-8 and load it again",
+                bytes[at]
+            ))
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::text_of;
+
+    /// A byte-order mark is dropped; UTF-16 and Latin-1 are refused with the line, never with
+    /// the bytes themselves.
+    #[test]
+    fn text_is_utf8_without_its_byte_order_mark() {
+        let read = |b: &[u8]| text_of("f.par", b.to_vec());
+        assert_eq!(read(b"\xEF\xBB\xBFrunmode\n").unwrap(), "runmode\n");
+        assert_eq!(read(b"runmode\n").unwrap(), "runmode\n");
+        let e = read(b"\xFF\xFEr\0u\0").unwrap_err();
+        assert!(e.starts_with("f.par: the file is UTF-16 text"), "{e}");
+        let e = read(b"# ok\nname caf\xE9\n").unwrap_err();
+        assert_eq!(
+            e,
+            "f.par: line 2: byte 0xE9 is not UTF-8 text (the file is in another encoding, e.g. \
+             Latin-1, or is not text); save it as UTF-8 and load it again"
+        );
+    }
 }

@@ -40,7 +40,7 @@ pub struct LookupArgs {
     #[arg(long)]
     z_source: f64,
     /// Lens redshift (default: the maps' ZLENS card).
-    #[arg(long)]
+    #[arg(long, allow_negative_numbers = true)]
     z_lens: Option<f64>,
 }
 

@@ -45,7 +45,7 @@ pub struct MapsArgs {
     #[arg(long, num_args = 2, value_names = ["X.fits", "Y.fits"])]
     deflection: Option<Vec<PathBuf>>,
     /// Lens redshift (with --deflection, default the maps' ZLENS card; a model file has its own).
-    #[arg(long)]
+    #[arg(long, allow_negative_numbers = true)]
     z_lens: Option<f64>,
     /// H0 in km/s/Mpc (with --deflection).
     #[arg(long, default_value_t = 70.0)]
@@ -86,6 +86,7 @@ impl From<Scale> for ColorScale {
 }
 
 pub fn run(args: &MapsArgs) -> Result<(), String> {
+    super::input::check_out_dir(&args.out)?;
     let opts = ProductOptions {
         z_source: args.z_source,
         size_arcsec: args.size,
@@ -106,10 +107,17 @@ pub fn run(args: &MapsArgs) -> Result<(), String> {
     } else {
         let paths = args.deflection.as_deref().unwrap_or_default();
         let (ax, ay) = (read_map(&paths[0])?, read_map(&paths[1])?);
-        let z_lens = args.z_lens.or(ax.2);
-        let z_lens = z_lens.ok_or("--deflection needs --z-lens (the maps have no ZLENS card)")?;
+        let z_lens = match args.z_lens {
+            Some(z) => z,
+            None => ax
+                .2?
+                .ok_or("--deflection needs --z-lens (the maps have no ZLENS card)")?,
+        };
         let cosmology = Cosmology::new(args.h0, args.omega_m).map_err(|e| e.to_string())?;
-        let plane = LensPlane::new(cosmology, z_lens).map_err(|e| e.to_string())?;
+        let plane = LensPlane::new(cosmology, z_lens).map_err(|e| match args.z_lens {
+            Some(_) => e.to_string(),
+            None => format!("{}: its ZLENS card: {e}", paths[0].display()),
+        })?;
         Products::from_deflection(ax.0, ay.0, plane, ax.1, args.z_source)
             .map_err(|e| e.to_string())?
     };
@@ -172,9 +180,19 @@ pub(super) fn load_lenstool(
 }
 
 /// A FITS map, its sky reference and its `ZLENS` card (the lens redshift the project writes).
+/// The redshift is `Ok(None)` without a card, an error naming the file when the card is there
+/// but is not a redshift (the caller needs it only when no `--z-lens` is given).
+#[allow(clippy::type_complexity)]
 pub(super) fn read_map(
     path: &Path,
-) -> Result<(wslap::Map, Option<wslap::SkyReference>, Option<f64>), String> {
+) -> Result<
+    (
+        wslap::Map,
+        Option<wslap::SkyReference>,
+        Result<Option<f64>, String>,
+    ),
+    String,
+> {
     let bytes = read_bytes(path, InputKind::Fits)?;
     let image = read_image(&bytes, &path.display().to_string()).map_err(|e| e.to_string())?;
     let (_, reference) = image.geometry().map_err(|e| e.to_string())?;
@@ -189,7 +207,18 @@ pub(super) fn read_map(
             no_data.zero_border
         );
     }
-    let z_lens = image.card("ZLENS").and_then(|c| c.as_f64());
+    let z_lens = match image.card("ZLENS") {
+        None => Ok(None),
+        Some(card) => match card.as_f64().filter(|z| z.is_finite() && *z > 0.0) {
+            Some(z) => Ok(Some(z)),
+            None => Err(format!(
+                "{}: the ZLENS card ({}) is not a lens redshift (a number above 0); give \
+                 --z-lens",
+                path.display(),
+                wslap::CardValue::shown(card.value.as_ref())
+            )),
+        },
+    };
     Ok((map, reference, z_lens))
 }
 

@@ -70,6 +70,7 @@ pub struct PaperArgs {
 }
 
 pub fn run(args: &PaperArgs) -> Result<(), String> {
+    super::input::check_out_dir(&args.out)?;
     let mut config = PaperConfig {
         iterations: args.iterations,
         long_iterations: args.long,

@@ -56,7 +56,7 @@ pub struct ReconstructArgs {
     #[arg(long, value_name = "SIGMA", requires = "shear")]
     shape_noise: Option<f64>,
     /// Lens redshift.
-    #[arg(long)]
+    #[arg(long, allow_negative_numbers = true)]
     z_lens: f64,
     /// Settings (JSON); every field is optional. `wslap config` prints them all with their
     /// defaults.
@@ -75,7 +75,7 @@ pub struct ReconstructArgs {
     #[arg(long, value_delimiter = ',', value_name = "IDS")]
     free_z: Vec<String>,
     /// The range an estimated redshift lies in, LOW,HIGH (default 0.5,8).
-    #[arg(long, value_delimiter = ',', num_args = 2, value_name = "LOW,HIGH")]
+    #[arg(long, value_delimiter = ',', num_args = 1..=2, value_name = "LOW,HIGH")]
     z_prior: Option<Vec<f64>>,
     /// QADP iterations (overrides the configuration).
     #[arg(long)]
@@ -130,6 +130,7 @@ pub fn print_config() -> Result<(), String> {
 }
 
 pub fn run(args: &ReconstructArgs) -> Result<(), String> {
+    super::input::check_out_dir(&args.out)?;
     let mut config = match &args.config {
         Some(path) => ReconstructConfig::from_json_str(
             &read_text(path, InputKind::Config)?,
@@ -150,7 +151,13 @@ pub fn run(args: &ReconstructArgs) -> Result<(), String> {
         config.constraints.free_z_systems.clone_from(&args.free_z);
     }
     if let Some(prior) = &args.z_prior {
-        config.constraints.free_z_prior = Some([prior[0], prior[1]]);
+        let &[low, high] = prior.as_slice() else {
+            return Err(format!(
+                "--z-prior needs two redshifts, LOW,HIGH (e.g. --z-prior 0.5,8); {} given",
+                prior.len()
+            ));
+        };
+        config.constraints.free_z_prior = Some([low, high]);
     }
     if args.default_z.is_some() {
         config.constraints.default_z = args.default_z;
@@ -232,14 +239,22 @@ pub fn run(args: &ReconstructArgs) -> Result<(), String> {
             // One line per exchange of the free set (the start, X = 0, says nothing).
             if r.iteration > 0 {
                 eprintln!(
-                    "pass {} exchange {:>3}: objective {:.6e}, grid mass {:.4e} Msun, C = {:?}",
-                    r.level, r.iteration, r.objective, r.grid_mass_msun, r.c
+                    "pass {} exchange {:>3}: objective {:.6e}, grid mass {:.4e} Msun{}",
+                    r.level,
+                    r.iteration,
+                    r.objective,
+                    r.grid_mass_msun,
+                    c_text(", ", &r.c)
                 );
             }
         } else if r.iteration % 1000 == 0 || r.iteration == total {
             eprintln!(
-                "level {} iteration {:>6}/{total}: objective {:.6e}, grid mass {:.4e} Msun, C = {:?}",
-                r.level, r.iteration, r.objective, r.grid_mass_msun, r.c
+                "level {} iteration {:>6}/{total}: objective {:.6e}, grid mass {:.4e} Msun{}",
+                r.level,
+                r.iteration,
+                r.objective,
+                r.grid_mass_msun,
+                c_text(", ", &r.c)
             );
         }
         Control::Continue
@@ -404,18 +419,27 @@ pub(super) fn write_reconstruction(r: &Reconstruction, dir: &Path) -> Result<(),
     Ok(())
 }
 
+/// `"{sep}C = 1.004"` (several layers: `"C = 1.004, 0.982"`), nothing without member layers.
+fn c_text(sep: &str, c: &[f64]) -> String {
+    if c.is_empty() {
+        return String::new();
+    }
+    let values: Vec<String> = c.iter().map(|v| format!("{v:.3}")).collect();
+    format!("{sep}C = {}", values.join(", "))
+}
+
 fn one_line(r: &Reconstruction, out: &Path) -> String {
     let choice = r
         .strength_choice
         .as_ref()
         .map_or(String::new(), |c| format!("; regulariser {}", c.describe()));
     format!(
-        "wrote {} ({} systems, {} constraint pixels, {} iterations; C = {:?}; grid mass {:.3e} Msun; Einstein radius at z_s = {}: {}; image offsets: rms {}, median {}{choice})",
+        "wrote {} ({} systems, {} constraint pixels, {} iterations{}; grid mass {:.3e} Msun; Einstein radius at z_s = {}: {}; image offsets: rms {}, median {}{choice})",
         out.display(),
         r.system.constraints.systems.len(),
         r.system.constraints.pixels.len(),
         r.iterations,
-        r.layer_factors(),
+        c_text("; ", &r.layer_factors()),
         r.grid_mass_msun(),
         r.config.products.z_source,
         r.products.summary().einstein_radius_text(),

@@ -26,6 +26,7 @@ pub struct SimulateArgs {
 }
 
 pub fn run(args: &SimulateArgs) -> Result<(), String> {
+    super::input::check_out_dir(&args.out)?;
     let config = SimulationConfig {
         seed: args.seed,
         pixel_arcsec: args.pixel,

@@ -11,6 +11,21 @@ pub enum CardValue {
     Unparsed(String),
 }
 
+impl CardValue {
+    /// The value as a FITS header writes it (`T`, `42`, `0.5`, `'TEXT'`), for messages;
+    /// "no value" for a card without one.
+    pub fn shown(value: Option<&CardValue>) -> String {
+        match value {
+            None => "no value".to_string(),
+            Some(CardValue::Logical(b)) => if *b { "T" } else { "F" }.to_string(),
+            Some(CardValue::Integer(v)) => v.to_string(),
+            Some(CardValue::Real(v)) => v.to_string(),
+            Some(CardValue::Text(t)) => format!("'{t}'"),
+            Some(CardValue::Unparsed(t)) => t.clone(),
+        }
+    }
+}
+
 /// One header card. Commentary cards (`COMMENT`, `HISTORY`, blank keyword) have no value and
 /// keep their text in `comment`.
 #[derive(Debug, Clone, PartialEq)]
@@ -226,6 +241,20 @@ fn parse_number(token: &str) -> CardValue {
 
 #[cfg(test)]
 mod tests {
+    use super::CardValue;
+
+    /// A card's value is shown as a header writes it, never as a Rust debug dump.
+    #[test]
+    fn values_are_shown_as_written() {
+        assert_eq!(
+            CardValue::shown(Some(&CardValue::Text("NAN".into()))),
+            "'NAN'"
+        );
+        assert_eq!(CardValue::shown(Some(&CardValue::Logical(true))), "T");
+        assert_eq!(CardValue::shown(Some(&CardValue::Real(0.5))), "0.5");
+        assert_eq!(CardValue::shown(None), "no value");
+    }
+
     use super::*;
 
     #[test]

@@ -471,14 +471,14 @@ impl FitsImage {
         let card = self.card(key).ok_or_else(|| self.missing(key))?;
         card.as_f64()
             .filter(|v| v.is_finite())
-            .ok_or_else(|| self.bad(key, &format!("{:?}", card.value), "not a number"))
+            .ok_or_else(|| self.bad(key, &CardValue::shown(card.value.as_ref()), "not a number"))
     }
 
     fn text(&self, key: &str) -> Result<String, FitsError> {
         let card = self.card(key).ok_or_else(|| self.missing(key))?;
         card.as_str()
             .map(str::to_string)
-            .ok_or_else(|| self.bad(key, &format!("{:?}", card.value), "not a string"))
+            .ok_or_else(|| self.bad(key, &CardValue::shown(card.value.as_ref()), "not a string"))
     }
 
     fn sky(&self, ra_key: &str, dec_key: &str) -> Result<SkyReference, FitsError> {

@@ -128,7 +128,7 @@ impl Hdu<'_> {
     fn int(&self, key: &str) -> Result<i64, FitsError> {
         match self.card(key).map(|c| &c.value) {
             Some(Some(CardValue::Integer(v))) => Ok(*v),
-            Some(v) => Err(self.bad(key, format!("{v:?}"), "not an integer")),
+            Some(v) => Err(self.bad(key, CardValue::shown(v.as_ref()), "not an integer")),
             None => Err(FitsError::MissingKeyword {
                 file: self.file.into(),
                 keyword: key.into(),
@@ -142,7 +142,7 @@ impl Hdu<'_> {
             Some(c) => c
                 .as_f64()
                 .filter(|v| v.is_finite())
-                .ok_or_else(|| self.bad(key, format!("{:?}", c.value), "not a number")),
+                .ok_or_else(|| self.bad(key, CardValue::shown(c.value.as_ref()), "not a number")),
         }
     }
 

@@ -42,7 +42,7 @@ pub enum ConstraintError {
         mode: &'static str,
         given: &'static str,
     },
-    #[error("{source_name}: line {line}: image {id}: {field} = {value} is not allowed ({reason})")]
+    #[error("{source_name}: line {line}: image {id}: {field} = {} is not allowed ({reason})", crate::error::number(*.value))]
     BadImage {
         source_name: String,
         line: usize,

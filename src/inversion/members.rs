@@ -46,7 +46,7 @@ pub enum MembersError {
     #[error("members: layers = \"{value}\" is not one of none, single, bcg, brightest:N (N from 1 to {MAX_SINGLE_LAYERS})")]
     BadLayers { value: String },
     #[error(
-        "{source_name}: line {line}: member {id}: {field} = {value} is not allowed ({reason})"
+        "{source_name}: line {line}: member {id}: {field} = {} is not allowed ({reason})", crate::error::number(*.value)
     )]
     BadMember {
         source_name: String,

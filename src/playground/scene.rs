@@ -31,7 +31,7 @@ pub enum SceneError {
     #[error("scene: version v = {found} is not supported (this build reads v = {SCENE_VERSION})")]
     Version { found: u32 },
     /// A number out of range.
-    #[error("scene: {field} = {value} is not allowed ({reason})")]
+    #[error("scene: {field} = {} is not allowed ({reason})", crate::error::number(*.value))]
     BadField {
         field: String,
         value: f64,

@@ -6,7 +6,7 @@ use thiserror::Error;
 #[derive(Debug, Error, Clone, PartialEq)]
 pub enum ProfileError {
     /// `component` (e.g. `"nfw"`) got `field = value`, which is not allowed for `reason`.
-    #[error("{component}: {field} = {value} is not allowed ({reason})")]
+    #[error("{component}: {field} = {} is not allowed ({reason})", crate::error::number(*.value))]
     BadParameter {
         component: &'static str,
         field: &'static str,

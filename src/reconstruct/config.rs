@@ -125,6 +125,12 @@ impl ReconstructConfig {
     /// over [`crate::limits::MAX_JSON_BYTES`] is refused before parsing.
     pub fn from_json_str(text: &str, source_name: &str) -> Result<Self, ReconstructError> {
         TooLarge::check_bytes(source_name, InputKind::Config, text.len() as u64)?;
+        if let Some((line, column, reason)) = crate::limits::not_an_object(text) {
+            return Err(ReconstructError::Config {
+                source_name: source_name.to_string(),
+                message: format!("line {line}, column {column}: {reason}"),
+            });
+        }
         let config: Self = serde_json::from_str(text).map_err(|e| ReconstructError::Config {
             source_name: source_name.to_string(),
             message: json_error_message(text, &e),

@@ -2,7 +2,7 @@
 //! names the file, says line and column once, and the size limits refuse a huge input before
 //! it is parsed. Catalogue cases are in tests/files/catalog.rs, command-line ones in tests/cli.rs.
 
-use wslap::app::Session;
+use wslap::app::{DataRole, Session};
 use wslap::ModelFile;
 use wslap::ReconstructConfig;
 use wslap::{parse_arcs, ArcsError};
@@ -35,23 +35,79 @@ fn config_syntax_errors_say_the_place_once() {
     assert_eq!(err, "config.json: line 2, column 21: expected value");
     let err = config_err("{\"solver\": {\"method\": \"newton\"}}");
     assert!(
-        err.starts_with("config.json: line 1, column 30: unknown variant `newton`, expected one of `exact`, `qadp`, `accelerated_gradient`"),
+        err.starts_with("config.json: line 1, column 30: 'method' must be one of exact, qadp, accelerated_gradient (got newton)"),
         "{err}"
     );
     let err = config_err("{\"solver\": {\"iterations\": 10, \"speed\": 2}}");
     assert!(
-        err.starts_with("config.json: line 1, column 37: unknown field `speed`"),
+        err.starts_with("config.json: line 1, column 37: unknown field 'speed' (the fields here: "),
         "{err}"
     );
     assert_place_once(&err);
     // JSON has no NaN or infinity; a number beyond f64 is refused where it is written.
     let err = config_err("{\"products\": {\"z_source\": 1e999}}");
-    assert_eq!(err, "config.json: line 1, column 31: number out of range");
+    assert_eq!(
+        err,
+        "config.json: line 1, column 31: a number too large for a computer (above 1.8e308)"
+    );
     let err = config_err("");
     assert_eq!(
         err,
-        "config.json: line 1, column 0: EOF while parsing a value"
+        "config.json: line 1, column 0: ends too early, where a value should be"
     );
+}
+
+/// A value of the wrong type in a settings file is refused in words a person reads, naming the
+/// field and what was found: never serde's "invalid type: ..., expected usize" or "expected
+/// struct GridConfig".
+#[cfg_attr(not(target_arch = "wasm32"), test)]
+#[cfg_attr(target_arch = "wasm32", wasm_bindgen_test::wasm_bindgen_test)]
+fn config_values_of_the_wrong_type_are_refused_in_words() {
+    for (text, expected) in [
+        (
+            "{\"grid\": {\"cells\": 32.5}}",
+            "config.json: line 1, column 23: 'cells' must be a whole number of 0 or more (got 32.5)",
+        ),
+        (
+            "{\"grid\": {\"cells\": \"32\"}}",
+            "config.json: line 1, column 23: 'cells' must be a whole number of 0 or more (got the \
+             text \"32\")",
+        ),
+        (
+            "{\"grid\": null}",
+            "config.json: line 1, column 13: 'grid' must be an object in braces { } (got null)",
+        ),
+        (
+            "{\"grid\": {\"center_arcsec\": [1]}}",
+            "config.json: line 1, column 30: 'center_arcsec' must be a list of 2 numbers in \
+             brackets [ ] (got 1 value)",
+        ),
+        (
+            "{\"grid\": {\"cells\": 8}, \"grid\": {}}",
+            "config.json: line 1, column 29: the field 'grid' is given twice",
+        ),
+        (
+            "{\"grid\": {\"cells\": 8},}",
+            "config.json: line 1, column 23: a comma before a closing bracket or brace (JSON \
+             allows none there)",
+        ),
+        (
+            "{} {}",
+            "config.json: line 1, column 4: more text after the end of the JSON (a file holds \
+             one value)",
+        ),
+        (
+            "// settings\n{}",
+            "config.json: line 1, column 1: expected value: JSON has no comments (// or /* */); \
+             remove them",
+        ),
+    ] {
+        let err = config_err(text);
+        assert_eq!(err, expected, "{text}");
+        for word in ["usize", "f64", "invalid type", "struct", "EOF", "trailing"] {
+            assert!(!err.contains(word), "{err}");
+        }
+    }
 }
 
 #[cfg_attr(not(target_arch = "wasm32"), test)]
@@ -219,7 +275,10 @@ fn model_syntax_errors_say_the_place_once() {
     let err = ModelFile::from_json_str(text, "model.json")
         .unwrap_err()
         .to_string();
-    assert_eq!(err, "model.json: line 2, column 42: number out of range");
+    assert_eq!(
+        err,
+        "model.json: line 2, column 42: a number too large for a computer (above 1.8e308)"
+    );
     let err = ModelFile::from_json_str("{\"z_lens\": 0.3, \"components\": [", "model.json")
         .unwrap_err()
         .to_string();
@@ -244,12 +303,12 @@ fn arcs_errors_name_the_line_of_the_system() {
                 {\"id\": \"b\", \"z\": 2, \"pixels\": [[1e999, 0]]}]}";
     assert_eq!(
         arcs_err(text),
-        "arcs.json: line 3, column 39: number out of range"
+        "arcs.json: line 3, column 39: a number too large for a computer (above 1.8e308)"
     );
     let text = "{\"systems\": [\n  {\"id\": \"a\",\n   \"zz\": 2, \"pixels\": [[0, 1]]}]}";
     let err = arcs_err(text);
     assert!(
-        err.starts_with("arcs.json: line 3, column 7: unknown field `zz`"),
+        err.starts_with("arcs.json: line 3, column 7: unknown field 'zz'"),
         "{err}"
     );
     assert_place_once(&err);
@@ -419,4 +478,31 @@ fn settings_of_the_wrong_type_are_refused_in_words() {
             assert!(!m.contains(word), "{m}");
         }
     }
+}
+
+/// JSON that is not a model object is refused as JSON, not read as a Lenstool `.par` that
+/// lacks its blocks; a `.par` still reads as one.
+#[test]
+fn json_that_is_not_a_model_is_refused_as_json() {
+    let mut s = Session::new();
+    for (name, text) in [
+        ("m.json", "[]"),
+        ("m.txt", "[[[1]]]"),
+        ("m.json", "\"model\""),
+    ] {
+        let err = s
+            .load_text(DataRole::Model, name, text)
+            .unwrap_err()
+            .to_string();
+        assert!(
+            err.contains("must be an object in braces { }, not "),
+            "{name}: {err}"
+        );
+        assert!(!err.contains("cosmologie"), "{err}");
+    }
+    let err = s
+        .load_text(DataRole::Model, "m.par", "runmode\n\tend\n")
+        .unwrap_err()
+        .to_string();
+    assert!(err.contains("cosmologie"), "{err}");
 }

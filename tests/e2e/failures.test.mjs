@@ -33,6 +33,17 @@ test('a rejected file keeps the one before, and says so at the top and in the ca
     assert.equal(await page.textContent('#project-name'), 'Teaching example: one halo, four sources');
     await runToMap(page, '#reconstruct');
     assert.match(await page.textContent('#summary'), /Made with images\.cat: bad\.cat had errors and was not loaded\./);
+    // Your own data with a result on screen: a refused file, then a good one. The status line
+    // speaks of the good one, not of the refusal.
+    const good = join(ROOT, 'www', 'examples', 'teaching', 'images.cat');
+    await page.setInputFiles('#file-images', good);
+    await waitStatus(page, /^Ready: press Reconstruct\.$/);
+    await runToMap(page, '#reconstruct');
+    await page.setInputFiles('#file-images', { name: 'bad.cat', mimeType: 'text/plain', buffer: Buffer.from('#REFERENCE 0\n1 x 2 0.5 0.5 0 2.0 25\n') });
+    await waitStatus(page, /^bad\.cat was not loaded/);
+    await page.setInputFiles('#file-images', good);
+    await waitStatus(page, /^Loaded images\.cat: .*; the map shown was made before it\.$/);
+    assert.ok(await page.isHidden('#error'));
     assert.deepEqual(app.consoleErrors, []);
   } finally {
     await app.close();

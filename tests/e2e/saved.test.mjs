@@ -31,7 +31,7 @@ test('a corrupt and a too-new saved project are set aside, downloadable, and the
     assert.equal(entries.length, 2, entries.join(' | '));
     assert.ok(entries.every((t) => t.startsWith('A project saved in this browser could not be opened')), entries.join(' | '));
     assert.ok(entries.every((t) => /It was set aside, not deleted/.test(t)), entries.join(' | '));
-    const cut = entries.findIndex((t) => /: it ends too early, cut short while it was saved: line \d+, column \d+: /.test(t));
+    const cut = entries.findIndex((t) => /: it was cut short while it was saved: line \d+, column \d+: ends too early, /.test(t));
     const newer = entries.findIndex((t) => /saved by a newer version of wslap \(project format version 99; this version reads version 1\)/.test(t));
     assert.ok(cut >= 0 && newer >= 0, entries.join(' | '));
     // Neither is sent to the page as a debug dump.

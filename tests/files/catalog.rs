@@ -701,3 +701,20 @@ fn too_many_bytes() {
         )
     );
 }
+
+/// Absurd offsets are refused with numbers a person can read (`2.778e304 deg`, not 300 digits
+/// or `inf`).
+#[test]
+fn absurd_offsets_are_said_in_readable_numbers() {
+    for (y, shown) in [
+        ("1e308", "2.777777777777778e304 deg"),
+        ("-1e308", "-2.777777777777778e304"),
+    ] {
+        let text = format!("#REFERENCE 3 342.18 -44.53\n1.1 0 {y} 0.1 0.1 0 2 25\n");
+        let e = image_err(&text);
+        assert!(e.contains(shown) && e.contains("outside (-90, 90)"), "{e}");
+    }
+    let e = image_err("#REFERENCE 3 342.18 -44.53\n1.1 1e308 0 0.1 0.1 0 2 25\n");
+    assert!(e.contains("is 2.778e304 deg from"), "{e}");
+    assert!(!e.contains("inf"), "{e}");
+}
