@@ -1691,6 +1691,23 @@ fn lookup_matches_an_sis() {
     assert!(!out.status.success());
     let err = String::from_utf8_lossy(&out.stderr);
     assert!(err.contains("positions.txt: line 1"), "{err}");
+    // More positions than a catalogue has rows are refused (8 million took 2.6 GB), in words.
+    fs::write(&file, "0 0\n".repeat(wslap::MAX_CATALOG_ROWS + 1)).unwrap();
+    let out = wslap(&[
+        "lookup",
+        "--maps",
+        maps.to_str().unwrap(),
+        "--z-source",
+        "2",
+        "--positions",
+        file.to_str().unwrap(),
+    ]);
+    assert!(!out.status.success());
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        err.contains("positions.txt: 1000001 positions is more than the limit of 1000000"),
+        "{err}"
+    );
 }
 
 /// `--out` naming an existing file is refused before any work, not after a whole run.

@@ -6,7 +6,9 @@ use std::path::{Path, PathBuf};
 use clap::Args;
 use glam::DVec2;
 use serde::Serialize;
-use wslap::{magnification_at_point, parse_sky_angle, InputKind, LensMaps, Map};
+use wslap::{
+    magnification_at_point, parse_sky_angle, InputKind, LensMaps, Map, TooLarge, MAX_CATALOG_ROWS,
+};
 
 use super::images::read_maps_dir;
 use super::input::read_text;
@@ -269,6 +271,17 @@ fn positions(args: &LookupArgs) -> Result<Vec<Position>, String> {
             }
         };
         let at = |e: String| format!("{}: line {}: {e}", path.display(), n + 1);
+        // Each position's answer is kept until all are written: as many as a catalogue's rows.
+        let count = out.len() as u64 + 1;
+        let name = path.display().to_string();
+        TooLarge::check(
+            &name,
+            "positions",
+            count,
+            MAX_CATALOG_ROWS as u64,
+            "a look-up",
+        )
+        .map_err(|e| e.to_string())?;
         out.push(Position {
             id,
             radec: Some((
