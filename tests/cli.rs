@@ -735,7 +735,8 @@ fn config_errors_say_file_line_and_column_once() {
 }
 
 /// Files saved with a byte-order mark (as Windows editors do) read as without one; the forms
-/// of `--z-prior` that the help gives are taken, a third is refused in words.
+/// of `--z-prior` that the help gives are taken, a third is refused in words; an option's error
+/// names the option.
 #[test]
 fn byte_order_marks_and_option_forms_as_people_write_them() {
     let dir = temp_dir("bom");
@@ -776,6 +777,25 @@ fn byte_order_marks_and_option_forms_as_people_write_them() {
         let given = s["settings"]["constraints"]["free_z_prior"].clone();
         assert_eq!(given, serde_json::json!([0.5, 7.0]), "{prior:?}");
     }
+    // A hold-out system that is not in the catalogue blames the option, not the settings file.
+    let err = refused(
+        &dir,
+        "reconstruct",
+        &[
+            "--images",
+            &images,
+            "--z-lens",
+            "0.348",
+            "--config",
+            path,
+            "--holdout",
+            "999",
+        ],
+    );
+    assert!(
+        err.starts_with("error: --holdout: constraints: hold-out system \"999\""),
+        "{err}"
+    );
     for prior in [&["1,2", "3,4"][..], &["1"][..]] {
         let mut args = vec!["--images", &images, "--z-lens", "0.348", "--z-prior"];
         args.extend(prior);

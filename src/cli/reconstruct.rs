@@ -9,7 +9,7 @@ use wslap::{
     check_ensemble_size, check_memory, cross_validate, export_system, fold_groups, image_regions,
     reconstruct, run_ensemble, ColorScale, Control, ConvergenceRecord, Cosmology, CrossValidation,
     Dataset, InputKind, InputText, InputTexts, Inputs, LensPlane, ReconstructConfig,
-    Reconstruction, SolverMethod,
+    ReconstructError, Reconstruction, SolverMethod,
 };
 
 use super::input::read_text;
@@ -231,7 +231,17 @@ pub fn run(args: &ReconstructArgs) -> Result<(), String> {
         check_ensemble_size(n).map_err(|e| format!("--ensemble: {e}"))?;
     }
     // So is a run larger than the machine's memory (`reconstruct` checks it again).
-    check_memory(&inputs, &config).map_err(|e| format!("{settings_name}: {e}"))?;
+    // Only a size the settings ask for is theirs to blame; a bad hold-out or an empty
+    // system names its own file or option.
+    check_memory(&inputs, &config).map_err(|e| match e {
+        ReconstructError::Memory(_) | ReconstructError::BadFieldValue(_) => {
+            format!("{settings_name}: {e}")
+        }
+        ReconstructError::Constraints(_) if !args.holdout.is_empty() => {
+            format!("--holdout: {e}")
+        }
+        other => other.to_string(),
+    })?;
     let total = config.solver.iterations;
     let exact = config.solver.method == SolverMethod::Exact;
     let mut progress = |r: &ConvergenceRecord| {
