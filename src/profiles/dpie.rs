@@ -41,7 +41,7 @@
 
 use glam::DVec2;
 
-use super::error::{require_finite_center, require_positive, ProfileError};
+use super::error::{require_finite_center, require_positive, require_sigma_v, ProfileError};
 use super::MassComponent;
 use crate::cosmology::LensPlane;
 use crate::units::{ARCSEC_PER_RAD, C_KM_S};
@@ -98,7 +98,7 @@ impl Dpie {
         ellipticity: f64,
         pa_deg: f64,
     ) -> Result<Self, ProfileError> {
-        let sigma_v_km_s = require_positive("dpie", "sigma_v", sigma_v_km_s)?;
+        let sigma_v_km_s = require_sigma_v("dpie", sigma_v_km_s)?;
         let bad = |field, value, reason| ProfileError::BadParameter {
             component: "dpie",
             field,

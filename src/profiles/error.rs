@@ -26,6 +26,25 @@ impl ProfileError {
 
 /// `Ok(value)` if `value` is finite and strictly positive, else a [`ProfileError::BadParameter`]
 /// with reason "must be positive and finite".
+/// Largest velocity dispersion a profile takes (km/s): the richest clusters have about 1500;
+/// far above, `sigma^2` overflows on the way to the maps (1e200 gave NaN pixels).
+pub(crate) const MAX_SIGMA_V_KM_S: f64 = 1e4;
+
+/// `value` when it is a velocity dispersion in `(0, MAX_SIGMA_V_KM_S]` km/s.
+pub(crate) fn require_sigma_v(component: &'static str, value: f64) -> Result<f64, ProfileError> {
+    if value.is_finite() && value > 0.0 && value <= MAX_SIGMA_V_KM_S {
+        Ok(value)
+    } else {
+        Err(ProfileError::BadParameter {
+            component,
+            field: "sigma_v",
+            value,
+            reason: "a velocity dispersion must be above 0 and at most 1e4 km/s; the richest \
+                     clusters have about 1500",
+        })
+    }
+}
+
 pub(crate) fn require_positive(
     component: &'static str,
     field: &'static str,

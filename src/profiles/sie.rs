@@ -15,7 +15,7 @@
 
 use glam::DVec2;
 
-use super::error::{require_finite_center, require_positive, ProfileError};
+use super::error::{require_finite_center, require_positive, require_sigma_v, ProfileError};
 use super::MassComponent;
 
 /// Radius in arcsec inside which the SIE's singular fields are replaced by finite values
@@ -45,7 +45,7 @@ impl Sie {
         q: f64,
         pa_deg: f64,
     ) -> Result<Self, ProfileError> {
-        let sigma_v_km_s = require_positive("sie", "sigma_v", sigma_v_km_s)?;
+        let sigma_v_km_s = require_sigma_v("sie", sigma_v_km_s)?;
         Self::from_theta_e(center, super::sis_theta_e_arcsec(sigma_v_km_s), q, pa_deg)
     }
 

@@ -13,7 +13,7 @@
 
 use glam::DVec2;
 
-use super::error::{require_finite_center, require_positive, ProfileError};
+use super::error::{require_finite_center, require_positive, require_sigma_v, ProfileError};
 use super::MassComponent;
 use crate::units::{ARCSEC_PER_RAD, C_KM_S};
 
@@ -32,7 +32,7 @@ impl Sis {
     /// An SIS with 1-D velocity dispersion `sigma_v_km_s` [km/s]:
     /// `theta_E,ref = 4 pi (sigma_v / c)^2` rad (for `D_ls/D_s = 1`).
     pub fn new(center: DVec2, sigma_v_km_s: f64) -> Result<Self, ProfileError> {
-        let sigma_v_km_s = require_positive("sis", "sigma_v", sigma_v_km_s)?;
+        let sigma_v_km_s = require_sigma_v("sis", sigma_v_km_s)?;
         Self::from_theta_e(center, sis_theta_e_arcsec(sigma_v_km_s))
     }
 

@@ -121,7 +121,7 @@ fn model_errors_name_component_and_field() {
 
     let (_, m) = model_error(&with(r#"{"type": "sis", "x": 0, "y": 0, "sigma_v": -3}"#));
     let expected =
-        "model.json: component 1 (sis): sigma_v = -3 is not allowed (must be positive and finite)";
+        "model.json: component 1 (sis): sigma_v = -3 is not allowed (a velocity dispersion must be above 0 and at most 1e4 km/s; the richest clusters have about 1500)";
     assert_eq!(m, expected);
 
     let (e, m) = model_error(&with(r#"{"type": "point", "x": 0, "y": 0, "mass": -1e12}"#));
@@ -281,4 +281,25 @@ fn model_errors_at_top_level() {
     };
     let m = model.validate().expect_err("NaN rejected").to_string();
     assert!(m.starts_with("model: component 0 (sis): x = NaN"), "{m}");
+}
+
+/// A velocity dispersion far past any cluster's is refused where it is written, not met as
+/// NaN pixels in the maps (1e200 overflowed `sigma^2`).
+#[cfg_attr(not(target_arch = "wasm32"), test)]
+#[cfg_attr(target_arch = "wasm32", wasm_bindgen_test::wasm_bindgen_test)]
+fn velocity_dispersions_are_bounded() {
+    for (kind, extra) in [("sis", ""), ("sie", ", \"q\": 0.8, \"pa\": 0")] {
+        let text = format!(
+            "{{\"z_lens\": 0.3, \"components\": [{{\"type\": \"{kind}\", \"x\": 0, \"y\": 0, \
+             \"sigma_v\": 1e200{extra}}}]}}"
+        );
+        let (_, m) = model_error(&text);
+        assert!(
+            m.contains("sigma_v = 1e200 is not allowed") && m.contains("at most 1e4 km/s"),
+            "{m}"
+        );
+    }
+    let ok = "{\"z_lens\": 0.3, \"components\": [{\"type\": \"sis\", \"x\": 0, \"y\": 0, \
+              \"sigma_v\": 1500}]}";
+    assert!(wslap::ModelFile::from_json_str(ok, "model.json").is_ok());
 }

@@ -427,7 +427,7 @@ fn bad_profile_parameters_are_named() {
     let e = field(Sis::new(DVec2::ZERO, -3.0).map(|_| ()));
     assert_eq!(
         e.to_string(),
-        "sis: sigma_v = -3 is not allowed (must be positive and finite)"
+        "sis: sigma_v = -3 is not allowed (a velocity dispersion must be above 0 and at most 1e4 km/s; the richest clusters have about 1500)"
     );
     let e = field(PointMass::new(DVec2::ZERO, f64::INFINITY, &lp).map(|_| ()));
     assert_eq!(e.field(), "mass");
