@@ -326,12 +326,22 @@ pub fn not_an_object(text: &str) -> Option<(usize, usize, String)> {
     ))
 }
 
+/// [`not_an_object`] as `"line L, column C: reason"`, as [`json_error_message`] says a place.
+pub fn not_an_object_message(text: &str) -> Option<String> {
+    not_an_object(text).map(placed)
+}
+
 /// `"line L, column C: reason"` for a `serde_json` error in `text` (only the reason when
 /// serde_json does not know the place); see [`json_error_parts`].
 pub fn json_error_message(text: &str, e: &serde_json::Error) -> String {
-    match json_error_parts(text, e) {
-        (0, _, reason) => reason,
-        (line, column, reason) => format!("line {line}, column {column}: {reason}"),
+    placed(json_error_parts(text, e))
+}
+
+/// `"line L, column C: reason"`, only the reason at line 0 (a place not known).
+fn placed((line, column, reason): (usize, usize, String)) -> String {
+    match line {
+        0 => reason,
+        _ => format!("line {line}, column {column}: {reason}"),
     }
 }
 

@@ -1697,33 +1697,26 @@ fn lookup_matches_an_sis() {
     check(&rows[0], 25.0);
     assert_eq!(rows[1]["has_data"], false);
     assert!(rows[1].get("magnification").is_none());
+    // A file of positions that is refused: the error message.
+    let refused_file = |text: &str| {
+        fs::write(&file, text).unwrap();
+        let out = wslap(&[
+            "lookup",
+            "--maps",
+            maps.to_str().unwrap(),
+            "--z-source",
+            "2",
+            "--positions",
+            file.to_str().unwrap(),
+        ]);
+        assert!(!out.status.success());
+        String::from_utf8_lossy(&out.stderr).into_owned()
+    };
     // A bad line names the file and line.
-    fs::write(&file, "sn1 342.18\n").unwrap();
-    let out = wslap(&[
-        "lookup",
-        "--maps",
-        maps.to_str().unwrap(),
-        "--z-source",
-        "2",
-        "--positions",
-        file.to_str().unwrap(),
-    ]);
-    assert!(!out.status.success());
-    let err = String::from_utf8_lossy(&out.stderr);
+    let err = refused_file("sn1 342.18\n");
     assert!(err.contains("positions.txt: line 1"), "{err}");
     // More positions than a catalogue has rows are refused (8 million took 2.6 GB), in words.
-    fs::write(&file, "0 0\n".repeat(wslap::MAX_CATALOG_ROWS + 1)).unwrap();
-    let out = wslap(&[
-        "lookup",
-        "--maps",
-        maps.to_str().unwrap(),
-        "--z-source",
-        "2",
-        "--positions",
-        file.to_str().unwrap(),
-    ]);
-    assert!(!out.status.success());
-    let err = String::from_utf8_lossy(&out.stderr);
+    let err = refused_file(&"0 0\n".repeat(wslap::MAX_CATALOG_ROWS + 1));
     assert!(
         err.contains("positions.txt: 1000001 positions is more than the limit of 1000000"),
         "{err}"

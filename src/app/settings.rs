@@ -157,11 +157,8 @@ impl AppSettings {
 
     /// Parses settings JSON (missing fields take their defaults); errors name the line.
     pub fn from_json_str(text: &str, source_name: &str) -> Result<Self, AppError> {
-        if let Some((line, column, reason)) = crate::limits::not_an_object(text) {
-            let place = format!("line {line}, column {column}");
-            return Err(AppError::Setting(format!(
-                "{source_name}: {place}: {reason}"
-            )));
+        if let Some(message) = crate::limits::not_an_object_message(text) {
+            return Err(AppError::Setting(format!("{source_name}: {message}")));
         }
         let s: Self = serde_json::from_str(text).map_err(|e| {
             AppError::Setting(format!("{source_name}: {}", json_error_message(text, &e)))

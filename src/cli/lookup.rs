@@ -251,6 +251,7 @@ fn positions(args: &LookupArgs) -> Result<Vec<Position>, String> {
     }
     let path = args.positions.as_deref().expect("clap requires a position");
     let text = read_text(path, InputKind::Catalog)?;
+    let name = path.display().to_string();
     let mut out = Vec::new();
     for (n, line) in text.lines().enumerate() {
         let line = line.split('#').next().unwrap_or("").trim();
@@ -273,7 +274,6 @@ fn positions(args: &LookupArgs) -> Result<Vec<Position>, String> {
         let at = |e: String| format!("{}: line {}: {e}", path.display(), n + 1);
         // Each position's answer is kept until all are written: as many as a catalogue's rows.
         let count = out.len() as u64 + 1;
-        let name = path.display().to_string();
         TooLarge::check(
             &name,
             "positions",

@@ -241,7 +241,7 @@ fn parse_number(token: &str) -> CardValue {
 
 #[cfg(test)]
 mod tests {
-    use super::CardValue;
+    use super::*;
 
     /// A card's value is shown as a header writes it, never as a Rust debug dump.
     #[test]
@@ -254,8 +254,6 @@ mod tests {
         assert_eq!(CardValue::shown(Some(&CardValue::Real(0.5))), "0.5");
         assert_eq!(CardValue::shown(None), "no value");
     }
-
-    use super::*;
 
     #[test]
     fn cards_round_trip() {

@@ -24,8 +24,6 @@ impl ProfileError {
     }
 }
 
-/// `Ok(value)` if `value` is finite and strictly positive, else a [`ProfileError::BadParameter`]
-/// with reason "must be positive and finite".
 /// Largest velocity dispersion a profile takes (km/s): the richest clusters have about 1500;
 /// far above, `sigma^2` overflows on the way to the maps (1e200 gave NaN pixels).
 pub(crate) const MAX_SIGMA_V_KM_S: f64 = 1e4;
@@ -45,6 +43,8 @@ pub(crate) fn require_sigma_v(component: &'static str, value: f64) -> Result<f64
     }
 }
 
+/// `Ok(value)` if `value` is finite and strictly positive, else a [`ProfileError::BadParameter`]
+/// with reason "must be positive and finite".
 pub(crate) fn require_positive(
     component: &'static str,
     field: &'static str,

@@ -125,10 +125,11 @@ impl ReconstructConfig {
     /// over [`crate::limits::MAX_JSON_BYTES`] is refused before parsing.
     pub fn from_json_str(text: &str, source_name: &str) -> Result<Self, ReconstructError> {
         TooLarge::check_bytes(source_name, InputKind::Config, text.len() as u64)?;
-        if let Some((line, column, reason)) = crate::limits::not_an_object(text) {
+        if let Some(message) = crate::limits::not_an_object_message(text) {
+            let source_name = source_name.to_string();
             return Err(ReconstructError::Config {
-                source_name: source_name.to_string(),
-                message: format!("line {line}, column {column}: {reason}"),
+                source_name,
+                message,
             });
         }
         let config: Self = serde_json::from_str(text).map_err(|e| ReconstructError::Config {
