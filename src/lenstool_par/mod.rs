@@ -227,6 +227,21 @@ impl ParPotfile {
             return Err(fail("magnitude 0 (Lenstool would give it no mass)".into()));
         }
         let (sigma, core, cut) = self.scaled(m.mag, plane);
+        if !(sigma > 0.0 && sigma <= crate::profiles::MAX_SIGMA_V_KM_S) {
+            // Far outside any galaxy: the scaling's L* magnitude and the catalogue's
+            // magnitudes disagree (another band, a typo): blame both, not the row alone.
+            return Err(fail(format!(
+                "magnitude {} scaled from the L* galaxy of potfile `{}` (the block at line {}: \
+                 mag0 = {}, sigma = {} km/s) gives a velocity dispersion of {:.2e} km/s; check \
+                 that mag0 and the catalogue's magnitudes are in the same band",
+                m.mag,
+                self.block,
+                self.line,
+                crate::error::number(self.mag0),
+                crate::error::number(self.sigma_km_s),
+                sigma,
+            )));
+        }
         let e = (a * a - b * b) / (a * a + b * b);
         Dpie::new(m.position, sigma, core, cut, e, m.theta_deg)
             .map_err(|e| fail(format!("{e} (potfile `{}`)", self.block)))

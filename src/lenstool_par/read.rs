@@ -219,6 +219,16 @@ const VALUE_MUST_BE_NUMBER: [&str; 3] = [
     "value 3 must be a number",
 ];
 
+/// Why a `cosmologie` block whose densities do not add to 1 is refused, in its own keywords.
+fn flat_reason(om_key: &str, ol_key: &str) -> &'static str {
+    match (om_key, ol_key) {
+        ("omegaM", "omegaX") => "only flat models are supported: omegaM + omegaX must be 1",
+        ("omegaM", _) => "only flat models are supported: omegaM + lambda must be 1",
+        (_, "omegaX") => "only flat models are supported: omega + omegaX must be 1",
+        _ => "only flat models are supported: omega + lambda must be 1",
+    }
+}
+
 /// A `cosmologie` keyword, the test its value (and omegaM) must pass, and the message.
 type FlatCheck = (&'static str, fn(f64, f64) -> bool, &'static str);
 
@@ -458,6 +468,19 @@ impl Ctx<'_> {
             "omega"
         };
         let om = self.req(b, om_key, 0)?;
+        // Each value is checked on its own line first, so a typo is blamed where it is.
+        if !(h0 > 0.0 && h0 <= 500.0) {
+            return Err(self.bad(
+                b,
+                "H0",
+                &b.entries["H0"],
+                "H0 must be above 0 and at most 500 km/s/Mpc",
+            ));
+        }
+        if !(0.0..=1.0).contains(&om) {
+            let reason = "the matter density of a flat universe must be 0 to 1";
+            return Err(self.bad(b, om_key, &b.entries[om_key], reason));
+        }
         let ol_key = if b.entries.contains_key("omegaX") {
             "omegaX"
         } else {
@@ -467,7 +490,7 @@ impl Ctx<'_> {
             (
                 ol_key,
                 |v, om| (om + v - 1.0).abs() < 1e-6,
-                "only flat models are supported",
+                flat_reason(om_key, ol_key),
             ),
             ("wX", |v, _| v == -1.0, "only wX = -1 is supported"),
             ("wa", |v, _| v == 0.0, "only wa = 0 is supported"),

@@ -29,6 +29,7 @@ pub use dpie::{
     DPIE_SINGULAR_CORE_ARCSEC,
 };
 pub use error::ProfileError;
+pub(crate) use error::MAX_SIGMA_V_KM_S;
 pub use gaussian::{
     cell_unit_deflection, gaussian_unit_deflection, gaussian_unit_hessian, gaussian_unit_kappa,
     Gaussian,

@@ -48,6 +48,19 @@ fn singular_cores_load_and_no_measurement_members_are_skipped() {
             "{text}"
         );
     }
+    // An L* magnitude in another band than the catalogue's (here off by 100 magnitudes)
+    // scales the members far beyond any galaxy: the potfile's mag0 is named with the row.
+    let other_band = SINGULAR_CORE.replace("mag0    19.440000", "mag0    119.44");
+    assert_ne!(other_band, SINGULAR_CORE);
+    let e = parse_par(&other_band, "singular_core.par")
+        .expect("loads")
+        .build_from_texts(&[("members.cat", MEMBERS)])
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.starts_with("members.cat:") && e.contains("mag0 = 119.44") && e.contains("same band"),
+        "{e}"
+    );
     // A catalogue of no-measurement rows only has no member to use, and says so.
     let only_99: String = MEMBERS
         .lines()
@@ -234,6 +247,46 @@ fn a_recent_english_bestopt_loads_without_warnings() {
         panic!("a dPIE");
     };
     assert_eq!(ellipticity, 0.600442);
+}
+
+#[cfg_attr(not(target_arch = "wasm32"), test)]
+#[cfg_attr(target_arch = "wasm32", wasm_bindgen_test::wasm_bindgen_test)]
+fn a_bad_cosmology_is_blamed_on_the_line_that_holds_it() {
+    // identity.par's block: H0 70.0 on line 35, omegaM 0.3 on 36, omegaX 0.7 on 37.
+    for (from, to, line, words) in [
+        (
+            "omegaM 0.3",
+            "omegaM 1.3",
+            36,
+            "`omegaM` in block `cosmologie`: the matter density",
+        ),
+        (
+            "omegaM 0.3",
+            "omegaM -0.3",
+            36,
+            "must be 0 to 1 (got `-0.3`)",
+        ),
+        (
+            "H0 70.0",
+            "H0 0",
+            35,
+            "`H0` in block `cosmologie`: H0 must be above 0",
+        ),
+        (
+            "omegaM 0.3",
+            "omegaM 0.03",
+            37,
+            "omegaM + omegaX must be 1 (got `0.7`)",
+        ),
+    ] {
+        let text = IDENTITY.replace(from, to);
+        assert_ne!(text, IDENTITY, "{from}");
+        let e = refused(&text, "cosmo.par");
+        assert!(
+            e.starts_with(&format!("cosmo.par:{line}: ")) && e.contains(words),
+            "{to}: {e}"
+        );
+    }
 }
 
 #[cfg_attr(not(target_arch = "wasm32"), test)]
