@@ -119,8 +119,8 @@ pub use lenstool_par::{
     Radius,
 };
 pub use limits::{
-    InputKind, TooLarge, MAX_ARCS_BYTES, MAX_ARC_PIXELS, MAX_CATALOG_BYTES, MAX_CATALOG_ROWS,
-    MAX_FITS_BYTES, MAX_FITS_PIXELS, MAX_JSON_BYTES,
+    with_line_feeds, InputKind, TooLarge, MAX_ARCS_BYTES, MAX_ARC_PIXELS, MAX_CATALOG_BYTES,
+    MAX_CATALOG_ROWS, MAX_FITS_BYTES, MAX_FITS_PIXELS, MAX_JSON_BYTES,
 };
 
 // The WSLAP+ inversion: cells, members, constraints, the linear system.

@@ -1,4 +1,4 @@
-//! Size limits on inputs, and where a JSON error is.
+//! Size limits on inputs, line ends, and where a JSON error is.
 //!
 //! Every limit is far above any real use (the largest real catalogues are a few thousand rows,
 //! HFF maps 4096 x 4096 pixels, the paper's arcs about 10^4 pixels) and well below what would
@@ -25,6 +25,18 @@ pub const MAX_ARC_PIXELS: usize = 1_000_000;
 pub const MAX_FITS_PIXELS: usize = 100_000_000;
 /// Largest FITS file in bytes: 1 GiB (10^8 double-precision pixels and their headers).
 pub const MAX_FITS_BYTES: u64 = 1 << 30;
+
+/// `text` with its line ends as every parser reads them: a file whose lines end in a carriage
+/// return alone (classic Mac OS, some spreadsheet exports) has them turned into line feeds, so
+/// it is read line by line and not as one long first line. Text with any line feed (Unix, or
+/// Windows' CR LF, which the parsers take as it is) comes back unchanged.
+pub fn with_line_feeds(text: &str) -> std::borrow::Cow<'_, str> {
+    if text.contains('\r') && !text.contains('\n') {
+        std::borrow::Cow::Owned(text.replace('\r', "\n"))
+    } else {
+        std::borrow::Cow::Borrowed(text)
+    }
+}
 
 /// The kinds of input file, each with its size limit.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]

@@ -325,6 +325,7 @@ impl LoadedData {
         arc_pixel_arcsec: f64,
         par_options: &ParOptions,
     ) -> Result<LoadReport, AppError> {
+        let text = &*crate::limits::with_line_feeds(text);
         let file = |e: &dyn std::fmt::Display| AppError::File(e.to_string());
         let (summary, warnings) = match role {
             DataRole::Images => {

@@ -5,7 +5,7 @@ use std::fs::File;
 use std::io::Read;
 use std::path::Path;
 
-use wslap::{InputKind, TooLarge};
+use wslap::{with_line_feeds, InputKind, TooLarge};
 
 /// The bytes of `path`, refused when over the limit of `kind` (checked on the metadata first,
 /// then while reading, for files that grow or report no size).
@@ -52,10 +52,13 @@ fn text_of(name: &str, bytes: Vec<u8>) -> Result<String, String> {
         ));
     }
     match String::from_utf8(bytes) {
-        Ok(text) => Ok(match text.strip_prefix('\u{feff}') {
-            Some(rest) => rest.to_string(),
-            None => text,
-        }),
+        Ok(text) => {
+            let text = match text.strip_prefix('\u{feff}') {
+                Some(rest) => rest.to_string(),
+                None => text,
+            };
+            Ok(with_line_feeds(&text).into_owned())
+        }
         Err(e) => {
             let at = e.utf8_error().valid_up_to();
             let bytes = e.as_bytes();
@@ -80,6 +83,12 @@ mod tests {
         let read = |b: &[u8]| text_of("f.par", b.to_vec());
         assert_eq!(read(b"\xEF\xBB\xBFrunmode\n").unwrap(), "runmode\n");
         assert_eq!(read(b"runmode\n").unwrap(), "runmode\n");
+        // Lines ended by a carriage return alone are read as lines; CR LF stays as it is.
+        assert_eq!(read(b"runmode\r\tend\r").unwrap(), "runmode\n\tend\n");
+        assert_eq!(
+            read(b"runmode\r\n\tend\r\n").unwrap(),
+            "runmode\r\n\tend\r\n"
+        );
         let e = read(b"\xFF\xFEr\0u\0").unwrap_err();
         assert!(e.starts_with("f.par: the file is UTF-16 text"), "{e}");
         let e = read(b"# ok\nname caf\xE9\n").unwrap_err();

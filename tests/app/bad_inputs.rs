@@ -506,3 +506,18 @@ fn json_that_is_not_a_model_is_refused_as_json() {
         .to_string();
     assert!(err.contains("cosmologie"), "{err}");
 }
+
+/// A catalogue whose lines end in a carriage return alone (classic Mac OS, some spreadsheet
+/// exports) reads as the same rows as with line feeds, not as one long first line.
+#[test]
+fn carriage_return_line_ends_read_as_lines() {
+    let images = include_str!("../data/weak_lensing/images.cat");
+    assert!(images.lines().count() > 5 && !images.contains('\r'));
+    let mut s = Session::new();
+    let unix = s.load_text(DataRole::Images, "i.cat", images).unwrap();
+    let mac = s
+        .load_text(DataRole::Images, "i.cat", &images.replace('\n', "\r"))
+        .unwrap();
+    assert_eq!(mac.summary, unix.summary);
+    assert_eq!(mac.warnings, unix.warnings);
+}
