@@ -234,7 +234,19 @@ fn bad_inputs_give_clear_errors() {
         "3",
     ]);
     assert!(!out.status.success());
-    assert!(String::from_utf8_lossy(&out.stderr).contains("pixels = 3"));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("--pixels = 3 is not allowed"));
+    // A negative width is the option's value (not an unknown flag), refused by its name.
+    let out = wslap(&[
+        "maps",
+        "--model",
+        good.to_str().unwrap(),
+        "--out",
+        dir.join("o").to_str().unwrap(),
+        "--size",
+        "-1",
+    ]);
+    assert!(!out.status.success());
+    assert!(String::from_utf8_lossy(&out.stderr).contains("--size = -1 is not allowed"));
 
     let not_fits = dir.join("x.fits");
     fs::write(&not_fits, b"SIMPLE  = nonsense").unwrap();

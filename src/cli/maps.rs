@@ -14,7 +14,7 @@ use wslap::LenstoolModel;
 use wslap::ModelFile;
 use wslap::{parse_par_with, ParOptions};
 use wslap::{Cosmology, LensPlane};
-use wslap::{ProductOptions, Products};
+use wslap::{ProductOptions, Products, ProductsError};
 
 /// Maps, critical curves, caustics and figures of a lens.
 ///
@@ -57,10 +57,10 @@ pub struct MapsArgs {
     #[arg(long, value_name = "DIR")]
     out: PathBuf,
     /// Source redshift of the magnification map and the critical curves.
-    #[arg(long, default_value_t = 2.0)]
+    #[arg(long, allow_negative_numbers = true, default_value_t = 2.0)]
     z_source: f64,
     /// Map width in arcsec, centred on (0, 0) (model files and Lenstool models).
-    #[arg(long, default_value_t = 200.0)]
+    #[arg(long, allow_negative_numbers = true, default_value_t = 200.0)]
     size: f64,
     /// Pixels on a side (model files and Lenstool models).
     #[arg(long, default_value_t = 512)]
@@ -94,6 +94,18 @@ pub fn run(args: &MapsArgs) -> Result<(), String> {
         scale: args.scale.into(),
         maps_only: false,
     };
+    // Checked before any file is read, and blamed on the option that set it (the settings'
+    // names, `products.pixels`, are not what the user typed here).
+    if let (None, Err(ProductsError::BadFieldValue(mut e))) = (&args.deflection, opts.validate()) {
+        e.field = match e.field.as_str() {
+            "products.size" => "--size",
+            "products.pixels" => "--pixels",
+            "products.z_source" => "--z-source",
+            other => other,
+        }
+        .to_string();
+        return Err(e.to_string());
+    }
     let products = if let Some(path) = &args.model {
         let text = read_text(path, InputKind::Model)?;
         let model = ModelFile::from_json_str(&text, &path.display().to_string())
