@@ -327,11 +327,27 @@ impl fmt::Display for TooMuchMemory {
         if s.side_by_side > 1 {
             write!(f, ", for each of {} runs side by side", s.side_by_side)?;
         }
-        let advice = match e.maps_bytes > e.matrix_bytes {
-            true => "products.pixels",
-            false => "grid.cells (or grid.refinements)",
-        };
-        write!(f, "; lower {advice}")
+        // The advice lowers what takes the most: the maps, else the largest share of the
+        // unknowns (cells, two per system for its source position, one per member layer).
+        let (systems, layers) = (s.systems.saturating_mul(2), s.layers);
+        if e.maps_bytes > e.matrix_bytes {
+            write!(f, "; lower products.pixels")
+        } else if s.cells >= systems.max(layers) {
+            write!(f, "; lower grid.cells (or grid.refinements)")
+        } else if systems >= layers {
+            write!(
+                f,
+                "; fit fewer systems: {} systems are {systems} of the unknowns (hold some out, \
+                 or split the catalogue)",
+                s.systems
+            )
+        } else {
+            write!(
+                f,
+                "; use fewer member layers (members.layers): {layers} layers are {layers} of \
+                 the unknowns"
+            )
+        }
     }
 }
 
@@ -442,6 +458,21 @@ mod tests {
             message.starts_with(
                 "a run with these settings would need at least 3.4 GiB of memory, more than \
                  the 2.5 GiB a browser tab can give a run: its maps of 8192 x 8192 pixels take"
+            ),
+            "{message}"
+        );
+        // Where the systems' source positions are most of the unknowns, fewer cells would
+        // not help: the advice says so.
+        config.grid.cells = 16;
+        let message = RunSize::of(&config, 40_000, 20_000, 1)
+            .memory_on(&config, Heap::Wasm)
+            .check(tab)
+            .unwrap_err()
+            .to_string();
+        assert!(
+            message.ends_with(
+                "; fit fewer systems: 20000 systems are 40000 of the unknowns (hold some out, \
+                 or split the catalogue)"
             ),
             "{message}"
         );
