@@ -408,6 +408,15 @@ impl Ctx<'_> {
             _ => Err(self.bad(b, key, e, VALUE_MUST_BE_NUMBER[k.min(2)])),
         }
     }
+    /// Value number `k` of the radius `key` (kpc or arcsec), refused on its own line when
+    /// negative: later checks see it converted to arcsec, not as written.
+    fn radius(&self, b: &Block, key: &'static str, k: usize) -> Result<Option<f64>, ParError> {
+        let r = self.opt(b, key, k)?;
+        match (r, b.entries.get(key)) {
+            (Some(v), Some(e)) if v < 0.0 => Err(self.bad(b, key, e, "a radius must be 0 or more")),
+            _ => Ok(r),
+        }
+    }
     fn req(&self, b: &Block, key: &'static str, k: usize) -> Result<f64, ParError> {
         self.opt(b, key, k)?.ok_or_else(|| ParError::Missing {
             file: self.file.into(),
@@ -536,7 +545,8 @@ impl Ctx<'_> {
             81 => {
                 self.only(b, &[&POTENTIAL_COMMON, &DPIE_KEYS], "profile 81")?;
                 let radius = |kpc: &'static str, arcsec: &'static str| {
-                    Ok::<_, ParError>(match (self.opt(b, kpc, 0)?, self.opt(b, arcsec, 0)?) {
+                    let (in_kpc, in_arcsec) = (self.radius(b, kpc, 0)?, self.radius(b, arcsec, 0)?);
+                    Ok::<_, ParError>(match (in_kpc, in_arcsec) {
                         // Lenstool: a non-zero kpc value wins over the arcsec one.
                         (Some(r), _) if r != 0.0 => Some(Radius::Kpc(r)),
                         (_, Some(r)) => Some(Radius::Arcsec(r)),
@@ -652,9 +662,12 @@ impl Ctx<'_> {
             }
         }
         let radius = |arcsec: &'static str, kpc: &'static str, k: usize| {
-            Ok::<_, ParError>(match self.opt(b, arcsec, k)? {
+            Ok::<_, ParError>(match self.radius(b, arcsec, k)? {
                 Some(r) => Radius::Arcsec(r),
-                None => Radius::Kpc(self.req(b, kpc, k)?),
+                None => match self.radius(b, kpc, k)? {
+                    Some(r) => Radius::Kpc(r),
+                    None => Radius::Kpc(self.req(b, kpc, k)?),
+                },
             })
         };
         let p = ParPotfile {

@@ -251,8 +251,9 @@ fn a_recent_english_bestopt_loads_without_warnings() {
 
 #[cfg_attr(not(target_arch = "wasm32"), test)]
 #[cfg_attr(target_arch = "wasm32", wasm_bindgen_test::wasm_bindgen_test)]
-fn a_bad_cosmology_is_blamed_on_the_line_that_holds_it() {
-    // identity.par's block: H0 70.0 on line 35, omegaM 0.3 on 36, omegaX 0.7 on 37.
+fn a_bad_cosmology_or_radius_is_blamed_on_the_line_that_holds_it() {
+    // identity.par's block: H0 70.0 on line 35, omegaM 0.3 on 36, omegaX 0.7 on 37; O1's
+    // core radius on line 20.
     for (from, to, line, words) in [
         (
             "omegaM 0.3",
@@ -277,6 +278,13 @@ fn a_bad_cosmology_is_blamed_on_the_line_that_holds_it() {
             "omegaM 0.03",
             37,
             "omegaM + omegaX must be 1 (got `0.7`)",
+        ),
+        // A negative radius is refused as written (kpc or arcsec), not once converted.
+        (
+            "core_radius 18.816964",
+            "core_radius_kpc -5",
+            20,
+            "`core_radius_kpc` in block `potentiel O1`: a radius must be 0 or more (got `-5`)",
         ),
     ] {
         let text = IDENTITY.replace(from, to);
