@@ -227,7 +227,7 @@ impl ParPotfile {
             return Err(fail("magnitude 0 (Lenstool would give it no mass)".into()));
         }
         let (sigma, core, cut) = self.scaled(m.mag, plane);
-        if !(sigma > 0.0 && sigma <= crate::profiles::MAX_SIGMA_V_KM_S) {
+        if crate::profiles::require_sigma_v("dpie", sigma).is_err() {
             // Far outside any galaxy: the scaling's L* magnitude and the catalogue's
             // magnitudes disagree (another band, a typo): blame both, not the row alone.
             return Err(fail(format!(

@@ -418,12 +418,16 @@ impl Ctx<'_> {
         }
     }
     fn req(&self, b: &Block, key: &'static str, k: usize) -> Result<f64, ParError> {
-        self.opt(b, key, k)?.ok_or_else(|| ParError::Missing {
+        self.opt(b, key, k)?.ok_or_else(|| self.missing(b, key))
+    }
+    /// The error for a keyword `b` must hold and does not.
+    fn missing(&self, b: &Block, key: &'static str) -> ParError {
+        ParError::Missing {
             file: self.file.into(),
             line: b.line,
             block: b.header.clone(),
             keyword: key,
-        })
+        }
     }
     /// Fails on a keyword outside `allowed` that Lenstool reads (it would change the model),
     /// naming it and its line; a keyword Lenstool does not read is ignored with a warning, as
@@ -664,10 +668,10 @@ impl Ctx<'_> {
         let radius = |arcsec: &'static str, kpc: &'static str, k: usize| {
             Ok::<_, ParError>(match self.radius(b, arcsec, k)? {
                 Some(r) => Radius::Arcsec(r),
-                None => match self.radius(b, kpc, k)? {
-                    Some(r) => Radius::Kpc(r),
-                    None => Radius::Kpc(self.req(b, kpc, k)?),
-                },
+                None => Radius::Kpc(
+                    self.radius(b, kpc, k)?
+                        .ok_or_else(|| self.missing(b, kpc))?,
+                ),
             })
         };
         let p = ParPotfile {

@@ -28,8 +28,8 @@ pub use dpie::{
     dpie_b0_arcsec, kk_epsilon, Dpie, CIRCULAR_EPSILON as DPIE_CIRCULAR_EPSILON,
     DPIE_SINGULAR_CORE_ARCSEC,
 };
+pub(crate) use error::require_sigma_v;
 pub use error::ProfileError;
-pub(crate) use error::MAX_SIGMA_V_KM_S;
 pub use gaussian::{
     cell_unit_deflection, gaussian_unit_deflection, gaussian_unit_hessian, gaussian_unit_kappa,
     Gaussian,
