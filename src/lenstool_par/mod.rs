@@ -197,6 +197,10 @@ pub struct ParPotfile {
     pub vdslope: f64,
 }
 
+/// How far (in magnitudes) a member may lie from its potfile's `mag0`: `10^8` times brighter
+/// or fainter than L*, as the members of `wslap reconstruct` may lie from `mag_star`.
+const MAX_MAG_FROM_L_STAR: f64 = 20.0;
+
 impl ParPotfile {
     /// Lenstool's scaling for a member of magnitude `mag`: `(sigma [km/s], r_core [arcsec],
     /// r_cut [arcsec])` with `L/L* = 10^(-0.4 (mag - mag0))` (see the module documentation).
@@ -227,9 +231,12 @@ impl ParPotfile {
             return Err(fail("magnitude 0 (Lenstool would give it no mass)".into()));
         }
         let (sigma, core, cut) = self.scaled(m.mag, plane);
-        if crate::profiles::require_sigma_v("dpie", sigma).is_err() {
-            // Far outside any galaxy: the scaling's L* magnitude and the catalogue's
-            // magnitudes disagree (another band, a typo): blame both, not the row alone.
+        // Far outside any galaxy, too heavy or (more than MAX_MAG_FROM_L_STAR magnitudes
+        // fainter than L*) all but massless: the scaling's L* magnitude and the catalogue's
+        // magnitudes disagree (another band, a typo). Blame both, not the row alone.
+        if (m.mag - self.mag0).abs() > MAX_MAG_FROM_L_STAR
+            || crate::profiles::require_sigma_v("dpie", sigma).is_err()
+        {
             return Err(fail(format!(
                 "magnitude {} scaled from the L* galaxy of potfile `{}` (the block at line {}: \
                  mag0 = {}, sigma = {} km/s) gives a velocity dispersion of {:.2e} km/s; check \

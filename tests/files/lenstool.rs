@@ -61,6 +61,19 @@ fn singular_cores_load_and_no_measurement_members_are_skipped() {
         e.starts_with("members.cat:") && e.contains("mag0 = 119.44") && e.contains("same band"),
         "{e}"
     );
+    // The other way (mag0 far brighter than every member) the members would be all but
+    // massless, a map without its galaxies and no word of it: refused the same way.
+    let massless = SINGULAR_CORE.replace("mag0    19.440000", "mag0    -300");
+    assert_ne!(massless, SINGULAR_CORE);
+    let e = parse_par(&massless, "singular_core.par")
+        .expect("loads")
+        .build_from_texts(&[("members.cat", MEMBERS)])
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.starts_with("members.cat:") && e.contains("mag0 = -300") && e.contains("same band"),
+        "{e}"
+    );
     // A catalogue of no-measurement rows only has no member to use, and says so.
     let only_99: String = MEMBERS
         .lines()
