@@ -118,22 +118,37 @@ fn split_all_outside_braces(mut s: &str, sep: char) -> Vec<&str> {
 }
 
 /// The value of `key={...}`, `key="..."`, `key='...'` or `key=word` in a property list.
+/// The list is read pair by pair, so a key written inside another property's value
+/// (`text={tag=1} tag={x}`) is not taken for the property itself.
 fn property<'a>(props: &'a str, key: &str) -> Option<&'a str> {
-    let mut rest = props;
-    while let Some(k) = rest.find(key) {
-        let before_ok = k == 0 || rest[..k].ends_with([' ', '\t']);
-        let after = rest[k + key.len()..].trim_start();
-        if let (true, Some(v)) = (before_ok, after.strip_prefix('=')) {
-            let v = v.trim_start();
-            let close = match v.chars().next() {
-                Some('{') => '}',
-                Some('"') => '"',
-                Some('\'') => '\'',
-                _ => return v.split_whitespace().next(),
-            };
-            return v[1..].find(close).map(|e| &v[1..1 + e]);
+    let mut rest = props.trim_start();
+    while !rest.is_empty() {
+        let name_end = rest.find(['=', ' ', '\t']).unwrap_or(rest.len());
+        let name = &rest[..name_end];
+        let after = rest[name_end..].trim_start();
+        let Some(v) = after.strip_prefix('=') else {
+            // A word without a value (`source`, `background`): skip it. `name` is not
+            // empty here (a list starting with `=` has a value), so this moves on.
+            rest = after;
+            continue;
+        };
+        let v = v.trim_start();
+        // `None`: an unclosed brace or quote, or no value at all.
+        let parsed = match v.chars().next() {
+            Some(open @ ('{' | '"' | '\'')) => {
+                let close = if open == '{' { '}' } else { open };
+                v[1..].find(close).map(|e| (&v[1..1 + e], &v[2 + e..]))
+            }
+            _ => {
+                let e = v.find([' ', '\t']).unwrap_or(v.len());
+                (e > 0).then(|| (&v[..e], &v[e..]))
+            }
+        };
+        let (value, tail) = parsed?;
+        if name == key {
+            return Some(value);
         }
-        rest = &rest[k + key.len()..];
+        rest = tail.trim_start();
     }
     None
 }
@@ -365,5 +380,24 @@ mod tests {
         assert_eq!(property(p, "text"), Some("a # b"));
         assert_eq!(property(p, "color"), Some("red"));
         assert_eq!(property(p, "width"), None);
+        // A key inside another property's value is not the property.
+        let p = "text={tag=1 color=blue} tag={x} color=red";
+        assert_eq!(property(p, "tag"), Some("x"));
+        assert_eq!(property(p, "color"), Some("red"));
+        assert_eq!(property(p, "text"), Some("tag=1 color=blue"));
+        assert_eq!(
+            property("text='z = 2' color = green", "color"),
+            Some("green")
+        );
+        assert_eq!(
+            property("text='z = 2' color = green", "text"),
+            Some("z = 2")
+        );
+        // Unclosed values and a bare key give nothing; an empty value is empty.
+        assert_eq!(property("text={open", "text"), None);
+        assert_eq!(property("text=", "text"), None);
+        assert_eq!(property("text={}", "text"), Some(""));
+        assert_eq!(property("source background", "source"), None);
+        assert_eq!(property("colour=red", "color"), None);
     }
 }
