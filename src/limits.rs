@@ -26,16 +26,27 @@ pub const MAX_FITS_PIXELS: usize = 100_000_000;
 /// Largest FITS file in bytes: 1 GiB (10^8 double-precision pixels and their headers).
 pub const MAX_FITS_BYTES: u64 = 1 << 30;
 
-/// `text` with its line ends as every parser reads them: a file whose lines end in a carriage
-/// return alone (classic Mac OS, some spreadsheet exports) has them turned into line feeds, so
-/// it is read line by line and not as one long first line. Text with any line feed (Unix, or
-/// Windows' CR LF, which the parsers take as it is) comes back unchanged.
+/// `text` with its line ends as every parser reads them: a carriage return alone (classic
+/// Mac OS, some spreadsheet exports, or a few lines of a file edited on several systems)
+/// becomes a line feed, so the file is read line by line and not with lines run together.
+/// Windows' CR LF, which the parsers take as it is, stays; text without a lone carriage
+/// return comes back unchanged.
 pub fn with_line_feeds(text: &str) -> std::borrow::Cow<'_, str> {
-    if text.contains('\r') && !text.contains('\n') {
-        std::borrow::Cow::Owned(text.replace('\r', "\n"))
-    } else {
-        std::borrow::Cow::Borrowed(text)
+    let bytes = text.as_bytes();
+    let lone_cr = |k: usize| bytes[k] == b'\r' && bytes.get(k + 1) != Some(&b'\n');
+    if !(0..bytes.len()).any(lone_cr) {
+        return std::borrow::Cow::Borrowed(text);
     }
+    let mut out = String::with_capacity(text.len());
+    let mut chars = text.chars().peekable();
+    while let Some(c) = chars.next() {
+        if c == '\r' && chars.peek() != Some(&'\n') {
+            out.push('\n');
+        } else {
+            out.push(c);
+        }
+    }
+    std::borrow::Cow::Owned(out)
 }
 
 /// The kinds of input file, each with its size limit.
@@ -360,6 +371,27 @@ fn placed((line, column, reason): (usize, usize, String)) -> String {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// Lone carriage returns become line feeds wherever they are; CR LF and LF stay, and
+    /// text without a lone CR is not copied.
+    #[test]
+    fn lone_carriage_returns_become_line_feeds() {
+        use std::borrow::Cow;
+        for text in ["a\nb\n", "a\r\nb\r\n", "", "no line end", "a\r\n"] {
+            assert!(
+                matches!(with_line_feeds(text), Cow::Borrowed(t) if t == text),
+                "{text:?}"
+            );
+        }
+        for (text, read) in [
+            ("a\rb\r", "a\nb\n"),
+            ("a\r\nb\rc\nd\r", "a\r\nb\nc\nd\n"),
+            ("\r\r\n\r", "\n\r\n\n"),
+            ("é\rü", "é\nü"),
+        ] {
+            assert_eq!(with_line_feeds(text), read, "{text:?}");
+        }
+    }
 
     #[test]
     fn json_place_is_said_once() {

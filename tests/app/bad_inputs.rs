@@ -520,4 +520,13 @@ fn carriage_return_line_ends_read_as_lines() {
         .unwrap();
     assert_eq!(mac.summary, unix.summary);
     assert_eq!(mac.warnings, unix.warnings);
+    // A file edited on several systems: some lines end in CR LF, some in LF, some in CR.
+    let mixed: String = images
+        .lines()
+        .enumerate()
+        .map(|(k, line)| format!("{line}{}", ["\r\n", "\n", "\r"][k % 3]))
+        .collect();
+    let mixed = s.load_text(DataRole::Images, "i.cat", &mixed).unwrap();
+    assert_eq!(mixed.summary, unix.summary);
+    assert_eq!(mixed.warnings, unix.warnings);
 }
