@@ -19,12 +19,19 @@ function facts(v) {
     v.holdout_offset_median_arcsec == null ? '' : `, held out ${arcsec(v.holdout_offset_median_arcsec)}`}`];
   const parts = [`${v.systems_matched} as many as observed`];
   if (v.systems_fewer_predicted) parts.push(`${v.systems_fewer_predicted} fewer`);
-  if (v.systems_more_predicted) parts.push(`${v.systems_more_predicted} more`);
+  if (v.systems_more_predicted) {
+    const far = v.systems_far_more_predicted ? ` (${v.systems_far_more_predicted} more than twice as many)` : '';
+    parts.push(`${v.systems_more_predicted} more${far}`);
+  }
   out.push(`Predicted images (|μ| ≥ 0.1) of ${v.systems} systems: ${parts.join(', ')}${
     v.systems_with_lost_images ? `; ${v.systems_with_lost_images} with an image not reproduced` : ''}`);
   const z = v.z_source == null ? '' : ` at z_s = ${v.z_source}`;
   const c = v.members_with_own_curves && v.c_unmeasured ? ' (their mass is assumed: C is hardly measured)' : '';
-  out.push(`Members with critical curves of their own${z}: ${v.members_with_own_curves}${c}`);
+  // Without member galaxies there is nothing to say about them.
+  if (v.members) out.push(`Members with critical curves of their own${z}: ${v.members_with_own_curves}${c}`);
+  if (v.images_on_curves) {
+    out.push(`Observed images on a critical curve (|μ| > 100): ${v.images_on_curves} of ${v.images}`);
+  }
   if (v.worst.length) out.push(`Worst systems (ringed on the map; why: Image systems): ${v.worst.map((w) => w.id).join(', ')}`);
   return out;
 }
