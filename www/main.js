@@ -4,7 +4,7 @@
 import { LensClient } from './lens-client.js';
 import { loadProject, loadPrevious, saveProject, hasSaved, setAside, setAsideList, deleteSetAside } from './js/store.js';
 import { buildFileRows, setFileStatus, ROLES } from './js/files.js';
-import { buildSettings, showSettings } from './js/settings.js';
+import { buildSettings, showSettings, fieldMessage } from './js/settings.js';
 import { wireViews, showPng, showSystems, showCrossval, showStrengthChoice, viewOptions, currentView, refreshReadout, clearPin, pinAt } from './js/views.js';
 import { showDownloads, save } from './js/downloads.js';
 import { wireFigureDownload } from './js/figure-download.js';
@@ -587,8 +587,10 @@ async function onFile(role, file) {
     // results and in the next run's caption, so that nobody takes a run on it for one on theirs.
     const kept = role === 'project' ? null : (await ask('loaded').catch(() => ({})))[role];
     const still = kept ? ` Still using ${kept} loaded before.` : '';
-    setFileStatus(role, `${err.message}${still ? `\n${still.trim()}` : ''}`, true);
-    showError(`${file.name} was not loaded: ${err.message}${still}`);
+    // A sentence of its own before the next one ("... (at most 10^6). Still using ...").
+    const message = /[.!?]$/.test(err.message) ? err.message : `${err.message}.`;
+    setFileStatus(role, `${message}${still ? `\n${still.trim()}` : ''}`, true);
+    showError(`${file.name} was not loaded: ${message}${still}`);
     setStatus(`${file.name} was not loaded (see the message below).`);
     if (kept) rejected.set(role, { file: file.name, kept });
     return;
@@ -699,7 +701,7 @@ async function start() {
   for (const id of ['show-members', 'show-observed', 'show-predicted', 'show-model-curves']) $(id).addEventListener('change', render);
   $('z-curves').addEventListener('change', async () => {
     try { await setZ(Number($('z-curves').value)); $('z-curves-error').textContent = ''; } catch (err) {
-      $('z-curves-error').textContent = err.message;
+      $('z-curves-error').textContent = fieldMessage(err.message, 'reconstruct.products.z_source');
       $('z-curves').value = settings?.reconstruct?.products?.z_source ?? 2;
     }
   });

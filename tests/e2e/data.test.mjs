@@ -145,6 +145,13 @@ test('systems without a redshift have it estimated, or take the one the settings
     await page.waitForFunction(() => /images with z = 0: z_s = 0.3 is not behind the lens/
       .test(document.getElementById('set-reconstruct-constraints-default_z-error').textContent));
     assert.equal(await page.inputValue('#set-reconstruct-constraints-default_z'), '');
+    // A lens redshift out of range is refused next to its field in plain words, without the
+    // names the core gives it ("z_lens: cosmology.z_lens = -1 ...").
+    await page.fill('#set-z_lens', '-1');
+    await page.dispatchEvent('#set-z_lens', 'change');
+    await page.waitForFunction(() => document.getElementById('set-z_lens-error').textContent !== '');
+    assert.match(await page.textContent('#set-z_lens-error'), /^-1 is not allowed \(/);
+    assert.equal(await page.inputValue('#set-z_lens'), '0.352');
     // A default redshift replaces the estimates.
     await setField(page, '#set-reconstruct-constraints-default_z', 2);
     const withZ = await run();

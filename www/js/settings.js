@@ -92,6 +92,20 @@ function parse(field, raw) {
 }
 
 /** Builds the form. `apply(path, value)` resolves with the new settings or throws. */
+/**
+ * `message` about the setting at `path`, as shown next to its labelled field: without the path
+ * the core puts first ("reconstruct.grid.cells: ...") nor the dotted name a range check gives
+ * the value ("grid.cells = 0 is not allowed" -> "0 is not allowed"; "cosmology.z_lens = -1"
+ * for the field z_lens). A message about another setting keeps its names.
+ */
+export function fieldMessage(message, path) {
+  const last = path.split('.').at(-1);
+  let text = message.startsWith(`${path}: `) ? message.slice(path.length + 2) : message;
+  const named = text.match(/^([\w]+(?:\.[\w]+)*) = /);
+  if (named && named[1].split('.').at(-1) === last) text = text.slice(named[0].length);
+  return text;
+}
+
 export function buildSettings(form, apply) {
   for (const f of FIELDS) {
     const row = document.createElement('div');
@@ -134,8 +148,7 @@ export function buildSettings(form, apply) {
       if (problem) {
         // Shown next to the labelled field: without the setting's path the core puts first,
         // nor the path a range check names its value by ("members.x = 5 is not allowed").
-        const inBlock = f.path.replace(/^reconstruct\./, '');
-        err.textContent = problem.message.replace(`${f.path}: `, '').replace(`${inBlock} = `, '');
+        err.textContent = fieldMessage(problem.message, f.path);
         if (!state.edited) input.value = input.dataset.good ?? '';
         return;
       }
