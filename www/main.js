@@ -83,7 +83,13 @@ async function refreshLoaded() {
   $('forward').disabled = !loaded.model;
   $('lookup').disabled = !(loaded.deflection_x && loaded.deflection_y);
   $('crossval').disabled = $('reconstruct').disabled;
+  // Overlays with nothing to draw are greyed out (their choice is kept for when there is).
+  $('show-members').disabled = !(loaded.members || loaded.model);
+  $('show-model-curves').disabled = !loaded.model;
   showSkyWarnings(loaded.sky_warnings ?? []);
+  // A refused file's predecessor that is gone (an example's file replaced by one's own
+  // data) is no longer what runs are made with: nothing to say about it.
+  for (const [role, { kept }] of rejected) if (loaded[role] !== kept) rejected.delete(role);
   return loaded;
 }
 
@@ -573,6 +579,10 @@ async function onFile(role, file) {
       // The example's result drew the example's data: it goes with them.
       await ask('clearResult');
       showNoResult();
+    } else if ($('project-name').textContent === NEW_PROJECT) {
+      // The new project has data now: its heading no longer says nothing is loaded.
+      await ask('setName', { name: OWN_DATA });
+      describe(OWN_DATA, 'Your files, with the settings below: check z_lens before you run.');
     }
     const loaded = await refreshLoaded();
     await persist();

@@ -33,12 +33,17 @@ test('a rejected file keeps the one before, and says so at the top and in the ca
     assert.equal(await page.textContent('#project-name'), 'Teaching example: one halo, four sources');
     await runToMap(page, '#reconstruct');
     assert.match(await page.textContent('#summary'), /Made with images\.cat: bad\.cat had errors and was not loaded\./);
+    // A refused model keeps the example's model.json, until one's own data replace the
+    // example (and its model): the caption then has nothing to say about either.
+    await page.setInputFiles('#file-model', { name: 'garbage.json', mimeType: 'application/json', buffer: Buffer.from('{ nope') });
+    await waitStatus(page, /^garbage\.json was not loaded/);
     // Your own data with a result on screen: a refused file, then a good one. The status line
     // speaks of the good one, not of the refusal.
     const good = join(ROOT, 'www', 'examples', 'teaching', 'images.cat');
     await page.setInputFiles('#file-images', good);
     await waitStatus(page, /^Ready: press Reconstruct\.$/);
     await runToMap(page, '#reconstruct');
+    assert.doesNotMatch(await page.textContent('#summary'), /Made with|had errors/);
     await page.setInputFiles('#file-images', { name: 'bad.cat', mimeType: 'text/plain', buffer: Buffer.from('#REFERENCE 0\n1 x 2 0.5 0.5 0 2.0 25\n') });
     await waitStatus(page, /^bad\.cat was not loaded/);
     await page.setInputFiles('#file-images', good);
@@ -98,6 +103,12 @@ test('New project starts over and can be undone', async () => {
     await page.reload();
     await waitStatus(page, /^Restored your project/);
     assert.equal(await page.textContent('#project-name'), 'New project');
+    // A file loaded into it makes it one's own data: the heading no longer says nothing is
+    // loaded.
+    await page.setInputFiles('#file-images', join(ROOT, 'www', 'examples', 'teaching', 'images.cat'));
+    await waitStatus(page, /^Ready: press Reconstruct\.$/);
+    assert.equal(await page.textContent('#project-name'), 'Your data');
+    assert.doesNotMatch(await page.textContent('#project-description'), /Nothing loaded/);
     // Undo is offered right after New project (in this page, not after a reload).
     await teaching(page);
     await page.click('#new-project');

@@ -121,6 +121,24 @@ test('catalogues and DS9 regions dropped on the drop zone load in their roles', 
   }
 });
 
+test('the drop zone opens a chooser of several files from the keyboard', async () => {
+  const app = await openApp();
+  try {
+    const { page } = app;
+    await waitStatus(page, /^Ready/);
+    await page.focus('#drop-zone');
+    const [chooser] = await Promise.all([page.waitForEvent('filechooser'), page.keyboard.press('Enter')]);
+    assert.ok(chooser.isMultiple());
+    await chooser.setFiles([join(AS1063, 'cats_gold_mul_gold.cat'), join(AS1063, 'cats_gold_ref_potential_w_clumpNE.cat')]);
+    await page.waitForFunction(() => /19 systems, 50 images/.test(document.getElementById('status-images').textContent));
+    await page.waitForFunction(() => /cats_gold_ref_potential_w_clumpNE\.cat: \d+ members/
+      .test(document.getElementById('status-members').textContent));
+    assert.deepEqual(app.consoleErrors, []);
+  } finally {
+    await app.close();
+  }
+});
+
 test('forward mode draws a model file; the PNG download and the read-out follow', async () => {
   const app = await openApp();
   try {

@@ -44,15 +44,37 @@ export function buildFileRows(container, dropZone, onFile) {
       input.value = '';
     });
   }
+  // Several files at once, each to the role its name and first lines say.
+  const several = async (list) => {
+    // Roles are guessed for all files first: a drop's file list is only readable now.
+    const files = [...list];
+    const roles = await Promise.all(files.map(guessRole));
+    files.forEach((file, k) => onFile(roles[k], file));
+  };
   const over = (on) => (e) => { e.preventDefault(); dropZone.classList.toggle('over', on); };
   dropZone.addEventListener('dragover', over(true));
   dropZone.addEventListener('dragleave', over(false));
-  dropZone.addEventListener('drop', async (e) => {
+  dropZone.addEventListener('drop', (e) => {
     over(false)(e);
-    // Roles are guessed for all files first: the drop's file list is only readable now.
-    const files = [...e.dataTransfer.files];
-    const roles = await Promise.all(files.map(guessRole));
-    files.forEach((file, k) => onFile(roles[k], file));
+    several(e.dataTransfer.files);
+  });
+  // Without a mouse to drag with (the keyboard, a phone): a click, Enter or Space opens a
+  // chooser of several files, sorted the same way.
+  const chooser = document.createElement('input');
+  chooser.type = 'file';
+  chooser.multiple = true;
+  chooser.hidden = true;
+  chooser.id = 'drop-zone-chooser';
+  dropZone.after(chooser);
+  chooser.addEventListener('change', () => {
+    several(chooser.files);
+    chooser.value = '';
+  });
+  dropZone.addEventListener('click', () => chooser.click());
+  dropZone.addEventListener('keydown', (e) => {
+    if (e.key !== 'Enter' && e.key !== ' ') return;
+    e.preventDefault();
+    chooser.click();
   });
 }
 
