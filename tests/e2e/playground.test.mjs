@@ -154,6 +154,10 @@ for (const query of ['?embed&playground', '?embed&lesson=lens-equation']) {
       assert.notEqual(after.canvas, before.canvas, 'the pixels on screen changed');
       assert.equal(await page.evaluate(() => window.scrollY), 0, 'the page scrolled');
       await page.screenshot({ path: join(ARTIFACTS, `touch-${query.includes('lesson') ? 'lesson' : 'playground'}-390.png`) });
+      // A finger cannot hover: a tap away from the handles reads out the ray there.
+      await page.touchscreen.tap(box.x + 0.1 * box.width, box.y + 0.9 * box.height);
+      await page.waitForFunction(() => /^Ray seen at/.test(document.getElementById('pg-readout').textContent),
+        null, { timeout: READY_TIMEOUT_MS });
       assert.deepEqual(app.consoleErrors, []);
     } finally {
       await app.close();

@@ -66,7 +66,7 @@ root.innerHTML = `
       </figure>
     </div>
     <aside class="pg-panel" id="pg-panel">
-      <div class="pg-readout" id="pg-readout">Hover the image plane to see where a ray lands; hover the source plane to see every image of that point.</div>
+      <div class="pg-readout" id="pg-readout">Hover (or tap) the image plane to see where a ray lands; hover (or tap) the source plane to see every image of that point.</div>
       ${EMBED ? '' : '<details class="pg-observe-opts" id="pg-observe-opts"></details>'}
       <div class="pg-palette">
         <span>Add lens:</span>
@@ -439,7 +439,11 @@ function hit(list, canvas, side, ev) {
 function wirePointer(canvas, list, side) {
   canvas.addEventListener('pointerdown', (ev) => {
     const k = hit(list, canvas, side(), ev);
-    if (k < 0) return;
+    if (k < 0) {
+      // A touch screen has no hover: a tap away from the handles reads out where it lands.
+      if (ev.pointerType !== 'mouse') hoverAt(list, ...toSky(canvas, side(), ev));
+      return;
+    }
     ev.preventDefault();
     canvas.setPointerCapture(ev.pointerId);
     const [x, y] = toSky(canvas, side(), ev);
