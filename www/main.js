@@ -124,6 +124,7 @@ function showNoResult() {
   resultKind = null;
   $('summary').textContent = '';
   showVerdict(null);
+  locateExamples(null);
   runNotes(null);
   showStrengthChoice(null);
   showIterates(null);

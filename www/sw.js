@@ -30,6 +30,7 @@ const APP_FILES = [
   'js/verdict.js',
   'js/views.js',
   'playground/client.js',
+  'playground/index.html',
   'playground/lessons.css',
   'playground/lessons.js',
   'playground/observe.js',

@@ -165,6 +165,17 @@ for (const query of ['?embed&playground', '?embed&lesson=lens-equation']) {
   });
 }
 
+test('/playground/ leads to the playground', async () => {
+  const app = await openApp({ width: 1280, height: 720, query: 'playground/' });
+  try {
+    await app.page.waitForURL(/\/\?playground$/);
+    await ready(app.page);
+    assert.deepEqual(app.consoleErrors, []);
+  } finally {
+    await app.close();
+  }
+});
+
 test('Download PNG gives both views drawn again at 1024 pixels a side', async () => {
   const app = await openApp({ width: 1280, height: 720, query: '?playground' });
   const { page } = app;

@@ -16,6 +16,9 @@ const WORDS = ['good', 'usable with care', 'do not trust the small scales'];
 async function reconstructed(viewport = {}) {
   const app = await openApp(viewport);
   await waitStatus(app.page, /^Ready/);
+  // Before a result the position box gives no cluster's coordinates as its example.
+  assert.equal(await app.page.getAttribute('#locate-input', 'placeholder'), 'RA Dec, or x y in arcsec');
+  assert.doesNotMatch(await app.page.textContent('#locate-help'), /\d\d:\d\d:\d\d/);
   await setField(app.page, '#set-reconstruct-solver-iterations', QUICK_ITERATIONS);
   await runToMap(app.page, '#reconstruct', 120_000);
   await app.page.waitForSelector('#verdict:not([hidden])');

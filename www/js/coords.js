@@ -59,13 +59,17 @@ export function counterImagesText(c) {
     `${items.join('; ')}. ${atPoint}; ${found}.`;
 }
 
+/** The position box's placeholder before there is a result to read. */
+const NO_DATA_PLACEHOLDER = 'RA Dec, or x y in arcsec';
+
 /** The box's help, its examples at the data's sky reference (`h`: the read-out at the frame's
  * origin, or null before any result). */
 function locateHelp(h) {
   const what = 'κ, μ and the images of the source behind it.';
   if (!h) {
-    return `RA Dec in degrees (342.1832 -44.5309) or sexagesimal (22:48:43.97 -44:31:51.2), or x y in
-      arcsec from the reference (12.5 -3.2 arcsec): ${what}`;
+    // No data's sky reference yet: the forms, with no cluster's position as an example.
+    return `RA Dec in degrees or sexagesimal (hh:mm:ss.ss ±dd:mm:ss.s), or x y in arcsec from the
+      reference (12.5 -3.2 arcsec): ${what}`;
   }
   if (!h.radec_sexagesimal) return `x y in arcsec from the frame's origin (12.5 -3.2; these data give no sky reference): ${what}`;
   return `RA Dec in degrees (${fmt(h.radec_deg[0], 4)} ${fmt(h.radec_deg[1], 4)}) or sexagesimal
@@ -79,7 +83,7 @@ export function locateExamples(h) {
   const input = document.getElementById('locate-input');
   if (!help || !input) return;
   help.textContent = locateHelp(h).replace(/\s+/g, ' ');
-  input.placeholder = h?.radec_sexagesimal ?? '12.5 -3.2';
+  input.placeholder = h ? (h.radec_sexagesimal ?? '12.5 -3.2') : NO_DATA_PLACEHOLDER;
 }
 
 /** Adds the box for a typed position after the read-out. `locate(text)` resolves to the point
@@ -92,7 +96,7 @@ export function wireLocate({ locate, pinAt }) {
   form.noValidate = true;
   form.innerHTML = `<label for="locate-input">Go to a position</label>
     <span class="locate-row"><input id="locate-input" type="text" autocomplete="off" spellcheck="false"
-      placeholder="22:48:43.97 -44:31:51.2" aria-describedby="locate-help locate-error">
+      placeholder="${NO_DATA_PLACEHOLDER}" aria-describedby="locate-help locate-error">
     <button type="submit" id="locate-go" class="secondary">Show</button></span>
     <span id="locate-help" class="hint">${locateHelp(null)}</span>
     <span id="locate-error" class="field-error" role="alert"></span>`;
