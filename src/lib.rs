@@ -164,9 +164,9 @@ pub use reconstruct::{
 
 // The verdict on a reconstruction and its thresholds.
 pub use reconstruct::{
-    members_with_own_curves, FLAG_OFFSET_ARCSEC, GOOD_FIT_OFFSET_ARCSEC,
+    members_with_own_curves, FAR_MORE_PREDICTED_FACTOR, FLAG_OFFSET_ARCSEC, GOOD_FIT_OFFSET_ARCSEC,
     GOOD_HOLDOUT_OFFSET_ARCSEC, LOST_IMAGE_ARCSEC, LOST_SYSTEMS_SHARE, MAIN_CURVE_MIN_SHARE,
-    SMALL_SCALE_OFFSET_ARCSEC, WORST_SHOWN,
+    ON_CURVE_MAGNIFICATION, ON_CURVE_SHARE, SMALL_SCALE_OFFSET_ARCSEC, WORST_SHOWN,
 };
 
 // Figures.
