@@ -133,11 +133,19 @@ function showNoResult() {
   $('downloads').innerHTML = '<p class="hint">Run something first.</p>';
 }
 
+/** The Example menu: a blank entry for one's own data, then every example (a playground
+ * observation opened in this page is one too, added after the menu was first made). */
+function fillExampleMenu() {
+  $('example-select').innerHTML = '<option value="" disabled>(your data)</option>'
+    + examples.map((e, k) => `<option value="${k}">${e.name}</option>`).join('');
+}
+
 function describe(name, text) {
   $('project-name').textContent = name;
   $('project-description').textContent = text;
   // The menu shows the example that is open, or its blank entry for anything else, so that
   // choosing any example (also the first) is a change that loads it.
+  if ($('example-select').options.length !== examples.length + 1) fillExampleMenu();
   const k = examples.findIndex((e) => e.name === name);
   $('example-select').value = k >= 0 ? String(k) : '';
   // An example's model file is the true lens it was made from: legends say so.
@@ -721,8 +729,7 @@ async function start() {
   } catch (err) {
     showError(`could not read the examples: ${err.message}`);
   }
-  $('example-select').innerHTML = '<option value="" disabled>(your data)</option>'
-    + examples.map((e, k) => `<option value="${k}">${e.name}</option>`).join('');
+  fillExampleMenu();
   $('example-select').addEventListener('change', () => {
     const ex = examples[$('example-select').value];
     enqueue(() => loadExample(ex));

@@ -85,6 +85,9 @@ for (const [width, height, tag] of [[1280, 720, '1280x720'], [390, 844, '390']])
       assert.ok(Math.abs(ours / truth - 1) < EINSTEIN_RTOL, `${ours} vs ${truth}`);
       assert.equal(await page.getAttribute('body', 'data-truth-model'), 'yes');
       assert.match(await page.textContent('#project-name'), /^Playground: SIE/);
+      // The Example menu shows the observation (an example of its own), not a blank.
+      const menu = await page.$eval('#example-select', (s) => s.selectedOptions[0]?.textContent ?? '');
+      assert.match(menu, /^Playground: SIE/);
       const back = await page.getAttribute('#back-to-playground', 'href');
       assert.ok(back.startsWith('./?playground#s1='), back);
 
