@@ -228,14 +228,25 @@ pub(super) fn draw_overlay(
             }
         }
     }
+    let mut placed = Vec::new();
     for label in &overlay.labels {
-        draw_map_label(pm, l, g, label);
+        draw_map_label(pm, l, g, label, &mut placed);
     }
 }
 
-/// Draws `label` beside its position, one ring radius away: right of it, or left of it when
-/// the text would leave the map; nothing when the position is off the map.
-fn draw_map_label(pm: &mut Pixmap, l: &Layout, g: &MapGeometry, label: &OverlayLabel) {
+/// A label's box on screen: `[left, top, right, bottom]` in pixels.
+type LabelBox = [f32; 4];
+
+/// Draws `label` beside its position, one ring radius away, where it overlaps no label in
+/// `placed` ([`place_label`]), and adds its box there. Nothing when the position is off the
+/// map.
+fn draw_map_label(
+    pm: &mut Pixmap,
+    l: &Layout,
+    g: &MapGeometry,
+    label: &OverlayLabel,
+    placed: &mut Vec<LabelBox>,
+) {
     let (x, y) = l.screen(g, label.position_arcsec);
     let inside = |v: f32, lo: f32| v >= lo && v <= lo + l.m;
     if !(inside(x, l.left) && inside(y, l.top)) {
@@ -243,11 +254,16 @@ fn draw_map_label(pm: &mut Pixmap, l: &Layout, g: &MapGeometry, label: &OverlayL
     }
     let s = l.s;
     let gap = 3.0 * marker_radius(l) + 2.0 * s;
-    let right = x + gap + text_width(&label.text, s) <= l.left + l.m;
-    let (at, anchor) = if right {
-        ((x + gap, y), Anchor::MiddleLeft)
+    let size = (
+        text_width(&label.text, s),
+        1.6 * crate::render::font::CAP * s,
+    );
+    let (at, left_side, taken) = place_label((x, y), gap, size, (l.left, l.left + l.m), placed);
+    placed.push(taken);
+    let anchor = if left_side {
+        Anchor::MiddleRight
     } else {
-        ((x - gap, y), Anchor::MiddleRight)
+        Anchor::MiddleLeft
     };
     // A dark halo: the text drawn offset in eight directions, then in its colour on top.
     let halo = Color::from_rgba8(0, 0, 0, 200);
@@ -273,6 +289,38 @@ fn draw_map_label(pm: &mut Pixmap, l: &Layout, g: &MapGeometry, label: &OverlayL
         anchor,
         true,
     );
+}
+
+/// Where a label of `(width, height)` goes beside the point `(x, y)`, `gap` away, with the
+/// map's columns `map = (left, right)`: right of the point, left of it, then a line above or
+/// below on either side, the first that stays on the map and overlaps no box of `placed`
+/// (else the first that stays on the map). Returns the text's anchor point, whether it is
+/// left of the point (anchored on its right end), and its box.
+fn place_label(
+    (x, y): (f32, f32),
+    gap: f32,
+    (w, h): (f32, f32),
+    map: (f32, f32),
+    placed: &[LabelBox],
+) -> ((f32, f32), bool, LabelBox) {
+    let mut options = Vec::new();
+    for dy in [0.0, -h, h] {
+        options.push(((x + gap, y + dy), false, x + gap));
+        options.push(((x - gap, y + dy), true, x - gap - w));
+    }
+    let on_map = |left: f32| left >= map.0 && left + w <= map.1;
+    let boxed = |at: (f32, f32), left: f32| [left, at.1 - h / 2.0, left + w, at.1 + h / 2.0];
+    let overlaps = |b: &LabelBox| {
+        placed
+            .iter()
+            .any(|p| b[0] < p[2] && p[0] < b[2] && b[1] < p[3] && p[1] < b[3])
+    };
+    let &(at, left_side, left) = options
+        .iter()
+        .find(|&&(at, _, left)| on_map(left) && !overlaps(&boxed(at, left)))
+        .or_else(|| options.iter().find(|o| on_map(o.2)))
+        .unwrap_or(&options[0]);
+    (at, left_side, boxed(at, left))
 }
 
 /// Width of the curves and marker strokes (3 pixels on a 512-pixel map).
@@ -430,5 +478,37 @@ pub(super) fn draw_legend(
         let cy = y + pad + row * k as f32 + ch / 2.0;
         draw_sample(pm, l, key, x + pad, cy, sample);
         text(pm, label, (x + pad + sample + gap, cy));
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Labels of nearby points do not overlap: the second goes left, the third a line up; on
+    /// their own they sit right of their point, or left of it at the map's right edge.
+    #[test]
+    fn labels_of_nearby_points_stand_apart() {
+        let (gap, size, map) = (10.0, (30.0, 12.0), (0.0, 500.0));
+        let mut placed = Vec::new();
+        let mut sides = Vec::new();
+        for p in [(200.0, 200.0), (203.0, 201.0), (198.0, 199.0)] {
+            let (at, left, b) = place_label(p, gap, size, map, &placed);
+            assert!(
+                placed.iter().all(|q: &LabelBox| b[2] <= q[0]
+                    || q[2] <= b[0]
+                    || b[3] <= q[1]
+                    || q[3] <= b[1]),
+                "{b:?} overlaps {placed:?}"
+            );
+            placed.push(b);
+            sides.push((left, at.1 - p.1));
+        }
+        assert_eq!(sides, [(false, 0.0), (true, 0.0), (false, -12.0)]);
+        let alone = |p| place_label(p, gap, size, map, &[]);
+        assert_eq!(alone((100.0, 50.0)).0, (110.0, 50.0));
+        assert!(!alone((100.0, 50.0)).1);
+        assert_eq!(alone((480.0, 50.0)).0, (470.0, 50.0));
+        assert!(alone((480.0, 50.0)).1);
     }
 }
