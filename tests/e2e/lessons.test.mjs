@@ -29,6 +29,11 @@ test('a first visit opens the first lesson; each lesson opens its scene and the 
     assert.match(page.url(), /\?lesson=lens-equation(#|$)/);
     assert.match(await page.textContent('.pg-lesson-count'), /^Lesson 1 of \d+$/);
     assert.equal(await page.getAttribute('.pg-lesson-app', 'href'), './?app');
+    // The read-out the lessons ask to look at sits right under the planes, on the first
+    // screen, not below the lesson's text.
+    const [canvas, readout] = await Promise.all(['#pg-image', '#pg-readout'].map((s) => page.locator(s).boundingBox()));
+    assert.ok(readout.y > canvas.y + canvas.height && readout.y < 720 - 40 && readout.x < canvas.x + canvas.width,
+      `read-out at ${JSON.stringify(readout)}, image plane at ${JSON.stringify(canvas)}`);
     for (let k = 0; k < lessons.length; k++) {
       const lesson = lessons[k];
       await page.waitForFunction((t) => document.querySelector('.pg-lesson-title')?.textContent === t, lesson.title);

@@ -26,6 +26,13 @@ export async function startLessons(api, id) {
     api.root.querySelector('.pg-main').before(box);
   } else {
     api.root.querySelector('#pg-panel').prepend(box);
+    // The read-out the lessons ask to look at goes right under the two planes: in the panel
+    // it sat below the lesson's text, out of view.
+    const stage = document.createElement('div');
+    stage.className = 'pg-stage';
+    const views = api.root.querySelector('#pg-views');
+    views.before(stage);
+    stage.append(views, api.root.querySelector('#pg-readout'));
   }
   let first = true;
   const open = (k, push) => {
