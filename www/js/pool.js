@@ -46,19 +46,27 @@ export class StrengthPool {
    * the number of folds finished of all the candidates (those of a running one counted from
    * the reports: a fold's first solve pass, `level` 0, follows the last pass of the fold
    * before; a fold shorter than the 100 ms between reports can be missed, which only makes
-   * the count low). A worker that fails or dies fails the whole
+   * the count low), and `work` the same folds each weighted by `weight(candidate)` (its
+   * relative cost; 1 each without). A worker that fails or dies fails the whole
    * run with a message naming the candidate; the caller closes the pool in any case. */
-  async trials(project, plan, onProgress) {
+  async trials(project, plan, onProgress, weight = () => 1) {
     const { candidates, folds } = plan;
     const rows = new Array(candidates.length);
     const running = new Map();
     const foldsSeen = new Map(); // candidate -> folds of it seen to end
+    const weights = new Map(candidates.map((c) => [candidateLabel(c), weight(c)]));
     let next = 0;
     let done = 0;
+    let doneWork = 0;
     const report = () => {
       let partial = 0;
-      for (const f of foldsSeen.values()) partial += Math.min(f, folds - 1);
-      onProgress({ done, total: candidates.length, folds: done * folds + partial, running });
+      let partialWork = 0;
+      for (const [label, f] of foldsSeen) {
+        partial += Math.min(f, folds - 1);
+        partialWork += Math.min(f, folds - 1) * weights.get(label);
+      }
+      onProgress({ done, total: candidates.length, folds: done * folds + partial,
+        work: doneWork + partialWork, running });
     };
     report();
     const work = async (worker, k) => {
@@ -87,6 +95,7 @@ export class StrengthPool {
         running.delete(label);
         foldsSeen.delete(label);
         done += 1;
+        doneWork += folds * weights.get(label);
         report();
       }
     };
