@@ -372,6 +372,12 @@ pub struct MemberModel {
     pub warnings: Vec<String>,
 }
 
+/// How far (in magnitudes) a member may lie from the L* magnitude it is scaled from: `10^8`
+/// times brighter or fainter. Beyond, the catalogue's magnitudes and the L* magnitude are in
+/// different bands (or one is a typo), and a member would weigh far more than a cluster or
+/// next to nothing. Used for `mag_star` here and for a Lenstool potfile's `mag0`.
+pub(crate) const MAX_MAG_FROM_L_STAR: f64 = 20.0;
+
 /// `mu(c) = ln(1 + c) - c/(1 + c)` (dimensionless).
 fn nfw_mu(c: f64) -> f64 {
     c.ln_1p() - c / (1.0 + c)
@@ -475,7 +481,7 @@ pub fn build_member_layers(
                 return Err(bad_member(field, v, "a position in arcsec must be finite"));
             }
         }
-        if !(m.mag.is_finite() && (m.mag - mag_star).abs() <= 20.0) {
+        if !(m.mag.is_finite() && (m.mag - mag_star).abs() <= MAX_MAG_FROM_L_STAR) {
             return Err(bad_member(
                 "mag",
                 m.mag,

@@ -23,6 +23,7 @@ pub use constraints::{
     Weighting,
 };
 pub(crate) use members::member_halo;
+pub(crate) use members::MAX_MAG_FROM_L_STAR;
 pub(crate) use members::MAX_MASS_TO_LIGHT;
 pub use members::{
     build_member_layers, HaloProfile, Layer, LayerSplit, MemberConfig, MemberHalo, MemberModel,

@@ -197,10 +197,6 @@ pub struct ParPotfile {
     pub vdslope: f64,
 }
 
-/// How far (in magnitudes) a member may lie from its potfile's `mag0`: `10^8` times brighter
-/// or fainter than L*, as the members of `wslap reconstruct` may lie from `mag_star`.
-const MAX_MAG_FROM_L_STAR: f64 = 20.0;
-
 impl ParPotfile {
     /// Lenstool's scaling for a member of magnitude `mag`: `(sigma [km/s], r_core [arcsec],
     /// r_cut [arcsec])` with `L/L* = 10^(-0.4 (mag - mag0))` (see the module documentation).
@@ -234,7 +230,7 @@ impl ParPotfile {
         // Far outside any galaxy, too heavy or (more than MAX_MAG_FROM_L_STAR magnitudes
         // fainter than L*) all but massless: the scaling's L* magnitude and the catalogue's
         // magnitudes disagree (another band, a typo). Blame both, not the row alone.
-        if (m.mag - self.mag0).abs() > MAX_MAG_FROM_L_STAR
+        if (m.mag - self.mag0).abs() > crate::inversion::MAX_MAG_FROM_L_STAR
             || crate::profiles::require_sigma_v("dpie", sigma).is_err()
         {
             return Err(fail(format!(
