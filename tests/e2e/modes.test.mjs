@@ -125,8 +125,10 @@ test('the drop zone opens a chooser of several files from the keyboard', async (
   const app = await openApp();
   try {
     const { page } = app;
-    await waitStatus(page, /^Ready/);
+    // The first example has opened (its loading moves the page and the focus): then the key.
+    await waitStatus(page, /^Ready: press Reconstruct\.$/);
     await page.focus('#drop-zone');
+    assert.equal(await page.evaluate(() => document.activeElement?.id), 'drop-zone');
     const [chooser] = await Promise.all([page.waitForEvent('filechooser'), page.keyboard.press('Enter')]);
     assert.ok(chooser.isMultiple());
     await chooser.setFiles([join(AS1063, 'cats_gold_mul_gold.cat'), join(AS1063, 'cats_gold_ref_potential_w_clumpNE.cat')]);
