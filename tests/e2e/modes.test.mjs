@@ -125,11 +125,22 @@ test('the drop zone opens a chooser of several files from the keyboard', async (
   const app = await openApp();
   try {
     const { page } = app;
+    // Listen for the chooser from the start: Playwright turns the browser's chooser
+    // interception on when the first listener is added, a round trip that a key pressed at
+    // once could overtake under load (the chooser then opens natively and is never seen).
+    const chooserSeen = new Promise((resolve) => page.once('filechooser', resolve));
     // The first example has opened (its loading moves the page and the focus): then the key.
     await waitStatus(page, /^Ready: press Reconstruct\.$/);
     await page.focus('#drop-zone');
     assert.equal(await page.evaluate(() => document.activeElement?.id), 'drop-zone');
-    const [chooser] = await Promise.all([page.waitForEvent('filechooser'), page.keyboard.press('Enter')]);
+    await page.keyboard.press('Enter');
+    let timer;
+    const chooser = await Promise.race([
+      chooserSeen,
+      new Promise((_, reject) => {
+        timer = setTimeout(() => reject(new Error('no file chooser within 30 s of Enter')), 30000);
+      }),
+    ]).finally(() => clearTimeout(timer));
     assert.ok(chooser.isMultiple());
     await chooser.setFiles([join(AS1063, 'cats_gold_mul_gold.cat'), join(AS1063, 'cats_gold_ref_potential_w_clumpNE.cat')]);
     await page.waitForFunction(() => /19 systems, 50 images/.test(document.getElementById('status-images').textContent));
