@@ -6,7 +6,8 @@
 //! ```
 //! (defaults 512 5). Scene: the page's default scene (www/playground/scene.js). Prints the
 //! median wall time of the whole frame (drawn again with nothing changed, and after the SIE
-//! moved: a released lens drag) and of its stages.
+//! moved: a released lens drag, also for a heavier SIE whose curve leaves the view) and of its
+//! stages.
 
 use std::time::Instant;
 
@@ -74,6 +75,25 @@ fn main() {
             moving.set_scene(scene).expect("scene");
             std::hint::black_box(moving.frame(pixels));
         });
+        // The same with a heavier SIE whose tangential curve leaves the view: the caustics
+        // are then traced again on a field twice as wide (src/playground/frame.rs).
+        let heavy = SCENE.replace(
+            r#""sigma_v": 850, "q": 0.75"#,
+            r#""sigma_v": 1200, "q": 0.6"#,
+        );
+        let mut moving = Playground::new(Scene::from_json_str(&heavy).expect("heavy scene"))
+            .expect("playground");
+        let mut step = 0;
+        let heavy_moved = median_ms(repeats, || {
+            step += 1;
+            let moved = heavy.replace(
+                r#""sie", "x": 0,"#,
+                &format!(r#""sie", "x": {},"#, 0.1 * step as f64),
+            );
+            let scene = Scene::from_json_str(&moved).expect("moved scene");
+            moving.set_scene(scene).expect("scene");
+            std::hint::black_box(moving.frame(pixels));
+        });
         // The same without the point source: what its image search costs.
         let no_point = SCENE.replace(
             r#",
@@ -111,7 +131,8 @@ fn main() {
             .sum();
         println!(
             "{pixels}^2: frame {frame:.1} ms (lens and sources kept; {without_point:.1} ms \
-             without the point source's images), {lens_moved:.1} ms after the lens moved; maps with Hessian {maps:.1} ms ({curve_maps:.1} ms on the curve grid); \
+             without the point source's images), {lens_moved:.1} ms after the lens moved \
+             ({heavy_moved:.1} ms with a tangential curve that leaves the view); maps with Hessian {maps:.1} ms ({curve_maps:.1} ms on the curve grid); \
              deflection only {deflection:.1} ms; curves of {} planes {curves:.1} ms \
              ({vertices} curve and caustic vertices)",
             pg.built().planes.len()

@@ -6,11 +6,13 @@
 //! traced on a grid of at most [`CURVE_PIXELS`] a side (the marching squares interpolate
 //! between pixel centres, and critical curves are smooth on that scale: see the playground
 //! tests), so the Hessian is evaluated at a quarter of the pixels of a 512² frame; the
-//! deflection is evaluated at every pixel of the frame, without the Hessian.
+//! deflection is evaluated at every pixel of the frame, without the Hessian. Where a critical
+//! curve leaves the view, its caustic (and the Einstein radius) come from the curves traced
+//! again over a wider field, so that the source plane shows whole caustics, not pieces.
 
 use glam::DVec2;
 
-use crate::curves::critical_curves;
+use crate::curves::{critical_curves, CriticalCurves, Polyline};
 use crate::map::{LensMaps, MapGeometry};
 use crate::profiles::MassComponent;
 
@@ -81,8 +83,7 @@ impl LensCache {
     }
 
     /// The maps (with Hessian) of the curve grid for a frame of `geometry`.
-    pub fn curve_maps(&mut self, lens: &dyn MassComponent, geometry: MapGeometry) -> &LensMaps {
-        let grid = curve_geometry(geometry);
+    pub fn curve_maps(&mut self, lens: &dyn MassComponent, grid: MapGeometry) -> &LensMaps {
         let k = match self.maps.iter().position(|m| m.geometry() == grid) {
             Some(k) => k,
             None => {
@@ -107,19 +108,39 @@ impl LensCache {
                 out.push(c.clone());
                 continue;
             }
-            let c = critical_curves(
-                self.curve_maps(lens, geometry),
-                plane.f,
-                plane.z,
-                Some(lens),
-            );
+            let view = curve_geometry(geometry);
+            let seen = critical_curves(self.curve_maps(lens, view), plane.f, plane.z, Some(lens));
+            // A curve cut by the view's border maps to caustic pieces that end in mid-air, and
+            // its Einstein radius counts only closed loops: trace the caustics and the radius
+            // on a wider field (the view's own curves stay, at the view's resolution).
+            let mut whole = None;
+            let mut wide = view;
+            for _ in 0..MAX_WIDENINGS {
+                if !cut_by_border(whole.as_ref().unwrap_or(&seen), wide) {
+                    break;
+                }
+                wide = MapGeometry {
+                    size_arcsec: 2.0 * wide.size_arcsec,
+                    ..wide
+                };
+                whole = Some(critical_curves(
+                    self.curve_maps(lens, wide),
+                    plane.f,
+                    plane.z,
+                    Some(lens),
+                ));
+            }
+            let (whole, traced) = match &whole {
+                Some(w) => (w, wide),
+                None => (&seen, view),
+            };
             let c = PlaneCurves {
                 z: plane.z,
-                einstein_radius_arcsec: c.einstein_radius_arcsec,
-                tangential: c.tangential,
-                radial: c.radial,
-                tangential_caustics: c.caustics.tangential,
-                radial_caustics: c.caustics.radial,
+                einstein_radius_arcsec: whole.einstein_radius_arcsec,
+                tangential_caustics: closed(&whole.caustics.tangential, &whole.tangential, traced),
+                radial_caustics: closed(&whole.caustics.radial, &whole.radial, traced),
+                tangential: closed(&seen.tangential, &seen.tangential, view),
+                radial: closed(&seen.radial, &seen.radial, view),
             };
             self.curves.push((side, plane.z, c.clone()));
             out.push(c);
@@ -135,6 +156,47 @@ pub fn curve_geometry(geometry: MapGeometry) -> MapGeometry {
         pixels: geometry.pixels.min(CURVE_PIXELS),
         ..geometry
     }
+}
+
+/// Times the field of a frame's caustics is doubled, at most, while a critical curve crosses
+/// its border (a 40″ view: up to 160″). The pixel count stays: a caustic traced at half or a
+/// quarter of the view's resolution lies within a pixel of one traced finely (tested), and a
+/// lens release costs a curve grid more per widening, not four.
+const MAX_WIDENINGS: usize = 2;
+
+/// True when `line`, a critical curve traced on `geometry`, is cut by its border: an open
+/// polyline, whose ends lie on the outermost cell edges of the marching squares (closed loops
+/// repeat no point, so their ends are neighbours inside the map).
+fn is_cut(line: &[DVec2], geometry: MapGeometry) -> bool {
+    let pixel = geometry.pixel_arcsec();
+    let edge = 0.5 * (geometry.size_arcsec - pixel) - 1e-6 * pixel;
+    let on_border = |p: DVec2| {
+        let d = p - geometry.center;
+        d.x.abs() >= edge || d.y.abs() >= edge
+    };
+    line.len() > 1 && on_border(line[0]) && on_border(line[line.len() - 1])
+}
+
+/// True when a critical curve of `curves` is cut by the border of `geometry`.
+fn cut_by_border(curves: &CriticalCurves, geometry: MapGeometry) -> bool {
+    let mut lines = curves.tangential.iter().chain(&curves.radial);
+    lines.any(|line| is_cut(line, geometry))
+}
+
+/// `lines` with the first point repeated at the end of each whose critical curve (`curves`,
+/// traced on `geometry`, one per line) is a closed loop, so that a polyline draws all of it.
+fn closed(lines: &[Polyline], curves: &[Polyline], geometry: MapGeometry) -> Vec<Polyline> {
+    lines
+        .iter()
+        .zip(curves)
+        .map(|(line, curve)| {
+            let mut line = line.clone();
+            if line.len() > 2 && !is_cut(curve, geometry) {
+                line.push(line[0]);
+            }
+            line
+        })
+        .collect()
 }
 
 /// [`MassComponent::deflection`] of `lens` (arcsec, `D_ls/D_s = 1`) at every pixel centre of

@@ -80,7 +80,9 @@ pub const IMAGE_SEARCH_PIXELS: usize = 200;
 /// Most pixels a side of a frame or a contour map.
 pub const MAX_FRAME_PIXELS: usize = 1024;
 
-/// The critical curves and caustics for one source redshift, in arcsec.
+/// The critical curves and caustics for one source redshift, in arcsec, ready to draw as
+/// polylines: a closed loop (and the caustic of one) ends with its first point again; a curve
+/// cut by the view's border does not.
 #[derive(Debug, Clone, Serialize)]
 pub struct PlaneCurves {
     pub z: f64,
@@ -276,7 +278,7 @@ impl Playground {
             }
         }
         let curves = cache.curves(&self.built, geometry);
-        let maps = cache.curve_maps(lens, geometry);
+        let maps = cache.curve_maps(lens, frame::curve_geometry(geometry));
         let points = self
             .scene
             .sources

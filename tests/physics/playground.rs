@@ -262,3 +262,64 @@ fn a_frame_with_kept_lens_results_is_the_frame_computed_afresh() {
     pg.set_scene(scene).expect("scene");
     assert_eq!(pg.frame(256).image_rgba, first.image_rgba);
 }
+
+#[cfg_attr(not(target_arch = "wasm32"), test)]
+#[cfg_attr(target_arch = "wasm32", wasm_bindgen_test::wasm_bindgen_test)]
+fn a_critical_curve_that_leaves_the_view_still_gives_whole_caustics() {
+    use wslap::{critical_curves, LensMaps, MapGeometry};
+    // An SIE whose tangential curve (major axis ~37″) leaves the 40″ view.
+    let text = r#"{"v": 1, "z_lens": 0.3, "fov": 40,
+        "lenses": [{"type": "sie", "x": 0, "y": 0, "sigma_v": 1200, "q": 0.6, "pa": 15}],
+        "sources": [{"type": "point", "x": 1.0, "y": 0.5, "z": 2.0}]}"#;
+    let pg = Playground::new(Scene::from_json_str(text).expect("scene")).expect("playground");
+    let lens = &pg.built().lens;
+    let plane = &pg.built().planes[0];
+    let view = critical_curves(
+        &LensMaps::from_lens(lens, MapGeometry::centered(40.0, 256)),
+        plane.f,
+        plane.z,
+        Some(lens),
+    );
+    assert!(
+        view.tangential_leaves_map,
+        "the scene's curve must leave the view"
+    );
+    // Independently: the same lens on a field four times as wide, as fine as the view.
+    let whole_geometry = MapGeometry::centered(160.0, 1024);
+    let whole = critical_curves(
+        &LensMaps::from_lens(lens, whole_geometry),
+        plane.f,
+        plane.z,
+        Some(lens),
+    );
+    assert!(!whole.tangential_leaves_map);
+    let frame = pg.frame(512);
+    let c = &frame.curves[0];
+    // The image plane keeps the view's curves, cut at its border.
+    assert_eq!(c.tangential, view.tangential);
+    // The caustic is whole: one loop, the same as on the wide field, drawn closed.
+    assert_eq!(c.tangential_caustics.len(), whole.caustics.tangential.len());
+    for line in &c.tangential_caustics {
+        assert_eq!(line.first(), line.last(), "a loop ends where it starts");
+    }
+    let pixel = whole_geometry.pixel_arcsec();
+    let (there, back) = (
+        farthest_vertex(&c.tangential_caustics, &whole.caustics.tangential),
+        farthest_vertex(&whole.caustics.tangential, &c.tangential_caustics),
+    );
+    assert!(
+        there < pixel && back < pixel,
+        "{there} and {back} arcsec apart"
+    );
+    assert_rel(
+        "Einstein radius",
+        c.einstein_radius_arcsec,
+        whole.einstein_radius_arcsec,
+        0.005,
+    );
+    assert!(
+        c.einstein_radius_arcsec > 20.0,
+        "{}",
+        c.einstein_radius_arcsec
+    );
+}
