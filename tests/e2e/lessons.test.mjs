@@ -99,7 +99,7 @@ test('the mass-sheet lesson: lens B keeps lens A\'s images, and its delays are 0
   }
 });
 
-test('an embedded lesson fits 900 x 720 and 390 x 844 without scrolling', async () => {
+test('an embedded lesson fits 900 x 720 and 390 x 844 without scrolling, read-out included', async () => {
   for (const [width, height] of [[900, 720], [390, 844]]) {
     const app = await openApp({ width, height, query: '?embed&lesson=curves-and-caustics' });
     const { page } = app;
@@ -109,6 +109,13 @@ test('an embedded lesson fits 900 x 720 and 390 x 844 without scrolling', async 
       const size = await page.evaluate(() => [document.documentElement.scrollWidth, document.documentElement.scrollHeight]);
       assert.ok(size[0] <= width && size[1] <= height, `${width} x ${height}: the page is ${size.join(' x ')}`);
       assert.ok(await page.isHidden('#pg-panel'), 'no research controls');
+      // What a hover says (the lessons ask to read it) is under the planes, inside the page.
+      const box = await page.locator('#pg-source').boundingBox();
+      await page.mouse.move(box.x + box.width * 0.52, box.y + box.height * 0.49);
+      await page.waitForFunction(() => /images? of a point/.test(document.getElementById('pg-readout').textContent));
+      const readout = await page.locator('#pg-readout').boundingBox();
+      assert.ok(readout.y >= box.y + box.height && readout.y + readout.height <= height,
+        `${width} x ${height}: read-out at ${readout.y} - ${readout.y + readout.height}`);
       await page.screenshot({ path: join(ARTIFACTS, `lesson-embed-${width}x${height}.png`) });
       assert.deepEqual(app.consoleErrors, []);
     } finally {

@@ -87,6 +87,14 @@ root.innerHTML = `
 document.body.append(root);
 
 const $ = (id) => document.getElementById(id);
+if (EMBED) {
+  // Embedded, the panel is hidden: the read-out (what a hover or a tap says: positions, μ,
+  // parity, delays) goes under the two planes instead.
+  const stage = document.createElement('div');
+  stage.className = 'pg-stage';
+  $('pg-views').before(stage);
+  stage.append($('pg-views'), $('pg-readout'));
+}
 const imageCanvas = $('pg-image');
 const sourceCanvas = $('pg-source');
 const client = new PlaygroundClient();
@@ -218,7 +226,7 @@ function sizeCanvases() {
   if (EMBED) {
     // Everything above the views (the bar, a lesson's card) takes its height from them.
     const top = views.getBoundingClientRect().top + window.scrollY;
-    const free = h - top - 2 * 22 - 18; // two captions, margins
+    const free = h - top - 2 * 22 - 18 - $('pg-readout').offsetHeight - 6; // captions, read-out, margins
     stacked = w < free * 0.9;
     side = stacked ? Math.min(w - 12, free / 2) : Math.min((w - 24) / 2, free + 22);
   } else {
