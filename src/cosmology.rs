@@ -53,6 +53,11 @@ impl Default for Cosmology {
 /// relative errors far below 1e-9.
 const SIMPSON_INTERVALS_PER_UNIT_Z: f64 = 400.0;
 
+/// The largest `H0` (km/s/Mpc) accepted from settings or a Lenstool file: seven times the
+/// measured value, far beyond any cosmology anyone would lens with, but a bound that keeps a
+/// typo (`H0 7000`) from passing as a universe.
+pub const H0_MAX_KM_S_MPC: f64 = 500.0;
+
 impl Cosmology {
     /// A validated cosmology.
     pub fn new(h0: f64, omega_m: f64) -> Result<Self, CosmologyError> {
@@ -61,16 +66,26 @@ impl Cosmology {
         Ok(c)
     }
 
-    /// Checks `0 < H0 <= 500` and `0 <= Ωm <= 1`.
+    /// True for an `H0` (km/s/Mpc) the distances accept: `0 < H0 <=` [`H0_MAX_KM_S_MPC`].
+    pub fn h0_allowed(h0: f64) -> bool {
+        h0.is_finite() && h0 > 0.0 && h0 <= H0_MAX_KM_S_MPC
+    }
+
+    /// True for an `Ωm` of a flat universe: `0 <= Ωm <= 1`.
+    pub fn omega_m_allowed(omega_m: f64) -> bool {
+        omega_m.is_finite() && (0.0..=1.0).contains(&omega_m)
+    }
+
+    /// Checks [`Self::h0_allowed`] and [`Self::omega_m_allowed`].
     pub fn validate(&self) -> Result<(), CosmologyError> {
-        if !(self.h0.is_finite() && self.h0 > 0.0 && self.h0 <= 500.0) {
+        if !Self::h0_allowed(self.h0) {
             return Err(CosmologyError::from(crate::error::BadFieldValue::new(
                 "cosmology.h0",
                 self.h0,
                 "H0 in km/s/Mpc must be in (0, 500]",
             )));
         }
-        if !(self.omega_m.is_finite() && (0.0..=1.0).contains(&self.omega_m)) {
+        if !Self::omega_m_allowed(self.omega_m) {
             return Err(CosmologyError::from(crate::error::BadFieldValue::new(
                 "cosmology.omega_m",
                 self.omega_m,

@@ -69,7 +69,7 @@ mod wasm;
 pub use coordinates::{
     parse_position, sexagesimal_text, CoordinateError, PositionForm, TypedPosition, SKY_MATCH_DEG,
 };
-pub use cosmology::{Cosmology, CosmologyError, LensPlane};
+pub use cosmology::{Cosmology, CosmologyError, LensPlane, H0_MAX_KM_S_MPC};
 pub use sky::{parse_sky_angle, SkyReference};
 
 // Mass components and the maps of a lens.

@@ -482,7 +482,7 @@ impl Ctx<'_> {
         };
         let om = self.req(b, om_key, 0)?;
         // Each value is checked on its own line first, so a typo is blamed where it is.
-        if !(h0 > 0.0 && h0 <= 500.0) {
+        if !Cosmology::h0_allowed(h0) {
             return Err(self.bad(
                 b,
                 "H0",
@@ -490,7 +490,7 @@ impl Ctx<'_> {
                 "H0 must be above 0 and at most 500 km/s/Mpc",
             ));
         }
-        if !(0.0..=1.0).contains(&om) {
+        if !Cosmology::omega_m_allowed(om) {
             let reason = "the matter density of a flat universe must be 0 to 1";
             return Err(self.bad(b, om_key, &b.entries[om_key], reason));
         }
