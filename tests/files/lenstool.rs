@@ -48,32 +48,29 @@ fn singular_cores_load_and_no_measurement_members_are_skipped() {
             "{text}"
         );
     }
+    // The build's error when the potfile's mag0 is `mag0` instead of 19.44: it must name the
+    // member catalogue, the value and the band.
+    let refused_with_mag0 = |mag0: &str| {
+        let text = SINGULAR_CORE.replace("mag0    19.440000", &format!("mag0    {mag0}"));
+        assert_ne!(text, SINGULAR_CORE);
+        let e = parse_par(&text, "singular_core.par")
+            .expect("loads")
+            .build_from_texts(&[("members.cat", MEMBERS)])
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.starts_with("members.cat:")
+                && e.contains(&format!("mag0 = {mag0}"))
+                && e.contains("same band"),
+            "{e}"
+        );
+    };
     // An L* magnitude in another band than the catalogue's (here off by 100 magnitudes)
     // scales the members far beyond any galaxy: the potfile's mag0 is named with the row.
-    let other_band = SINGULAR_CORE.replace("mag0    19.440000", "mag0    119.44");
-    assert_ne!(other_band, SINGULAR_CORE);
-    let e = parse_par(&other_band, "singular_core.par")
-        .expect("loads")
-        .build_from_texts(&[("members.cat", MEMBERS)])
-        .unwrap_err()
-        .to_string();
-    assert!(
-        e.starts_with("members.cat:") && e.contains("mag0 = 119.44") && e.contains("same band"),
-        "{e}"
-    );
+    refused_with_mag0("119.44");
     // The other way (mag0 far brighter than every member) the members would be all but
     // massless, a map without its galaxies and no word of it: refused the same way.
-    let massless = SINGULAR_CORE.replace("mag0    19.440000", "mag0    -300");
-    assert_ne!(massless, SINGULAR_CORE);
-    let e = parse_par(&massless, "singular_core.par")
-        .expect("loads")
-        .build_from_texts(&[("members.cat", MEMBERS)])
-        .unwrap_err()
-        .to_string();
-    assert!(
-        e.starts_with("members.cat:") && e.contains("mag0 = -300") && e.contains("same band"),
-        "{e}"
-    );
+    refused_with_mag0("-300");
     // A catalogue of no-measurement rows only has no member to use, and says so.
     let only_99: String = MEMBERS
         .lines()
