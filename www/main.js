@@ -344,8 +344,9 @@ async function ensemble(mainMs) {
 
 /** Relative cost of trying `candidate`, its cells per side to the power 0.75, so that the time
  * left is not read from the cheap coarse-grid trials that run first. Measured on AS1063 gold
- * with the defaults (27 candidates, 2 workers): equal costs said 62 s left where 92 s were
- * (-33%), the power 1.5 said 116 s for 76 s (+53%), 0.75 stays within -13% to +21%. */
+ * with the defaults (27 candidates, 2 workers; `node benches/app-eta.mjs`, BENCHMARKS.md): the
+ * time left read with equal costs was 25% low (median over the run), with 0.75 +12% and +17%
+ * in two runs; a power of 1.5 read +36 to +74% (with other work on the cores) and was not kept. */
 const trialCost = (candidate) => (candidate?.cells ?? 32) ** 0.75;
 
 /** An "auto" regulariser strength: each candidate of `plan` is cross-validated in a pool
