@@ -99,6 +99,27 @@ test('the mass-sheet lesson: lens B keeps lens A\'s images, and its delays are 0
   }
 });
 
+test('on a phone the lesson comes before the planes; on a wide screen it stays beside them', async () => {
+  for (const [width, height] of [[390, 844], [1280, 720]]) {
+    const app = await openApp({ width, height, query: '?lesson=curves-and-caustics' });
+    const { page } = app;
+    try {
+      await page.waitForSelector('#pg-lesson');
+      await fullFrame(page);
+      const [title, canvas] = await Promise.all(['.pg-lesson-title', '#pg-image'].map((s) => page.locator(s).boundingBox()));
+      if (width < 900) {
+        assert.ok(title.y + title.height < canvas.y, `${width}: title at ${title.y}, image plane at ${canvas.y}`);
+      } else {
+        assert.ok(title.x > canvas.x + canvas.width, `${width}: title at x ${title.x}, image plane ends at ${canvas.x + canvas.width}`);
+      }
+      await page.screenshot({ path: join(ARTIFACTS, `lesson-placement-${width}x${height}.png`) });
+      assert.deepEqual(app.consoleErrors, []);
+    } finally {
+      await app.close();
+    }
+  }
+});
+
 test('an embedded lesson fits 900 x 720 and 390 x 844 without scrolling, read-out included', async () => {
   for (const [width, height] of [[900, 720], [390, 844]]) {
     const app = await openApp({ width, height, query: '?embed&lesson=curves-and-caustics' });

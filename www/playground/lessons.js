@@ -33,6 +33,15 @@ export async function startLessons(api, id) {
     const views = api.root.querySelector('#pg-views');
     views.before(stage);
     stage.append(views, api.root.querySelector('#pg-readout'));
+    // On a narrow screen the panel comes after the planes: the lesson goes above them, so that
+    // a phone shows what the lesson is about before two pictures it has not explained.
+    const narrow = window.matchMedia('(max-width: 899px)');
+    const place = () => {
+      if (narrow.matches) stage.before(box);
+      else api.root.querySelector('#pg-panel').prepend(box);
+    };
+    narrow.addEventListener('change', () => { place(); api.resize(); });
+    place();
   }
   let first = true;
   const open = (k, push) => {
