@@ -62,38 +62,29 @@ fn main() {
             }
             std::hint::black_box(s);
         });
-        // A frame after the lens moved (a released drag): nothing of the lens is kept.
-        let mut moving = Playground::new(pg.scene().clone()).expect("playground");
-        let mut step = 0;
-        let lens_moved = median_ms(repeats, || {
-            step += 1;
-            let moved = SCENE.replace(
-                r#""sie", "x": 0,"#,
-                &format!(r#""sie", "x": {},"#, 0.1 * step as f64),
-            );
-            let scene = Scene::from_json_str(&moved).expect("moved scene");
-            moving.set_scene(scene).expect("scene");
-            std::hint::black_box(moving.frame(pixels));
-        });
+        // A frame after the lens of `text` moved (a released drag): nothing of it is kept.
+        let released = |text: &str| {
+            let mut moving =
+                Playground::new(Scene::from_json_str(text).expect("scene")).expect("playground");
+            let mut step = 0;
+            median_ms(repeats, || {
+                step += 1;
+                let moved = text.replace(
+                    r#""sie", "x": 0,"#,
+                    &format!(r#""sie", "x": {},"#, 0.1 * step as f64),
+                );
+                let scene = Scene::from_json_str(&moved).expect("moved scene");
+                moving.set_scene(scene).expect("scene");
+                std::hint::black_box(moving.frame(pixels));
+            })
+        };
+        let lens_moved = released(SCENE);
         // The same with a heavier SIE whose tangential curve leaves the view: the caustics
         // are then traced again on a field twice as wide (src/playground/frame.rs).
-        let heavy = SCENE.replace(
+        let heavy_moved = released(&SCENE.replace(
             r#""sigma_v": 850, "q": 0.75"#,
             r#""sigma_v": 1200, "q": 0.6"#,
-        );
-        let mut moving = Playground::new(Scene::from_json_str(&heavy).expect("heavy scene"))
-            .expect("playground");
-        let mut step = 0;
-        let heavy_moved = median_ms(repeats, || {
-            step += 1;
-            let moved = heavy.replace(
-                r#""sie", "x": 0,"#,
-                &format!(r#""sie", "x": {},"#, 0.1 * step as f64),
-            );
-            let scene = Scene::from_json_str(&moved).expect("moved scene");
-            moving.set_scene(scene).expect("scene");
-            std::hint::black_box(moving.frame(pixels));
-        });
+        ));
         // The same without the point source: what its image search costs.
         let no_point = SCENE.replace(
             r#",
