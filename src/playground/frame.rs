@@ -13,6 +13,7 @@
 use glam::DVec2;
 
 use crate::curves::{critical_curves, CriticalCurves, Polyline};
+use crate::ds9::polyline_is_open;
 use crate::map::{LensMaps, MapGeometry};
 use crate::profiles::MassComponent;
 
@@ -164,23 +165,10 @@ pub fn curve_geometry(geometry: MapGeometry) -> MapGeometry {
 /// lens release costs a curve grid more per widening, not four.
 const MAX_WIDENINGS: usize = 2;
 
-/// True when `line`, a critical curve traced on `geometry`, is cut by its border: an open
-/// polyline, whose ends lie on the outermost cell edges of the marching squares (closed loops
-/// repeat no point, so their ends are neighbours inside the map).
-fn is_cut(line: &[DVec2], geometry: MapGeometry) -> bool {
-    let pixel = geometry.pixel_arcsec();
-    let edge = 0.5 * (geometry.size_arcsec - pixel) - 1e-6 * pixel;
-    let on_border = |p: DVec2| {
-        let d = p - geometry.center;
-        d.x.abs() >= edge || d.y.abs() >= edge
-    };
-    line.len() > 1 && on_border(line[0]) && on_border(line[line.len() - 1])
-}
-
 /// True when a critical curve of `curves` is cut by the border of `geometry`.
 fn cut_by_border(curves: &CriticalCurves, geometry: MapGeometry) -> bool {
     let mut lines = curves.tangential.iter().chain(&curves.radial);
-    lines.any(|line| is_cut(line, geometry))
+    lines.any(|line| polyline_is_open(line, &geometry))
 }
 
 /// `lines` with the first point repeated at the end of each whose critical curve (`curves`,
@@ -191,7 +179,7 @@ fn closed(lines: &[Polyline], curves: &[Polyline], geometry: MapGeometry) -> Vec
         .zip(curves)
         .map(|(line, curve)| {
             let mut line = line.clone();
-            if line.len() > 2 && !is_cut(curve, geometry) {
+            if line.len() > 2 && !polyline_is_open(curve, &geometry) {
                 line.push(line[0]);
             }
             line
