@@ -273,6 +273,13 @@
 //! `(C_l - 1) / sigma_C = 0` (`members.c_prior_sigma`); by default a prior of width 0.1 is given
 //! only to a layer the data hardly measure (§9).
 //!
+//! **The brightest cluster galaxy.** Lenstool set-ups often model the BCG as its own
+//! `potentiel` in the `.par` and leave it out of the potfile catalogue. A grid of cells several
+//! arcsec wide cannot hold a galaxy of about ten `L*` at the centre, and the map is worse for
+//! it (both real catalogues the crate is measured on: BENCHMARKS.md). When no member within the
+//! median image distance of the images' centroid reaches 4 `L*` (a BCG is typically 5 to 15),
+//! the run warns and asks for the BCG's row.
+//!
 //! # 5. The solver: QADP
 //!
 //! The weighted least-squares problem of §3 with non-negative unknowns is a quadratic program:

@@ -53,9 +53,9 @@ use crate::catalog::{ArcletCatalog, ImageCatalog, MemberCatalog};
 use crate::cosmology::LensPlane;
 use crate::image_search::ImageError;
 use crate::inversion::{
-    build_constraints, build_member_layers, capped_inverse_jacobian, CellGrid, ConstraintError,
-    ConstraintSet, ConstraintSource, GridError, GridMass, Layer, LinearSystem, MembersError,
-    ObjectiveTerms, Regulariser, ShearSet, Strength, SystemError,
+    build_constraints, build_member_layers, capped_inverse_jacobian, missing_bcg_warning, CellGrid,
+    ConstraintError, ConstraintSet, ConstraintSource, GridError, GridMass, Layer, LinearSystem,
+    MembersError, ObjectiveTerms, Regulariser, ShearSet, Strength, SystemError,
 };
 use crate::map::MapGeometry;
 use crate::products::{ProductOptions, Products, ProductsError};
@@ -798,6 +798,13 @@ fn reconstruct_limited(
         LayerSource::Given(layers) => layers.to_vec(),
         LayerSource::Members(catalog) => {
             let model = build_member_layers(catalog, &config.members, &inputs.plane, &grid)?;
+            // A missing BCG first: it matters more than the members left out one by one.
+            let images = image_centres(&constraints);
+            warnings.extend(missing_bcg_warning(
+                &catalog.source_name,
+                &model.halos,
+                &images,
+            ));
             warnings.extend(model.warnings);
             model.layers
         }
@@ -1022,6 +1029,19 @@ pub(crate) fn grid_of(
 }
 
 /// The member catalogue's positions (arcsec) of `inputs` (none for layers given directly).
+/// The centre (mean of its pixels) of each image of the fitted systems, in arcsec.
+fn image_centres(constraints: &ConstraintSet) -> Vec<DVec2> {
+    let mut sums: std::collections::BTreeMap<(usize, usize), (DVec2, f64)> = Default::default();
+    for p in &constraints.pixels {
+        let e = sums
+            .entry((p.system, p.image))
+            .or_insert((DVec2::ZERO, 0.0));
+        e.0 += p.position;
+        e.1 += 1.0;
+    }
+    sums.values().map(|(sum, n)| *sum / *n).collect()
+}
+
 fn member_positions(inputs: &Inputs<'_>) -> Vec<DVec2> {
     match inputs.layers {
         LayerSource::Members(catalog) => catalog.members.iter().map(|m| m.position).collect(),
