@@ -6,10 +6,10 @@ use serde::{Deserialize, Serialize};
 
 use crate::curves::critical_curves;
 use crate::inversion::{
-    build_constraints, build_member_layers, Layer, LinearSystem, ObjectiveTerms,
+    build_constraints, build_member_layers, missing_bcg_warning, Layer, LinearSystem,
+    ObjectiveTerms,
 };
 use crate::products::{own_map_side, ProductOptions, Products};
-use crate::reconstruct::shear_set;
 use crate::reconstruct::{
     check_memory, cross_validate, fitted_system_ids, grid_of, map_geometry, product_options,
     reconstruct, reconstruct_with_choice, strength_candidates, strength_folds, Candidate,
@@ -17,6 +17,7 @@ use crate::reconstruct::{
     ReconstructConfig, ReconstructError, Reconstruction, RunSize, RunStatus, SourceReport,
     StageTimings, StrengthCandidate, StrengthChoice, DEFAULT_FOLDS,
 };
+use crate::reconstruct::{image_centres, shear_set};
 use crate::solver::{Control, Iterate};
 
 use super::data::{DataMarks, DataViews};
@@ -355,11 +356,17 @@ impl Session {
         let mut warnings = parsed.warnings.clone();
         warnings.extend(shear_warning);
         warnings.extend(unfitted);
+        let mut central_galaxy_missing = false;
         let layers: Vec<Layer> = match &parsed.members {
             None => Vec::new(),
             Some(m) => {
                 let model =
                     build_member_layers(m, &config.members, &plane, &grid).map_err(|e| run(&e))?;
+                // As the run did (`reconstruct`): a missing BCG first.
+                let images = image_centres(&constraints);
+                let bcg = missing_bcg_warning(&m.source_name, &model.halos, &images);
+                central_galaxy_missing = bcg.is_some();
+                warnings.extend(bcg);
                 warnings.extend(model.warnings);
                 model.layers
             }
@@ -397,6 +404,7 @@ impl Session {
                 strength_choice: None,
                 free_z: None,
                 member_positions_arcsec: parsed.members_arcsec(),
+                central_galaxy_missing,
             })),
             marks: parsed.marks(),
             elapsed_ms: t.ms(),

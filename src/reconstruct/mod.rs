@@ -233,6 +233,9 @@ pub struct Reconstruction {
     /// Positions of the member galaxies of the catalogue (arcsec; none for layers given
     /// directly), for the verdict's members with critical curves of their own.
     pub member_positions_arcsec: Vec<DVec2>,
+    /// No member near the images is bright enough to be the brightest cluster galaxy (the
+    /// run warned: `missing_bcg_warning` in the inversion).
+    pub central_galaxy_missing: bool,
 }
 
 /// What one candidate of an "auto" strength sets: the regulariser, its strength and the
@@ -375,6 +378,7 @@ impl Reconstruction {
             main_curve_share,
             members_arcsec: &self.member_positions_arcsec,
             c_unmeasured: self.system.members_unmeasured(),
+            central_galaxy_missing: self.central_galaxy_missing,
         };
         Verdict::assess(&self.sources, inputs)
     }
@@ -793,6 +797,7 @@ fn reconstruct_limited(
     let (shear, shear_warning) = shear_set(inputs.shear, config, &inputs.plane);
     warnings.extend(shear_warning);
     let mut grid = grid_of(&constraints, &shear, config)?;
+    let mut central_galaxy_missing = false;
     let mut layers: Vec<Layer> = match inputs.layers {
         LayerSource::None => Vec::new(),
         LayerSource::Given(layers) => layers.to_vec(),
@@ -800,11 +805,9 @@ fn reconstruct_limited(
             let model = build_member_layers(catalog, &config.members, &inputs.plane, &grid)?;
             // A missing BCG first: it matters more than the members left out one by one.
             let images = image_centres(&constraints);
-            warnings.extend(missing_bcg_warning(
-                &catalog.source_name,
-                &model.halos,
-                &images,
-            ));
+            let bcg = missing_bcg_warning(&catalog.source_name, &model.halos, &images);
+            central_galaxy_missing = bcg.is_some();
+            warnings.extend(bcg);
             warnings.extend(model.warnings);
             model.layers
         }
@@ -981,6 +984,7 @@ fn reconstruct_limited(
         strength_choice: None,
         free_z: None,
         member_positions_arcsec: member_positions(inputs),
+        central_galaxy_missing,
     })
 }
 
@@ -1030,7 +1034,7 @@ pub(crate) fn grid_of(
 
 /// The member catalogue's positions (arcsec) of `inputs` (none for layers given directly).
 /// The centre (mean of its pixels) of each image of the fitted systems, in arcsec.
-fn image_centres(constraints: &ConstraintSet) -> Vec<DVec2> {
+pub(crate) fn image_centres(constraints: &ConstraintSet) -> Vec<DVec2> {
     let mut sums: std::collections::BTreeMap<(usize, usize), (DVec2, f64)> = Default::default();
     for p in &constraints.pixels {
         let e = sums

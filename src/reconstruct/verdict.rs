@@ -2,8 +2,9 @@
 //! `verdict`, the box beside the app's map): how far the observed images lie from the images
 //! the map predicts, for the fitted and the held-out systems; whether each system has as many
 //! predicted images as it has observed ones; whether member galaxies draw critical curves of
-//! their own; and what that means for trusting the map, as one of three words with the reasons
-//! in one or two sentences.
+//! their own; whether the member catalogue seems to lack the brightest cluster galaxy (which
+//! costs the synthetic clusters of BENCHMARKS.md twice their deflection error); and what that
+//! means for trusting the map, as one of three words with the reasons in one or two sentences.
 //!
 //! The thresholds are stated with the constants below and argued there. They are rules of
 //! thumb of the field, not statistics: a map judged "good" can still be wrong where no image
@@ -218,6 +219,9 @@ pub struct VerdictInputs<'a> {
     /// The data hardly measure the members' factors `C`
     /// ([`crate::inversion::LinearSystem::members_unmeasured`]).
     pub c_unmeasured: bool,
+    /// No member near the images is bright enough to be the brightest cluster galaxy
+    /// (`missing_bcg_warning` in the inversion): the catalogue has most likely left it out.
+    pub central_galaxy_missing: bool,
 }
 
 /// `summary.json`'s `verdict`.
@@ -257,6 +261,8 @@ pub struct Verdict {
     /// [`MAIN_CURVE_MIN_SHARE`]).
     pub main_curve_share: Option<f64>,
     pub c_unmeasured: bool,
+    /// See [`VerdictInputs::central_galaxy_missing`].
+    pub central_galaxy_missing: bool,
     /// The worst systems (at most [`WORST_SHOWN`]), worst first: those with a
     /// [`SystemCheck::problem`].
     pub worst: Vec<SystemCheck>,
@@ -421,6 +427,13 @@ impl Verdict {
                  instead of between them, an over-focused fit."
             ));
         }
+        if inputs.central_galaxy_missing {
+            care.push(
+                "No member near the images is bright enough to be the brightest cluster \
+                 galaxy: if the catalogue leaves it out, add its row (see the warnings)."
+                    .to_string(),
+            );
+        }
         if members > 0 && inputs.c_unmeasured {
             care.push(format!(
                 "{members} member galax{} draw{} critical curves of {} own, with a mass the \
@@ -492,6 +505,7 @@ impl Verdict {
             z_source,
             main_curve_share: main_share,
             c_unmeasured: inputs.c_unmeasured,
+            central_galaxy_missing: inputs.central_galaxy_missing,
             worst,
         }
     }
@@ -782,6 +796,7 @@ mod tests {
             main_curve_share: Some(0.99),
             members_arcsec: &members,
             c_unmeasured,
+            central_galaxy_missing: false,
         };
         let v = Verdict::assess(&sources, inputs(true));
         assert_eq!(v.trust, Trust::UsableWithCare);
@@ -795,6 +810,25 @@ mod tests {
         );
         // When the images measure the members' mass, their curves are the data's.
         assert_eq!(Verdict::assess(&sources, inputs(false)).trust, Trust::Good);
+    }
+
+    #[test]
+    fn a_missing_central_galaxy_needs_care() {
+        let inputs = VerdictInputs {
+            central_galaxy_missing: true,
+            ..VerdictInputs::default()
+        };
+        let v = Verdict::assess(&[fitted("1", &[0.2, 0.3])], inputs);
+        assert_eq!(v.trust, Trust::UsableWithCare);
+        assert!(v.central_galaxy_missing);
+        assert!(
+            v.reasons
+                .starts_with("No member near the images is bright enough"),
+            "{}",
+            v.reasons
+        );
+        let v = Verdict::assess(&[fitted("1", &[0.2, 0.3])], VerdictInputs::default());
+        assert_eq!(v.trust, Trust::Good, "{}", v.reasons);
     }
 
     #[test]
