@@ -623,8 +623,8 @@ pub fn missing_bcg_warning(
         None => "there is none there".to_string(),
     };
     Some(format!(
-        "{catalog_name}: no member within {radius:.0} arcsec of the multiple images' centre is \
-         as bright as a brightest cluster galaxy ({BCG_MIN_LSTAR} L* \
+        "{catalog_name}: no member within {radius:.0} arcsec of the multiple images' centre \
+         is as bright as a brightest cluster galaxy ({BCG_MIN_LSTAR} L* \
          or more): {there}. Lenstool set-ups often model the BCG as its own `potentiel` in the \
          .par and leave it out of the potfile catalogue (sometimes as a commented row); the \
          grid cannot hold that much mass in so small a place. If the cluster has one, add its \
@@ -663,7 +663,7 @@ mod tests {
         // The brightest member of the catalogue lies far outside the images; inside, an L*.
         let halos = [halo("far", 150.0, 0.0, 20.0), halo("7", 12.0, -3.0, 1.0)];
         let w = missing_bcg_warning("m.cat", &halos, &ring()).expect("a warning");
-        assert!(w.starts_with("m.cat: no member within 20 arcsec"), "{w}");
+        assert!(w.starts_with("m.cat: no member within 20 arcsec of the multiple images' centre is as bright as a brightest cluster galaxy (4 L* or more)"), "{w}");
         // The centre is (10, -5): a member 20.1 arcsec from it is not counted.
         let halos = [halo("edge", 10.0, 15.1, 8.0), halo("7", 12.0, -3.0, 1.0)];
         assert!(missing_bcg_warning("m.cat", &halos, &ring()).is_some());
