@@ -5,10 +5,7 @@ use glam::DVec2;
 use serde::{Deserialize, Serialize};
 
 use crate::curves::critical_curves;
-use crate::inversion::{
-    build_constraints, build_member_layers, missing_bcg_warning, Layer, LinearSystem,
-    ObjectiveTerms,
-};
+use crate::inversion::{build_constraints, Layer, LinearSystem, ObjectiveTerms};
 use crate::products::{own_map_side, ProductOptions, Products};
 use crate::reconstruct::{
     check_memory, cross_validate, fitted_system_ids, grid_of, map_geometry, product_options,
@@ -17,7 +14,7 @@ use crate::reconstruct::{
     ReconstructConfig, ReconstructError, Reconstruction, RunSize, RunStatus, SourceReport,
     StageTimings, StrengthCandidate, StrengthChoice, DEFAULT_FOLDS,
 };
-use crate::reconstruct::{image_centres, shear_set};
+use crate::reconstruct::{member_layers, shear_set};
 use crate::solver::{Control, Iterate};
 
 use super::data::{DataMarks, DataViews};
@@ -360,15 +357,11 @@ impl Session {
         let layers: Vec<Layer> = match &parsed.members {
             None => Vec::new(),
             Some(m) => {
-                let model =
-                    build_member_layers(m, &config.members, &plane, &grid).map_err(|e| run(&e))?;
-                // As the run did (`reconstruct`): a missing BCG first.
-                let images = image_centres(&constraints);
-                let bcg = missing_bcg_warning(&m.source_name, &model.halos, &images);
-                central_galaxy_missing = bcg.is_some();
-                warnings.extend(bcg);
-                warnings.extend(model.warnings);
-                model.layers
+                let members = member_layers(m, &config.members, &plane, &grid, &constraints)
+                    .map_err(|e| run(&e))?;
+                warnings.extend(members.warnings);
+                central_galaxy_missing = members.central_galaxy_missing;
+                members.layers
             }
         };
         let system = LinearSystem::build_with_shear(

@@ -55,7 +55,7 @@ use crate::image_search::ImageError;
 use crate::inversion::{
     build_constraints, build_member_layers, capped_inverse_jacobian, missing_bcg_warning, CellGrid,
     ConstraintError, ConstraintSet, ConstraintSource, GridError, GridMass, Layer, LinearSystem,
-    MembersError, ObjectiveTerms, Regulariser, ShearSet, Strength, SystemError,
+    MemberConfig, MembersError, ObjectiveTerms, Regulariser, ShearSet, Strength, SystemError,
 };
 use crate::map::MapGeometry;
 use crate::products::{ProductOptions, Products, ProductsError};
@@ -802,14 +802,11 @@ fn reconstruct_limited(
         LayerSource::None => Vec::new(),
         LayerSource::Given(layers) => layers.to_vec(),
         LayerSource::Members(catalog) => {
-            let model = build_member_layers(catalog, &config.members, &inputs.plane, &grid)?;
-            // A missing BCG first: it matters more than the members left out one by one.
-            let images = image_centres(&constraints);
-            let bcg = missing_bcg_warning(&catalog.source_name, &model.halos, &images);
-            central_galaxy_missing = bcg.is_some();
-            warnings.extend(bcg);
-            warnings.extend(model.warnings);
-            model.layers
+            let members =
+                member_layers(catalog, &config.members, &inputs.plane, &grid, &constraints)?;
+            warnings.extend(members.warnings);
+            central_galaxy_missing = members.central_galaxy_missing;
+            members.layers
         }
     };
     // The system's true sizes (the layers built, the systems kept, the weak-lensing ring's
@@ -1032,9 +1029,41 @@ pub(crate) fn grid_of(
     crate::inversion::with_ring(&grid, reach, config.shear.ring_cells_max)
 }
 
-/// The member catalogue's positions (arcsec) of `inputs` (none for layers given directly).
+/// The member layers of a run and what they warn about.
+pub(crate) struct MemberLayers {
+    pub layers: Vec<Layer>,
+    /// A missing BCG's warning first (it matters more than the members left out one by one),
+    /// then [`build_member_layers`]'s.
+    pub warnings: Vec<String>,
+    /// No member near the images is bright enough to be the brightest cluster galaxy.
+    pub central_galaxy_missing: bool,
+}
+
+/// The layers of `catalog`'s members on `grid` ([`build_member_layers`]), checked for a missing
+/// BCG near the images of `constraints` (`missing_bcg_warning` in the inversion). Shared by a
+/// run and the app's rebuilding of a saved result, so both warn alike.
+pub(crate) fn member_layers(
+    catalog: &MemberCatalog,
+    config: &MemberConfig,
+    plane: &LensPlane,
+    grid: &CellGrid,
+    constraints: &ConstraintSet,
+) -> Result<MemberLayers, MembersError> {
+    let model = build_member_layers(catalog, config, plane, grid)?;
+    let images = image_centres(constraints);
+    let bcg = missing_bcg_warning(&catalog.source_name, &model.halos, &images);
+    let central_galaxy_missing = bcg.is_some();
+    let mut warnings: Vec<String> = bcg.into_iter().collect();
+    warnings.extend(model.warnings);
+    Ok(MemberLayers {
+        layers: model.layers,
+        warnings,
+        central_galaxy_missing,
+    })
+}
+
 /// The centre (mean of its pixels) of each image of the fitted systems, in arcsec.
-pub(crate) fn image_centres(constraints: &ConstraintSet) -> Vec<DVec2> {
+fn image_centres(constraints: &ConstraintSet) -> Vec<DVec2> {
     let mut sums: std::collections::BTreeMap<(usize, usize), (DVec2, f64)> = Default::default();
     for p in &constraints.pixels {
         let e = sums
@@ -1046,6 +1075,7 @@ pub(crate) fn image_centres(constraints: &ConstraintSet) -> Vec<DVec2> {
     sums.values().map(|(sum, n)| *sum / *n).collect()
 }
 
+/// The member catalogue's positions (arcsec) of `inputs` (none for layers given directly).
 fn member_positions(inputs: &Inputs<'_>) -> Vec<DVec2> {
     match inputs.layers {
         LayerSource::Members(catalog) => catalog.members.iter().map(|m| m.position).collect(),
