@@ -278,7 +278,11 @@
 //! arcsec wide cannot hold a galaxy of about ten `L*` at the centre, and the map is worse for
 //! it (both real catalogues the crate is measured on: BENCHMARKS.md). When no member within the
 //! median image distance of the images' centroid reaches 4 `L*` (a BCG is typically 5 to 15),
-//! the run warns and asks for the BCG's row.
+//! the run warns and asks for the BCG's row; when the catalogue holds such a row commented
+//! out (`#` before a line that reads as a member, as MACS1931's does), the warning names its
+//! line. The run does not guess one: a galaxy of ten `L*` put at the peak of a grid-only
+//! first solution helps the synthetic clusters but misses the real BCGs by 1 - 5 arcsec and
+//! makes both real catalogues worse (BENCHMARKS.md).
 //!
 //! # 5. The solver: QADP
 //!

@@ -182,7 +182,7 @@ async function render() {
 }
 
 function caption(info) {
-  showVerdict(info.summary.verdict);
+  showVerdict(info.summary.verdict, fitCommentedRow);
   const s = info.summary.maps ?? info.summary;
   // The solver, when it is not the paper's QADP.
   const best = info.summary.settings?.solver?.method === 'accelerated_gradient'
@@ -663,6 +663,26 @@ async function newProject() {
     setStatus(`Back to the project as it was${report.message ? `: ${report.message}` : ''}.`);
   }));
   $('status').append(undo);
+}
+
+/** The verdict's offer: the member catalogue's commented-out row `{line, id}` (the BCG a
+ * Lenstool set-up models in its .par) becomes a member, and the reconstruction runs again. */
+async function fitCommentedRow({ line, id }) {
+  let fitted = false;
+  await enqueue(async () => {
+    clearError();
+    try {
+      const report = await ask('uncommentMember', { line });
+      setFileStatus('members', reportText(report));
+      clearCrossval();
+      await refreshLoaded();
+      await persist();
+      fitted = true;
+    } catch (err) {
+      showError(`Member ${id} was not fitted: ${err.message}`);
+    }
+  });
+  if (fitted) await run('reconstruct');
 }
 
 async function applySetting(path, value) {

@@ -433,6 +433,53 @@ impl LoadedData {
             .map(Some)
     }
 
+    /// Makes the commented-out row on `line` (1-based) of the loaded member catalogue a member:
+    /// the line's first `#` goes and the catalogue is checked and kept as [`Self::load_text`]
+    /// does. The line must be commented out and read as one more member once it is not; on an
+    /// error the catalogue stays as it was.
+    pub fn uncomment_member(
+        &mut self,
+        line: usize,
+        arc_pixel_arcsec: f64,
+        par_options: &ParOptions,
+    ) -> Result<LoadReport, AppError> {
+        let Some(NamedText { name, text }) = self.members.clone() else {
+            return Err(AppError::Missing(
+                "load a member catalogue first".to_string(),
+            ));
+        };
+        let at = line.checked_sub(1).and_then(|i| text.split('\n').nth(i));
+        let Some(old) = at.filter(|l| l.trim_start().starts_with('#')) else {
+            return Err(AppError::File(format!(
+                "{name}: line {line} is not a commented-out row"
+            )));
+        };
+        let count = |t: &str| parse_member_catalog(t, &name, None).map(|(c, _)| c.members.len());
+        let before = count(&text).map_err(|e| AppError::File(e.to_string()))?;
+        let new = old.replacen('#', "", 1);
+        let edited: Vec<&str> = text
+            .split('\n')
+            .enumerate()
+            .map(|(i, l)| if i + 1 == line { new.as_str() } else { l })
+            .collect();
+        let edited = edited.join("\n");
+        if count(&edited).ok() != Some(before + 1) {
+            return Err(AppError::File(format!(
+                "{name}: line {line} does not read as a member without its '#': {}",
+                old.trim()
+            )));
+        }
+        let mut report = self.load_text(
+            DataRole::Members,
+            &name,
+            &edited,
+            arc_pixel_arcsec,
+            par_options,
+        )?;
+        report.summary = format!("{} (line {line} uncommented)", report.summary);
+        Ok(report)
+    }
+
     /// Forgets the file of `role`.
     pub fn clear(&mut self, role: DataRole) {
         *self.slot(role) = None;

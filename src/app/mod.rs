@@ -145,6 +145,14 @@ impl Session {
         self.data.reload(role, pixel, &par)
     }
 
+    /// Fits the commented-out row on `line` of the loaded member catalogue (e.g. the BCG a
+    /// result's verdict names: `Verdict::commented_bcg`); see [`LoadedData::uncomment_member`].
+    pub fn uncomment_member(&mut self, line: usize) -> Result<LoadReport, AppError> {
+        let pixel = self.settings.reconstruct.constraints.pixel_arcsec;
+        let par = self.settings.par_options();
+        self.data.uncomment_member(line, pixel, &par)
+    }
+
     /// The last result, or an error saying that nothing was computed yet.
     pub fn result(&self) -> Result<&SessionResult, AppError> {
         self.result

@@ -353,7 +353,7 @@ impl Session {
         let mut warnings = parsed.warnings.clone();
         warnings.extend(shear_warning);
         warnings.extend(unfitted);
-        let mut central_galaxy_missing = false;
+        let (mut central_galaxy_missing, mut commented_bcg) = (false, None);
         let layers: Vec<Layer> = match &parsed.members {
             None => Vec::new(),
             Some(m) => {
@@ -361,6 +361,7 @@ impl Session {
                     .map_err(|e| run(&e))?;
                 warnings.extend(members.warnings);
                 central_galaxy_missing = members.central_galaxy_missing;
+                commented_bcg = members.commented_bcg;
                 members.layers
             }
         };
@@ -398,6 +399,7 @@ impl Session {
                 free_z: None,
                 member_positions_arcsec: parsed.members_arcsec(),
                 central_galaxy_missing,
+                commented_bcg,
             })),
             marks: parsed.marks(),
             elapsed_ms: t.ms(),

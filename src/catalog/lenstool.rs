@@ -10,7 +10,7 @@ use std::collections::HashMap;
 use glam::DVec2;
 
 use super::frame;
-use super::rows::{read_table, warn_extra_columns, warn_repeated_id, Fields};
+use super::rows::{read_table, warn_extra_columns, warn_repeated_id, Fields, Table, ALL_COLUMNS};
 use super::units::{check_field, RowPosition};
 use super::{
     CatalogError, CatalogWarning, Image, ImageCatalog, ImageSystem, Member, MemberCatalog,
@@ -186,12 +186,58 @@ pub fn parse_member_catalog(
     for (m, p) in members.iter_mut().zip(positions) {
         m.position = p;
     }
+    let commented = commented_members(&table, &names, source_name, frame_ref);
     let catalog = MemberCatalog {
         source_name: source_name.into(),
         reference: Some(frame_ref),
         members,
+        commented,
     };
     Ok((catalog, warnings))
+}
+
+/// The members of `table`'s commented rows that read in full (a measured magnitude, a valid
+/// ellipse and position), in the frame `frame_ref`; the others are ignored, as comments.
+fn commented_members(
+    table: &Table<'_>,
+    names: &[&'static str; ALL_COLUMNS],
+    source_name: &str,
+    frame_ref: SkyReference,
+) -> Vec<Member> {
+    let mut out = Vec::new();
+    let mut raw = Vec::new();
+    for row in &table.commented {
+        let f = Fields {
+            row,
+            names,
+            source_name,
+        };
+        let (Ok(shape), Ok(mag), Ok(lum)) = (f.shape(table.coords), f.number(6), f.optional(7))
+        else {
+            continue;
+        };
+        if mag.abs() >= MAG_NO_MEASUREMENT {
+            continue;
+        }
+        raw.push(shape.raw);
+        out.push(Member {
+            id: row.fields[0].into(),
+            position: shape.raw,
+            a_arcsec: shape.a,
+            b_arcsec: shape.b,
+            theta_deg: shape.theta,
+            mag,
+            lum,
+            line: row.line,
+        });
+    }
+    if !raw.is_empty() {
+        let (_, positions) = table.coords.into_frame(&raw, Some(frame_ref));
+        for (m, p) in out.iter_mut().zip(positions) {
+            m.position = p;
+        }
+    }
+    out
 }
 
 /// The images of one system while grouping, with each image's `(line, z)` as written.

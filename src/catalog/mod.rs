@@ -83,12 +83,25 @@ pub struct Member {
     pub line: usize,
 }
 
+/// One row of a catalogue, by its 1-based line and id: e.g. the commented-out BCG row a run
+/// offers to fit (`Verdict::commented_bcg`).
+#[derive(Debug, Clone, PartialEq, Eq, Serialize, Deserialize)]
+pub struct CatalogRow {
+    pub line: usize,
+    pub id: String,
+}
+
 /// A parsed member (potfile) catalogue.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct MemberCatalog {
     pub source_name: String,
     pub reference: Option<SkyReference>,
     pub members: Vec<Member>,
+    /// Rows the file comments out (`#` lines that read as members), in the same frame: never
+    /// fitted, but named when the members seem to lack their brightest cluster galaxy, which
+    /// Lenstool set-ups often comment out because the `.par` models it on its own.
+    #[serde(default)]
+    pub commented: Vec<Member>,
 }
 
 impl ImageCatalog {
@@ -152,7 +165,7 @@ impl MemberCatalog {
     /// The catalogue in the arcsec frame of `to` (see [`ImageCatalog::reframed`]).
     pub fn reframed(mut self, to: SkyReference) -> Result<Self, CatalogError> {
         let (from, to) = reframe_pair(self.reference, to, &self.source_name)?;
-        for m in &mut self.members {
+        for m in self.members.iter_mut().chain(&mut self.commented) {
             m.position = frame::reframe(m.position, from, to);
         }
         self.reference = Some(to);

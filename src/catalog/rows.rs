@@ -23,6 +23,9 @@ pub(super) struct Row<'a> {
 pub(super) struct Table<'a> {
     pub(super) coords: Coords,
     pub(super) rows: Vec<Row<'a>>,
+    /// `#` lines that read as rows (an id, then numbers in the required columns): rows the
+    /// author commented out, e.g. a member catalogue's BCG that the `.par` models on its own.
+    pub(super) commented: Vec<Row<'a>>,
 }
 
 /// Splits the text into rows, reading the `#REFERENCE` header (which must precede the rows
@@ -32,6 +35,7 @@ pub(super) fn read_table<'a>(text: &'a str, source_name: &str) -> Result<Table<'
     let text = text.strip_prefix('\u{feff}').unwrap_or(text);
     let mut header: Option<(usize, Coords)> = None;
     let mut rows: Vec<Row<'a>> = Vec::new();
+    let mut commented: Vec<Row<'a>> = Vec::new();
     let mut lines = 0;
     for (i, raw) in text.lines().enumerate() {
         let line = i + 1;
@@ -53,6 +57,11 @@ pub(super) fn read_table<'a>(text: &'a str, source_name: &str) -> Result<Table<'
             continue;
         }
         if !frame::is_reference_header(t) {
+            if let Some(fields) = commented_row(t) {
+                if commented.len() < MAX_CATALOG_ROWS {
+                    commented.push(Row { line, fields });
+                }
+            }
             continue;
         }
         let misplaced = |reason: String| CatalogError::BadReference {
@@ -81,7 +90,20 @@ pub(super) fn read_table<'a>(text: &'a str, source_name: &str) -> Result<Table<'
         });
     }
     let coords = header.map_or(Coords::AbsoluteDeg { header: None }, |(_, c)| c);
-    Ok(Table { coords, rows })
+    Ok(Table {
+        coords,
+        rows,
+        commented,
+    })
+}
+
+/// The fields of a `#` line that reads as a row: at least the required columns, the ones
+/// after the id finite numbers (so a column header such as `#(string name) X Y ...` is not).
+fn commented_row(line: &str) -> Option<Vec<&str>> {
+    let fields: Vec<&str> = line.trim_start_matches('#').split_whitespace().collect();
+    let numeric = |f: &&str| f.parse::<f64>().is_ok_and(f64::is_finite);
+    (fields.len() >= REQUIRED_COLUMNS && fields[1..REQUIRED_COLUMNS].iter().all(numeric))
+        .then_some(fields)
 }
 
 /// Position (as written) and ellipse of one row.

@@ -34,7 +34,7 @@ use serde::{Deserialize, Serialize};
 use thiserror::Error;
 
 use super::cells::CellGrid;
-use crate::catalog::MemberCatalog;
+use crate::catalog::{CatalogRow, Member, MemberCatalog};
 use crate::cosmology::LensPlane;
 use crate::profiles::{tnfw_total_mass_unit, Lens, MassComponent, Nfw, ProfileError, TruncatedNfw};
 
@@ -596,11 +596,17 @@ pub const BCG_MIN_LSTAR: f64 = 4.0;
 /// whose cells are several arcsec wide cannot hold that much mass in so small a place: on
 /// MACS1931 the held-out images move from 1.78 to 1.41 arcsec when the catalogue's commented
 /// BCG row is restored (BENCHMARKS.md). The cure is the user's: add the row.
+///
+/// `commented` are the catalogue's commented-out rows with their luminosity in `L*`
+/// ([`MemberCatalog::commented`]): when one of them near the images is bright enough, the
+/// warning names its line, since a set-up that models the BCG in the `.par` often keeps its
+/// row commented out in the catalogue.
 pub fn missing_bcg_warning(
     catalog_name: &str,
     halos: &[MemberHalo],
     images: &[DVec2],
-) -> Option<String> {
+    commented: &[(&Member, f64)],
+) -> Option<MissingBcg> {
     if halos.is_empty() || images.is_empty() {
         return None;
     }
@@ -622,14 +628,44 @@ pub fn missing_bcg_warning(
         ),
         None => "there is none there".to_string(),
     };
-    Some(format!(
+    let row = commented
+        .iter()
+        .filter(|(m, lstar)| m.position.distance(centre) <= radius && *lstar >= BCG_MIN_LSTAR)
+        .max_by(|a, b| a.1.total_cmp(&b.1));
+    let cure = match row {
+        Some((m, lstar)) => format!(
+            "Line {} comments out member {}, {:.0} arcsec from that centre with mag {:.2} \
+             ({lstar:.1} L*): if that is the BCG, remove the '#' to fit it",
+            m.line,
+            m.id,
+            m.position.distance(centre),
+            m.mag
+        ),
+        None => "If the cluster has one, add its row (id x y a b theta mag lum) to the member \
+                 catalogue"
+            .to_string(),
+    };
+    let warning = format!(
         "{catalog_name}: no member within {radius:.0} arcsec of the multiple images' centre \
          is as bright as a brightest cluster galaxy ({BCG_MIN_LSTAR} L* \
          or more): {there}. Lenstool set-ups often model the BCG as its own `potentiel` in the \
          .par and leave it out of the potfile catalogue (sometimes as a commented row); the \
-         grid cannot hold that much mass in so small a place. If the cluster has one, add its \
-         row (id x y a b theta mag lum) to the member catalogue"
-    ))
+         grid cannot hold that much mass in so small a place. {cure}"
+    );
+    Some(MissingBcg {
+        warning,
+        commented: row.map(|(m, _)| CatalogRow {
+            line: m.line,
+            id: m.id.clone(),
+        }),
+    })
+}
+
+/// What [`missing_bcg_warning`] found: its warning and the commented-out row it names, if any.
+#[derive(Debug, Clone, PartialEq)]
+pub struct MissingBcg {
+    pub warning: String,
+    pub commented: Option<CatalogRow>,
 }
 
 #[cfg(test)]
@@ -662,25 +698,72 @@ mod tests {
     fn a_core_without_a_bright_member_is_named() {
         // The brightest member of the catalogue lies far outside the images; inside, an L*.
         let halos = [halo("far", 150.0, 0.0, 20.0), halo("7", 12.0, -3.0, 1.0)];
-        let w = missing_bcg_warning("m.cat", &halos, &ring()).expect("a warning");
+        let w = missing_bcg_warning("m.cat", &halos, &ring(), &[])
+            .expect("a warning")
+            .warning;
         assert!(w.starts_with("m.cat: no member within 20 arcsec of the multiple images' centre is as bright as a brightest cluster galaxy (4 L* or more)"), "{w}");
         assert!(w.contains("member 7 at mag 20.00 (1.0 L*)"), "{w}");
         // The centre is (10, -5): a bright member 20.1 arcsec from it is not counted, and
         // alone it leaves no member there at all.
         let halos = [halo("edge", 10.0, 15.1, 8.0), halo("7", 12.0, -3.0, 1.0)];
-        assert!(missing_bcg_warning("m.cat", &halos, &ring()).is_some());
-        let w = missing_bcg_warning("m.cat", &halos[..1], &ring()).expect("a warning");
+        assert!(missing_bcg_warning("m.cat", &halos, &ring(), &[]).is_some());
+        let w = missing_bcg_warning("m.cat", &halos[..1], &ring(), &[])
+            .expect("a warning")
+            .warning;
         assert!(w.contains("there is none there"), "{w}");
+    }
+
+    fn commented(id: &str, line: usize, x: f64, y: f64, mag: f64) -> Member {
+        Member {
+            id: id.to_string(),
+            position: DVec2::new(x, y),
+            a_arcsec: 1.0,
+            b_arcsec: 1.0,
+            theta_deg: 0.0,
+            mag,
+            lum: 0.0,
+            line,
+        }
+    }
+
+    #[test]
+    fn a_commented_bcg_row_near_the_images_is_named_with_its_line() {
+        let halos = [halo("7", 12.0, -3.0, 1.0)];
+        let (bcg, faint) = (
+            commented("1009", 10, 10.0, -3.0, 17.3),
+            commented("1186", 19, 11.0, -6.0, 24.7),
+        );
+        let far = commented("far", 30, 150.0, 0.0, 16.0);
+        let rows = [(&faint, 0.02), (&bcg, 9.5), (&far, 20.0)];
+        let found = missing_bcg_warning("m.cat", &halos, &ring(), &rows).expect("a warning");
+        let row = CatalogRow {
+            line: 10,
+            id: "1009".to_string(),
+        };
+        assert_eq!(found.commented, Some(row));
+        let w = found.warning;
+        assert!(
+            w.ends_with(
+                "Line 10 comments out member 1009, 2 arcsec from that centre with mag 17.30 \
+                 (9.5 L*): if that is the BCG, remove the '#' to fit it"
+            ),
+            "{w}"
+        );
+        // Faint or far commented rows are not offered: the generic advice stays.
+        let found = missing_bcg_warning("m.cat", &halos, &ring(), &[rows[0], rows[2]]).unwrap();
+        assert_eq!(found.commented, None);
+        let w = found.warning;
+        assert!(w.ends_with("add its row (id x y a b theta mag lum) to the member catalogue"));
     }
 
     #[test]
     fn a_bright_central_member_or_no_members_need_no_warning() {
         let halos = [halo("far", 150.0, 0.0, 20.0), halo("bcg", 9.0, -4.0, 8.0)];
-        assert_eq!(missing_bcg_warning("m.cat", &halos, &ring()), None);
+        assert_eq!(missing_bcg_warning("m.cat", &halos, &ring(), &[]), None);
         // Just at the threshold, and just inside the radius.
         let halos = [halo("bcg", 10.0, 14.9, BCG_MIN_LSTAR)];
-        assert_eq!(missing_bcg_warning("m.cat", &halos, &ring()), None);
-        assert_eq!(missing_bcg_warning("m.cat", &[], &ring()), None);
-        assert_eq!(missing_bcg_warning("m.cat", &halos, &[]), None);
+        assert_eq!(missing_bcg_warning("m.cat", &halos, &ring(), &[]), None);
+        assert_eq!(missing_bcg_warning("m.cat", &[], &ring(), &[]), None);
+        assert_eq!(missing_bcg_warning("m.cat", &halos, &[], &[]), None);
     }
 }

@@ -49,7 +49,7 @@ pub use verdict::{
     SMALL_SCALE_OFFSET_ARCSEC, WORST_SHOWN,
 };
 
-use crate::catalog::{ArcletCatalog, ImageCatalog, MemberCatalog};
+use crate::catalog::{ArcletCatalog, CatalogRow, ImageCatalog, Member, MemberCatalog};
 use crate::cosmology::LensPlane;
 use crate::image_search::ImageError;
 use crate::inversion::{
@@ -236,6 +236,9 @@ pub struct Reconstruction {
     /// No member near the images is bright enough to be the brightest cluster galaxy (the
     /// run warned: `missing_bcg_warning` in the inversion).
     pub central_galaxy_missing: bool,
+    /// The member catalogue's commented-out row that could be the missing BCG (the warning
+    /// names it; the app offers to fit it).
+    pub commented_bcg: Option<CatalogRow>,
 }
 
 /// What one candidate of an "auto" strength sets: the regulariser, its strength and the
@@ -379,6 +382,7 @@ impl Reconstruction {
             members_arcsec: &self.member_positions_arcsec,
             c_unmeasured: self.system.members_unmeasured(),
             central_galaxy_missing: self.central_galaxy_missing,
+            commented_bcg: self.commented_bcg.as_ref(),
         };
         Verdict::assess(&self.sources, inputs)
     }
@@ -797,7 +801,7 @@ fn reconstruct_limited(
     let (shear, shear_warning) = shear_set(inputs.shear, config, &inputs.plane);
     warnings.extend(shear_warning);
     let mut grid = grid_of(&constraints, &shear, config)?;
-    let mut central_galaxy_missing = false;
+    let (mut central_galaxy_missing, mut commented_bcg) = (false, None);
     let mut layers: Vec<Layer> = match inputs.layers {
         LayerSource::None => Vec::new(),
         LayerSource::Given(layers) => layers.to_vec(),
@@ -806,6 +810,7 @@ fn reconstruct_limited(
                 member_layers(catalog, &config.members, &inputs.plane, &grid, &constraints)?;
             warnings.extend(members.warnings);
             central_galaxy_missing = members.central_galaxy_missing;
+            commented_bcg = members.commented_bcg;
             members.layers
         }
     };
@@ -982,6 +987,7 @@ fn reconstruct_limited(
         free_z: None,
         member_positions_arcsec: member_positions(inputs),
         central_galaxy_missing,
+        commented_bcg,
     })
 }
 
@@ -1037,6 +1043,8 @@ pub(crate) struct MemberLayers {
     pub warnings: Vec<String>,
     /// No member near the images is bright enough to be the brightest cluster galaxy.
     pub central_galaxy_missing: bool,
+    /// The catalogue's commented-out row that could be it, when there is one.
+    pub commented_bcg: Option<CatalogRow>,
 }
 
 /// The layers of `catalog`'s members on `grid` ([`build_member_layers`]), checked for a missing
@@ -1051,14 +1059,25 @@ pub(crate) fn member_layers(
 ) -> Result<MemberLayers, MembersError> {
     let model = build_member_layers(catalog, config, plane, grid)?;
     let images = image_centres(constraints);
-    let bcg = missing_bcg_warning(&catalog.source_name, &model.halos, &images);
+    let lstar_lsun = config.mass_to_light * config.l_star_lsun;
+    let mag_star = config.mag_star_on(plane);
+    let commented: Vec<(&Member, f64)> = catalog
+        .commented
+        .iter()
+        .map(|m| (m, config.mass_msun(m.mag, mag_star) / lstar_lsun))
+        .collect();
+    let bcg = missing_bcg_warning(&catalog.source_name, &model.halos, &images, &commented);
     let central_galaxy_missing = bcg.is_some();
-    let mut warnings: Vec<String> = bcg.into_iter().collect();
+    let (mut warnings, commented_bcg) = match bcg {
+        Some(b) => (vec![b.warning], b.commented),
+        None => (Vec::new(), None),
+    };
     warnings.extend(model.warnings);
     Ok(MemberLayers {
         layers: model.layers,
         warnings,
         central_galaxy_missing,
+        commented_bcg,
     })
 }
 

@@ -15,6 +15,7 @@ use serde::Serialize;
 
 use super::summary::median_arcsec;
 use super::{ImageReport, SourceReport};
+use crate::catalog::CatalogRow;
 use crate::curves::{signed_area_arcsec2, CriticalCurves};
 use crate::ds9::polyline_is_open;
 use crate::map::MapGeometry;
@@ -222,6 +223,8 @@ pub struct VerdictInputs<'a> {
     /// No member near the images is bright enough to be the brightest cluster galaxy
     /// (`missing_bcg_warning` in the inversion): the catalogue has most likely left it out.
     pub central_galaxy_missing: bool,
+    /// The member catalogue's commented-out row that could be that galaxy, when it has one.
+    pub commented_bcg: Option<&'a CatalogRow>,
 }
 
 /// `summary.json`'s `verdict`.
@@ -263,6 +266,8 @@ pub struct Verdict {
     pub c_unmeasured: bool,
     /// See [`VerdictInputs::central_galaxy_missing`].
     pub central_galaxy_missing: bool,
+    /// See [`VerdictInputs::commented_bcg`]: the app offers to fit it.
+    pub commented_bcg: Option<CatalogRow>,
     /// The worst systems (at most [`WORST_SHOWN`]), worst first: those with a
     /// [`SystemCheck::problem`].
     pub worst: Vec<SystemCheck>,
@@ -427,12 +432,19 @@ impl Verdict {
                  instead of between them, an over-focused fit."
             ));
         }
-        if inputs.central_galaxy_missing {
-            care.push(
+        match (inputs.commented_bcg, inputs.central_galaxy_missing) {
+            (Some(row), true) => care.push(format!(
+                "No member near the images is bright enough to be the brightest cluster \
+                 galaxy: the member catalogue comments one out (member {}, line {}); fit it \
+                 (see the warnings).",
+                row.id, row.line
+            )),
+            (None, true) => care.push(
                 "No member near the images is bright enough to be the brightest cluster \
                  galaxy: if the catalogue leaves it out, add its row (see the warnings)."
                     .to_string(),
-            );
+            ),
+            (_, false) => {}
         }
         if members > 0 && inputs.c_unmeasured {
             care.push(format!(
@@ -506,6 +518,10 @@ impl Verdict {
             main_curve_share: main_share,
             c_unmeasured: inputs.c_unmeasured,
             central_galaxy_missing: inputs.central_galaxy_missing,
+            commented_bcg: inputs
+                .commented_bcg
+                .filter(|_| inputs.central_galaxy_missing)
+                .cloned(),
             worst,
         }
     }
@@ -797,6 +813,7 @@ mod tests {
             members_arcsec: &members,
             c_unmeasured,
             central_galaxy_missing: false,
+            commented_bcg: None,
         };
         let v = Verdict::assess(&sources, inputs(true));
         assert_eq!(v.trust, Trust::UsableWithCare);
@@ -824,6 +841,27 @@ mod tests {
         assert!(
             v.reasons
                 .starts_with("No member near the images is bright enough"),
+            "{}",
+            v.reasons
+        );
+        // A commented-out row that could be the BCG is named, and offered to the app.
+        let row = CatalogRow {
+            line: 10,
+            id: "1009.0".to_string(),
+        };
+        let inputs = VerdictInputs {
+            central_galaxy_missing: true,
+            commented_bcg: Some(&row),
+            ..VerdictInputs::default()
+        };
+        let v = Verdict::assess(&[fitted("1", &[0.2, 0.3])], inputs);
+        assert_eq!(v.commented_bcg.as_ref(), Some(&row));
+        assert!(
+            v.reasons.starts_with(
+                "No member near the images is bright enough to be the brightest cluster \
+                 galaxy: the member catalogue comments one out (member 1009.0, line 10); fit \
+                 it (see the warnings)."
+            ),
             "{}",
             v.reasons
         );

@@ -134,6 +134,12 @@ impl AppSession {
         to_js(&self.inner.reload(role).map_err(err)?)
     }
 
+    /// Fits the commented-out row on `line` (1-based) of the loaded member catalogue: its
+    /// `LoadReport`. An error leaves the catalogue as it was.
+    pub fn uncomment_member(&mut self, line: usize) -> Result<JsValue, JsError> {
+        to_js(&self.inner.uncomment_member(line).map_err(err)?)
+    }
+
     /// Forgets the last result (its maps were made from data that have been replaced).
     pub fn clear_result(&mut self) {
         self.inner.result = None;

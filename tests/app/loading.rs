@@ -345,3 +345,50 @@ fn files_of_two_clusters_are_named_and_of_one_cluster_are_not() {
     f.load_fits(0, "a1689_x.fits", x).unwrap();
     assert!(f.sky_warnings().is_empty(), "{:?}", f.sky_warnings());
 }
+
+#[cfg_attr(not(target_arch = "wasm32"), test)]
+#[cfg_attr(target_arch = "wasm32", wasm_bindgen_test::wasm_bindgen_test)]
+fn a_commented_member_row_is_fitted_on_request_and_nothing_else_is() {
+    let text = "#REFERENCE 3 342.18322 -44.530889\n\
+        #(string name) X Y A B THETA MAG LUM\n\
+        1 79.7 33.2 1.2 1.1 38.85 18.39 0.0\n\
+        #1009 0.0 0.0 2.0 1.1 58.8 17.3 0.35\n\
+        ##7 1.0 2.0 0.3 0.2 10.0 19.5\n";
+    let mut s = Session::new();
+    s.load_text(DataRole::Members, "m.cat", text).unwrap();
+    // Refused, the catalogue untouched: a row, the header, a doubly commented row, no line.
+    for (line, says) in [
+        (3, "m.cat: line 3 is not a commented-out row"),
+        (
+            2,
+            "m.cat: line 2 does not read as a member without its '#': #(string name)",
+        ),
+        (
+            5,
+            "m.cat: line 5 does not read as a member without its '#': ##7",
+        ),
+        (9, "m.cat: line 9 is not a commented-out row"),
+        (0, "m.cat: line 0 is not a commented-out row"),
+    ] {
+        let err = s.uncomment_member(line).unwrap_err().to_string();
+        assert!(err.starts_with(says), "{err}");
+        assert_eq!(s.data.members.as_ref().unwrap().text, text);
+    }
+    let report = s.uncomment_member(4).unwrap();
+    assert_eq!(report.summary, "2 members (line 4 uncommented)");
+    let kept = &s.data.members.as_ref().unwrap().text;
+    assert_eq!(
+        kept.lines().nth(3),
+        Some("1009 0.0 0.0 2.0 1.1 58.8 17.3 0.35")
+    );
+    assert_eq!(kept.lines().count(), text.lines().count());
+    let parsed = s.parsed().unwrap();
+    let members = parsed.members.unwrap();
+    assert_eq!(members.members[1].id, "1009");
+    assert!(members.commented.iter().all(|m| m.id != "1009"));
+    // Once uncommented it is no longer commented out.
+    assert!(s.uncomment_member(4).is_err());
+    let mut empty = Session::new();
+    let err = empty.uncomment_member(4).unwrap_err().to_string();
+    assert!(err.contains("load a member catalogue first"), "{err}");
+}

@@ -171,6 +171,45 @@ test('systems without a redshift have it estimated, or take the one the settings
   }
 });
 
+test('a BCG the member catalogue comments out is offered, and fitted on a click', async () => {
+  const app = await openApp();
+  try {
+    const { page } = app;
+    await waitStatus(page, /^Ready/);
+    await page.setInputFiles('#file-images', join(MACS1931, 'immul_ongoing.cat'));
+    await page.waitForFunction(() => /systems/.test(document.getElementById('status-images').textContent));
+    await page.setInputFiles('#file-members', join(MACS1931, 'm1931.cat'));
+    await page.waitForFunction(() => /198 members/.test(document.getElementById('status-members').textContent));
+    await setField(page, '#set-z_lens', 0.352);
+    // A fixed strength and redshift keep both runs quick.
+    await setField(page, '#set-reconstruct-objective-strength', 0.1);
+    await setField(page, '#set-reconstruct-constraints-default_z', 2);
+    await runToMap(page, '#reconstruct', 120_000);
+    // m1931.cat comments its BCG out (line 10, member 1009.0: the .par models it): the
+    // verdict names it and offers to fit it.
+    const reasons = await page.textContent('#verdict-reasons');
+    assert.match(reasons, /No member near the images is bright enough to be the brightest cluster galaxy: the member catalogue comments one out \(member 1009\.0, line 10\); fit it \(see the warnings\)\./);
+    const items = await page.locator('#run-warnings li').allTextContents();
+    assert.ok(items.some((t) => /Line 10 comments out member 1009\.0, \d+ arcsec from that centre with mag 17\.32 \([\d.]+ L\*\): if that is the BCG, remove the '#' to fit it$/.test(t)), items.slice(0, 2).join(' | '));
+    const fit = page.locator('#fit-commented-bcg');
+    assert.equal(await fit.textContent(), 'Fit member 1009.0 (line 10) and reconstruct again');
+    await page.screenshot({ path: join(ARTIFACTS, 'app-commented-bcg.png'), fullPage: true });
+    await fit.click();
+    // The row is fitted (the file on disk is not touched) and the map made again, without
+    // the warning, the reason or the offer.
+    await page.waitForFunction(() => /199 members \(line 10 uncommented\)/.test(document.getElementById('status-members').textContent));
+    await page.waitForFunction(() => !document.getElementById('fit-commented-bcg')
+      && /^Done in/.test(document.getElementById('status').textContent), null, { timeout: 120_000 });
+    assert.doesNotMatch(await page.textContent('#verdict-reasons'), /brightest cluster galaxy/);
+    const after = await page.locator('#run-warnings li').allTextContents();
+    assert.deepEqual(after.filter((t) => /brightest cluster galaxy/.test(t)), []);
+    await page.screenshot({ path: join(ARTIFACTS, 'app-commented-bcg-fitted.png'), fullPage: true });
+    assert.deepEqual(app.consoleErrors, []);
+  } finally {
+    await app.close();
+  }
+});
+
 test('a malformed catalogue shows its line and keeps the previous data', async () => {
   const app = await openApp();
   try {

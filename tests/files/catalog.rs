@@ -207,6 +207,13 @@ mod real_files {
                 im.id
             );
         }
+        // Five rows are commented out, its BCG (line 10) among them: kept aside, never
+        // fitted, for the run to name.
+        let lines: Vec<usize> = members.commented.iter().map(|m| m.line).collect();
+        assert_eq!(lines, [10, 19, 20, 22, 30]);
+        let bcg = &members.commented[0];
+        assert_eq!((bcg.id.as_str(), bcg.line, bcg.mag), ("1009.0", 10, 17.325));
+        assert_eq!(bcg.position, DVec2::ZERO);
         let im = &cat.systems[0].images[0];
         let expected = lenstool_offset(292.96063, -26.569172, 292.95682, -26.575718);
         assert!(
@@ -251,6 +258,45 @@ fn relative_catalogue_reprojects_and_back() {
             b.position
         );
     }
+}
+
+#[cfg_attr(not(target_arch = "wasm32"), test)]
+#[cfg_attr(target_arch = "wasm32", wasm_bindgen_test::wasm_bindgen_test)]
+fn commented_rows_are_kept_aside_in_the_frame() {
+    // A header, prose, a short row, a row without a magnitude and one with a bad axis are
+    // comments; the two full rows are kept, in the requested frame like the members.
+    let text = "#REFERENCE 3 342.18322 -44.530889\n\
+        #(string name) X Y A B THETA MAG LUM\n\
+        # the BCG is potential O3 of the .par\n\
+        #bcg 0.5 -1.0 2.0 1.5 -35.0 17.04 0.0\n\
+        ## 7 1.0 2.0 0.3 0.2 10.0 19.5\n\
+        #8 1.0 2.0 0.3 0.2 10.0\n\
+        #9 1.0 2.0 0.3 0.2 10.0 nan 0\n\
+        #10 1.0 2.0 -0.3 0.2 10.0 20.0 0\n\
+        1 79.7384 33.1776 1.2 1.1 38.85 18.39 0.0\n";
+    let (native, warnings) = parse_member_catalog(text, "m.cat", None).unwrap();
+    assert!(warnings.is_empty(), "{warnings:?}");
+    assert_eq!(native.members.len(), 1);
+    let ids: Vec<(&str, usize)> = native
+        .commented
+        .iter()
+        .map(|m| (m.id.as_str(), m.line))
+        .collect();
+    assert_eq!(ids, [("bcg", 4), ("7", 5)]);
+    assert_eq!(native.commented[0].position, DVec2::new(0.5, -1.0));
+    assert_eq!(native.commented[1].mag, 19.5);
+    let other = SkyReference::new(342.21, -44.49).unwrap();
+    let (moved, _) = parse_member_catalog(text, "m.cat", Some(other)).unwrap();
+    let (ra, dec) = as1063_reference().offset_to_radec(DVec2::new(0.5, -1.0));
+    let expected = lenstool_offset(ra, dec, other.ra_deg, other.dec_deg);
+    let p = moved.commented[0].position;
+    assert!((p - expected).length() < POSITION_ATOL_ARCSEC, "{p}");
+    let back = moved.reframed(as1063_reference()).unwrap();
+    let p = back.commented[0].position;
+    assert!(
+        (p - DVec2::new(0.5, -1.0)).length() < ROUND_TRIP_ATOL_ARCSEC,
+        "{p}"
+    );
 }
 
 #[cfg_attr(not(target_arch = "wasm32"), test)]

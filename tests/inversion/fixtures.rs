@@ -93,5 +93,6 @@ pub fn members() -> MemberCatalog {
             member("e", -20.0, -3.0, 19.0),
             member("f", 3.0, -9.0, 18.9),
         ],
+        commented: Vec::new(),
     }
 }

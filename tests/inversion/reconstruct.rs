@@ -917,6 +917,20 @@ fn macs1931_runs_end_to_end_with_a_default_redshift() {
         "systems with unknown z take the default"
     );
     assert!(theta_e > 5.0 && theta_e < 60.0, "Einstein radius {theta_e}");
+    // The catalogue comments its BCG out (line 10, mag 17.325, at the frame's origin): the
+    // run says so, naming the line to uncomment.
+    assert!(r.central_galaxy_missing);
+    let bcg = r
+        .warnings
+        .iter()
+        .find(|w| w.contains("as bright as a brightest cluster galaxy"))
+        .expect("a missing-BCG warning");
+    assert!(
+        bcg.contains(" Line 10 comments out member 1009.0, ")
+            && bcg.contains(" with mag 17.32 (")
+            && bcg.ends_with(" L*): if that is the BCG, remove the '#' to fit it"),
+        "{bcg}"
+    );
     // The curve passes between the images of most systems (measured 0.9).
     let share = straddling_share(&r);
     assert!(

@@ -54,6 +54,7 @@ fn member_galaxies_are_the_inversions_halos() {
             lum: 0.0,
             line: 1,
         }],
+        commented: Vec::new(),
     };
     let grid = CellGrid::regular(DVec2::ZERO, 40.0, 8, 1.0).expect("grid");
     let members =

@@ -36,8 +36,10 @@ function facts(v) {
   return out;
 }
 
-/** Shows `verdict` (or hides the box for `null`: no result, or no reconstruction). */
-export function showVerdict(verdict) {
+/** Shows `verdict` (or hides the box for `null`: no result, or no reconstruction). When the
+ * member catalogue comments out a row that could be the missing BCG (`commented_bcg`), a
+ * button offers to fit it: `fitRow(row)` is called with `{line, id}`. */
+export function showVerdict(verdict, fitRow = null) {
   last = verdict ?? null;
   const box = document.getElementById('verdict');
   if (!box) return;
@@ -62,4 +64,14 @@ export function showVerdict(verdict) {
     list.append(li);
   }
   box.append(head, reasons, list);
+  const row = last.commented_bcg;
+  if (row && fitRow) {
+    const fit = document.createElement('button');
+    fit.type = 'button';
+    fit.id = 'fit-commented-bcg';
+    fit.textContent = `Fit member ${row.id} (line ${row.line}) and reconstruct again`;
+    fit.title = 'Removes the # before that row of the member catalogue you loaded (in this app only: your file is not changed) and runs the reconstruction again.';
+    fit.addEventListener('click', () => fitRow(row));
+    box.append(fit);
+  }
 }
