@@ -74,6 +74,11 @@ put("member_catalog", "a1689.cat", first_lines(read("www/examples/a1689-sim/memb
 put("member_catalog", "absolute.cat",
     "# id ra dec a b theta mag lum\n1 342.18322 -44.53092 1.2 0.8 30 17.2 3.1\n"
     "2 342.1801 -44.5302 0.6 0.5 -10 19.5\n2 342.1855 -44.5322 0.3 0.3 0 21.0 0.2\n")
+# Commented-out rows, as Lenstool set-ups keep a BCG the .par models: kept aside when they read.
+put("member_catalog", "commented.cat",
+    "#REFERENCE 3 292.95682 -26.575718\n#(string name) X Y A B THETA MAG LUM\n"
+    "  #1009.0 0.0 0.0 1.98 1.13 58.82 17.325 0.35\n##7 1 2 0.3 0.2 10 19.5\n#8 1 2 -0.3 0.2 10 nan\n"
+    "853.0 -18.18 -26.42 0.51 0.34 78.61 20.12 0.34\n")
 
 # Arc pixel files (JSON): both layouts, numeric ids, null and 0 redshifts.
 arcs = json.loads(read("www/examples/a1689-sim/arcs.json"))
