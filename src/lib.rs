@@ -116,8 +116,8 @@ pub use fits::{
 #[cfg(not(target_arch = "wasm32"))]
 pub use lenstool_par::load_lenstool_model;
 pub use lenstool_par::{
-    parse_par, parse_par_with, LenstoolModel, ParComponent, ParError, ParOptions, ParWarning,
-    Radius,
+    parse_par, parse_par_with, LenstoolModel, LenstoolPar, ParComponent, ParError, ParGalaxies,
+    ParOptions, ParWarning, Radius, GALAXY_MAX_CORE_KPC,
 };
 pub use limits::{
     with_line_feeds, InputKind, TooLarge, MAX_ARCS_BYTES, MAX_ARC_PIXELS, MAX_CATALOG_BYTES,

@@ -280,7 +280,10 @@
 //! median image distance of the images' centroid reaches 4 `L*` (a BCG is typically 5 to 15),
 //! the run warns and asks for the BCG's row; when the catalogue holds such a row commented
 //! out (`#` before a line that reads as a member, as MACS1931's does), the warning names its
-//! line. The run does not guess one: a galaxy of ten `L*` put at the peak of a grid-only
+//! line. Given the `.par` (`wslap reconstruct --par`, or the app's setting "Members from the
+//! .par"), its dPIE potentials with a core of at most 5 kpc and a `mag` become members, placed
+//! through the sky from the `.par`'s frame ([`crate::Dataset::add_par_galaxies`]). The run
+//! does not guess one: a galaxy of ten `L*` put at the peak of a grid-only
 //! first solution helps the synthetic clusters but misses the real BCGs by 1 - 5 arcsec and
 //! makes both real catalogues worse (BENCHMARKS.md).
 //!

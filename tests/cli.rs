@@ -494,6 +494,30 @@ fn reconstruct_bad_inputs_name_the_problem() {
     ]);
     assert!(!out.status.success());
     assert!(String::from_utf8_lossy(&out.stderr).contains("999"));
+    // A `.par` that does not read is named with its line, before any run (an unknown
+    // profile here), and no output directory is made.
+    let par = dir.join("bad.par");
+    fs::write(
+        &par,
+        "runmode\n\treference 3 342.18322 -44.530889\n\tend\npotentiel O1\n\tprofil 7\n\t\
+         z_lens 0.348\n\tend\nfini\n",
+    )
+    .unwrap();
+    let out = wslap(&[
+        "reconstruct",
+        "--images",
+        &images,
+        "--z-lens",
+        "0.348",
+        "--par",
+        par.to_str().unwrap(),
+        "--out",
+        dir.join("e").to_str().unwrap(),
+    ]);
+    assert!(!out.status.success());
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(err.contains("bad.par") && err.contains("profil 7"), "{err}");
+    assert!(!dir.join("e").exists());
 }
 
 #[test]

@@ -182,7 +182,8 @@ async function render() {
 }
 
 function caption(info) {
-  showVerdict(info.summary.verdict, fitCommentedRow);
+  showVerdict(info.summary.verdict,
+    { fitRow: fitCommentedRow, modelGalaxies: info.model_galaxies ?? [], fitModel: fitModelGalaxies });
   const s = info.summary.maps ?? info.summary;
   // The solver, when it is not the paper's QADP.
   const best = info.summary.settings?.solver?.method === 'accelerated_gradient'
@@ -683,6 +684,23 @@ async function fitCommentedRow({ line, id }) {
     }
   });
   if (fitted) await run('reconstruct');
+}
+
+/** The verdict's other offer: the galaxies the loaded .par models on its own (its BCG) are
+ * fitted as members from now on (the setting shows it), and the reconstruction runs again. */
+async function fitModelGalaxies() {
+  let set = false;
+  await enqueue(async () => {
+    clearError();
+    try {
+      await applySetting('members_from_model', true);
+      showSettings(settings);
+      set = true;
+    } catch (err) {
+      showError(`The .par's galaxies were not fitted: ${err.message}`);
+    }
+  });
+  if (set) await run('reconstruct');
 }
 
 async function applySetting(path, value) {

@@ -10,7 +10,7 @@ use crate::catalog::{
 };
 use crate::cosmology::LensPlane;
 use crate::fits::read_image;
-use crate::lenstool_par::{parse_par_with, ParOptions};
+use crate::lenstool_par::{parse_par_with, LenstoolPar, ParOptions};
 use crate::map::Map;
 use crate::model::ModelFile;
 use crate::profiles::Lens;
@@ -116,6 +116,21 @@ pub struct ModelLens {
     pub lens: Lens,
     pub plane: LensPlane,
     pub reference: Option<SkyReference>,
+}
+
+impl LoadedData {
+    /// The loaded model file when it is a Lenstool `.par`, read with `par_options`; `None`
+    /// without one (or with a JSON model).
+    pub fn model_par(&self, par_options: &ParOptions) -> Result<Option<LenstoolPar>, AppError> {
+        match &self.model {
+            Some(f) if is_lenstool_par(&f.name, &f.text) => {
+                parse_par_with(&f.text, &f.name, par_options)
+                    .map(Some)
+                    .map_err(|e| AppError::File(e.to_string()))
+            }
+            _ => Ok(None),
+        }
+    }
 }
 
 /// Whether a model file's text is a Lenstool parameter file rather than a JSON model file: a

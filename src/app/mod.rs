@@ -18,6 +18,7 @@ mod settings;
 mod source_plane;
 mod views;
 
+use crate::catalog::Member;
 use thiserror::Error;
 
 pub use crate::reconstruct::SHOWN_MIN_MAGNIFICATION;
@@ -101,6 +102,14 @@ impl Session {
         let mut warnings = self.sky_warnings();
         warnings.append(&mut parsed.warnings);
         parsed.warnings = warnings;
+        if self.settings.members_from_model {
+            if let Some(par) = self.data.model_par(&self.settings.par_options())? {
+                let notes = parsed
+                    .add_par_galaxies(&par)
+                    .map_err(|e| AppError::File(e.to_string()))?;
+                parsed.warnings.extend(notes);
+            }
+        }
         Ok(parsed)
     }
 
@@ -143,6 +152,20 @@ impl Session {
         let pixel = self.settings.reconstruct.constraints.pixel_arcsec;
         let par = self.settings.par_options();
         self.data.reload(role, pixel, &par)
+    }
+
+    /// The galaxies of the loaded Lenstool `.par` that a run could fit as members
+    /// ([`crate::lenstool_par::LenstoolPar::galaxies`] with a `mag`, in the `.par`'s frame),
+    /// when the setting `members_from_model` is off: what the verdict of a run that lacks its
+    /// BCG offers to fit. Empty without a `.par`, or when it cannot be read.
+    pub fn model_galaxies(&self) -> Vec<Member> {
+        if self.settings.members_from_model {
+            return Vec::new();
+        }
+        match self.data.model_par(&self.settings.par_options()) {
+            Ok(Some(par)) => par.galaxies().map(|g| g.members).unwrap_or_default(),
+            _ => Vec::new(),
+        }
     }
 
     /// Fits the commented-out row on `line` of the loaded member catalogue (e.g. the BCG a

@@ -35,6 +35,10 @@ pub struct AppSettings {
     /// single-plane approximation ([`ParOptions::single_plane`], `wslap maps --single-plane`);
     /// default `false`: such a model is refused.
     pub lenstool_single_plane: bool,
+    /// The galaxies a loaded Lenstool `.par` models on its own (dPIE potentials with a core of
+    /// at most 5 kpc and a `mag`: typically the BCG, which its member catalogue then leaves
+    /// out) are fitted as members, as `wslap reconstruct --par` does; default `false`.
+    pub members_from_model: bool,
     /// After each reconstruction, an ensemble of that many more (0, the default: none), as
     /// `wslap reconstruct --ensemble N --seed S` runs it.
     pub ensemble: EnsembleSettings,
@@ -54,6 +58,7 @@ impl Default for AppSettings {
             reconstruct,
             holdout: Vec::new(),
             lenstool_single_plane: false,
+            members_from_model: false,
             ensemble: EnsembleSettings::default(),
         }
     }

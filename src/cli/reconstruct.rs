@@ -7,9 +7,9 @@ use clap::Args;
 use serde::Serialize;
 use wslap::{
     check_ensemble_size, check_memory, cross_validate, export_system, fold_groups, image_regions,
-    reconstruct, run_ensemble, ColorScale, Control, ConvergenceRecord, Cosmology, CrossValidation,
-    Dataset, InputKind, InputText, InputTexts, Inputs, LensPlane, ReconstructConfig,
-    ReconstructError, Reconstruction, SolverMethod,
+    parse_par, reconstruct, run_ensemble, ColorScale, Control, ConvergenceRecord, Cosmology,
+    CrossValidation, Dataset, InputKind, InputText, InputTexts, Inputs, LensPlane,
+    ReconstructConfig, ReconstructError, Reconstruction, SolverMethod,
 };
 
 use super::input::read_text;
@@ -45,6 +45,12 @@ pub struct ReconstructArgs {
     /// Lenstool member catalogue (potfile: id x y a b theta mag lum).
     #[arg(long, value_name = "MEMBERS.cat")]
     members: Option<PathBuf>,
+    /// A Lenstool .par of the same cluster (e.g. the published model's bestopt.par): the
+    /// galaxies it models on its own, dPIE potentials with a core of at most 5 kpc and a `mag`
+    /// (typically the BCG, which the member catalogue then leaves out), are fitted as members.
+    /// Its cluster-scale potentials are not used.
+    #[arg(long, value_name = "MODEL.par")]
+    par: Option<PathBuf>,
     /// Lenstool arclet catalogue (id x y a b theta z) of weakly lensed background galaxies:
     /// each galaxy's ellipticity (a - b)/(a + b) exp(2i theta) adds two reduced-shear rows,
     /// and a ring of coarser cells around the grid reaches the median galaxy (the outer half,
@@ -215,7 +221,16 @@ pub fn run(args: &ReconstructArgs) -> Result<(), String> {
         arcs: text(&arcs),
         shear: text(&shear),
     };
-    let data = Dataset::read(&files, config.constraints.pixel_arcsec).map_err(|e| e.to_string())?;
+    let mut data =
+        Dataset::read(&files, config.constraints.pixel_arcsec).map_err(|e| e.to_string())?;
+    if let Some(path) = &args.par {
+        let par_name = name(path);
+        let par =
+            parse_par(&read_text(path, InputKind::Model)?, &par_name).map_err(|e| e.to_string())?;
+        for note in data.add_par_galaxies(&par).map_err(|e| e.to_string())? {
+            eprintln!("note: {note}");
+        }
+    }
     let unfitted = data.unfitted_arcs(config.constraints.mode);
     for w in data.warnings.iter().chain(&unfitted) {
         eprintln!("warning: {w}");

@@ -153,6 +153,19 @@ impl Radius {
     }
 }
 
+/// Largest core radius (kpc) of a `potentiel` that [`LenstoolPar::galaxies`] takes for a galaxy:
+/// the CATS model of AS1063 gives its BCG (O3) 0.5 kpc and its north-east group (O4) 49 kpc.
+pub const GALAXY_MAX_CORE_KPC: f64 = 5.0;
+
+/// The galaxies of a `.par` ([`LenstoolPar::galaxies`]).
+#[derive(Debug, Clone, PartialEq)]
+pub struct ParGalaxies {
+    /// Those with a `mag`, as member rows in the file's frame.
+    pub members: Vec<Member>,
+    /// Those without one: each block's name and line.
+    pub without_mag: Vec<(String, usize)>,
+}
+
 /// One mass component of a `potentiel` block (positions in arcsec, angles in degrees
 /// counter-clockwise from +x).
 #[derive(Debug, Clone, PartialEq)]
@@ -180,6 +193,9 @@ pub struct ParPotential {
     pub block: String,
     pub line: usize,
     pub component: ParComponent,
+    /// The block's `mag`, when it gives one (Lenstool scales a galaxy's dPIE with it; a BCG
+    /// modelled on its own usually has it).
+    pub mag: Option<f64>,
 }
 
 /// A `potfile` block: the member catalogue and the `L*` galaxy of the scaling relations.
@@ -284,6 +300,52 @@ impl LenstoolPar {
         LensPlane::new(self.cosmology, self.z_lens).map_err(|source| ParError::Cosmology {
             file: self.source_name.clone(),
             source,
+        })
+    }
+
+    /// The galaxies the file models on their own: its dPIE `potentiel` blocks with a core of
+    /// at most [`GALAXY_MAX_CORE_KPC`] (a BCG's is below a kpc; a group or cluster halo's tens
+    /// of kpc), as member rows in the file's frame (id: the block's name, e.g. `O3`; a and b
+    /// from the ellipticity `(a^2 - b^2)/(a^2 + b^2)`; line: the block's). Those without a
+    /// `mag`, which a member needs, come second, by block name and line.
+    pub fn galaxies(&self) -> Result<ParGalaxies, ParError> {
+        let plane = self.lens_plane()?;
+        let (mut rows, mut without_mag) = (Vec::new(), Vec::new());
+        for p in &self.potentials {
+            let ParComponent::Dpie {
+                center_arcsec,
+                r_core,
+                ellipticity,
+                pa_deg,
+                ..
+            } = p.component
+            else {
+                continue;
+            };
+            let core_kpc = r_core.arcsec(&plane) * plane.mpc_per_arcsec * 1.0e3;
+            if core_kpc > GALAXY_MAX_CORE_KPC {
+                continue;
+            }
+            let id = p.block.split_whitespace().last().unwrap_or("potentiel");
+            let Some(mag) = p.mag else {
+                without_mag.push((p.block.clone(), p.line));
+                continue;
+            };
+            let e = ellipticity.clamp(0.0, 0.99);
+            rows.push(Member {
+                id: id.to_string(),
+                position: center_arcsec,
+                a_arcsec: 1.0,
+                b_arcsec: ((1.0 - e) / (1.0 + e)).sqrt(),
+                theta_deg: pa_deg,
+                mag,
+                lum: 0.0,
+                line: p.line,
+            });
+        }
+        Ok(ParGalaxies {
+            members: rows,
+            without_mag,
         })
     }
 

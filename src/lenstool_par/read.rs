@@ -635,6 +635,7 @@ impl Ctx<'_> {
             block: b.header.clone(),
             line: b.line,
             component,
+            mag: self.opt(b, "mag", 0)?,
         };
         Ok((p, z))
     }

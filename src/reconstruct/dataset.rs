@@ -27,6 +27,7 @@ use crate::catalog::{
 };
 use crate::cosmology::LensPlane;
 use crate::inversion::{ConstraintMode, ConstraintSource};
+use crate::lenstool_par::{LenstoolPar, ParError, ParGalaxies, GALAXY_MAX_CORE_KPC};
 use crate::sky::SkyReference;
 
 /// One input file: the name used in messages and its text.
@@ -59,7 +60,13 @@ pub enum DatasetError {
     Arcs(#[from] ArcsError),
     #[error("give an image catalogue or an arcs file to reconstruct")]
     NoConstraints,
+    #[error(transparent)]
+    Par(#[from] ParError),
 }
+
+/// Two galaxies closer than this (arcsec) are the same one: a `.par` galaxy the member
+/// catalogue already lists is not added again ([`Dataset::add_par_galaxies`]).
+pub const SAME_GALAXY_ARCSEC: f64 = 1.0;
 
 /// The catalogues read into one frame (see the module documentation).
 #[derive(Debug, Clone, Default)]
@@ -114,6 +121,76 @@ impl Dataset {
             });
         }
         Ok(out)
+    }
+
+    /// Adds the galaxies a Lenstool `.par` models on its own ([`LenstoolPar::galaxies`]: e.g.
+    /// the BCG a potfile catalogue leaves out) to the members, in the data's frame (a member
+    /// catalogue is made when there is none). One sentence per galaxy says what became of it:
+    /// added; already a member (one lies within 1 arcsec); or left out for want
+    /// of a `mag`.
+    pub fn add_par_galaxies(&mut self, par: &LenstoolPar) -> Result<Vec<String>, DatasetError> {
+        let ParGalaxies {
+            members: rows,
+            without_mag,
+        } = par.galaxies()?;
+        let name = &par.source_name;
+        let mut notes: Vec<String> = without_mag
+            .iter()
+            .map(|(block, line)| {
+                format!(
+                    "{name}: line {line}: `{block}` is a galaxy (core at most \
+                     {GALAXY_MAX_CORE_KPC} kpc) without a `mag`, which a member needs: not \
+                     fitted; give its row in the member catalogue"
+                )
+            })
+            .collect();
+        if rows.is_empty() {
+            return Ok(notes);
+        }
+        let frame = self.reference();
+        let mut found = MemberCatalog {
+            source_name: name.clone(),
+            reference: par.reference,
+            members: rows,
+            commented: Vec::new(),
+        };
+        match (par.reference, frame) {
+            (Some(_), Some(to)) => found = found.reframed(to)?,
+            (None, Some(_)) => notes.push(format!(
+                "{name}: no `runmode reference`: its galaxies' positions are taken in the \
+                 catalogues' frame"
+            )),
+            _ => {}
+        }
+        let members = self.members.get_or_insert_with(|| MemberCatalog {
+            source_name: name.clone(),
+            reference: frame.or(par.reference),
+            members: Vec::new(),
+            commented: Vec::new(),
+        });
+        for g in found.members {
+            let (x, y) = (g.position.x, g.position.y);
+            let near = members
+                .members
+                .iter()
+                .find(|m| m.position.distance(g.position) <= SAME_GALAXY_ARCSEC);
+            notes.push(match near {
+                Some(m) => format!(
+                    "{name}: line {}: galaxy {} at ({x:.2}, {y:.2}) arcsec is member {} of \
+                     {} already: not added twice",
+                    g.line, g.id, m.id, members.source_name
+                ),
+                None => format!(
+                    "{name}: line {}: galaxy {} at ({x:.2}, {y:.2}) arcsec, mag {:.2}, fitted \
+                     as a member",
+                    g.line, g.id, g.mag
+                ),
+            });
+            if near.is_none() {
+                members.members.push(g);
+            }
+        }
+        Ok(notes)
     }
 
     /// The frame's sky reference: the image catalogue's, else the member catalogue's, else the

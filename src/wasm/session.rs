@@ -297,6 +297,10 @@ impl AppSession {
             "iterations": rec.map(|x| x.iterations),
             "summary": summary,
             "model_note": self.inner.model_not_compared(r),
+            // What the verdict may offer to fit: `[{id, line, mag}]` of the loaded .par.
+            "model_galaxies": self.inner.model_galaxies().iter()
+                .map(|g| serde_json::json!({"id": g.id, "line": g.line, "mag": g.mag}))
+                .collect::<Vec<_>>(),
         }))
     }
 

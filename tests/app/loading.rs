@@ -392,3 +392,53 @@ fn a_commented_member_row_is_fitted_on_request_and_nothing_else_is() {
     let err = empty.uncomment_member(4).unwrap_err().to_string();
     assert!(err.contains("load a member catalogue first"), "{err}");
 }
+
+/// A Lenstool `.par` loaded as the model: the galaxies it models on its own are offered, and
+/// fitted as members once `members_from_model` is on (the published AS1063 files).
+#[cfg(not(target_arch = "wasm32"))]
+#[test]
+fn the_bcg_of_a_loaded_par_is_offered_then_fitted_as_a_member() {
+    let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../shared/data/AS1063/lenstool_cats");
+    let read = |f: &str| std::fs::read_to_string(dir.join(f)).unwrap();
+    let mut s = Session::new();
+    s.load_text(
+        DataRole::Images,
+        "gold.cat",
+        &read("cats_gold_mul_gold.cat"),
+    )
+    .unwrap();
+    s.load_text(
+        DataRole::Members,
+        "members.cat",
+        &read("cats_gold_ref_potential_w_clumpNE.cat"),
+    )
+    .unwrap();
+    // Before a .par is loaded there is nothing to offer, and the members are the catalogue's.
+    assert!(s.model_galaxies().is_empty());
+    let n = s.parsed().unwrap().members.unwrap().members.len();
+    s.load_text(DataRole::Model, "best.par", &read("cats_gold_bestopt.par"))
+        .unwrap();
+    let offered: Vec<(String, usize, f64)> = s
+        .model_galaxies()
+        .into_iter()
+        .map(|g| (g.id, g.line, g.mag))
+        .collect();
+    assert_eq!(offered, [("O3".to_string(), 55, 17.037)]);
+    assert_eq!(s.parsed().unwrap().members.unwrap().members.len(), n);
+    s.set_field("members_from_model", json!(true)).unwrap();
+    let parsed = s.parsed().unwrap();
+    let members = parsed.members.unwrap().members;
+    assert_eq!((members.len(), members[n].id.as_str()), (n + 1, "O3"));
+    assert!(
+        parsed
+            .warnings
+            .iter()
+            .any(|w| w.starts_with("best.par: line 55: galaxy O3 at (")
+                && w.ends_with(" fitted as a member")),
+        "{:?}",
+        parsed.warnings
+    );
+    // Fitted, it is no longer offered.
+    assert!(s.model_galaxies().is_empty());
+}

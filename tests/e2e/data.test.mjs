@@ -210,6 +210,41 @@ test('a BCG the member catalogue comments out is offered, and fitted on a click'
   }
 });
 
+test('the BCG a loaded .par models on its own is offered, and fitted on a click', async () => {
+  const app = await openApp();
+  try {
+    const { page } = app;
+    await waitStatus(page, /^Ready/);
+    await page.setInputFiles('#file-images', join(AS1063, 'cats_gold_mul_gold.cat'));
+    await page.waitForFunction(() => /19 systems/.test(document.getElementById('status-images').textContent));
+    await page.setInputFiles('#file-members', join(AS1063, 'cats_gold_ref_potential_w_clumpNE.cat'));
+    await page.waitForFunction(() => /members/.test(document.getElementById('status-members').textContent));
+    await page.setInputFiles('#file-model', join(AS1063, 'cats_gold_bestopt.par'));
+    await page.waitForFunction(() => /Lenstool model/.test(document.getElementById('status-model').textContent));
+    await setField(page, '#set-z_lens', 0.348);
+    await setField(page, '#set-reconstruct-objective-strength', 0.1);
+    await runToMap(page, '#reconstruct', 120_000);
+    // The member catalogue leaves the BCG out; the .par has it (O3: core 0.5 kpc, mag 17.037).
+    assert.match(await page.textContent('#verdict-reasons'), /No member near the images is bright enough to be the brightest cluster galaxy/);
+    const fit = page.locator('#fit-model-galaxies');
+    assert.equal(await fit.textContent(), "Fit the .par's galaxy (O3, mag 17.04) and reconstruct again");
+    assert.equal(await page.inputValue('#set-members_from_model'), 'false');
+    await fit.click();
+    await page.waitForFunction(() => !document.getElementById('fit-model-galaxies')
+      && /^Done in/.test(document.getElementById('status').textContent), null, { timeout: 120_000 });
+    // Fitted as a member from now on (the setting says so), the verdict no longer asks for it.
+    assert.equal(await page.inputValue('#set-members_from_model'), 'true');
+    assert.doesNotMatch(await page.textContent('#verdict-reasons'), /brightest cluster galaxy/);
+    const items = await page.locator('#run-warnings li').allTextContents();
+    assert.ok(items.some((t) => /^cats_gold_bestopt\.par: line 55: galaxy O3 at \(-?[\d.]+, -?[\d.]+\) arcsec, mag 17\.04, fitted as a member$/.test(t)), items.slice(0, 3).join(' | '));
+    assert.deepEqual(items.filter((t) => /as bright as a brightest cluster galaxy/.test(t)), []);
+    await page.screenshot({ path: join(ARTIFACTS, 'app-par-bcg-fitted.png'), fullPage: true });
+    assert.deepEqual(app.consoleErrors, []);
+  } finally {
+    await app.close();
+  }
+});
+
 test('a malformed catalogue shows its line and keeps the previous data', async () => {
   const app = await openApp();
   try {

@@ -386,3 +386,114 @@ fn hff_maps_with_blank_and_zero_borders_are_used_without_them() {
         assert_eq!(back.non_finite_count(), expected.total(), "{name}");
     }
 }
+
+/// The real published files (../shared/data, read natively).
+#[cfg(not(target_arch = "wasm32"))]
+mod galaxies_of_a_par {
+    use glam::DVec2;
+    use wslap::{parse_par, Dataset, InputText, InputTexts};
+
+    fn read(rel: &str) -> String {
+        let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("../shared/data")
+            .join(rel);
+        std::fs::read_to_string(&path).unwrap_or_else(|e| panic!("{}: {e}", path.display()))
+    }
+
+    const AS1063: &str = "AS1063/lenstool_cats/";
+
+    fn as1063(members: bool) -> Dataset {
+        let images = read(&format!("{AS1063}cats_gold_mul_gold.cat"));
+        let cat = read(&format!("{AS1063}cats_gold_ref_potential_w_clumpNE.cat"));
+        let files = InputTexts {
+            images: Some(InputText {
+                name: "gold.cat",
+                text: &images,
+            }),
+            members: members.then_some(InputText {
+                name: "members.cat",
+                text: &cat,
+            }),
+            ..InputTexts::default()
+        };
+        Dataset::read(&files, 0.2).unwrap()
+    }
+
+    #[test]
+    fn the_as1063_bcg_of_the_par_becomes_a_member_once() {
+        let par = parse_par(&read(&format!("{AS1063}cats_gold_bestopt.par")), "best.par").unwrap();
+        // O1 (core 99 kpc) is the cluster, O4 (49 kpc) a group, O2 a shear: only the BCG, O3.
+        let found = par.galaxies().unwrap();
+        let rows = found.members;
+        assert!(found.without_mag.is_empty());
+        assert_eq!(rows.len(), 1);
+        let o3 = &rows[0];
+        assert_eq!((o3.id.as_str(), o3.mag), ("O3", 17.037));
+        assert_eq!(o3.position, DVec2::new(0.006, 0.037));
+        // b / a from Lenstool's ellipticity (a^2 - b^2) / (a^2 + b^2) = 0.271.
+        let (a, b) = (o3.a_arcsec, o3.b_arcsec);
+        assert!(((a * a - b * b) / (a * a + b * b) - 0.271).abs() < 1e-12);
+
+        let mut data = as1063(true);
+        let before = data.members.as_ref().unwrap().members.len();
+        let notes = data.add_par_galaxies(&par).unwrap();
+        let members = &data.members.as_ref().unwrap().members;
+        assert_eq!(members.len(), before + 1);
+        let added = members.last().unwrap();
+        // Where the .par puts it on the sky, in the images' frame (lenstool offsets:
+        // x = -(RA - RA0) cos Dec0 * 3600, y = (Dec - Dec0) * 3600).
+        let frame = data.reference().unwrap();
+        let r = par.reference.unwrap();
+        let dec = r.dec_deg + 0.037 / 3600.0;
+        let ra = r.ra_deg - 0.006 / 3600.0 / r.dec_deg.to_radians().cos();
+        let expected = DVec2::new(
+            -(ra - frame.ra_deg) * frame.dec_deg.to_radians().cos() * 3600.0,
+            (dec - frame.dec_deg) * 3600.0,
+        );
+        assert!(
+            (added.position - expected).length() < 1e-3,
+            "{}",
+            added.position
+        );
+        assert_eq!(notes.len(), 1);
+        assert!(
+            notes[0].starts_with("best.par: line 55: galaxy O3 at (")
+                && notes[0].ends_with(" arcsec, mag 17.04, fitted as a member"),
+            "{}",
+            notes[0]
+        );
+        // Given twice, or with a catalogue that has it, it is not added again.
+        let notes = data.add_par_galaxies(&par).unwrap();
+        assert_eq!(data.members.as_ref().unwrap().members.len(), before + 1);
+        assert!(
+            notes[0].contains("is member O3 of members.cat already: not added twice"),
+            "{notes:?}"
+        );
+        // Without a member catalogue it makes one, in the images' frame.
+        let mut alone = as1063(false);
+        alone.add_par_galaxies(&par).unwrap();
+        let made = alone.members.unwrap();
+        assert_eq!((made.members.len(), made.reference), (1, Some(frame)));
+        assert!((made.members[0].position - expected).length() < 1e-3);
+    }
+
+    #[test]
+    fn a_galaxy_without_a_magnitude_is_named_and_left_out() {
+        // MACS1931's .par is a starting model: its BCG (potential 3, core 0.115 kpc) has a
+        // velocity dispersion to fit and no `mag`.
+        let par = parse_par(&read("MACS1931/lenstool_cats/m1931.par"), "m1931.par").unwrap();
+        let found = par.galaxies().unwrap();
+        assert!(found.members.is_empty());
+        assert_eq!(found.without_mag, [("potentiel 3".to_string(), 66)]);
+        let mut data = Dataset::default();
+        let notes = data.add_par_galaxies(&par).unwrap();
+        assert_eq!(
+            notes,
+            [
+                "m1931.par: line 66: `potentiel 3` is a galaxy (core at most 5 kpc) without a \
+              `mag`, which a member needs: not fitted; give its row in the member catalogue"
+            ]
+        );
+        assert!(data.members.is_none());
+    }
+}

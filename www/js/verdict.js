@@ -37,9 +37,10 @@ function facts(v) {
 }
 
 /** Shows `verdict` (or hides the box for `null`: no result, or no reconstruction). When the
- * member catalogue comments out a row that could be the missing BCG (`commented_bcg`), a
- * button offers to fit it: `fitRow(row)` is called with `{line, id}`. */
-export function showVerdict(verdict, fitRow = null) {
+ * members lack their BCG, a button offers to fit it: the member catalogue's commented-out row
+ * (`commented_bcg`: `fitRow({line, id})`), else the galaxies of the loaded Lenstool .par
+ * (`modelGalaxies`, `[{id, line, mag}]`: `fitModel()`). */
+export function showVerdict(verdict, { fitRow = null, modelGalaxies = [], fitModel = null } = {}) {
   last = verdict ?? null;
   const box = document.getElementById('verdict');
   if (!box) return;
@@ -64,14 +65,24 @@ export function showVerdict(verdict, fitRow = null) {
     list.append(li);
   }
   box.append(head, reasons, list);
-  const row = last.commented_bcg;
-  if (row && fitRow) {
+  const offer = (id, text, title, onClick) => {
     const fit = document.createElement('button');
     fit.type = 'button';
-    fit.id = 'fit-commented-bcg';
-    fit.textContent = `Fit member ${row.id} (line ${row.line}) and reconstruct again`;
-    fit.title = 'Removes the # before that row of the member catalogue you loaded (in this app only: your file is not changed) and runs the reconstruction again.';
-    fit.addEventListener('click', () => fitRow(row));
+    fit.id = id;
+    fit.textContent = text;
+    fit.title = title;
+    fit.addEventListener('click', onClick);
     box.append(fit);
+  };
+  const row = last.commented_bcg;
+  if (row && fitRow) {
+    offer('fit-commented-bcg', `Fit member ${row.id} (line ${row.line}) and reconstruct again`,
+      'Removes the # before that row of the member catalogue you loaded (in this app only: your file is not changed) and runs the reconstruction again.',
+      () => fitRow(row));
+  } else if (last.central_galaxy_missing && modelGalaxies.length && fitModel) {
+    const names = modelGalaxies.map((g) => `${g.id}, mag ${g.mag.toFixed(2)}`).join('; ');
+    offer('fit-model-galaxies', `Fit the .par's galaxy (${names}) and reconstruct again`,
+      'The loaded Lenstool .par models this galaxy on its own (a core of at most 5 kpc and a magnitude): fits it as a member (the setting "Members from the .par"), as wslap reconstruct --par does, and runs the reconstruction again.',
+      fitModel);
   }
 }
