@@ -642,7 +642,8 @@ pub fn missing_bcg_warning(
             m.mag
         ),
         None => "If the cluster has one, add its row (id x y a b theta mag lum) to the member \
-                 catalogue"
+                 catalogue, or give the .par that models it (wslap reconstruct --par; in the \
+                 app, load it as the model file)"
             .to_string(),
     };
     let warning = format!(
@@ -753,7 +754,10 @@ mod tests {
         let found = missing_bcg_warning("m.cat", &halos, &ring(), &[rows[0], rows[2]]).unwrap();
         assert_eq!(found.commented, None);
         let w = found.warning;
-        assert!(w.ends_with("add its row (id x y a b theta mag lum) to the member catalogue"));
+        assert!(w.ends_with(
+            "add its row (id x y a b theta mag lum) to the member catalogue, or give the .par \
+             that models it (wslap reconstruct --par; in the app, load it as the model file)"
+        ));
     }
 
     #[test]
