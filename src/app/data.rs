@@ -449,7 +449,7 @@ impl LoadedData {
     }
 
     /// Makes the commented-out row on `line` (1-based) of the loaded member catalogue a member:
-    /// the line's first `#` goes and the catalogue is checked and kept as [`Self::load_text`]
+    /// the line's leading `#`s go and the catalogue is checked and kept as [`Self::load_text`]
     /// does. The line must be commented out and read as one more member once it is not; on an
     /// error the catalogue stays as it was.
     pub fn uncomment_member(
@@ -471,7 +471,13 @@ impl LoadedData {
         };
         let count = |t: &str| parse_member_catalog(t, &name, None).map(|(c, _)| c.members.len());
         let before = count(&text).map_err(|e| AppError::File(e.to_string()))?;
-        let new = old.replacen('#', "", 1);
+        // Every leading `#` goes, as the catalogue reader strips them (`##7 ...` reads as 7).
+        let body = old.trim_start();
+        let new = format!(
+            "{}{}",
+            &old[..old.len() - body.len()],
+            body.trim_start_matches('#')
+        );
         let edited: Vec<&str> = text
             .split('\n')
             .enumerate()

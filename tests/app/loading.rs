@@ -356,7 +356,7 @@ fn a_commented_member_row_is_fitted_on_request_and_nothing_else_is() {
         ##7 1.0 2.0 0.3 0.2 10.0 19.5\n";
     let mut s = Session::new();
     s.load_text(DataRole::Members, "m.cat", text).unwrap();
-    // Refused, the catalogue untouched: a row, the header, a doubly commented row, no line.
+    // Refused, the catalogue untouched: a row, the header, the frame, no line.
     for (line, says) in [
         (3, "m.cat: line 3 is not a commented-out row"),
         (
@@ -364,8 +364,8 @@ fn a_commented_member_row_is_fitted_on_request_and_nothing_else_is() {
             "m.cat: line 2 does not read as a member without its '#': #(string name)",
         ),
         (
-            5,
-            "m.cat: line 5 does not read as a member without its '#': ##7",
+            1,
+            "m.cat: line 1 does not read as a member without its '#': #REFERENCE",
         ),
         (9, "m.cat: line 9 is not a commented-out row"),
         (0, "m.cat: line 0 is not a commented-out row"),
@@ -388,6 +388,11 @@ fn a_commented_member_row_is_fitted_on_request_and_nothing_else_is() {
     assert!(members.commented.iter().all(|m| m.id != "1009"));
     // Once uncommented it is no longer commented out.
     assert!(s.uncomment_member(4).is_err());
+    // A doubly commented row loses both '#', as the reader strips both.
+    let report = s.uncomment_member(5).unwrap();
+    assert_eq!(report.summary, "3 members (line 5 uncommented)");
+    let kept = &s.data.members.as_ref().unwrap().text;
+    assert_eq!(kept.lines().nth(4), Some("7 1.0 2.0 0.3 0.2 10.0 19.5"));
     let mut empty = Session::new();
     let err = empty.uncomment_member(4).unwrap_err().to_string();
     assert!(err.contains("load a member catalogue first"), "{err}");
