@@ -669,38 +669,38 @@ async function newProject() {
 /** The verdict's offer: the member catalogue's commented-out row `{line, id}` (the BCG a
  * Lenstool set-up models in its .par) becomes a member, and the reconstruction runs again. */
 async function fitCommentedRow({ line, id }) {
-  let fitted = false;
-  await enqueue(async () => {
-    clearError();
-    try {
-      const report = await ask('uncommentMember', { line });
-      setFileStatus('members', reportText(report));
-      clearCrossval();
-      await refreshLoaded();
-      await persist();
-      fitted = true;
-    } catch (err) {
-      showError(`Member ${id} was not fitted: ${err.message}`);
-    }
+  await changeThenReconstruct(`Member ${id} was not fitted`, async () => {
+    const report = await ask('uncommentMember', { line });
+    setFileStatus('members', reportText(report));
+    clearCrossval();
+    await refreshLoaded();
+    await persist();
   });
-  if (fitted) await run('reconstruct');
 }
 
 /** The verdict's other offer: the galaxies the loaded .par models on its own (its BCG) are
  * fitted as members from now on (the setting shows it), and the reconstruction runs again. */
 async function fitModelGalaxies() {
-  let set = false;
+  await changeThenReconstruct("The .par's galaxies were not fitted", async () => {
+    await applySetting('members_from_model', true);
+    showSettings(settings);
+  });
+}
+
+/** Runs `change` in the file queue, then reconstructs; if it fails, says so after `failed`
+ * and does not run. */
+async function changeThenReconstruct(failed, change) {
+  let changed = false;
   await enqueue(async () => {
     clearError();
     try {
-      await applySetting('members_from_model', true);
-      showSettings(settings);
-      set = true;
+      await change();
+      changed = true;
     } catch (err) {
-      showError(`The .par's galaxies were not fitted: ${err.message}`);
+      showError(`${failed}: ${err.message}`);
     }
   });
-  if (set) await run('reconstruct');
+  if (changed) await run('reconstruct');
 }
 
 async function applySetting(path, value) {

@@ -10,7 +10,9 @@ use std::collections::HashMap;
 use glam::DVec2;
 
 use super::frame;
-use super::rows::{read_table, warn_extra_columns, warn_repeated_id, Fields, Table, ALL_COLUMNS};
+use super::rows::{
+    read_table, warn_extra_columns, warn_repeated_id, Fields, Row, Shape, Table, ALL_COLUMNS,
+};
 use super::units::{check_field, RowPosition};
 use super::{
     CatalogError, CatalogWarning, Image, ImageCatalog, ImageSystem, Member, MemberCatalog,
@@ -162,16 +164,7 @@ pub fn parse_member_catalog(
             continue;
         }
         positions.push(RowPosition::of(row, shape.raw));
-        members.push(Member {
-            id: id.into(),
-            position: shape.raw,
-            a_arcsec: shape.a,
-            b_arcsec: shape.b,
-            theta_deg: shape.theta,
-            mag,
-            lum: f.optional(7)?,
-            line: row.line,
-        });
+        members.push(member_of(row, &shape, mag, f.optional(7)?));
     }
     if members.is_empty() {
         return Err(CatalogError::NoMeasuredMembers {
@@ -194,6 +187,20 @@ pub fn parse_member_catalog(
         commented,
     };
     Ok((catalog, warnings))
+}
+
+/// The member of a row read as `shape`, `mag` and `lum`, at its position as written.
+fn member_of(row: &Row<'_>, shape: &Shape, mag: f64, lum: f64) -> Member {
+    Member {
+        id: row.fields[0].into(),
+        position: shape.raw,
+        a_arcsec: shape.a,
+        b_arcsec: shape.b,
+        theta_deg: shape.theta,
+        mag,
+        lum,
+        line: row.line,
+    }
 }
 
 /// The members of `table`'s commented rows that read in full (a measured magnitude, a valid
@@ -220,16 +227,7 @@ fn commented_members(
             continue;
         }
         raw.push(shape.raw);
-        out.push(Member {
-            id: row.fields[0].into(),
-            position: shape.raw,
-            a_arcsec: shape.a,
-            b_arcsec: shape.b,
-            theta_deg: shape.theta,
-            mag,
-            lum,
-            line: row.line,
-        });
+        out.push(member_of(row, &shape, mag, lum));
     }
     if !raw.is_empty() {
         let (_, positions) = table.coords.into_frame(&raw, Some(frame_ref));

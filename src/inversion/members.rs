@@ -293,6 +293,12 @@ impl MemberConfig {
         self.mass_to_light * self.l_star_lsun * 10f64.powf(-0.4 * (mag - mag_star))
     }
 
+    /// Luminosity in `L*` of a galaxy of apparent magnitude `mag`: its halo mass
+    /// ([`Self::mass_msun`]) over that of an `L*` galaxy.
+    pub fn luminosity_lstar(&self, mag: f64, mag_star: f64) -> f64 {
+        self.mass_msun(mag, mag_star) / (self.mass_to_light * self.l_star_lsun)
+    }
+
     /// Truncation radius in kpc of a halo of mass `mass_msun`: `r_t* (M / M*)^e`.
     pub fn r_trunc_kpc(&self, mass_msun: f64) -> f64 {
         self.r_trunc_lstar_kpc * self.size_scale(mass_msun)
@@ -518,7 +524,7 @@ pub fn build_member_layers(
             id: m.id.clone(),
             position: m.position,
             mag: m.mag,
-            luminosity_lstar: mass_msun / (config.mass_to_light * config.l_star_lsun),
+            luminosity_lstar: config.luminosity_lstar(m.mag, mag_star),
             mass_msun,
             m200_msun,
             c200,

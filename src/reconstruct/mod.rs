@@ -1059,12 +1059,11 @@ pub(crate) fn member_layers(
 ) -> Result<MemberLayers, MembersError> {
     let model = build_member_layers(catalog, config, plane, grid)?;
     let images = image_centres(constraints);
-    let lstar_lsun = config.mass_to_light * config.l_star_lsun;
     let mag_star = config.mag_star_on(plane);
     let commented: Vec<(&Member, f64)> = catalog
         .commented
         .iter()
-        .map(|m| (m, config.mass_msun(m.mag, mag_star) / lstar_lsun))
+        .map(|m| (m, config.luminosity_lstar(m.mag, mag_star)))
         .collect();
     let bcg = missing_bcg_warning(&catalog.source_name, &model.halos, &images, &commented);
     let central_galaxy_missing = bcg.is_some();
