@@ -94,7 +94,9 @@ impl Session {
     }
 
     /// The loaded files parsed into one frame (see [`LoadedData::parse`]); its warnings
-    /// begin with [`Self::sky_warnings`].
+    /// begin with [`Self::sky_warnings`]. The galaxies of the loaded `.par` are members when
+    /// the setting `members_from_model` is on, and a commented-out BCG row is fitted when
+    /// `reconstruct.members.fit_commented_bcg` is ([`Dataset::fit_commented_bcg`]).
     pub fn parsed(&self) -> Result<Dataset, AppError> {
         let mut parsed = self
             .data
@@ -110,6 +112,8 @@ impl Session {
                 parsed.warnings.extend(notes);
             }
         }
+        // The run's warnings say so when it fits a commented-out BCG row.
+        parsed.fit_commented_bcg(&self.settings.lens_plane()?, &self.settings.reconstruct);
         Ok(parsed)
     }
 

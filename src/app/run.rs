@@ -353,7 +353,7 @@ impl Session {
         let mut warnings = parsed.warnings.clone();
         warnings.extend(shear_warning);
         warnings.extend(unfitted);
-        let (mut central_galaxy_missing, mut commented_bcg) = (false, None);
+        let (mut central_galaxy_missing, mut commented_bcg, mut fitted_bcg) = (false, None, None);
         let layers: Vec<Layer> = match &parsed.members {
             None => Vec::new(),
             Some(m) => {
@@ -362,6 +362,7 @@ impl Session {
                 warnings.extend(members.warnings);
                 central_galaxy_missing = members.central_galaxy_missing;
                 commented_bcg = members.commented_bcg;
+                fitted_bcg = m.fitted_bcg.as_ref().map(|b| b.row.clone());
                 members.layers
             }
         };
@@ -400,6 +401,7 @@ impl Session {
                 member_positions_arcsec: parsed.members_arcsec(),
                 central_galaxy_missing,
                 commented_bcg,
+                fitted_bcg,
             })),
             marks: parsed.marks(),
             elapsed_ms: t.ms(),

@@ -185,6 +185,7 @@ pub fn parse_member_catalog(
         reference: Some(frame_ref),
         members,
         commented,
+        fitted_bcg: None,
     };
     Ok((catalog, warnings))
 }

@@ -91,6 +91,15 @@ pub struct CatalogRow {
     pub id: String,
 }
 
+/// A commented-out member row that is most likely the brightest cluster galaxy (BCG): near the
+/// multiple images, bright enough, where no fitted member is (`missing_bcg_warning` in the
+/// inversion). `note` says so in a sentence naming the file and the line.
+#[derive(Debug, Clone, PartialEq, Eq, Serialize, Deserialize)]
+pub struct CommentedBcg {
+    pub row: CatalogRow,
+    pub note: String,
+}
+
 /// A parsed member (potfile) catalogue.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct MemberCatalog {
@@ -102,6 +111,10 @@ pub struct MemberCatalog {
     /// Lenstool set-ups often comment out because the `.par` models it on its own.
     #[serde(default)]
     pub commented: Vec<Member>,
+    /// The commented-out row a run fits as the BCG, moved from `commented` to `members`
+    /// (`Dataset::fit_commented_bcg`); a run's warnings carry its note.
+    #[serde(default)]
+    pub fitted_bcg: Option<CommentedBcg>,
 }
 
 impl ImageCatalog {

@@ -231,6 +231,8 @@ pub fn run(args: &ReconstructArgs) -> Result<(), String> {
             eprintln!("note: {note}");
         }
     }
+    // The run's warnings say so when it fits a commented-out BCG row.
+    data.fit_commented_bcg(&plane, &config);
     let unfitted = data.unfitted_arcs(config.constraints.mode);
     for w in data.warnings.iter().chain(&unfitted) {
         eprintln!("warning: {w}");

@@ -34,7 +34,7 @@ use serde::{Deserialize, Serialize};
 use thiserror::Error;
 
 use super::cells::CellGrid;
-use crate::catalog::{CatalogRow, Member, MemberCatalog};
+use crate::catalog::{CatalogRow, CommentedBcg, Member, MemberCatalog};
 use crate::cosmology::LensPlane;
 use crate::profiles::{tnfw_total_mass_unit, Lens, MassComponent, Nfw, ProfileError, TruncatedNfw};
 
@@ -186,6 +186,12 @@ pub struct MemberConfig {
     /// Lenstool model of AS1063 fits 100 km/s, where its prior was 158 +- 27 km/s and this
     /// law's L* is about 200 km/s (mass ∝ sigma^2: 0.6 dex below the law). Allowed [0, 2].
     pub mass_to_light_scatter_dex: f64,
+    /// When no member near the multiple images is as bright as a brightest cluster galaxy
+    /// and a commented-out row of the catalogue there is, that row is fitted as the BCG
+    /// (default `true`): Lenstool set-ups model the BCG in the `.par` and comment its row out
+    /// of the potfile catalogue, and without it the grid cannot hold its mass. `false`: the
+    /// row stays out and the run warns instead.
+    pub fit_commented_bcg: bool,
 }
 
 /// Largest `MemberConfig::mass_to_light` a run accepts (Msun/Lsun).
@@ -213,6 +219,7 @@ impl Default for MemberConfig {
             c_prior_sigma: None,
             c_prior_sigma_unmeasured: Some(0.1),
             mass_to_light_scatter_dex: 0.3,
+            fit_commented_bcg: true,
         }
     }
 }
@@ -596,49 +603,55 @@ pub const BCG_MIN_LSTAR: f64 = 4.0;
 /// A warning when no member near the multiple images is as bright as a brightest cluster
 /// galaxy ([`BCG_MIN_LSTAR`]), `None` otherwise (or without members or images).
 ///
-/// "Near" is within the median distance of the images (`images`, arcsec) from their centroid.
-/// Lenstool set-ups often model the BCG as its own `potentiel` in the `.par` and leave it out
-/// of the potfile catalogue (both real catalogues this crate is measured on do), and a grid
-/// whose cells are several arcsec wide cannot hold that much mass in so small a place: on
-/// MACS1931 the held-out images move from 1.78 to 1.41 arcsec when the catalogue's commented
-/// BCG row is restored (BENCHMARKS.md). The cure is the user's: add the row.
+/// `members` and `commented` are the catalogue's rows and its commented-out rows
+/// ([`MemberCatalog::commented`]), each with its luminosity in `L*`
+/// ([`MemberConfig::luminosity_lstar`]). "Near" is within the median distance of the images
+/// (`images`, arcsec) from their centroid. Lenstool set-ups often model the BCG as its own
+/// `potentiel` in the `.par` and leave it out of the potfile catalogue (both real catalogues
+/// this crate is measured on do), and a grid whose cells are several arcsec wide cannot hold
+/// that much mass in so small a place: on MACS1931 the held-out images move from 1.78 to 1.41
+/// arcsec when the catalogue's commented BCG row is fitted (BENCHMARKS.md).
 ///
-/// `commented` are the catalogue's commented-out rows with their luminosity in `L*`
-/// ([`MemberCatalog::commented`]): when one of them near the images is bright enough, the
-/// warning names its line, since a set-up that models the BCG in the `.par` often keeps its
-/// row commented out in the catalogue.
+/// When a commented-out row near the images is bright enough, the result names it
+/// ([`MissingBcg::commented`]): a set-up that models the BCG in the `.par` often keeps its row
+/// commented out in the catalogue, and a run fits it by default
+/// ([`MemberConfig::fit_commented_bcg`], `Dataset::fit_commented_bcg`).
 pub fn missing_bcg_warning(
     catalog_name: &str,
-    halos: &[MemberHalo],
+    members: &[(&Member, f64)],
     images: &[DVec2],
     commented: &[(&Member, f64)],
 ) -> Option<MissingBcg> {
-    if halos.is_empty() || images.is_empty() {
+    if members.is_empty() || images.is_empty() {
         return None;
     }
     let centre = images.iter().copied().sum::<DVec2>() / images.len() as f64;
     let mut distances: Vec<f64> = images.iter().map(|p| p.distance(centre)).collect();
     distances.sort_by(f64::total_cmp);
     let radius = crate::stats::quantile(&distances, 0.5).max(1.0);
-    let brightest = halos
-        .iter()
-        .filter(|h| h.position.distance(centre) <= radius)
-        .max_by(|a, b| a.luminosity_lstar.total_cmp(&b.luminosity_lstar));
-    if brightest.is_some_and(|h| h.luminosity_lstar >= BCG_MIN_LSTAR) {
+    let brightest_near = |rows: &[(&Member, f64)]| {
+        rows.iter()
+            .filter(|(m, _)| m.position.distance(centre) <= radius)
+            .max_by(|a, b| a.1.total_cmp(&b.1))
+            .map(|&(m, lstar)| (m.clone(), lstar))
+    };
+    let brightest = brightest_near(members);
+    if brightest.as_ref().is_some_and(|b| b.1 >= BCG_MIN_LSTAR) {
         return None;
     }
-    let there = match brightest {
-        Some(h) => format!(
-            "the brightest there is member {} at mag {:.2} ({:.1} L*)",
-            h.id, h.mag, h.luminosity_lstar
+    let there = match &brightest {
+        Some((m, lstar)) => format!(
+            "the brightest there is member {} at mag {:.2} ({lstar:.1} L*)",
+            m.id, m.mag
         ),
         None => "there is none there".to_string(),
     };
-    let row = commented
-        .iter()
-        .filter(|(m, lstar)| m.position.distance(centre) <= radius && *lstar >= BCG_MIN_LSTAR)
-        .max_by(|a, b| a.1.total_cmp(&b.1));
-    let cure = match row {
+    let finding = format!(
+        "{catalog_name}: no member within {radius:.0} arcsec of the multiple images' centre \
+         is as bright as a brightest cluster galaxy ({BCG_MIN_LSTAR} L* or more): {there}"
+    );
+    let row = brightest_near(commented).filter(|(_, lstar)| *lstar >= BCG_MIN_LSTAR);
+    let cure = match &row {
         Some((m, lstar)) => format!(
             "Line {} comments out member {}, {:.0} arcsec from that centre with mag {:.2} \
              ({lstar:.1} L*): if that is the BCG, remove the '#' to fit it",
@@ -653,45 +666,50 @@ pub fn missing_bcg_warning(
             .to_string(),
     };
     let warning = format!(
-        "{catalog_name}: no member within {radius:.0} arcsec of the multiple images' centre \
-         is as bright as a brightest cluster galaxy ({BCG_MIN_LSTAR} L* \
-         or more): {there}. Lenstool set-ups often model the BCG as its own `potentiel` in the \
-         .par and leave it out of the potfile catalogue (sometimes as a commented row); the \
-         grid cannot hold that much mass in so small a place. {cure}"
+        "{finding}. Lenstool set-ups often model the BCG as its own `potentiel` in the .par and \
+         leave it out of the potfile catalogue (sometimes as a commented row); the grid cannot \
+         hold that much mass in so small a place. {cure}"
     );
-    Some(MissingBcg {
-        warning,
-        commented: row.map(|(m, _)| CatalogRow {
+    let commented = row.map(|(m, lstar)| CommentedBcg {
+        row: CatalogRow {
             line: m.line,
             id: m.id.clone(),
-        }),
-    })
+        },
+        note: format!(
+            "{finding}, but line {} comments out member {} ({:.0} arcsec from that centre, mag \
+             {:.2}, {lstar:.1} L*): it is fitted as the BCG, which Lenstool set-ups model in \
+             the .par and comment out of the potfile catalogue. To leave it out, set \
+             members.fit_commented_bcg to false (in the app: \"Fit a commented-out BCG row\")",
+            m.line,
+            m.id,
+            m.position.distance(centre),
+            m.mag
+        ),
+    });
+    Some(MissingBcg { warning, commented })
 }
 
-/// What [`missing_bcg_warning`] found: its warning and the commented-out row it names, if any.
+/// What [`missing_bcg_warning`] found: its warning and the commented-out row that could be the
+/// BCG, if any.
 #[derive(Debug, Clone, PartialEq)]
 pub struct MissingBcg {
     pub warning: String,
-    pub commented: Option<CatalogRow>,
+    pub commented: Option<CommentedBcg>,
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
 
-    fn halo(id: &str, x: f64, y: f64, luminosity_lstar: f64) -> MemberHalo {
-        MemberHalo {
-            member: 0,
-            id: id.to_string(),
-            position: DVec2::new(x, y),
-            mag: 20.0 - 2.5 * luminosity_lstar.log10(),
-            luminosity_lstar,
-            mass_msun: 1e12 * luminosity_lstar,
-            m200_msun: 1e12 * luminosity_lstar,
-            c200: 10.0,
-            r_s_arcsec: 2.0,
-            r_trunc_arcsec: None,
-        }
+    /// A member of `luminosity_lstar` with `L*` at mag 20.
+    fn halo(id: &str, x: f64, y: f64, luminosity_lstar: f64) -> Member {
+        commented(id, 1, x, y, 20.0 - 2.5 * luminosity_lstar.log10())
+    }
+
+    /// `members` with their luminosity, `L*` at mag 20.
+    fn lum(members: &[Member]) -> Vec<(&Member, f64)> {
+        let lstar = |m: &Member| 10f64.powf(-0.4 * (m.mag - 20.0));
+        members.iter().map(|m| (m, lstar(m))).collect()
     }
 
     /// Four images on a ring of 20 arcsec about (10, -5).
@@ -705,7 +723,7 @@ mod tests {
     fn a_core_without_a_bright_member_is_named() {
         // The brightest member of the catalogue lies far outside the images; inside, an L*.
         let halos = [halo("far", 150.0, 0.0, 20.0), halo("7", 12.0, -3.0, 1.0)];
-        let w = missing_bcg_warning("m.cat", &halos, &ring(), &[])
+        let w = missing_bcg_warning("m.cat", &lum(&halos), &ring(), &[])
             .expect("a warning")
             .warning;
         assert!(w.starts_with("m.cat: no member within 20 arcsec of the multiple images' centre is as bright as a brightest cluster galaxy (4 L* or more)"), "{w}");
@@ -713,8 +731,8 @@ mod tests {
         // The centre is (10, -5): a bright member 20.1 arcsec from it is not counted, and
         // alone it leaves no member there at all.
         let halos = [halo("edge", 10.0, 15.1, 8.0), halo("7", 12.0, -3.0, 1.0)];
-        assert!(missing_bcg_warning("m.cat", &halos, &ring(), &[]).is_some());
-        let w = missing_bcg_warning("m.cat", &halos[..1], &ring(), &[])
+        assert!(missing_bcg_warning("m.cat", &lum(&halos), &ring(), &[]).is_some());
+        let w = missing_bcg_warning("m.cat", &lum(&halos[..1]), &ring(), &[])
             .expect("a warning")
             .warning;
         assert!(w.contains("there is none there"), "{w}");
@@ -742,12 +760,27 @@ mod tests {
         );
         let far = commented("far", 30, 150.0, 0.0, 16.0);
         let rows = [(&faint, 0.02), (&bcg, 9.5), (&far, 20.0)];
-        let found = missing_bcg_warning("m.cat", &halos, &ring(), &rows).expect("a warning");
+        let found = missing_bcg_warning("m.cat", &lum(&halos), &ring(), &rows).expect("a warning");
         let row = CatalogRow {
             line: 10,
             id: "1009".to_string(),
         };
-        assert_eq!(found.commented, Some(row));
+        let named = found.commented.expect("the row is named");
+        assert_eq!(named.row, row);
+        // The note a run that fits it carries says what was found and how to leave it out.
+        assert!(
+            named.note.starts_with(
+                "m.cat: no member within 20 arcsec of the multiple images' centre is as \
+                 bright as a brightest cluster galaxy (4 L* or more): the brightest there is \
+                 member 7 at mag 20.00 (1.0 L*), but line 10 comments out member 1009 (2 \
+                 arcsec from that centre, mag 17.30, 9.5 L*): it is fitted as the BCG"
+            ),
+            "{}",
+            named.note
+        );
+        assert!(named.note.ends_with(
+            "set members.fit_commented_bcg to false (in the app: \"Fit a commented-out BCG row\")"
+        ));
         let w = found.warning;
         assert!(
             w.ends_with(
@@ -757,7 +790,8 @@ mod tests {
             "{w}"
         );
         // Faint or far commented rows are not offered: the generic advice stays.
-        let found = missing_bcg_warning("m.cat", &halos, &ring(), &[rows[0], rows[2]]).unwrap();
+        let found =
+            missing_bcg_warning("m.cat", &lum(&halos), &ring(), &[rows[0], rows[2]]).unwrap();
         assert_eq!(found.commented, None);
         let w = found.warning;
         assert!(w.ends_with(
@@ -769,11 +803,17 @@ mod tests {
     #[test]
     fn a_bright_central_member_or_no_members_need_no_warning() {
         let halos = [halo("far", 150.0, 0.0, 20.0), halo("bcg", 9.0, -4.0, 8.0)];
-        assert_eq!(missing_bcg_warning("m.cat", &halos, &ring(), &[]), None);
+        assert_eq!(
+            missing_bcg_warning("m.cat", &lum(&halos), &ring(), &[]),
+            None
+        );
         // Just at the threshold, and just inside the radius.
         let halos = [halo("bcg", 10.0, 14.9, BCG_MIN_LSTAR)];
-        assert_eq!(missing_bcg_warning("m.cat", &halos, &ring(), &[]), None);
+        assert_eq!(
+            missing_bcg_warning("m.cat", &lum(&halos), &ring(), &[]),
+            None
+        );
         assert_eq!(missing_bcg_warning("m.cat", &[], &ring(), &[]), None);
-        assert_eq!(missing_bcg_warning("m.cat", &halos, &[], &[]), None);
+        assert_eq!(missing_bcg_warning("m.cat", &lum(&halos), &[], &[]), None);
     }
 }

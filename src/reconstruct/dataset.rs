@@ -17,16 +17,16 @@
 
 use thiserror::Error;
 
-use super::{Inputs, LayerSource, ReconstructConfig};
+use super::{image_centres, with_luminosity, Inputs, LayerSource, ReconstructConfig};
 use crate::arcs::{
     arcs_from_regions, is_region_file, parse_arcs, ArcCatalog, ArcsError, RegionArcs,
 };
 use crate::catalog::{
     parse_arclet_catalog, parse_image_catalog, parse_member_catalog, ArcletCatalog, CatalogError,
-    ImageCatalog, MemberCatalog,
+    CatalogRow, ImageCatalog, MemberCatalog,
 };
 use crate::cosmology::LensPlane;
-use crate::inversion::{ConstraintMode, ConstraintSource};
+use crate::inversion::{build_constraints, missing_bcg_warning, ConstraintMode, ConstraintSource};
 use crate::lenstool_par::{LenstoolPar, ParError, ParGalaxies, GALAXY_MAX_CORE_KPC};
 use crate::sky::SkyReference;
 
@@ -153,6 +153,7 @@ impl Dataset {
             reference: par.reference,
             members: rows,
             commented: Vec::new(),
+            fitted_bcg: None,
         };
         match (par.reference, frame) {
             (Some(_), Some(to)) => found = found.reframed(to)?,
@@ -167,6 +168,7 @@ impl Dataset {
             reference: frame.or(par.reference),
             members: Vec::new(),
             commented: Vec::new(),
+            fitted_bcg: None,
         });
         for g in found.members {
             let (x, y) = (g.position.x, g.position.y);
@@ -191,6 +193,48 @@ impl Dataset {
             }
         }
         Ok(notes)
+    }
+
+    /// Fits the member catalogue's commented-out row that is most likely the brightest cluster
+    /// galaxy (BCG), when `config.members.fit_commented_bcg` is on (the default): no member
+    /// near the multiple images is as bright as a BCG and a commented row there is
+    /// (`missing_bcg_warning` in the inversion). Lenstool set-ups model the BCG as its own
+    /// `potentiel` in the `.par` and comment its row out of the potfile catalogue; a run
+    /// without the `.par` has no other way to fit it. The row moves from
+    /// [`MemberCatalog::commented`] to the members, [`MemberCatalog::fitted_bcg`] keeps it with
+    /// a note a run's warnings carry, and it is returned. Call it after
+    /// [`Self::add_par_galaxies`]: a BCG the `.par` gives is not replaced. The multiple images
+    /// are the constraints `config` fits, every system included.
+    pub fn fit_commented_bcg(
+        &mut self,
+        plane: &LensPlane,
+        config: &ReconstructConfig,
+    ) -> Option<CatalogRow> {
+        let members = self.members.as_ref()?;
+        if !config.members.fit_commented_bcg
+            || members.commented.is_empty()
+            || members.fitted_bcg.is_some()
+        {
+            return None;
+        }
+        let (source, _) = self.constraints(config.constraints.mode).ok()?;
+        let constraints = build_constraints(source, &config.constraints, &[]).ok()?;
+        let found = missing_bcg_warning(
+            &members.source_name,
+            &with_luminosity(&members.members, &config.members, plane),
+            &image_centres(&constraints),
+            &with_luminosity(&members.commented, &config.members, plane),
+        )?
+        .commented?;
+        let members = self.members.as_mut()?;
+        let k = members
+            .commented
+            .iter()
+            .position(|m| m.line == found.row.line)?;
+        let row = members.commented.remove(k);
+        members.members.push(row);
+        members.fitted_bcg = Some(found.clone());
+        Some(found.row)
     }
 
     /// The frame's sky reference: the image catalogue's, else the member catalogue's, else the

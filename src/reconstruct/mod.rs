@@ -239,6 +239,9 @@ pub struct Reconstruction {
     /// The member catalogue's commented-out row that could be the missing BCG (the warning
     /// names it; the app offers to fit it).
     pub commented_bcg: Option<CatalogRow>,
+    /// The member catalogue's commented-out row the run fitted as the BCG
+    /// ([`MemberCatalog::fitted_bcg`]; the warnings say why).
+    pub fitted_bcg: Option<CatalogRow>,
 }
 
 /// What one candidate of an "auto" strength sets: the regulariser, its strength and the
@@ -383,6 +386,7 @@ impl Reconstruction {
             c_unmeasured: self.system.members_unmeasured(),
             central_galaxy_missing: self.central_galaxy_missing,
             commented_bcg: self.commented_bcg.as_ref(),
+            fitted_bcg: self.fitted_bcg.as_ref(),
         };
         Verdict::assess(&self.sources, inputs)
     }
@@ -801,7 +805,7 @@ fn reconstruct_limited(
     let (shear, shear_warning) = shear_set(inputs.shear, config, &inputs.plane);
     warnings.extend(shear_warning);
     let mut grid = grid_of(&constraints, &shear, config)?;
-    let (mut central_galaxy_missing, mut commented_bcg) = (false, None);
+    let (mut central_galaxy_missing, mut commented_bcg, mut fitted_bcg) = (false, None, None);
     let mut layers: Vec<Layer> = match inputs.layers {
         LayerSource::None => Vec::new(),
         LayerSource::Given(layers) => layers.to_vec(),
@@ -811,6 +815,7 @@ fn reconstruct_limited(
             warnings.extend(members.warnings);
             central_galaxy_missing = members.central_galaxy_missing;
             commented_bcg = members.commented_bcg;
+            fitted_bcg = catalog.fitted_bcg.as_ref().map(|b| b.row.clone());
             members.layers
         }
     };
@@ -988,6 +993,7 @@ fn reconstruct_limited(
         member_positions_arcsec: member_positions(inputs),
         central_galaxy_missing,
         commented_bcg,
+        fitted_bcg,
     })
 }
 
@@ -1038,7 +1044,8 @@ pub(crate) fn grid_of(
 /// The member layers of a run and what they warn about.
 pub(crate) struct MemberLayers {
     pub layers: Vec<Layer>,
-    /// A missing BCG's warning first (it matters more than the members left out one by one),
+    /// The note of a commented row fitted as the BCG ([`MemberCatalog::fitted_bcg`]) and a
+    /// missing BCG's warning first (they matter more than the members left out one by one),
     /// then [`build_member_layers`]'s.
     pub warnings: Vec<String>,
     /// No member near the images is bright enough to be the brightest cluster galaxy.
@@ -1059,18 +1066,20 @@ pub(crate) fn member_layers(
 ) -> Result<MemberLayers, MembersError> {
     let model = build_member_layers(catalog, config, plane, grid)?;
     let images = image_centres(constraints);
-    let mag_star = config.mag_star_on(plane);
-    let commented: Vec<(&Member, f64)> = catalog
-        .commented
-        .iter()
-        .map(|m| (m, config.luminosity_lstar(m.mag, mag_star)))
-        .collect();
-    let bcg = missing_bcg_warning(&catalog.source_name, &model.halos, &images, &commented);
+    let bcg = missing_bcg_warning(
+        &catalog.source_name,
+        &with_luminosity(&catalog.members, config, plane),
+        &images,
+        &with_luminosity(&catalog.commented, config, plane),
+    );
     let central_galaxy_missing = bcg.is_some();
-    let (mut warnings, commented_bcg) = match bcg {
-        Some(b) => (vec![b.warning], b.commented),
-        None => (Vec::new(), None),
-    };
+    // A commented row fitted as the BCG, then a missing BCG: they matter more than the
+    // members left out one by one.
+    let mut warnings: Vec<String> = catalog.fitted_bcg.iter().map(|b| b.note.clone()).collect();
+    let commented_bcg = bcg.and_then(|b| {
+        warnings.push(b.warning);
+        b.commented.map(|c| c.row)
+    });
     warnings.extend(model.warnings);
     Ok(MemberLayers {
         layers: model.layers,
@@ -1078,6 +1087,19 @@ pub(crate) fn member_layers(
         central_galaxy_missing,
         commented_bcg,
     })
+}
+
+/// Each of `members` with its luminosity in `L*` ([`MemberConfig::luminosity_lstar`]).
+fn with_luminosity<'a>(
+    members: &'a [Member],
+    config: &MemberConfig,
+    plane: &LensPlane,
+) -> Vec<(&'a Member, f64)> {
+    let mag_star = config.mag_star_on(plane);
+    members
+        .iter()
+        .map(|m| (m, config.luminosity_lstar(m.mag, mag_star)))
+        .collect()
 }
 
 /// The centre (mean of its pixels) of each image of the fitted systems, in arcsec.

@@ -225,6 +225,9 @@ pub struct VerdictInputs<'a> {
     pub central_galaxy_missing: bool,
     /// The member catalogue's commented-out row that could be that galaxy, when it has one.
     pub commented_bcg: Option<&'a CatalogRow>,
+    /// The member catalogue's commented-out row that was fitted as that galaxy
+    /// (`Dataset::fit_commented_bcg`).
+    pub fitted_bcg: Option<&'a CatalogRow>,
 }
 
 /// `summary.json`'s `verdict`.
@@ -268,6 +271,8 @@ pub struct Verdict {
     pub central_galaxy_missing: bool,
     /// See [`VerdictInputs::commented_bcg`]: the app offers to fit it.
     pub commented_bcg: Option<CatalogRow>,
+    /// See [`VerdictInputs::fitted_bcg`]: the app names it among the facts.
+    pub fitted_bcg: Option<CatalogRow>,
     /// The worst systems (at most [`WORST_SHOWN`]), worst first: those with a
     /// [`SystemCheck::problem`].
     pub worst: Vec<SystemCheck>,
@@ -522,6 +527,7 @@ impl Verdict {
                 .commented_bcg
                 .filter(|_| inputs.central_galaxy_missing)
                 .cloned(),
+            fitted_bcg: inputs.fitted_bcg.cloned(),
             worst,
         }
     }
@@ -814,6 +820,7 @@ mod tests {
             c_unmeasured,
             central_galaxy_missing: false,
             commented_bcg: None,
+            fitted_bcg: None,
         };
         let v = Verdict::assess(&sources, inputs(true));
         assert_eq!(v.trust, Trust::UsableWithCare);

@@ -171,7 +171,7 @@ test('systems without a redshift have it estimated, or take the one the settings
   }
 });
 
-test('a BCG the member catalogue comments out is offered, and fitted on a click', async () => {
+test('a BCG the member catalogue comments out is fitted, or offered when the setting is off', async () => {
   const app = await openApp();
   try {
     const { page } = app;
@@ -185,8 +185,19 @@ test('a BCG the member catalogue comments out is offered, and fitted on a click'
     await setField(page, '#set-reconstruct-objective-strength', 0.1);
     await setField(page, '#set-reconstruct-constraints-default_z', 2);
     await runToMap(page, '#reconstruct', 120_000);
-    // m1931.cat comments its BCG out (line 10, member 1009.0: the .par models it): the
-    // verdict names it and offers to fit it.
+    // m1931.cat comments its BCG out (line 10, member 1009.0: the .par models it): by default
+    // the run fits it and says so; the verdict has nothing to say about it.
+    const fitted = await page.locator('#run-warnings li').allTextContents();
+    assert.ok(fitted.some((t) => /, but line 10 comments out member 1009\.0 \(\d+ arcsec from that centre, mag 17\.32, [\d.]+ L\*\): it is fitted as the BCG, /.test(t)), fitted.slice(0, 2).join(' | '));
+    assert.doesNotMatch(await page.textContent('#verdict-reasons'), /brightest cluster galaxy/);
+    assert.equal(await page.locator('#fit-commented-bcg').count(), 0);
+    const facts = await page.locator('#verdict-facts li').allTextContents();
+    assert.ok(facts.includes('Brightest cluster galaxy: member 1009.0, commented out on line 10 of the member catalogue, fitted (setting "Fit a commented-out BCG row"; the warnings say why)'), facts.join(' | '));
+    assert.equal(await page.inputValue('#set-reconstruct-members-fit_commented_bcg'), 'true');
+    await page.screenshot({ path: join(ARTIFACTS, 'app-commented-bcg-default.png'), fullPage: true });
+    // Off, the row stays out: the verdict names it and offers to fit it.
+    await setField(page, '#set-reconstruct-members-fit_commented_bcg', 'false');
+    await runToMap(page, '#reconstruct', 120_000);
     const reasons = await page.textContent('#verdict-reasons');
     assert.match(reasons, /No member near the images is bright enough to be the brightest cluster galaxy: the member catalogue comments one out \(member 1009\.0, line 10\); fit it \(see the warnings\)\./);
     const items = await page.locator('#run-warnings li').allTextContents();

@@ -704,7 +704,7 @@ pub(crate) mod real {
     use wslap::einstein_radius_for;
     use wslap::load_lenstool_model;
     use wslap::Reconstruction;
-    use wslap::{parse_image_catalog, parse_member_catalog, MemberCatalog};
+    use wslap::{Dataset, InputText, InputTexts};
 
     /// How far the free-form Einstein radius at z_s = 2 may lie from the published parametric
     /// model's (the issue asks for 25%), with a prior on the member factor C of width
@@ -745,6 +745,9 @@ pub(crate) mod real {
         config
     }
 
+    /// `wslap reconstruct --images IMAGES --members MEMBERS --z-lens Z` with `config`: the
+    /// files read as the CLI and the app read them (a commented-out BCG row fitted when
+    /// `config.members.fit_commented_bcg` says so).
     pub fn run(
         images: &str,
         members: &str,
@@ -752,21 +755,25 @@ pub(crate) mod real {
         config: &ReconstructConfig,
         holdout: &[String],
     ) -> (Reconstruction, ImageCatalog) {
-        let (catalog, _) = parse_image_catalog(&read(&data(images)), images, None).unwrap();
-        let (members, _): (MemberCatalog, _) =
-            parse_member_catalog(&read(&data(members)), members, catalog.reference).unwrap();
-        let plane = LensPlane::new(Cosmology::default(), z_lens).unwrap();
-        let inputs = Inputs {
-            images: ConstraintSource::Catalog(&catalog),
-            layers: LayerSource::Members(&members),
-            plane,
-            reference: catalog.reference,
-            holdout,
-            catalog: Some(&catalog),
-            shear: None,
+        let (images_text, members_text) = (read(&data(images)), read(&data(members)));
+        let files = InputTexts {
+            images: Some(InputText {
+                name: images,
+                text: &images_text,
+            }),
+            members: Some(InputText {
+                name: members,
+                text: &members_text,
+            }),
+            ..InputTexts::default()
         };
-        let r = reconstruct(&inputs, config, &mut quiet).unwrap();
-        (r, catalog)
+        let mut config = config.clone();
+        let mut dataset = Dataset::read(&files, config.constraints.pixel_arcsec).unwrap();
+        let plane = LensPlane::new(Cosmology::default(), z_lens).unwrap();
+        dataset.fit_commented_bcg(&plane, &config);
+        let inputs = dataset.inputs(plane, holdout, &mut config).unwrap();
+        let r = reconstruct(&inputs, &config, &mut quiet).unwrap();
+        (r, dataset.images.clone().unwrap())
     }
 
     /// Share of fitted systems with images on both sides of the tangential critical curve
@@ -886,6 +893,60 @@ pub(crate) mod real {
 
 #[cfg(not(target_arch = "wasm32"))]
 #[test]
+fn a_commented_out_bcg_row_is_fitted_unless_the_settings_say_not() {
+    use real::*;
+    use wslap::{Dataset, InputText, InputTexts};
+    let read_macs = || {
+        let (i, m) = (
+            read(&data("MACS1931/lenstool_cats/immul_ongoing.cat")),
+            read(&data("MACS1931/lenstool_cats/m1931.cat")),
+        );
+        let files = InputTexts {
+            images: Some(InputText {
+                name: "immul_ongoing.cat",
+                text: &i,
+            }),
+            members: Some(InputText {
+                name: "m1931.cat",
+                text: &m,
+            }),
+            ..InputTexts::default()
+        };
+        Dataset::read(&files, 0.2).unwrap()
+    };
+    let plane = LensPlane::new(Cosmology::default(), 0.352).unwrap();
+    let mut config = ReconstructConfig::default();
+    let mut data = read_macs();
+    let (members, commented) = {
+        let m = data.members.as_ref().unwrap();
+        (m.members.len(), m.commented.len())
+    };
+    let row = data
+        .fit_commented_bcg(&plane, &config)
+        .expect("line 10 fitted");
+    assert_eq!((row.line, row.id.as_str()), (10, "1009.0"));
+    let m = data.members.as_ref().unwrap();
+    assert_eq!(
+        (m.members.len(), m.commented.len()),
+        (members + 1, commented - 1)
+    );
+    assert_eq!(m.members.last().unwrap().line, 10);
+    assert!(m.commented.iter().all(|c| c.line != 10));
+    assert_eq!(m.fitted_bcg.as_ref().map(|b| &b.row), Some(&row));
+    // Once there is a BCG, the next commented rows (all fainter than 1 L*) are not fitted.
+    assert_eq!(data.fit_commented_bcg(&plane, &config), None);
+    assert_eq!(data.members.as_ref().unwrap().members.len(), members + 1);
+    // Off, the catalogue stays as written.
+    config.members.fit_commented_bcg = false;
+    let mut data = read_macs();
+    assert_eq!(data.fit_commented_bcg(&plane, &config), None);
+    let m = data.members.as_ref().unwrap();
+    assert_eq!((m.members.len(), m.commented.len()), (members, commented));
+    assert_eq!(m.fitted_bcg, None);
+}
+
+#[cfg(not(target_arch = "wasm32"))]
+#[test]
 fn macs1931_runs_end_to_end_with_a_default_redshift() {
     use real::*;
     let mut config = quick_config();
@@ -917,18 +978,21 @@ fn macs1931_runs_end_to_end_with_a_default_redshift() {
         "systems with unknown z take the default"
     );
     assert!(theta_e > 5.0 && theta_e < 60.0, "Einstein radius {theta_e}");
-    // The catalogue comments its BCG out (line 10, mag 17.325, at the frame's origin): the
-    // run says so, naming the line to uncomment.
-    assert!(r.central_galaxy_missing);
+    // The catalogue comments its BCG out (line 10, mag 17.325, at its frame's origin, where no
+    // other member is brighter than 1 L*): the run fits it and says so.
+    assert!(!r.central_galaxy_missing);
+    let fitted = r.fitted_bcg.as_ref().expect("the fitted row");
+    assert_eq!((fitted.line, fitted.id.as_str()), (10, "1009.0"));
+    assert_eq!(r.verdict().fitted_bcg.as_ref(), Some(fitted));
     let bcg = r
         .warnings
         .iter()
         .find(|w| w.contains("as bright as a brightest cluster galaxy"))
-        .expect("a missing-BCG warning");
+        .expect("a note on the BCG");
     assert!(
-        bcg.contains(" Line 10 comments out member 1009.0, ")
-            && bcg.contains(" with mag 17.32 (")
-            && bcg.ends_with(" L*): if that is the BCG, remove the '#' to fit it"),
+        bcg.contains(", but line 10 comments out member 1009.0 (")
+            && bcg.contains(" mag 17.32, ")
+            && bcg.contains(" L*): it is fitted as the BCG, "),
         "{bcg}"
     );
     // The curve passes between the images of most systems (measured 0.9).

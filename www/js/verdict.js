@@ -29,6 +29,9 @@ function facts(v) {
   const c = v.members_with_own_curves && v.c_unmeasured ? ' (their mass is assumed: C is hardly measured)' : '';
   // Without member galaxies there is nothing to say about them.
   if (v.members) out.push(`Members with critical curves of their own${z}: ${v.members_with_own_curves}${c}`);
+  if (v.fitted_bcg) {
+    out.push(`Brightest cluster galaxy: member ${v.fitted_bcg.id}, commented out on line ${v.fitted_bcg.line} of the member catalogue, fitted (setting "Fit a commented-out BCG row"; the warnings say why)`);
+  }
   if (v.images_on_curves) {
     out.push(`Observed images on a critical curve (|μ| > 100): ${v.images_on_curves} of ${v.images}`);
   }
