@@ -252,7 +252,8 @@ async function showResult(info) {
   resultKind = info.kind;
   caption(info);
   runNotes(info.summary);
-  showStrengthChoice(info.summary?.strength_choice);
+  showStrengthChoice(info.summary?.strength_choice,
+    (info.summary?.free_redshifts?.systems ?? []).map(([id]) => id));
   showDownloads(info.kind, app);
   showIterates(info.kind === 'reconstruct' ? (await ask('iterates')).iterates : null);
   showEnsemble(info.summary?.ensemble_members ? await ask('ensembleInfo') : null, app);

@@ -158,8 +158,9 @@ const fmt = (v, d = 2) => (v == null ? '–' : Number(v).toFixed(d));
  * `strength_choice`): per candidate strength (and regulariser, when several were tried) the
  * held-out images' median and rms offsets from their predictions, with a bar for the median,
  * and the fitted images' median; the chosen row is marked. `null` (or a choice without
- * candidates) hides it. */
-export function showStrengthChoice(choice) {
+ * candidates) hides it. `estimated`: ids of the systems whose redshift the run estimated
+ * (summary.json's `free_redshifts`), which the candidates' folds do not hold. */
+export function showStrengthChoice(choice, estimated = []) {
   const box = document.getElementById('strength-box');
   const rows = choice?.candidates ?? [];
   if (!rows.length) {
@@ -201,7 +202,9 @@ export function showStrengthChoice(choice) {
     predicted best. Each candidate was tried over ${choice.folds} folds: every fold fits the lens without some of
     the systems and predicts their images, so the held-out offsets say how well the map finds images it was not
     given (smaller is better), while the fitted median says how closely it reproduces those it was given.
-    Offsets from the predictions in arcsec${unmatched ? '; unmatched: held-out images with no predicted image, which count first' : ''}.</p>
+    Offsets from the predictions in arcsec${unmatched ? '; unmatched: held-out images with no predicted image, which count first' : ''}.${
+  estimated.length ? ` ${estimated.length === 1 ? 'System' : 'Systems'} ${estimated.map(esc).join(', ')} had no redshift and ${estimated.length === 1 ? 'is' : 'are'} not in
+    these folds (the redshift is estimated on the chosen map), so these offsets come from fewer systems than the result and its cross-validation.` : ''}</p>
     <div class="table-scroll"><table id="strength-table">
     <thead><tr><th scope="col">${byKind || byGrid ? 'candidate' : 'strength'}</th><th scope="col">held-out median</th>
     <th scope="col">held-out rms</th><th scope="col">fitted median</th>${unmatched ? '<th scope="col">unmatched</th>' : ''}</tr></thead>
