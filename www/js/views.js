@@ -19,7 +19,9 @@ let pin = null; // [x, y] arcsec last clicked on the kappa map: its source's ima
 let busy = false; // a hover question is on its way
 let queued = false; // ask again when it is answered (the cursor moved or the map changed)
 
-/** Asks for the read-out at `point` and shows it; one question at a time, the latest wins. */
+/** Asks for the read-out at `point` and shows it; one question at a time, the latest wins. An
+ * answer that arrives after another view was chosen is dropped: the read-out is of the mass
+ * map, and the tab switch has cleared it. */
 async function readOut() {
   if (!point) return;
   if (busy) { queued = true; return; }
@@ -28,7 +30,7 @@ async function readOut() {
   const readout = document.getElementById('readout');
   try {
     const h = await app.hover(x, y);
-    if (h) {
+    if (h && current === 'kappa') {
       const text = readoutText(h);
       readout.textContent = pin ? `Clicked: ${text}` : text;
     }
@@ -40,11 +42,14 @@ async function readOut() {
 /** The read-out at the pinned point when it was typed, not clicked (no cursor is over it). */
 async function readPin() {
   const readout = document.getElementById('readout');
+  let text;
   try {
-    readout.textContent = `Typed: ${readoutText(await app.pointReadout(pin))}`;
+    text = `Typed: ${readoutText(await app.pointReadout(pin))}`;
   } catch (err) {
-    readout.textContent = `Typed: ${err.message}`;
+    text = `Typed: ${err.message}`;
   }
+  // Another view may have been chosen while the worker answered (see readOut).
+  if (current === 'kappa') readout.textContent = text;
 }
 
 /** Lists the images of the pinned point's source (or hides the list). */
@@ -309,7 +314,8 @@ export function wireViews(appApi) {
   selectTab('kappa');
   const ask = (e, pin) => {
     const el = img();
-    if (el.dataset.view !== 'kappa' || !el.naturalWidth) return;
+    // The mass map still on screen while another view is drawn has no read-out either.
+    if (current !== 'kappa' || el.dataset.view !== 'kappa' || !el.naturalWidth) return;
     const r = el.getBoundingClientRect();
     point = {
       x: (e.clientX - r.left) * el.naturalWidth / r.width,
