@@ -42,7 +42,10 @@ pub struct ReconstructArgs {
     /// text={1.1 z=2.5}, sampled at constraints.pixel_arcsec; '-' regions cut pixels out.
     #[arg(long, value_name = "ARCS.json|ARCS.reg")]
     arcs: Option<PathBuf>,
-    /// Lenstool member catalogue (potfile: id x y a b theta mag lum).
+    /// Lenstool member catalogue (potfile: id x y a b theta mag lum). When no member near the
+    /// multiple images is as bright as a BCG (4 L*) and a commented-out row there is, that row
+    /// is fitted as the BCG and a warning names its line (`members.fit_commented_bcg` in the
+    /// --config file: false leaves it out).
     #[arg(long, value_name = "MEMBERS.cat")]
     members: Option<PathBuf>,
     /// A Lenstool .par of the same cluster (e.g. the published model's bestopt.par): the
