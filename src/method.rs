@@ -279,7 +279,7 @@
 //! it (both real catalogues the crate is measured on: BENCHMARKS.md). When no member within the
 //! median image distance of the images' centroid reaches 4 `L*` (a BCG is typically 5 to 15),
 //! and the catalogue holds such a row commented out (`#` before a line that reads as a member,
-//! as MACS1931's does), that row is fitted as the BCG and the run's warnings name its line
+//! as MACS1931's does; at most 50 `L*`, brighter than any BCG: a star, say), that row is fitted as the BCG and the run's warnings name its line
 //! ([`crate::Dataset::fit_commented_bcg`]; the setting `members.fit_commented_bcg` turns it
 //! off); without one the run warns and asks for the BCG's row. Given the `.par` (`wslap
 //! reconstruct --par`, or the app's setting "Members from the .par"), its dPIE potentials with

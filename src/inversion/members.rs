@@ -600,6 +600,12 @@ fn split_layers(
 /// core whose brightest member stays below 4 `L*` (1.5 magnitudes) has most likely lost it.
 pub const BCG_MIN_LSTAR: f64 = 4.0;
 
+/// Luminosity (in `L*`) above which a commented-out row is not taken for the brightest cluster
+/// galaxy: the most luminous BCGs reach about 25 `L*` (absolute magnitude -25 against `L*`'s
+/// -21.5), so a brighter row is more likely a star or a foreground galaxy the catalogue
+/// commented out for that reason.
+pub const BCG_MAX_LSTAR: f64 = 50.0;
+
 /// A warning when no member near the multiple images is as bright as a brightest cluster
 /// galaxy ([`BCG_MIN_LSTAR`]), `None` otherwise (or without members or images).
 ///
@@ -612,7 +618,8 @@ pub const BCG_MIN_LSTAR: f64 = 4.0;
 /// that much mass in so small a place: on MACS1931 the held-out images move from 1.78 to 1.41
 /// arcsec when the catalogue's commented BCG row is fitted (BENCHMARKS.md).
 ///
-/// When a commented-out row near the images is bright enough, the result names it
+/// When a commented-out row near the images is bright enough (and not too bright:
+/// [`BCG_MAX_LSTAR`]), the result names it
 /// ([`MissingBcg::commented`]): a set-up that models the BCG in the `.par` often keeps its row
 /// commented out in the catalogue, and a run fits it by default
 /// ([`MemberConfig::fit_commented_bcg`], `Dataset::fit_commented_bcg`).
@@ -650,7 +657,12 @@ pub fn missing_bcg_warning(
         "{catalog_name}: no member within {radius:.0} arcsec of the multiple images' centre \
          is as bright as a brightest cluster galaxy ({BCG_MIN_LSTAR} L* or more): {there}"
     );
-    let row = brightest_near(commented).filter(|(_, lstar)| *lstar >= BCG_MIN_LSTAR);
+    let bcg_like: Vec<(&Member, f64)> = commented
+        .iter()
+        .copied()
+        .filter(|(_, lstar)| (BCG_MIN_LSTAR..=BCG_MAX_LSTAR).contains(lstar))
+        .collect();
+    let row = brightest_near(&bcg_like);
     let cure = match &row {
         Some((m, lstar)) => format!(
             "Line {} comments out member {}, {:.0} arcsec from that centre with mag {:.2} \
@@ -789,6 +801,13 @@ mod tests {
             ),
             "{w}"
         );
+        // Too bright to be a galaxy of the cluster: a star, say, is passed over for the BCG.
+        let star = commented("star", 5, 9.0, -4.0, 12.0);
+        let with_star = [rows[0], (&star, 400.0), rows[1], rows[2]];
+        let found = missing_bcg_warning("m.cat", &lum(&halos), &ring(), &with_star).unwrap();
+        assert_eq!(found.commented.map(|c| c.row.line), Some(10));
+        let found = missing_bcg_warning("m.cat", &lum(&halos), &ring(), &with_star[..2]).unwrap();
+        assert_eq!(found.commented, None);
         // Faint or far commented rows are not offered: the generic advice stays.
         let found =
             missing_bcg_warning("m.cat", &lum(&halos), &ring(), &[rows[0], rows[2]]).unwrap();
