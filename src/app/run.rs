@@ -362,7 +362,7 @@ impl Session {
                 warnings.extend(members.warnings);
                 central_galaxy_missing = members.central_galaxy_missing;
                 commented_bcg = members.commented_bcg;
-                fitted_bcg = m.fitted_bcg.as_ref().map(|b| b.row.clone());
+                fitted_bcg = members.fitted_bcg;
                 members.layers
             }
         };

@@ -815,7 +815,7 @@ fn reconstruct_limited(
             warnings.extend(members.warnings);
             central_galaxy_missing = members.central_galaxy_missing;
             commented_bcg = members.commented_bcg;
-            fitted_bcg = catalog.fitted_bcg.as_ref().map(|b| b.row.clone());
+            fitted_bcg = members.fitted_bcg;
             members.layers
         }
     };
@@ -1052,6 +1052,8 @@ pub(crate) struct MemberLayers {
     pub central_galaxy_missing: bool,
     /// The catalogue's commented-out row that could be it, when there is one.
     pub commented_bcg: Option<CatalogRow>,
+    /// The catalogue's commented-out row fitted as the BCG ([`MemberCatalog::fitted_bcg`]).
+    pub fitted_bcg: Option<CatalogRow>,
 }
 
 /// The layers of `catalog`'s members on `grid` ([`build_member_layers`]), checked for a missing
@@ -1086,6 +1088,7 @@ pub(crate) fn member_layers(
         warnings,
         central_galaxy_missing,
         commented_bcg,
+        fitted_bcg: catalog.fitted_bcg.as_ref().map(|b| b.row.clone()),
     })
 }
 
