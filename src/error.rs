@@ -1,4 +1,5 @@
-//! The error every settings check shares: a field whose value is outside what a run can use.
+//! The error every settings check shares: a field whose value is outside what a run can use;
+//! and the small helpers that write messages for people.
 
 use std::borrow::Cow;
 
@@ -43,6 +44,16 @@ pub(crate) fn number(value: f64) -> String {
         format!("{value:e}")
     } else {
         value.to_string()
+    }
+}
+
+/// `items` joined as English lists them: "a", "a and b", "a, b and c".
+pub(crate) fn and_list(items: impl Iterator<Item = String>) -> String {
+    let items: Vec<String> = items.collect();
+    match items.split_last() {
+        None => String::new(),
+        Some((last, [])) => last.clone(),
+        Some((last, rest)) => format!("{} and {last}", rest.join(", ")),
     }
 }
 

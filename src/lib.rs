@@ -102,8 +102,8 @@ pub use radial::{radial_profile, rect_disc_area, RadialBins, RadialError, Radial
 pub use arcs::{arcs_from_regions, parse_arcs, ArcCatalog, ArcSystem, ArcsError};
 pub use catalog::{
     arclet_ellipticity, parse_arclet_catalog, parse_image_catalog, parse_member_catalog, Arclet,
-    ArcletCatalog, CatalogError, CatalogRow, Image, ImageCatalog, ImageSystem, Member,
-    MemberCatalog, DEGREE_LOOKALIKE, FIELD_ERROR_DEG, FIELD_WARN_DEG, MAG_NO_MEASUREMENT,
+    ArcletCatalog, CatalogError, CatalogRow, CommentedBcgs, Image, ImageCatalog, ImageSystem,
+    Member, MemberCatalog, DEGREE_LOOKALIKE, FIELD_ERROR_DEG, FIELD_WARN_DEG, MAG_NO_MEASUREMENT,
     Z_AGREEMENT_TOL,
 };
 pub use ds9::{
@@ -165,9 +165,10 @@ pub use reconstruct::{
 
 // The verdict on a reconstruction and its thresholds.
 pub use reconstruct::{
-    members_with_own_curves, FAR_MORE_PREDICTED_FACTOR, FLAG_OFFSET_ARCSEC, GOOD_FIT_OFFSET_ARCSEC,
-    GOOD_HOLDOUT_OFFSET_ARCSEC, LOST_IMAGE_ARCSEC, LOST_SYSTEMS_SHARE, MAIN_CURVE_MIN_SHARE,
-    ON_CURVE_MAGNIFICATION, ON_CURVE_SHARE, SMALL_SCALE_OFFSET_ARCSEC, WORST_SHOWN,
+    members_with_own_curves, BcgFacts, FAR_MORE_PREDICTED_FACTOR, FLAG_OFFSET_ARCSEC,
+    GOOD_FIT_OFFSET_ARCSEC, GOOD_HOLDOUT_OFFSET_ARCSEC, LOST_IMAGE_ARCSEC, LOST_SYSTEMS_SHARE,
+    MAIN_CURVE_MIN_SHARE, ON_CURVE_MAGNIFICATION, ON_CURVE_SHARE, SMALL_SCALE_OFFSET_ARCSEC,
+    WORST_SHOWN,
 };
 
 // Figures.

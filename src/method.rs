@@ -278,13 +278,15 @@
 //! arcsec wide cannot hold a galaxy of about ten `L*` at the centre, and the map is worse for
 //! it (both real catalogues the crate is measured on: BENCHMARKS.md). When no member within the
 //! median image distance of the images' centroid reaches 4 `L*` (a BCG is typically 5 to 15),
-//! and the catalogue holds such a row commented out (`#` before a line that reads as a member,
-//! as MACS1931's does; at most 50 `L*`, brighter than any BCG: a star, say), that row is fitted as the BCG and the run's warnings name its line
-//! ([`crate::Dataset::fit_commented_bcg`]; the setting `members.fit_commented_bcg` turns it
-//! off); without one the run warns and asks for the BCG's row. Given the `.par` (`wslap
+//! and the catalogue holds such rows commented out (`#` before a line that reads as a member,
+//! as MACS1931's does; at most 50 `L*`, brighter than any BCG: a star, say), every such row
+//! near the images is fitted (one BCG per core of a cluster with several) and the run's
+//! warnings name the lines ([`crate::Dataset::fit_commented_bcgs`]; the setting
+//! `members.fit_commented_bcg` turns it off); without one the run warns and asks for the BCG's
+//! row. Given the `.par` (`wslap
 //! reconstruct --par`, or the app's setting "Members from the .par"), its dPIE potentials with
 //! a core of at most 5 kpc and a `mag` become members, placed through the sky from the `.par`'s
-//! frame ([`crate::Dataset::add_par_galaxies`]), before a commented row is looked for. The run
+//! frame ([`crate::Dataset::add_par_galaxies`]), before commented rows are looked for. The run
 //! does not guess a position: a galaxy of ten `L*` put at the peak of a grid-only first
 //! solution helps the synthetic clusters but misses the real BCGs by 1 - 5 arcsec and makes
 //! both real catalogues worse (BENCHMARKS.md); a commented row is the catalogue's own position

@@ -183,7 +183,7 @@ async function render() {
 
 function caption(info) {
   showVerdict(info.summary.verdict,
-    { fitRow: fitCommentedRow, modelGalaxies: info.model_galaxies ?? [], fitModel: fitModelGalaxies });
+    { fitRows: fitCommentedRows, modelGalaxies: info.model_galaxies ?? [], fitModel: fitModelGalaxies });
   const s = info.summary.maps ?? info.summary;
   // The solver, when it is not the paper's QADP.
   const best = info.summary.settings?.solver?.method === 'accelerated_gradient'
@@ -667,11 +667,13 @@ async function newProject() {
   $('status').append(undo);
 }
 
-/** The verdict's offer: the member catalogue's commented-out row `{line, id}` (the BCG a
- * Lenstool set-up models in its .par) becomes a member, and the reconstruction runs again. */
-async function fitCommentedRow({ line, id }) {
-  await changeThenReconstruct(`Member ${id} was not fitted`, async () => {
-    const report = await ask('uncommentMember', { line });
+/** The verdict's offer: the member catalogue's commented-out rows `[{line, id}]` (the BCGs a
+ * Lenstool set-up models in its .par, one per core) become members, and the reconstruction
+ * runs again. */
+async function fitCommentedRows(rows) {
+  const ids = rows.map((r) => r.id).join(', ');
+  await changeThenReconstruct(`Member${rows.length > 1 ? 's' : ''} ${ids} ${rows.length > 1 ? 'were' : 'was'} not fitted`, async () => {
+    const report = await ask('uncommentMembers', { lines: rows.map((r) => r.line) });
     setFileStatus('members', reportText(report));
     clearCrossval();
     await refreshLoaded();

@@ -56,7 +56,7 @@ const valueAt = (obj, path) => path.split('.').reduce((o, k) => (o == null ? und
 
 const handlers = {
   loadText: (m) => session.load_text(m.role, m.name, m.text),
-  uncommentMember: (m) => session.uncomment_member(m.line),
+  uncommentMembers: (m) => session.uncomment_members(Uint32Array.from(m.lines)),
   clear: (m) => session.clear(m.role),
   loadFits: (m) => session.load_fits(m.axis, m.name, new Uint8Array(m.bytes)),
   settings: () => session.settings(),

@@ -448,13 +448,14 @@ impl LoadedData {
             .map(Some)
     }
 
-    /// Makes the commented-out row on `line` (1-based) of the loaded member catalogue a member:
-    /// the line's leading `#`s go and the catalogue is checked and kept as [`Self::load_text`]
-    /// does. The line must be commented out and read as one more member once it is not; on an
-    /// error the catalogue stays as it was.
-    pub fn uncomment_member(
+    /// Makes the commented-out rows on `lines` (1-based) of the loaded member catalogue members
+    /// (e.g. the BCGs a result's verdict names, one per core): the lines' leading `#`s go and
+    /// the catalogue is checked and kept as [`Self::load_text`] does. Each line must be
+    /// commented out and read as one more member once it is not; on an error the catalogue
+    /// stays as it was, every line included.
+    pub fn uncomment_members(
         &mut self,
-        line: usize,
+        lines: &[usize],
         arc_pixel_arcsec: f64,
         par_options: &ParOptions,
     ) -> Result<LoadReport, AppError> {
@@ -463,32 +464,41 @@ impl LoadedData {
                 "load a member catalogue first".to_string(),
             ));
         };
-        let at = line.checked_sub(1).and_then(|i| text.split('\n').nth(i));
-        let Some(old) = at.filter(|l| l.trim_start().starts_with('#')) else {
-            return Err(AppError::File(format!(
-                "{name}: line {line} is not a commented-out row"
-            )));
-        };
+        if lines.is_empty() {
+            return Err(AppError::File(format!("{name}: no line to uncomment")));
+        }
         let count = |t: &str| parse_member_catalog(t, &name, None).map(|(c, _)| c.members.len());
-        let before = count(&text).map_err(|e| AppError::File(e.to_string()))?;
-        // Every leading `#` goes, as the catalogue reader strips them (`##7 ...` reads as 7).
-        let body = old.trim_start();
-        let new = format!(
-            "{}{}",
-            &old[..old.len() - body.len()],
-            body.trim_start_matches('#')
-        );
-        let edited: Vec<&str> = text
-            .split('\n')
-            .enumerate()
-            .map(|(i, l)| if i + 1 == line { new.as_str() } else { l })
-            .collect();
-        let edited = edited.join("\n");
-        if count(&edited).ok() != Some(before + 1) {
-            return Err(AppError::File(format!(
-                "{name}: line {line} does not read as a member without its '#': {}",
-                old.trim()
-            )));
+        let mut edited = text.clone();
+        for &line in lines {
+            let rows: Vec<&str> = edited.split('\n').collect();
+            let at = line.checked_sub(1).and_then(|i| rows.get(i).copied());
+            let Some(old) = at.filter(|l| l.trim_start().starts_with('#')) else {
+                return Err(AppError::File(format!(
+                    "{name}: line {line} is not a commented-out row"
+                )));
+            };
+            let before = count(&edited).map_err(|e| AppError::File(e.to_string()))?;
+            // Every leading `#` goes, as the catalogue reader strips them (`##7 ...` reads
+            // as 7).
+            let body = old.trim_start();
+            let new = format!(
+                "{}{}",
+                &old[..old.len() - body.len()],
+                body.trim_start_matches('#')
+            );
+            let next = rows
+                .iter()
+                .enumerate()
+                .map(|(i, l)| if i + 1 == line { new.as_str() } else { l })
+                .collect::<Vec<&str>>()
+                .join("\n");
+            if count(&next).ok() != Some(before + 1) {
+                return Err(AppError::File(format!(
+                    "{name}: line {line} does not read as a member without its '#': {}",
+                    old.trim()
+                )));
+            }
+            edited = next;
         }
         let mut report = self.load_text(
             DataRole::Members,
@@ -497,7 +507,9 @@ impl LoadedData {
             arc_pixel_arcsec,
             par_options,
         )?;
-        report.summary = format!("{} (line {line} uncommented)", report.summary);
+        let which = crate::error::and_list(lines.iter().map(|l| l.to_string()));
+        let s = if lines.len() == 1 { "" } else { "s" };
+        report.summary = format!("{} (line{s} {which} uncommented)", report.summary);
         Ok(report)
     }
 

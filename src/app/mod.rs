@@ -95,8 +95,8 @@ impl Session {
 
     /// The loaded files parsed into one frame (see [`LoadedData::parse`]); its warnings
     /// begin with [`Self::sky_warnings`]. The galaxies of the loaded `.par` are members when
-    /// the setting `members_from_model` is on, and a commented-out BCG row is fitted when
-    /// `reconstruct.members.fit_commented_bcg` is ([`Dataset::fit_commented_bcg`]).
+    /// the setting `members_from_model` is on, and commented-out BCG rows are fitted when
+    /// `reconstruct.members.fit_commented_bcg` is ([`Dataset::fit_commented_bcgs`]).
     pub fn parsed(&self) -> Result<Dataset, AppError> {
         let mut parsed = self
             .data
@@ -112,8 +112,8 @@ impl Session {
                 parsed.warnings.extend(notes);
             }
         }
-        // The run's warnings say so when it fits a commented-out BCG row.
-        parsed.fit_commented_bcg(&self.settings.lens_plane()?, &self.settings.reconstruct);
+        // The run's warnings say so when it fits commented-out BCG rows.
+        parsed.fit_commented_bcgs(&self.settings.lens_plane()?, &self.settings.reconstruct);
         Ok(parsed)
     }
 
@@ -172,12 +172,12 @@ impl Session {
         }
     }
 
-    /// Fits the commented-out row on `line` of the loaded member catalogue (e.g. the BCG a
-    /// result's verdict names: `Verdict::commented_bcg`); see [`LoadedData::uncomment_member`].
-    pub fn uncomment_member(&mut self, line: usize) -> Result<LoadReport, AppError> {
+    /// Fits the commented-out rows on `lines` of the loaded member catalogue (e.g. the BCGs a
+    /// result's verdict names: `BcgFacts::commented`); see [`LoadedData::uncomment_members`].
+    pub fn uncomment_members(&mut self, lines: &[usize]) -> Result<LoadReport, AppError> {
         let pixel = self.settings.reconstruct.constraints.pixel_arcsec;
         let par = self.settings.par_options();
-        self.data.uncomment_member(line, pixel, &par)
+        self.data.uncomment_members(lines, pixel, &par)
     }
 
     /// The last result, or an error saying that nothing was computed yet.

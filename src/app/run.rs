@@ -14,7 +14,7 @@ use crate::reconstruct::{
     ReconstructConfig, ReconstructError, Reconstruction, RunSize, RunStatus, SourceReport,
     StageTimings, StrengthCandidate, StrengthChoice, DEFAULT_FOLDS,
 };
-use crate::reconstruct::{member_layers, shear_set};
+use crate::reconstruct::{member_layers, shear_set, BcgFacts};
 use crate::solver::{Control, Iterate};
 
 use super::data::{DataMarks, DataViews};
@@ -353,16 +353,14 @@ impl Session {
         let mut warnings = parsed.warnings.clone();
         warnings.extend(shear_warning);
         warnings.extend(unfitted);
-        let (mut central_galaxy_missing, mut commented_bcg, mut fitted_bcg) = (false, None, None);
+        let mut bcg = BcgFacts::default();
         let layers: Vec<Layer> = match &parsed.members {
             None => Vec::new(),
             Some(m) => {
                 let members = member_layers(m, &config.members, &plane, &grid, &constraints)
                     .map_err(|e| run(&e))?;
                 warnings.extend(members.warnings);
-                central_galaxy_missing = members.central_galaxy_missing;
-                commented_bcg = members.commented_bcg;
-                fitted_bcg = members.fitted_bcg;
+                bcg = members.bcg;
                 members.layers
             }
         };
@@ -399,9 +397,7 @@ impl Session {
                 strength_choice: None,
                 free_z: None,
                 member_positions_arcsec: parsed.members_arcsec(),
-                central_galaxy_missing,
-                commented_bcg,
-                fitted_bcg,
+                bcg,
             })),
             marks: parsed.marks(),
             elapsed_ms: t.ms(),

@@ -185,7 +185,7 @@ pub fn parse_member_catalog(
         reference: Some(frame_ref),
         members,
         commented,
-        fitted_bcg: None,
+        fitted_bcgs: None,
     };
     Ok((catalog, warnings))
 }

@@ -83,20 +83,22 @@ pub struct Member {
     pub line: usize,
 }
 
-/// One row of a catalogue, by its 1-based line and id: e.g. the commented-out BCG row a run
-/// offers to fit (`Verdict::commented_bcg`).
+/// One row of a catalogue, by its 1-based line and id: e.g. a commented-out BCG row a run
+/// offers to fit (`BcgFacts::commented`).
 #[derive(Debug, Clone, PartialEq, Eq, Serialize, Deserialize)]
 pub struct CatalogRow {
     pub line: usize,
     pub id: String,
 }
 
-/// A commented-out member row that is most likely the brightest cluster galaxy (BCG): near the
-/// multiple images, bright enough, where no fitted member is (`missing_bcg_warning` in the
-/// inversion). `note` says so in a sentence naming the file and the line.
+/// Commented-out member rows that are most likely the cluster's brightest galaxies (BCGs, one
+/// per core): near the multiple images, bright enough, where no fitted member is
+/// (`missing_bcg_warning` in the inversion). `note` says so in a sentence naming the file and
+/// the lines.
 #[derive(Debug, Clone, PartialEq, Eq, Serialize, Deserialize)]
-pub struct CommentedBcg {
-    pub row: CatalogRow,
+pub struct CommentedBcgs {
+    /// In the file's order; never empty.
+    pub rows: Vec<CatalogRow>,
     pub note: String,
 }
 
@@ -111,10 +113,10 @@ pub struct MemberCatalog {
     /// Lenstool set-ups often comment out because the `.par` models it on its own.
     #[serde(default)]
     pub commented: Vec<Member>,
-    /// The commented-out row a run fits as the BCG, moved from `commented` to `members`
-    /// (`Dataset::fit_commented_bcg`); a run's warnings carry its note.
+    /// The commented-out rows a run fits as BCGs, moved from `commented` to `members`
+    /// (`Dataset::fit_commented_bcgs`); a run's warnings carry their note.
     #[serde(default)]
-    pub fitted_bcg: Option<CommentedBcg>,
+    pub fitted_bcgs: Option<CommentedBcgs>,
 }
 
 impl ImageCatalog {

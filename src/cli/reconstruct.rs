@@ -43,9 +43,9 @@ pub struct ReconstructArgs {
     #[arg(long, value_name = "ARCS.json|ARCS.reg")]
     arcs: Option<PathBuf>,
     /// Lenstool member catalogue (potfile: id x y a b theta mag lum). When no member near the
-    /// multiple images is as bright as a BCG (4 L*) and a commented-out row there is, that row
-    /// is fitted as the BCG and a warning names its line (`members.fit_commented_bcg` in the
-    /// --config file: false leaves it out).
+    /// multiple images is as bright as a BCG (4 L*) and commented-out rows there are (one per
+    /// core), they are fitted as BCGs and a warning names their lines
+    /// (`members.fit_commented_bcg` in the --config file: false leaves them out).
     #[arg(long, value_name = "MEMBERS.cat")]
     members: Option<PathBuf>,
     /// A Lenstool .par of the same cluster (e.g. the published model's bestopt.par): the
@@ -235,7 +235,7 @@ pub fn run(args: &ReconstructArgs) -> Result<(), String> {
         }
     }
     // The run's warnings say so when it fits a commented-out BCG row.
-    data.fit_commented_bcg(&plane, &config);
+    data.fit_commented_bcgs(&plane, &config);
     let unfitted = data.unfitted_arcs(config.constraints.mode);
     for w in data.warnings.iter().chain(&unfitted) {
         eprintln!("warning: {w}");

@@ -34,8 +34,9 @@ use serde::{Deserialize, Serialize};
 use thiserror::Error;
 
 use super::cells::CellGrid;
-use crate::catalog::{CatalogRow, CommentedBcg, Member, MemberCatalog};
+use crate::catalog::{CatalogRow, CommentedBcgs, Member, MemberCatalog};
 use crate::cosmology::LensPlane;
+use crate::error::and_list;
 use crate::profiles::{tnfw_total_mass_unit, Lens, MassComponent, Nfw, ProfileError, TruncatedNfw};
 
 /// What can be wrong with member settings or a member galaxy.
@@ -187,10 +188,10 @@ pub struct MemberConfig {
     /// law's L* is about 200 km/s (mass ∝ sigma^2: 0.6 dex below the law). Allowed [0, 2].
     pub mass_to_light_scatter_dex: f64,
     /// When no member near the multiple images is as bright as a brightest cluster galaxy
-    /// and a commented-out row of the catalogue there is, that row is fitted as the BCG
-    /// (default `true`): Lenstool set-ups model the BCG in the `.par` and comment its row out
-    /// of the potfile catalogue, and without it the grid cannot hold its mass. `false`: the
-    /// row stays out and the run warns instead.
+    /// and commented-out rows of the catalogue there are, those rows are fitted as BCGs (one
+    /// per core; default `true`): Lenstool set-ups model the BCGs in the `.par` and comment
+    /// their rows out of the potfile catalogue, and without them the grid cannot hold their
+    /// mass. `false`: the rows stay out and the run warns instead.
     pub fit_commented_bcg: bool,
 }
 
@@ -618,11 +619,11 @@ pub const BCG_MAX_LSTAR: f64 = 50.0;
 /// that much mass in so small a place: on MACS1931 the held-out images move from 1.78 to 1.41
 /// arcsec when the catalogue's commented BCG row is fitted (BENCHMARKS.md).
 ///
-/// When a commented-out row near the images is bright enough (and not too bright:
-/// [`BCG_MAX_LSTAR`]), the result names it
-/// ([`MissingBcg::commented`]): a set-up that models the BCG in the `.par` often keeps its row
-/// commented out in the catalogue, and a run fits it by default
-/// ([`MemberConfig::fit_commented_bcg`], `Dataset::fit_commented_bcg`).
+/// Every commented-out row near the images that is bright enough (and not too bright:
+/// [`BCG_MAX_LSTAR`]) is named ([`MissingBcg::commented`], in the file's order): a set-up that
+/// models the BCG in the `.par` often keeps its row commented out in the catalogue, one row
+/// for each core of a cluster with several, and a run fits them by default
+/// ([`MemberConfig::fit_commented_bcg`], `Dataset::fit_commented_bcgs`).
 pub fn missing_bcg_warning(
     catalog_name: &str,
     members: &[(&Member, f64)],
@@ -636,17 +637,14 @@ pub fn missing_bcg_warning(
     let mut distances: Vec<f64> = images.iter().map(|p| p.distance(centre)).collect();
     distances.sort_by(f64::total_cmp);
     let radius = crate::stats::quantile(&distances, 0.5).max(1.0);
-    let brightest_near = |rows: &[(&Member, f64)]| {
-        rows.iter()
-            .filter(|(m, _)| m.position.distance(centre) <= radius)
-            .max_by(|a, b| a.1.total_cmp(&b.1))
-            .map(|&(m, lstar)| (m.clone(), lstar))
-    };
-    let brightest = brightest_near(members);
-    if brightest.as_ref().is_some_and(|b| b.1 >= BCG_MIN_LSTAR) {
+    let brightest = members
+        .iter()
+        .filter(|(m, _)| m.position.distance(centre) <= radius)
+        .max_by(|a, b| a.1.total_cmp(&b.1));
+    if brightest.is_some_and(|b| b.1 >= BCG_MIN_LSTAR) {
         return None;
     }
-    let there = match &brightest {
+    let there = match brightest {
         Some((m, lstar)) => format!(
             "the brightest there is member {} at mag {:.2} ({lstar:.1} L*)",
             m.id, m.mag
@@ -657,56 +655,85 @@ pub fn missing_bcg_warning(
         "{catalog_name}: no member within {radius:.0} arcsec of the multiple images' centre \
          is as bright as a brightest cluster galaxy ({BCG_MIN_LSTAR} L* or more): {there}"
     );
-    let bcg_like: Vec<(&Member, f64)> = commented
+    // Every commented row of a BCG's luminosity near the images, in the file's order: a
+    // cluster with two cores has two BCGs, and a set-up that models them in the .par comments
+    // out both.
+    let mut rows: Vec<(&Member, f64)> = commented
         .iter()
         .copied()
-        .filter(|(_, lstar)| (BCG_MIN_LSTAR..=BCG_MAX_LSTAR).contains(lstar))
+        .filter(|(m, lstar)| {
+            (BCG_MIN_LSTAR..=BCG_MAX_LSTAR).contains(lstar) && m.position.distance(centre) <= radius
+        })
         .collect();
-    let row = brightest_near(&bcg_like);
-    let cure = match &row {
-        Some((m, lstar)) => format!(
-            "Line {} comments out member {}, {:.0} arcsec from that centre with mag {:.2} \
-             ({lstar:.1} L*): if that is the BCG, remove the '#' to fit it",
-            m.line,
+    rows.sort_by_key(|(m, _)| m.line);
+    let described = |(m, lstar): &(&Member, f64)| {
+        format!(
+            "{} ({:.0} arcsec from that centre, mag {:.2}, {lstar:.1} L*)",
             m.id,
             m.position.distance(centre),
             m.mag
-        ),
-        None => "If the cluster has one, add its row (id x y a b theta mag lum) to the member \
-                 catalogue, or give the .par that models it (wslap reconstruct --par; in the \
-                 app, load it as the model file)"
-            .to_string(),
+        )
+    };
+    let lines = and_list(rows.iter().map(|(m, _)| m.line.to_string()));
+    let ids = and_list(rows.iter().map(described));
+    let one = rows.len() == 1;
+    let (line_s, member_s, comment_s) = if one {
+        ("line", "member", "comments")
+    } else {
+        ("lines", "members", "comment")
+    };
+    let cure = if rows.is_empty() {
+        "If the cluster has one, add its row (id x y a b theta mag lum) to the member catalogue, \
+         or give the .par that models it (wslap reconstruct --par; in the app, load it as the \
+         model file)"
+            .to_string()
+    } else {
+        format!(
+            "{} {lines} {comment_s} out {member_s} {ids}: if {}, remove the '#' to fit {}",
+            if one { "Line" } else { "Lines" },
+            if one {
+                "that is the BCG"
+            } else {
+                "those are the BCGs"
+            },
+            if one { "it" } else { "them" }
+        )
     };
     let warning = format!(
         "{finding}. Lenstool set-ups often model the BCG as its own `potentiel` in the .par and \
          leave it out of the potfile catalogue (sometimes as a commented row); the grid cannot \
          hold that much mass in so small a place. {cure}"
     );
-    let commented = row.map(|(m, lstar)| CommentedBcg {
-        row: CatalogRow {
-            line: m.line,
-            id: m.id.clone(),
-        },
+    let commented = (!rows.is_empty()).then(|| CommentedBcgs {
+        rows: rows
+            .iter()
+            .map(|(m, _)| CatalogRow {
+                line: m.line,
+                id: m.id.clone(),
+            })
+            .collect(),
         note: format!(
-            "{finding}, but line {} comments out member {} ({:.0} arcsec from that centre, mag \
-             {:.2}, {lstar:.1} L*): it is fitted as the BCG, which Lenstool set-ups model in \
-             the .par and comment out of the potfile catalogue. To leave it out, set \
-             members.fit_commented_bcg to false (in the app: \"Fit a commented-out BCG row\")",
-            m.line,
-            m.id,
-            m.position.distance(centre),
-            m.mag
+            "{finding}, but {line_s} {lines} {comment_s} out {member_s} {ids}: {}, which \
+             Lenstool set-ups model in the .par and comment out of the potfile catalogue. To \
+             leave {} out, set members.fit_commented_bcg to false (in the app: \"Fit \
+             commented-out BCG rows\")",
+            if one {
+                "it is fitted as the BCG"
+            } else {
+                "they are fitted as BCGs"
+            },
+            if one { "it" } else { "them" }
         ),
     });
     Some(MissingBcg { warning, commented })
 }
 
-/// What [`missing_bcg_warning`] found: its warning and the commented-out row that could be the
-/// BCG, if any.
+/// What [`missing_bcg_warning`] found: its warning and the commented-out rows that could be
+/// the cluster's BCGs, if any.
 #[derive(Debug, Clone, PartialEq)]
 pub struct MissingBcg {
     pub warning: String,
-    pub commented: Option<CommentedBcg>,
+    pub commented: Option<CommentedBcgs>,
 }
 
 #[cfg(test)]
@@ -778,7 +805,7 @@ mod tests {
             id: "1009".to_string(),
         };
         let named = found.commented.expect("the row is named");
-        assert_eq!(named.row, row);
+        assert_eq!(named.rows, [row]);
         // The note a run that fits it carries says what was found and how to leave it out.
         assert!(
             named.note.starts_with(
@@ -791,13 +818,13 @@ mod tests {
             named.note
         );
         assert!(named.note.ends_with(
-            "set members.fit_commented_bcg to false (in the app: \"Fit a commented-out BCG row\")"
+            "set members.fit_commented_bcg to false (in the app: \"Fit commented-out BCG rows\")"
         ));
         let w = found.warning;
         assert!(
             w.ends_with(
-                "Line 10 comments out member 1009, 2 arcsec from that centre with mag 17.30 \
-                 (9.5 L*): if that is the BCG, remove the '#' to fit it"
+                "Line 10 comments out member 1009 (2 arcsec from that centre, mag 17.30, 9.5 \
+                 L*): if that is the BCG, remove the '#' to fit it"
             ),
             "{w}"
         );
@@ -805,7 +832,7 @@ mod tests {
         let star = commented("star", 5, 9.0, -4.0, 12.0);
         let with_star = [rows[0], (&star, 400.0), rows[1], rows[2]];
         let found = missing_bcg_warning("m.cat", &lum(&halos), &ring(), &with_star).unwrap();
-        assert_eq!(found.commented.map(|c| c.row.line), Some(10));
+        assert_eq!(found.commented.map(|c| c.rows[0].line), Some(10));
         let found = missing_bcg_warning("m.cat", &lum(&halos), &ring(), &with_star[..2]).unwrap();
         assert_eq!(found.commented, None);
         // Faint or far commented rows are not offered: the generic advice stays.
@@ -817,6 +844,43 @@ mod tests {
             "add its row (id x y a b theta mag lum) to the member catalogue, or give the .par \
              that models it (wslap reconstruct --par; in the app, load it as the model file)"
         ));
+    }
+
+    #[test]
+    fn every_commented_bcg_row_of_a_cluster_with_two_cores_is_named() {
+        // Two cores, each BCG commented out (the synthetic bimodal clusters of BENCHMARKS.md);
+        // the list is in the file's order, not by brightness.
+        let halos = [halo("7", 12.0, -3.0, 1.0)];
+        let east = commented("1", 72, 0.0, -8.0, 18.1);
+        let west = commented("2", 73, 24.0, 0.0, 17.9);
+        let far = commented("far", 80, 150.0, 0.0, 17.0);
+        let rows = [(&west, 7.0), (&far, 9.0), (&east, 6.0)];
+        let found = missing_bcg_warning("m.cat", &lum(&halos), &ring(), &rows).expect("a warning");
+        let named = found.commented.expect("the rows are named");
+        let lines: Vec<(usize, &str)> =
+            named.rows.iter().map(|r| (r.line, r.id.as_str())).collect();
+        assert_eq!(lines, [(72, "1"), (73, "2")]);
+        assert!(
+            named.note.contains(
+                "but lines 72 and 73 comment out members 1 (10 arcsec from that centre, mag \
+                 18.10, 6.0 L*) and 2 (15 arcsec from that centre, mag 17.90, 7.0 L*): they \
+                 are fitted as BCGs, "
+            ),
+            "{}",
+            named.note
+        );
+        assert!(named
+            .note
+            .contains("To leave them out, set members.fit_commented_bcg"));
+        assert!(
+            found.warning.ends_with(
+                "Lines 72 and 73 comment out members 1 (10 arcsec from that centre, mag 18.10, \
+                 6.0 L*) and 2 (15 arcsec from that centre, mag 17.90, 7.0 L*): if those are \
+                 the BCGs, remove the '#' to fit them"
+            ),
+            "{}",
+            found.warning
+        );
     }
 
     #[test]

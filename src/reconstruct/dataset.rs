@@ -23,7 +23,7 @@ use crate::arcs::{
 };
 use crate::catalog::{
     parse_arclet_catalog, parse_image_catalog, parse_member_catalog, ArcletCatalog, CatalogError,
-    CatalogRow, ImageCatalog, MemberCatalog,
+    CatalogRow, ImageCatalog, Member, MemberCatalog,
 };
 use crate::cosmology::LensPlane;
 use crate::inversion::{build_constraints, missing_bcg_warning, ConstraintMode, ConstraintSource};
@@ -153,7 +153,7 @@ impl Dataset {
             reference: par.reference,
             members: rows,
             commented: Vec::new(),
-            fitted_bcg: None,
+            fitted_bcgs: None,
         };
         match (par.reference, frame) {
             (Some(_), Some(to)) => found = found.reframed(to)?,
@@ -168,7 +168,7 @@ impl Dataset {
             reference: frame.or(par.reference),
             members: Vec::new(),
             commented: Vec::new(),
-            fitted_bcg: None,
+            fitted_bcgs: None,
         });
         for g in found.members {
             let (x, y) = (g.position.x, g.position.y);
@@ -195,46 +195,57 @@ impl Dataset {
         Ok(notes)
     }
 
-    /// Fits the member catalogue's commented-out row that is most likely the brightest cluster
-    /// galaxy (BCG), when `config.members.fit_commented_bcg` is on (the default): no member
-    /// near the multiple images is as bright as a BCG and a commented row there is
-    /// (`missing_bcg_warning` in the inversion). Lenstool set-ups model the BCG as its own
-    /// `potentiel` in the `.par` and comment its row out of the potfile catalogue; a run
-    /// without the `.par` has no other way to fit it. The row moves from
-    /// [`MemberCatalog::commented`] to the members, [`MemberCatalog::fitted_bcg`] keeps it with
-    /// a note a run's warnings carry, and it is returned. Call it after
-    /// [`Self::add_par_galaxies`]: a BCG the `.par` gives is not replaced. The multiple images
-    /// are the constraints `config` fits, every system included.
-    pub fn fit_commented_bcg(
+    /// Fits the member catalogue's commented-out rows that are most likely the cluster's
+    /// brightest galaxies (BCGs, one per core), when `config.members.fit_commented_bcg` is on
+    /// (the default): no member near the multiple images is as bright as a BCG and commented
+    /// rows there are (`missing_bcg_warning` in the inversion). Lenstool set-ups model the BCGs
+    /// as their own `potentiel`s in the `.par` and comment their rows out of the potfile
+    /// catalogue; a run without the `.par` has no other way to fit them. The rows move from
+    /// [`MemberCatalog::commented`] to the members, [`MemberCatalog::fitted_bcgs`] keeps them
+    /// with a note a run's warnings carry, and they are returned (none when nothing is
+    /// fitted). Call it after [`Self::add_par_galaxies`]: a BCG the `.par` gives is not
+    /// replaced. The multiple images are the constraints `config` fits, every system included.
+    pub fn fit_commented_bcgs(
         &mut self,
         plane: &LensPlane,
         config: &ReconstructConfig,
-    ) -> Option<CatalogRow> {
-        let members = self.members.as_ref()?;
+    ) -> Vec<CatalogRow> {
+        let Some(members) = self.members.as_ref() else {
+            return Vec::new();
+        };
         if !config.members.fit_commented_bcg
             || members.commented.is_empty()
-            || members.fitted_bcg.is_some()
+            || members.fitted_bcgs.is_some()
         {
-            return None;
+            return Vec::new();
         }
-        let (source, _) = self.constraints(config.constraints.mode).ok()?;
-        let constraints = build_constraints(source, &config.constraints, &[]).ok()?;
-        let found = missing_bcg_warning(
+        let Some(constraints) = self
+            .constraints(config.constraints.mode)
+            .ok()
+            .and_then(|(source, _)| build_constraints(source, &config.constraints, &[]).ok())
+        else {
+            return Vec::new();
+        };
+        let Some(found) = missing_bcg_warning(
             &members.source_name,
             &with_luminosity(&members.members, &config.members, plane),
             &image_centres(&constraints),
             &with_luminosity(&members.commented, &config.members, plane),
-        )?
-        .commented?;
-        let members = self.members.as_mut()?;
-        let k = members
-            .commented
-            .iter()
-            .position(|m| m.line == found.row.line)?;
-        let row = members.commented.remove(k);
-        members.members.push(row);
-        members.fitted_bcg = Some(found.clone());
-        Some(found.row)
+        )
+        .and_then(|m| m.commented) else {
+            return Vec::new();
+        };
+        let Some(members) = self.members.as_mut() else {
+            return Vec::new();
+        };
+        let (fitted, kept): (Vec<Member>, Vec<Member>) = std::mem::take(&mut members.commented)
+            .into_iter()
+            .partition(|m| found.rows.iter().any(|r| r.line == m.line));
+        members.commented = kept;
+        members.members.extend(fitted);
+        let rows = found.rows.clone();
+        members.fitted_bcgs = Some(found);
+        rows
     }
 
     /// The frame's sky reference: the image catalogue's, else the member catalogue's, else the

@@ -43,13 +43,13 @@ pub use sources::{
 };
 pub use summary::{ReconstructSummary, Solved, WeakLensingFit};
 pub use verdict::{
-    members_with_own_curves, SystemCheck, Trust, Verdict, VerdictInputs, FAR_MORE_PREDICTED_FACTOR,
-    FLAG_OFFSET_ARCSEC, GOOD_FIT_OFFSET_ARCSEC, GOOD_HOLDOUT_OFFSET_ARCSEC, LOST_IMAGE_ARCSEC,
-    LOST_SYSTEMS_SHARE, MAIN_CURVE_MIN_SHARE, ON_CURVE_MAGNIFICATION, ON_CURVE_SHARE,
-    SMALL_SCALE_OFFSET_ARCSEC, WORST_SHOWN,
+    members_with_own_curves, BcgFacts, SystemCheck, Trust, Verdict, VerdictInputs,
+    FAR_MORE_PREDICTED_FACTOR, FLAG_OFFSET_ARCSEC, GOOD_FIT_OFFSET_ARCSEC,
+    GOOD_HOLDOUT_OFFSET_ARCSEC, LOST_IMAGE_ARCSEC, LOST_SYSTEMS_SHARE, MAIN_CURVE_MIN_SHARE,
+    ON_CURVE_MAGNIFICATION, ON_CURVE_SHARE, SMALL_SCALE_OFFSET_ARCSEC, WORST_SHOWN,
 };
 
-use crate::catalog::{ArcletCatalog, CatalogRow, ImageCatalog, Member, MemberCatalog};
+use crate::catalog::{ArcletCatalog, ImageCatalog, Member, MemberCatalog};
 use crate::cosmology::LensPlane;
 use crate::image_search::ImageError;
 use crate::inversion::{
@@ -233,15 +233,9 @@ pub struct Reconstruction {
     /// Positions of the member galaxies of the catalogue (arcsec; none for layers given
     /// directly), for the verdict's members with critical curves of their own.
     pub member_positions_arcsec: Vec<DVec2>,
-    /// No member near the images is bright enough to be the brightest cluster galaxy (the
-    /// run warned: `missing_bcg_warning` in the inversion).
-    pub central_galaxy_missing: bool,
-    /// The member catalogue's commented-out row that could be the missing BCG (the warning
-    /// names it; the app offers to fit it).
-    pub commented_bcg: Option<CatalogRow>,
-    /// The member catalogue's commented-out row the run fitted as the BCG
-    /// ([`MemberCatalog::fitted_bcg`]; the warnings say why).
-    pub fitted_bcg: Option<CatalogRow>,
+    /// What the run found about the cluster's brightest galaxies (the warnings say it in
+    /// words: `missing_bcg_warning` in the inversion, [`MemberCatalog::fitted_bcgs`]).
+    pub bcg: BcgFacts,
 }
 
 /// What one candidate of an "auto" strength sets: the regulariser, its strength and the
@@ -384,9 +378,7 @@ impl Reconstruction {
             main_curve_share,
             members_arcsec: &self.member_positions_arcsec,
             c_unmeasured: self.system.members_unmeasured(),
-            central_galaxy_missing: self.central_galaxy_missing,
-            commented_bcg: self.commented_bcg.as_ref(),
-            fitted_bcg: self.fitted_bcg.as_ref(),
+            bcg: self.bcg.clone(),
         };
         Verdict::assess(&self.sources, inputs)
     }
@@ -805,7 +797,7 @@ fn reconstruct_limited(
     let (shear, shear_warning) = shear_set(inputs.shear, config, &inputs.plane);
     warnings.extend(shear_warning);
     let mut grid = grid_of(&constraints, &shear, config)?;
-    let (mut central_galaxy_missing, mut commented_bcg, mut fitted_bcg) = (false, None, None);
+    let mut bcg = BcgFacts::default();
     let mut layers: Vec<Layer> = match inputs.layers {
         LayerSource::None => Vec::new(),
         LayerSource::Given(layers) => layers.to_vec(),
@@ -813,9 +805,7 @@ fn reconstruct_limited(
             let members =
                 member_layers(catalog, &config.members, &inputs.plane, &grid, &constraints)?;
             warnings.extend(members.warnings);
-            central_galaxy_missing = members.central_galaxy_missing;
-            commented_bcg = members.commented_bcg;
-            fitted_bcg = members.fitted_bcg;
+            bcg = members.bcg;
             members.layers
         }
     };
@@ -991,9 +981,7 @@ fn reconstruct_limited(
         strength_choice: None,
         free_z: None,
         member_positions_arcsec: member_positions(inputs),
-        central_galaxy_missing,
-        commented_bcg,
-        fitted_bcg,
+        bcg,
     })
 }
 
@@ -1044,16 +1032,12 @@ pub(crate) fn grid_of(
 /// The member layers of a run and what they warn about.
 pub(crate) struct MemberLayers {
     pub layers: Vec<Layer>,
-    /// The note of a commented row fitted as the BCG ([`MemberCatalog::fitted_bcg`]) and a
+    /// The note of commented rows fitted as BCGs ([`MemberCatalog::fitted_bcgs`]) and a
     /// missing BCG's warning first (they matter more than the members left out one by one),
     /// then [`build_member_layers`]'s.
     pub warnings: Vec<String>,
-    /// No member near the images is bright enough to be the brightest cluster galaxy.
-    pub central_galaxy_missing: bool,
-    /// The catalogue's commented-out row that could be it, when there is one.
-    pub commented_bcg: Option<CatalogRow>,
-    /// The catalogue's commented-out row fitted as the BCG ([`MemberCatalog::fitted_bcg`]).
-    pub fitted_bcg: Option<CatalogRow>,
+    /// What the catalogue's members say about the brightest cluster galaxies.
+    pub bcg: BcgFacts,
 }
 
 /// The layers of `catalog`'s members on `grid` ([`build_member_layers`]), checked for a missing
@@ -1074,21 +1058,29 @@ pub(crate) fn member_layers(
         &images,
         &with_luminosity(&catalog.commented, config, plane),
     );
-    let central_galaxy_missing = bcg.is_some();
-    // A commented row fitted as the BCG, then a missing BCG: they matter more than the
-    // members left out one by one.
-    let mut warnings: Vec<String> = catalog.fitted_bcg.iter().map(|b| b.note.clone()).collect();
-    let commented_bcg = bcg.and_then(|b| {
-        warnings.push(b.warning);
-        b.commented.map(|c| c.row)
-    });
+    // Commented rows fitted as BCGs, then a missing BCG: they matter more than the members
+    // left out one by one.
+    let mut warnings: Vec<String> = catalog.fitted_bcgs.iter().map(|b| b.note.clone()).collect();
+    let facts = BcgFacts {
+        missing: bcg.is_some(),
+        commented: bcg
+            .and_then(|b| {
+                warnings.push(b.warning);
+                b.commented
+            })
+            .map(|c| c.rows)
+            .unwrap_or_default(),
+        fitted: catalog
+            .fitted_bcgs
+            .as_ref()
+            .map(|b| b.rows.clone())
+            .unwrap_or_default(),
+    };
     warnings.extend(model.warnings);
     Ok(MemberLayers {
         layers: model.layers,
         warnings,
-        central_galaxy_missing,
-        commented_bcg,
-        fitted_bcg: catalog.fitted_bcg.as_ref().map(|b| b.row.clone()),
+        bcg: facts,
     })
 }
 

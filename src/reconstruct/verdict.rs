@@ -11,7 +11,7 @@
 //! constrains it (far from the arcs), which no image-plane check can see.
 
 use glam::DVec2;
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 
 use super::summary::median_arcsec;
 use super::{ImageReport, SourceReport};
@@ -206,8 +206,23 @@ impl SystemCheck {
     }
 }
 
+/// What a run found about the cluster's brightest galaxies (BCGs) among its members
+/// (`summary.json`'s `verdict.bcg`).
+#[derive(Debug, Clone, Default, PartialEq, Eq, Serialize, Deserialize)]
+pub struct BcgFacts {
+    /// No member near the images is bright enough to be a brightest cluster galaxy
+    /// (`missing_bcg_warning` in the inversion): the catalogue has most likely left it out.
+    pub missing: bool,
+    /// The member catalogue's commented-out rows that could be the missing BCGs (one per
+    /// core), in the file's order: the warnings name them and the app offers to fit them.
+    pub commented: Vec<CatalogRow>,
+    /// The member catalogue's commented-out rows the run fitted as BCGs
+    /// (`Dataset::fit_commented_bcgs`): the app names them among the facts.
+    pub fitted: Vec<CatalogRow>,
+}
+
 /// What the verdict was made from besides the systems.
-#[derive(Debug, Clone, Copy, Default)]
+#[derive(Debug, Clone, Default)]
 pub struct VerdictInputs<'a> {
     /// The result's critical curves (at the summary's source redshift) and the geometry of
     /// the map they were traced on.
@@ -220,14 +235,8 @@ pub struct VerdictInputs<'a> {
     /// The data hardly measure the members' factors `C`
     /// ([`crate::inversion::LinearSystem::members_unmeasured`]).
     pub c_unmeasured: bool,
-    /// No member near the images is bright enough to be the brightest cluster galaxy
-    /// (`missing_bcg_warning` in the inversion): the catalogue has most likely left it out.
-    pub central_galaxy_missing: bool,
-    /// The member catalogue's commented-out row that could be that galaxy, when it has one.
-    pub commented_bcg: Option<&'a CatalogRow>,
-    /// The member catalogue's commented-out row that was fitted as that galaxy
-    /// (`Dataset::fit_commented_bcg`).
-    pub fitted_bcg: Option<&'a CatalogRow>,
+    /// What the run found about the brightest cluster galaxies.
+    pub bcg: BcgFacts,
 }
 
 /// `summary.json`'s `verdict`.
@@ -267,12 +276,8 @@ pub struct Verdict {
     /// [`MAIN_CURVE_MIN_SHARE`]).
     pub main_curve_share: Option<f64>,
     pub c_unmeasured: bool,
-    /// See [`VerdictInputs::central_galaxy_missing`].
-    pub central_galaxy_missing: bool,
-    /// See [`VerdictInputs::commented_bcg`]: the app offers to fit it.
-    pub commented_bcg: Option<CatalogRow>,
-    /// See [`VerdictInputs::fitted_bcg`]: the app names it among the facts.
-    pub fitted_bcg: Option<CatalogRow>,
+    /// See [`BcgFacts`].
+    pub bcg: BcgFacts,
     /// The worst systems (at most [`WORST_SHOWN`]), worst first: those with a
     /// [`SystemCheck::problem`].
     pub worst: Vec<SystemCheck>,
@@ -437,19 +442,30 @@ impl Verdict {
                  instead of between them, an over-focused fit."
             ));
         }
-        match (inputs.commented_bcg, inputs.central_galaxy_missing) {
-            (Some(row), true) => care.push(format!(
-                "No member near the images is bright enough to be the brightest cluster \
-                 galaxy: the member catalogue comments one out (member {}, line {}); fit it \
-                 (see the warnings).",
-                row.id, row.line
-            )),
-            (None, true) => care.push(
-                "No member near the images is bright enough to be the brightest cluster \
-                 galaxy: if the catalogue leaves it out, add its row (see the warnings)."
+        if inputs.bcg.missing {
+            let rows = &inputs.bcg.commented;
+            let named: Vec<String> = rows
+                .iter()
+                .map(|r| format!("member {}, line {}", r.id, r.line))
+                .collect();
+            care.push(match rows.len() {
+                0 => "No member near the images is bright enough to be the brightest cluster \
+                      galaxy: if the catalogue leaves it out, add its row (see the warnings)."
                     .to_string(),
-            ),
-            (_, false) => {}
+                1 => format!(
+                    "No member near the images is bright enough to be the brightest cluster \
+                     galaxy: the member catalogue comments one out ({}); fit it (see the \
+                     warnings).",
+                    named[0]
+                ),
+                _ => format!(
+                    "No member near the images is bright enough to be the brightest cluster \
+                     galaxy: the member catalogue comments out {} that could be ({}); fit \
+                     them (see the warnings).",
+                    rows.len(),
+                    named.join("; ")
+                ),
+            });
         }
         if members > 0 && inputs.c_unmeasured {
             care.push(format!(
@@ -522,12 +538,14 @@ impl Verdict {
             z_source,
             main_curve_share: main_share,
             c_unmeasured: inputs.c_unmeasured,
-            central_galaxy_missing: inputs.central_galaxy_missing,
-            commented_bcg: inputs
-                .commented_bcg
-                .filter(|_| inputs.central_galaxy_missing)
-                .cloned(),
-            fitted_bcg: inputs.fitted_bcg.cloned(),
+            bcg: BcgFacts {
+                commented: if inputs.bcg.missing {
+                    inputs.bcg.commented
+                } else {
+                    Vec::new()
+                },
+                ..inputs.bcg
+            },
             worst,
         }
     }
@@ -818,9 +836,7 @@ mod tests {
             main_curve_share: Some(0.99),
             members_arcsec: &members,
             c_unmeasured,
-            central_galaxy_missing: false,
-            commented_bcg: None,
-            fitted_bcg: None,
+            bcg: BcgFacts::default(),
         };
         let v = Verdict::assess(&sources, inputs(true));
         assert_eq!(v.trust, Trust::UsableWithCare);
@@ -838,13 +854,17 @@ mod tests {
 
     #[test]
     fn a_missing_central_galaxy_needs_care() {
-        let inputs = VerdictInputs {
-            central_galaxy_missing: true,
+        let missing = |commented: &[CatalogRow]| VerdictInputs {
+            bcg: BcgFacts {
+                missing: true,
+                commented: commented.to_vec(),
+                fitted: Vec::new(),
+            },
             ..VerdictInputs::default()
         };
-        let v = Verdict::assess(&[fitted("1", &[0.2, 0.3])], inputs);
+        let v = Verdict::assess(&[fitted("1", &[0.2, 0.3])], missing(&[]));
         assert_eq!(v.trust, Trust::UsableWithCare);
-        assert!(v.central_galaxy_missing);
+        assert!(v.bcg.missing);
         assert!(
             v.reasons
                 .starts_with("No member near the images is bright enough"),
@@ -856,13 +876,11 @@ mod tests {
             line: 10,
             id: "1009.0".to_string(),
         };
-        let inputs = VerdictInputs {
-            central_galaxy_missing: true,
-            commented_bcg: Some(&row),
-            ..VerdictInputs::default()
-        };
-        let v = Verdict::assess(&[fitted("1", &[0.2, 0.3])], inputs);
-        assert_eq!(v.commented_bcg.as_ref(), Some(&row));
+        let v = Verdict::assess(
+            &[fitted("1", &[0.2, 0.3])],
+            missing(std::slice::from_ref(&row)),
+        );
+        assert_eq!(v.bcg.commented, std::slice::from_ref(&row));
         assert!(
             v.reasons.starts_with(
                 "No member near the images is bright enough to be the brightest cluster \
@@ -872,6 +890,37 @@ mod tests {
             "{}",
             v.reasons
         );
+        // A cluster with two cores: both rows are named.
+        let other = CatalogRow {
+            line: 73,
+            id: "2".to_string(),
+        };
+        let v = Verdict::assess(
+            &[fitted("1", &[0.2])],
+            missing(&[row.clone(), other.clone()]),
+        );
+        assert_eq!(v.bcg.commented, [row.clone(), other]);
+        assert!(
+            v.reasons.starts_with(
+                "No member near the images is bright enough to be the brightest cluster \
+                 galaxy: the member catalogue comments out 2 that could be (member 1009.0, \
+                 line 10; member 2, line 73); fit them (see the warnings)."
+            ),
+            "{}",
+            v.reasons
+        );
+        // Rows the run fitted are facts, not an offer.
+        let fitted_row = VerdictInputs {
+            bcg: BcgFacts {
+                fitted: vec![row.clone()],
+                commented: vec![row.clone()],
+                missing: false,
+            },
+            ..VerdictInputs::default()
+        };
+        let v = Verdict::assess(&[fitted("1", &[0.2])], fitted_row);
+        assert_eq!(v.trust, Trust::Good, "{}", v.reasons);
+        assert_eq!((v.bcg.fitted, v.bcg.commented), (vec![row], vec![]));
         let v = Verdict::assess(&[fitted("1", &[0.2, 0.3])], VerdictInputs::default());
         assert_eq!(v.trust, Trust::Good, "{}", v.reasons);
     }

@@ -134,10 +134,11 @@ impl AppSession {
         to_js(&self.inner.reload(role).map_err(err)?)
     }
 
-    /// Fits the commented-out row on `line` (1-based) of the loaded member catalogue: its
+    /// Fits the commented-out rows on `lines` (1-based) of the loaded member catalogue: its
     /// `LoadReport`. An error leaves the catalogue as it was.
-    pub fn uncomment_member(&mut self, line: usize) -> Result<JsValue, JsError> {
-        to_js(&self.inner.uncomment_member(line).map_err(err)?)
+    pub fn uncomment_members(&mut self, lines: Vec<u32>) -> Result<JsValue, JsError> {
+        let lines: Vec<usize> = lines.into_iter().map(|l| l as usize).collect();
+        to_js(&self.inner.uncomment_members(&lines).map_err(err)?)
     }
 
     /// Forgets the last result (its maps were made from data that have been replaced).

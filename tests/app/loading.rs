@@ -370,11 +370,17 @@ fn a_commented_member_row_is_fitted_on_request_and_nothing_else_is() {
         (9, "m.cat: line 9 is not a commented-out row"),
         (0, "m.cat: line 0 is not a commented-out row"),
     ] {
-        let err = s.uncomment_member(line).unwrap_err().to_string();
+        let err = s.uncomment_members(&[line]).unwrap_err().to_string();
+        assert!(err.starts_with(says), "{err}");
+        assert_eq!(s.data.members.as_ref().unwrap().text, text);
+        // With a good line first, nothing is uncommented either.
+        let err = s.uncomment_members(&[4, line]).unwrap_err().to_string();
         assert!(err.starts_with(says), "{err}");
         assert_eq!(s.data.members.as_ref().unwrap().text, text);
     }
-    let report = s.uncomment_member(4).unwrap();
+    assert!(s.uncomment_members(&[]).is_err());
+    assert_eq!(s.data.members.as_ref().unwrap().text, text);
+    let report = s.uncomment_members(&[4]).unwrap();
     assert_eq!(report.summary, "2 members (line 4 uncommented)");
     let kept = &s.data.members.as_ref().unwrap().text;
     assert_eq!(
@@ -387,14 +393,20 @@ fn a_commented_member_row_is_fitted_on_request_and_nothing_else_is() {
     assert_eq!(members.members[1].id, "1009");
     assert!(members.commented.iter().all(|m| m.id != "1009"));
     // Once uncommented it is no longer commented out.
-    assert!(s.uncomment_member(4).is_err());
+    assert!(s.uncomment_members(&[4]).is_err());
     // A doubly commented row loses both '#', as the reader strips both.
-    let report = s.uncomment_member(5).unwrap();
+    let report = s.uncomment_members(&[5]).unwrap();
     assert_eq!(report.summary, "3 members (line 5 uncommented)");
     let kept = &s.data.members.as_ref().unwrap().text;
     assert_eq!(kept.lines().nth(4), Some("7 1.0 2.0 0.3 0.2 10.0 19.5"));
+    // Two rows at once (the BCGs of a cluster with two cores).
+    let mut both = Session::new();
+    both.load_text(DataRole::Members, "m.cat", text).unwrap();
+    let report = both.uncomment_members(&[4, 5]).unwrap();
+    assert_eq!(report.summary, "3 members (lines 4 and 5 uncommented)");
+    assert_eq!(&both.data.members.as_ref().unwrap().text, kept);
     let mut empty = Session::new();
-    let err = empty.uncomment_member(4).unwrap_err().to_string();
+    let err = empty.uncomment_members(&[4]).unwrap_err().to_string();
     assert!(err.contains("load a member catalogue first"), "{err}");
 }
 

@@ -3,7 +3,7 @@
 import { test } from 'node:test';
 import assert from 'node:assert/strict';
 import { join } from 'node:path';
-import { writeFile, mkdtemp } from 'node:fs/promises';
+import { readFile, writeFile, mkdtemp } from 'node:fs/promises';
 import { tmpdir } from 'node:os';
 import { openApp, imageStats, runToMap, ARTIFACTS, ROOT, setField, waitStatus } from './browser.mjs';
 
@@ -192,7 +192,7 @@ test('a BCG the member catalogue comments out is fitted, or offered when the set
     assert.doesNotMatch(await page.textContent('#verdict-reasons'), /brightest cluster galaxy/);
     assert.equal(await page.locator('#fit-commented-bcg').count(), 0);
     const facts = await page.locator('#verdict-facts li').allTextContents();
-    assert.ok(facts.includes('Brightest cluster galaxy: member 1009.0, commented out on line 10 of the member catalogue, fitted (setting "Fit a commented-out BCG row"; the warnings say why)'), facts.join(' | '));
+    assert.ok(facts.includes('Brightest cluster galaxy: member 1009.0, commented out on line 10 of the member catalogue, fitted (setting "Fit commented-out BCG rows"; the warnings say why)'), facts.join(' | '));
     assert.equal(await page.inputValue('#set-reconstruct-members-fit_commented_bcg'), 'true');
     await page.screenshot({ path: join(ARTIFACTS, 'app-commented-bcg-default.png'), fullPage: true });
     // Off, the row stays out: the verdict names it and offers to fit it. A fixed strength and
@@ -204,7 +204,7 @@ test('a BCG the member catalogue comments out is fitted, or offered when the set
     const reasons = await page.textContent('#verdict-reasons');
     assert.match(reasons, /No member near the images is bright enough to be the brightest cluster galaxy: the member catalogue comments one out \(member 1009\.0, line 10\); fit it \(see the warnings\)\./);
     const items = await page.locator('#run-warnings li').allTextContents();
-    assert.ok(items.some((t) => /Line 10 comments out member 1009\.0, \d+ arcsec from that centre with mag 17\.32 \([\d.]+ L\*\): if that is the BCG, remove the '#' to fit it$/.test(t)), items.slice(0, 2).join(' | '));
+    assert.ok(items.some((t) => /Line 10 comments out member 1009\.0 \(\d+ arcsec from that centre, mag 17\.32, [\d.]+ L\*\): if that is the BCG, remove the '#' to fit it$/.test(t)), items.slice(0, 2).join(' | '));
     const fit = page.locator('#fit-commented-bcg');
     assert.equal(await fit.textContent(), 'Fit member 1009.0 (line 10) and reconstruct again');
     await page.screenshot({ path: join(ARTIFACTS, 'app-commented-bcg.png'), fullPage: true });
@@ -218,6 +218,49 @@ test('a BCG the member catalogue comments out is fitted, or offered when the set
     const after = await page.locator('#run-warnings li').allTextContents();
     assert.deepEqual(after.filter((t) => /brightest cluster galaxy/.test(t)), []);
     await page.screenshot({ path: join(ARTIFACTS, 'app-commented-bcg-fitted.png'), fullPage: true });
+    assert.deepEqual(app.consoleErrors, []);
+  } finally {
+    await app.close();
+  }
+});
+
+test('both BCGs of a cluster with two cores are fitted, or offered together', async () => {
+  // b_bimodal of tests/data/fidelity (lenstronomy's truth) with its two BCGs' rows (lines 4
+  // and 5: members 1 and 2, one per core) commented out, as a Lenstool set-up that models
+  // them in its .par writes its potfile.
+  const dir = join(ROOT, 'tests', 'data', 'fidelity', 'b_bimodal');
+  const members = (await readFile(join(dir, 'members.cat'), 'utf8')).split('\n')
+    .map((l, i) => (i === 3 || i === 4 ? `#${l}` : l)).join('\n');
+  const app = await openApp();
+  try {
+    const { page } = app;
+    await waitStatus(page, /^Ready/);
+    await page.setInputFiles('#file-images', join(dir, 'images.cat'));
+    await page.waitForFunction(() => /systems/.test(document.getElementById('status-images').textContent));
+    await page.setInputFiles('#file-members', { name: 'members.cat', mimeType: 'text/plain', buffer: Buffer.from(members) });
+    await page.waitForFunction(() => /68 members/.test(document.getElementById('status-members').textContent));
+    await setField(page, '#set-z_lens', 0.38);
+    // A fixed strength and a coarse grid keep the runs quick.
+    await setField(page, '#set-reconstruct-objective-strength', 0.1);
+    await setField(page, '#set-reconstruct-grid-cells', 16);
+    await runToMap(page, '#reconstruct', 120_000);
+    const facts = await page.locator('#verdict-facts li').allTextContents();
+    assert.ok(facts.includes('Brightest cluster galaxies: members 1 (line 4) and 2 (line 5), commented out of the member catalogue, fitted (setting "Fit commented-out BCG rows"; the warnings say why)'), facts.join(' | '));
+    const warnings = await page.locator('#run-warnings li').allTextContents();
+    assert.ok(warnings.some((t) => /, but lines 4 and 5 comment out members 1 \(\d+ arcsec .*\) and 2 \(\d+ arcsec .*\): they are fitted as BCGs, /.test(t)), warnings.slice(0, 2).join(' | '));
+    // Off, both stay out and one button offers both.
+    await setField(page, '#set-reconstruct-members-fit_commented_bcg', 'false');
+    await runToMap(page, '#reconstruct', 120_000);
+    const off = await page.locator('#run-warnings li').allTextContents();
+    assert.ok(off.some((t) => /Lines 4 and 5 comment out members 1 \(\d+ arcsec .*\) and 2 \(\d+ arcsec .*\): if those are the BCGs, remove the '#' to fit them$/.test(t)), off.slice(0, 2).join(' | '));
+    const fit = page.locator('#fit-commented-bcg');
+    assert.equal(await fit.textContent(), 'Fit members 1 (line 4) and 2 (line 5) and reconstruct again');
+    await page.screenshot({ path: join(ARTIFACTS, 'app-commented-bcgs.png'), fullPage: true });
+    await fit.click();
+    await page.waitForFunction(() => /70 members \(lines 4 and 5 uncommented\)/.test(document.getElementById('status-members').textContent));
+    await page.waitForFunction(() => !document.getElementById('fit-commented-bcg')
+      && /^Done in/.test(document.getElementById('status').textContent), null, { timeout: 120_000 });
+    assert.doesNotMatch(await page.textContent('#verdict-reasons'), /brightest cluster galaxy/);
     assert.deepEqual(app.consoleErrors, []);
   } finally {
     await app.close();

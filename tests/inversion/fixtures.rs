@@ -94,6 +94,6 @@ pub fn members() -> MemberCatalog {
             member("f", 3.0, -9.0, 18.9),
         ],
         commented: Vec::new(),
-        fitted_bcg: None,
+        fitted_bcgs: None,
     }
 }

@@ -746,7 +746,7 @@ pub(crate) mod real {
     }
 
     /// `wslap reconstruct --images IMAGES --members MEMBERS --z-lens Z` with `config`: the
-    /// files read as the CLI and the app read them (a commented-out BCG row fitted when
+    /// files read as the CLI and the app read them (commented-out BCG rows fitted when
     /// `config.members.fit_commented_bcg` says so).
     pub fn run(
         images: &str,
@@ -770,7 +770,7 @@ pub(crate) mod real {
         let mut config = config.clone();
         let mut dataset = Dataset::read(&files, config.constraints.pixel_arcsec).unwrap();
         let plane = LensPlane::new(Cosmology::default(), z_lens).unwrap();
-        dataset.fit_commented_bcg(&plane, &config);
+        dataset.fit_commented_bcgs(&plane, &config);
         let inputs = dataset.inputs(plane, holdout, &mut config).unwrap();
         let r = reconstruct(&inputs, &config, &mut quiet).unwrap();
         (r, dataset.images.clone().unwrap())
@@ -921,10 +921,13 @@ fn a_commented_out_bcg_row_is_fitted_unless_the_settings_say_not() {
         let m = data.members.as_ref().unwrap();
         (m.members.len(), m.commented.len())
     };
-    let row = data
-        .fit_commented_bcg(&plane, &config)
-        .expect("line 10 fitted");
-    assert_eq!((row.line, row.id.as_str()), (10, "1009.0"));
+    let rows = data.fit_commented_bcgs(&plane, &config);
+    let row = wslap::CatalogRow {
+        line: 10,
+        id: "1009.0".to_string(),
+    };
+    // Line 10 only: the other commented rows are fainter than 1 L*.
+    assert_eq!(rows, std::slice::from_ref(&row));
     let m = data.members.as_ref().unwrap();
     assert_eq!(
         (m.members.len(), m.commented.len()),
@@ -932,17 +935,79 @@ fn a_commented_out_bcg_row_is_fitted_unless_the_settings_say_not() {
     );
     assert_eq!(m.members.last().unwrap().line, 10);
     assert!(m.commented.iter().all(|c| c.line != 10));
-    assert_eq!(m.fitted_bcg.as_ref().map(|b| &b.row), Some(&row));
-    // Once there is a BCG, the next commented rows (all fainter than 1 L*) are not fitted.
-    assert_eq!(data.fit_commented_bcg(&plane, &config), None);
+    assert_eq!(
+        m.fitted_bcgs.as_ref().map(|b| &b.rows[..]),
+        Some(&[row][..])
+    );
+    // Not twice.
+    assert!(data.fit_commented_bcgs(&plane, &config).is_empty());
     assert_eq!(data.members.as_ref().unwrap().members.len(), members + 1);
     // Off, the catalogue stays as written.
     config.members.fit_commented_bcg = false;
     let mut data = read_macs();
-    assert_eq!(data.fit_commented_bcg(&plane, &config), None);
+    assert!(data.fit_commented_bcgs(&plane, &config).is_empty());
     let m = data.members.as_ref().unwrap();
     assert_eq!((m.members.len(), m.commented.len()), (members, commented));
-    assert_eq!(m.fitted_bcg, None);
+    assert_eq!(m.fitted_bcgs, None);
+}
+
+/// A cluster with two cores whose BCGs are both commented out (b_bimodal of
+/// tests/data/fidelity, lenstronomy's truth: its members 1 and 2, 6 and 5 L*, on lines 4
+/// and 5) gets both fitted; with one of them listed, the core has its BCG and nothing is.
+#[test]
+fn both_commented_bcg_rows_of_a_bimodal_cluster_are_fitted() {
+    use wslap::{Dataset, InputText, InputTexts};
+    let images = include_str!("../data/fidelity/b_bimodal/images.cat");
+    let members = include_str!("../data/fidelity/b_bimodal/members.cat");
+    let commented = |lines: &[usize]| {
+        members
+            .split('\n')
+            .enumerate()
+            .map(|(i, l)| {
+                if lines.contains(&(i + 1)) {
+                    format!("#{l}")
+                } else {
+                    l.to_string()
+                }
+            })
+            .collect::<Vec<_>>()
+            .join("\n")
+    };
+    let read = |members: &str| {
+        let files = InputTexts {
+            images: Some(InputText {
+                name: "images.cat",
+                text: images,
+            }),
+            members: Some(InputText {
+                name: "members.cat",
+                text: members,
+            }),
+            ..InputTexts::default()
+        };
+        Dataset::read(&files, 0.2).unwrap()
+    };
+    // The truth's lens redshift (tests/data/fidelity/b_bimodal/truth.json).
+    let plane = LensPlane::new(Cosmology::default(), 0.38).unwrap();
+    let config = ReconstructConfig::default();
+    let text = commented(&[4, 5]);
+    let mut data = read(&text);
+    let n = data.members.as_ref().unwrap().members.len();
+    let rows = data.fit_commented_bcgs(&plane, &config);
+    let got: Vec<(usize, &str)> = rows.iter().map(|r| (r.line, r.id.as_str())).collect();
+    assert_eq!(got, [(4, "1"), (5, "2")]);
+    let m = data.members.as_ref().unwrap();
+    assert_eq!(m.members.len(), n + 2);
+    assert!(m.commented.iter().all(|c| c.line != 4 && c.line != 5));
+    let note = &m.fitted_bcgs.as_ref().unwrap().note;
+    assert!(
+        note.contains(", but lines 4 and 5 comment out members 1 (")
+            && note.contains("): they are fitted as BCGs, "),
+        "{note}"
+    );
+    // Member 2 listed: a BCG near the images, so neither row is taken for a missing one.
+    let mut data = read(&commented(&[4]));
+    assert!(data.fit_commented_bcgs(&plane, &config).is_empty());
 }
 
 #[cfg(not(target_arch = "wasm32"))]
@@ -980,10 +1045,16 @@ fn macs1931_runs_end_to_end_with_a_default_redshift() {
     assert!(theta_e > 5.0 && theta_e < 60.0, "Einstein radius {theta_e}");
     // The catalogue comments its BCG out (line 10, mag 17.325, at its frame's origin, where no
     // other member is brighter than 1 L*): the run fits it and says so.
-    assert!(!r.central_galaxy_missing);
-    let fitted = r.fitted_bcg.as_ref().expect("the fitted row");
-    assert_eq!((fitted.line, fitted.id.as_str()), (10, "1009.0"));
-    assert_eq!(r.verdict().fitted_bcg.as_ref(), Some(fitted));
+    assert!(!r.bcg.missing);
+    let fitted = &r.bcg.fitted;
+    assert_eq!(
+        fitted
+            .iter()
+            .map(|f| (f.line, f.id.as_str()))
+            .collect::<Vec<_>>(),
+        [(10, "1009.0")]
+    );
+    assert_eq!(&r.verdict().bcg.fitted, fitted);
     let bcg = r
         .warnings
         .iter()

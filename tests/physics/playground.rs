@@ -55,7 +55,7 @@ fn member_galaxies_are_the_inversions_halos() {
             line: 1,
         }],
         commented: Vec::new(),
-        fitted_bcg: None,
+        fitted_bcgs: None,
     };
     let grid = CellGrid::regular(DVec2::ZERO, 40.0, 8, 1.0).expect("grid");
     let members =

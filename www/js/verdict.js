@@ -29,8 +29,11 @@ function facts(v) {
   const c = v.members_with_own_curves && v.c_unmeasured ? ' (their mass is assumed: C is hardly measured)' : '';
   // Without member galaxies there is nothing to say about them.
   if (v.members) out.push(`Members with critical curves of their own${z}: ${v.members_with_own_curves}${c}`);
-  if (v.fitted_bcg) {
-    out.push(`Brightest cluster galaxy: member ${v.fitted_bcg.id}, commented out on line ${v.fitted_bcg.line} of the member catalogue, fitted (setting "Fit a commented-out BCG row"; the warnings say why)`);
+  const fitted = v.bcg?.fitted ?? [];
+  if (fitted.length === 1) {
+    out.push(`Brightest cluster galaxy: member ${fitted[0].id}, commented out on line ${fitted[0].line} of the member catalogue, fitted (setting "Fit commented-out BCG rows"; the warnings say why)`);
+  } else if (fitted.length) {
+    out.push(`Brightest cluster galaxies: members ${andList(fitted.map((r) => `${r.id} (line ${r.line})`))}, commented out of the member catalogue, fitted (setting "Fit commented-out BCG rows"; the warnings say why)`);
   }
   if (v.images_on_curves) {
     out.push(`Observed images on a critical curve (|μ| > 100): ${v.images_on_curves} of ${v.images}`);
@@ -39,11 +42,15 @@ function facts(v) {
   return out;
 }
 
+/** `items` as English lists them: "a", "a and b", "a, b and c". */
+const andList = (items) => (items.length < 2 ? items.join('')
+  : `${items.slice(0, -1).join(', ')} and ${items[items.length - 1]}`);
+
 /** Shows `verdict` (or hides the box for `null`: no result, or no reconstruction). When the
- * members lack their BCG, a button offers to fit it: the member catalogue's commented-out row
- * (`commented_bcg`: `fitRow({line, id})`), else the galaxies of the loaded Lenstool .par
- * (`modelGalaxies`, `[{id, line, mag}]`: `fitModel()`). */
-export function showVerdict(verdict, { fitRow = null, modelGalaxies = [], fitModel = null } = {}) {
+ * members lack their BCG, a button offers to fit it: the member catalogue's commented-out rows
+ * (`bcg.commented`, one per core: `fitRows([{line, id}])`), else the galaxies of the loaded
+ * Lenstool .par (`modelGalaxies`, `[{id, line, mag}]`: `fitModel()`). */
+export function showVerdict(verdict, { fitRows = null, modelGalaxies = [], fitModel = null } = {}) {
   last = verdict ?? null;
   const box = document.getElementById('verdict');
   if (!box) return;
@@ -77,12 +84,14 @@ export function showVerdict(verdict, { fitRow = null, modelGalaxies = [], fitMod
     fit.addEventListener('click', onClick);
     box.append(fit);
   };
-  const row = last.commented_bcg;
-  if (row && fitRow) {
-    offer('fit-commented-bcg', `Fit member ${row.id} (line ${row.line}) and reconstruct again`,
-      'Removes the # before that row of the member catalogue you loaded (in this app only: your file is not changed) and runs the reconstruction again.',
-      () => fitRow(row));
-  } else if (last.central_galaxy_missing && modelGalaxies.length && fitModel) {
+  const rows = last.bcg?.commented ?? [];
+  if (rows.length && fitRows) {
+    const which = rows.length === 1 ? `member ${rows[0].id} (line ${rows[0].line})`
+      : `members ${andList(rows.map((r) => `${r.id} (line ${r.line})`))}`;
+    offer('fit-commented-bcg', `Fit ${which} and reconstruct again`,
+      `Removes the # before ${rows.length === 1 ? 'that row' : 'those rows'} of the member catalogue you loaded (in this app only: your file is not changed) and runs the reconstruction again.`,
+      () => fitRows(rows));
+  } else if (last.bcg?.missing && modelGalaxies.length && fitModel) {
     const names = modelGalaxies.map((g) => `${g.id}, mag ${g.mag.toFixed(2)}`).join('; ');
     offer('fit-model-galaxies', `Fit the .par's galaxy (${names}) and reconstruct again`,
       'The loaded Lenstool .par models this galaxy on its own (a core of at most 5 kpc and a magnitude): fits it as a member (the setting "Members from the .par"), as wslap reconstruct --par does, and runs the reconstruction again.',
