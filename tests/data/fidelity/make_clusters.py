@@ -237,6 +237,22 @@ CLUSTERS = [
          clumps=[], n_members=75, member_rc=25.0, member_scale=1.0 / 3.0,
          what="(h) bimodal: two elliptical NFW halos 47 arcsec apart, each with a BCG, "
               "75 members whose true masses are a third of the catalogue law's"),
+    # Lens redshifts outside the 0.30 - 0.42 of the clusters above (added after every default
+    # was chosen, like g and h): a nearby lens (A1689, A383 are at z ~ 0.19), where the
+    # sources' D_ls/D_s spans half as much and the mass-sheet degeneracy is looser, and a
+    # distant one (MACS0717, MACS1149 are at z ~ 0.55), where members look smaller and fainter.
+    dict(name="i_low_z", seed=909, z_l=0.19, ra0=197.8729, dec0=-1.3410, n_sys=30,
+         halos=[dict(m200=1.1e15, c=7.0, x=0.0, y=0.0, q=0.75, phi=35.0, bcg_l=10.0)],
+         clumps=[dict(m200=1.0e14, c=7.0, x=40.0, y=28.0)],
+         n_members=70, member_rc=40.0,
+         what="(i) a nearby lens (z_l = 0.19): elliptical NFW halo with a BCG, a dark clump "
+              "49 arcsec NE, 70 members"),
+    dict(name="j_high_z", seed=1010, z_l=0.55, ra0=177.3987, dec0=22.3953, n_sys=25,
+         halos=[dict(m200=1.4e15, c=5.0, x=0.0, y=0.0, q=0.7, phi=-50.0, bcg_l=8.0)],
+         clumps=[dict(m200=1.2e14, c=6.0, x=-30.0, y=-25.0)],
+         n_members=70, member_rc=22.0,
+         what="(j) a distant lens (z_l = 0.55): elliptical NFW halo with a BCG, a dark clump "
+              "39 arcsec SW, 70 members"),
 ]
 
 
