@@ -460,8 +460,8 @@ impl Verdict {
                 ),
                 _ => format!(
                     "No member near the images is bright enough to be the brightest cluster \
-                     galaxy: the member catalogue comments out {} that could be ({}); fit \
-                     them (see the warnings).",
+                     galaxy: the member catalogue comments out {} rows that could be BCGs \
+                     ({}); fit them (see the warnings).",
                     rows.len(),
                     named.join("; ")
                 ),
@@ -903,8 +903,8 @@ mod tests {
         assert!(
             v.reasons.starts_with(
                 "No member near the images is bright enough to be the brightest cluster \
-                 galaxy: the member catalogue comments out 2 that could be (member 1009.0, \
-                 line 10; member 2, line 73); fit them (see the warnings)."
+                 galaxy: the member catalogue comments out 2 rows that could be BCGs \
+                 (member 1009.0, line 10; member 2, line 73); fit them (see the warnings)."
             ),
             "{}",
             v.reasons
