@@ -192,6 +192,20 @@ export async function waitStatus(page, pattern, timeout = 60_000) {
   }
 }
 
+/** Loads an image catalogue and a member catalogue into the open app (each a path, or a
+ * `{ name, mimeType, buffer }` as `setInputFiles` takes it), waits until each file's status
+ * line matches its pattern, and sets z_lens. */
+export async function loadCatalogues(page, { images, members, zLens, imagesSay = /systems/, membersSay = /members/ }) {
+  const said = async (role, file, pattern) => {
+    await page.setInputFiles(`#file-${role}`, file);
+    await page.waitForFunction(([id, src]) => new RegExp(src).test(document.getElementById(id).textContent),
+      [`status-${role}`, pattern.source]);
+  };
+  await said('images', images, imagesSay);
+  await said('members', members, membersSay);
+  await setField(page, '#set-z_lens', zLens);
+}
+
 /** Runs `op` ('get', 'put', 'keys') on the app's IndexedDB store from the page. */
 export function idb(page, op, key, value) {
   return page.evaluate(([op, key, value]) => new Promise((resolve, reject) => {

@@ -5,7 +5,7 @@ import assert from 'node:assert/strict';
 import { join } from 'node:path';
 import { readFile, writeFile, mkdtemp } from 'node:fs/promises';
 import { tmpdir } from 'node:os';
-import { openApp, imageStats, runToMap, ARTIFACTS, ROOT, setField, waitStatus } from './browser.mjs';
+import { openApp, imageStats, loadCatalogues, runToMap, ARTIFACTS, ROOT, setField, waitStatus } from './browser.mjs';
 
 const AS1063 = join(ROOT, '..', 'shared', 'data', 'AS1063', 'lenstool_cats');
 const MACS1931 = join(ROOT, '..', 'shared', 'data', 'MACS1931', 'lenstool_cats');
@@ -176,11 +176,8 @@ test('a BCG the member catalogue comments out is fitted, or offered when the set
   try {
     const { page } = app;
     await waitStatus(page, /^Ready/);
-    await page.setInputFiles('#file-images', join(MACS1931, 'immul_ongoing.cat'));
-    await page.waitForFunction(() => /systems/.test(document.getElementById('status-images').textContent));
-    await page.setInputFiles('#file-members', join(MACS1931, 'm1931.cat'));
-    await page.waitForFunction(() => /198 members/.test(document.getElementById('status-members').textContent));
-    await setField(page, '#set-z_lens', 0.352);
+    await loadCatalogues(page, { images: join(MACS1931, 'immul_ongoing.cat'), members: join(MACS1931, 'm1931.cat'),
+      membersSay: /198 members/, zLens: 0.352 });
     // With every default ("auto", redshifts estimated for the four systems without one).
     await runToMap(page, '#reconstruct', 300_000);
     // The candidates' folds hold only the systems with a redshift, and the page says so.
@@ -235,11 +232,8 @@ test('both BCGs of a cluster with two cores are fitted, or offered together', as
   try {
     const { page } = app;
     await waitStatus(page, /^Ready/);
-    await page.setInputFiles('#file-images', join(dir, 'images.cat'));
-    await page.waitForFunction(() => /systems/.test(document.getElementById('status-images').textContent));
-    await page.setInputFiles('#file-members', { name: 'members.cat', mimeType: 'text/plain', buffer: Buffer.from(members) });
-    await page.waitForFunction(() => /68 members/.test(document.getElementById('status-members').textContent));
-    await setField(page, '#set-z_lens', 0.38);
+    await loadCatalogues(page, { images: join(dir, 'images.cat'),
+      members: { name: 'members.cat', mimeType: 'text/plain', buffer: Buffer.from(members) }, membersSay: /68 members/, zLens: 0.38 });
     // A fixed strength and a coarse grid keep the runs quick.
     await setField(page, '#set-reconstruct-objective-strength', 0.1);
     await setField(page, '#set-reconstruct-grid-cells', 16);
