@@ -469,6 +469,7 @@ impl LoadedData {
         }
         let count = |t: &str| parse_member_catalog(t, &name, None).map(|(c, _)| c.members.len());
         let mut edited = text.clone();
+        let mut members = count(&text).map_err(|e| AppError::File(e.to_string()))?;
         for &line in lines {
             let rows: Vec<&str> = edited.split('\n').collect();
             let at = line.checked_sub(1).and_then(|i| rows.get(i).copied());
@@ -477,7 +478,6 @@ impl LoadedData {
                     "{name}: line {line} is not a commented-out row"
                 )));
             };
-            let before = count(&edited).map_err(|e| AppError::File(e.to_string()))?;
             // Every leading `#` goes, as the catalogue reader strips them (`##7 ...` reads
             // as 7).
             let body = old.trim_start();
@@ -492,7 +492,8 @@ impl LoadedData {
                 .map(|(i, l)| if i + 1 == line { new.as_str() } else { l })
                 .collect::<Vec<&str>>()
                 .join("\n");
-            if count(&next).ok() != Some(before + 1) {
+            members += 1;
+            if count(&next).ok() != Some(members) {
                 return Err(AppError::File(format!(
                     "{name}: line {line} does not read as a member without its '#': {}",
                     old.trim()

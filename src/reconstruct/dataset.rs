@@ -23,7 +23,7 @@ use crate::arcs::{
 };
 use crate::catalog::{
     parse_arclet_catalog, parse_image_catalog, parse_member_catalog, ArcletCatalog, CatalogError,
-    CatalogRow, ImageCatalog, Member, MemberCatalog,
+    CatalogRow, CommentedBcgs, ImageCatalog, Member, MemberCatalog,
 };
 use crate::cosmology::LensPlane;
 use crate::inversion::{build_constraints, missing_bcg_warning, ConstraintMode, ConstraintSource};
@@ -210,32 +210,9 @@ impl Dataset {
         plane: &LensPlane,
         config: &ReconstructConfig,
     ) -> Vec<CatalogRow> {
-        let Some(members) = self.members.as_ref() else {
-            return Vec::new();
-        };
-        if !config.members.fit_commented_bcg
-            || members.commented.is_empty()
-            || members.fitted_bcgs.is_some()
-        {
-            return Vec::new();
-        }
-        let Some(constraints) = self
-            .constraints(config.constraints.mode)
-            .ok()
-            .and_then(|(source, _)| build_constraints(source, &config.constraints, &[]).ok())
+        let (Some(found), Some(members)) =
+            (self.commented_bcgs(plane, config), self.members.as_mut())
         else {
-            return Vec::new();
-        };
-        let Some(found) = missing_bcg_warning(
-            &members.source_name,
-            &with_luminosity(&members.members, &config.members, plane),
-            &image_centres(&constraints),
-            &with_luminosity(&members.commented, &config.members, plane),
-        )
-        .and_then(|m| m.commented) else {
-            return Vec::new();
-        };
-        let Some(members) = self.members.as_mut() else {
             return Vec::new();
         };
         let (fitted, kept): (Vec<Member>, Vec<Member>) = std::mem::take(&mut members.commented)
@@ -246,6 +223,30 @@ impl Dataset {
         let rows = found.rows.clone();
         members.fitted_bcgs = Some(found);
         rows
+    }
+
+    /// The commented-out rows [`Self::fit_commented_bcgs`] would fit, if any.
+    fn commented_bcgs(
+        &self,
+        plane: &LensPlane,
+        config: &ReconstructConfig,
+    ) -> Option<CommentedBcgs> {
+        let members = self.members.as_ref()?;
+        if !config.members.fit_commented_bcg
+            || members.commented.is_empty()
+            || members.fitted_bcgs.is_some()
+        {
+            return None;
+        }
+        let (source, _) = self.constraints(config.constraints.mode).ok()?;
+        let constraints = build_constraints(source, &config.constraints, &[]).ok()?;
+        missing_bcg_warning(
+            &members.source_name,
+            &with_luminosity(&members.members, &config.members, plane),
+            &image_centres(&constraints),
+            &with_luminosity(&members.commented, &config.members, plane),
+        )?
+        .commented
     }
 
     /// The frame's sky reference: the image catalogue's, else the member catalogue's, else the
