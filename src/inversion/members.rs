@@ -676,11 +676,27 @@ pub fn missing_bcg_warning(
     };
     let lines = and_list(rows.iter().map(|(m, _)| m.line.to_string()));
     let ids = and_list(rows.iter().map(described));
-    let one = rows.len() == 1;
-    let (line_s, member_s, comment_s) = if one {
-        ("line", "member", "comments")
+    // The words that agree with the number of rows, in one place.
+    let (line_s, member_s, comment_s, it, they_are_fitted, if_that) = if rows.len() == 1 {
+        let fitted = "it is fitted as the BCG";
+        (
+            "line",
+            "member",
+            "comments",
+            "it",
+            fitted,
+            "that is the BCG",
+        )
     } else {
-        ("lines", "members", "comment")
+        let fitted = "they are fitted as BCGs";
+        (
+            "lines",
+            "members",
+            "comment",
+            "them",
+            fitted,
+            "those are the BCGs",
+        )
     };
     let cure = if rows.is_empty() {
         "If the cluster has one, add its row (id x y a b theta mag lum) to the member catalogue, \
@@ -688,16 +704,12 @@ pub fn missing_bcg_warning(
          model file)"
             .to_string()
     } else {
-        format!(
-            "{} {lines} {comment_s} out {member_s} {ids}: if {}, remove the '#' to fit {}",
-            if one { "Line" } else { "Lines" },
-            if one {
-                "that is the BCG"
-            } else {
-                "those are the BCGs"
-            },
-            if one { "it" } else { "them" }
-        )
+        let mut said = format!(
+            "{line_s} {lines} {comment_s} out {member_s} {ids}: if {if_that}, remove the '#' to \
+             fit {it}"
+        );
+        said[..1].make_ascii_uppercase();
+        said
     };
     let warning = format!(
         "{finding}. Lenstool set-ups often model the BCG as its own `potentiel` in the .par and \
@@ -713,16 +725,10 @@ pub fn missing_bcg_warning(
             })
             .collect(),
         note: format!(
-            "{finding}, but {line_s} {lines} {comment_s} out {member_s} {ids}: {}, which \
-             Lenstool set-ups model in the .par and comment out of the potfile catalogue. To \
-             leave {} out, set members.fit_commented_bcg to false (in the app: \"Fit \
-             commented-out BCG rows\")",
-            if one {
-                "it is fitted as the BCG"
-            } else {
-                "they are fitted as BCGs"
-            },
-            if one { "it" } else { "them" }
+            "{finding}, but {line_s} {lines} {comment_s} out {member_s} {ids}: \
+             {they_are_fitted}, which Lenstool set-ups model in the .par and comment out of the \
+             potfile catalogue. To leave {it} out, set members.fit_commented_bcg to false (in \
+             the app: \"Fit commented-out BCG rows\")"
         ),
     });
     Some(MissingBcg { warning, commented })
