@@ -74,8 +74,8 @@ pub use sky::{parse_sky_angle, SkyReference};
 
 // Mass components and the maps of a lens.
 pub use curves::{
-    critical_curves, einstein_radius_for, zero_contours, Caustics, CriticalCurves, Polyline,
-    OPEN_AREA_SHARE, TANGENTIAL_BORDER_SHARE,
+    critical_curves, critical_curves_about, einstein_radius_for, zero_contours, Caustics,
+    CriticalCurves, LensRegion, Polyline, OPEN_AREA_SHARE, TANGENTIAL_BORDER_SHARE,
 };
 pub use demo::{CLUSTER_MODEL_JSON, TEACHING_MODEL_JSON};
 pub use image_search::{

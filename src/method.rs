@@ -380,8 +380,11 @@
 //! are the zero contours of `lambda_t`, the radial ones of `lambda_r` (together, the zeros of
 //! `det A`), traced between pixel centres. Caustics are the curves mapped to the source plane
 //! through the lens equation. The effective Einstein radius is
-//! `sqrt(area inside the tangential curves / pi)`; when the tangential curves leave the map it
-//! counts only the closed loops and is flagged as too small.
+//! `sqrt(area inside the tangential curves / pi)` of the lens at the map's centre: the loops
+//! that come within half the map's side of it and those inside them (a structure wholly
+//! beyond, such as a group in a corner of the map, is another lens). When the lens's curve
+//! leaves the map it is measured again on wider maps, still counting that lens only; when it
+//! leaves every one, only the closed loops count and the radius is flagged as too small.
 //!
 //! **Per system.** The source position `beta`, the scatter of the system's constraints in the
 //! source plane, the images predicted by solving the lens equation forward from `beta` (every

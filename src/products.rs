@@ -9,7 +9,7 @@ use serde::{Deserialize, Serialize};
 use thiserror::Error;
 
 use crate::cosmology::{CosmologyError, LensPlane};
-use crate::curves::{critical_curves, CriticalCurves};
+use crate::curves::{critical_curves, critical_curves_about, CriticalCurves, LensRegion};
 use crate::ds9::write_regions;
 use crate::fits::{write_image, Card, FitsError, FitsWriteOptions};
 use crate::map::{LensMaps, MapsError};
@@ -519,7 +519,9 @@ pub(crate) fn own_map_side(curves: &CriticalCurves, geometry: MapGeometry) -> Op
 
 /// The Einstein radius of `lens` measured on the maps of [`EINSTEIN_MAP_WIDENING`] around
 /// `geometry`, and the side of the first map that holds the whole tangential curve (`None` when
-/// none does: the radius is then the widest map's closed loops only).
+/// none does: the radius is then the widest map's closed loops only). The lens is the one of
+/// `geometry` (within half its side of its centre): what the wider maps add beyond is another
+/// structure's.
 fn einstein_radius_on_wider_maps(
     lens: &dyn MassComponent,
     geometry: MapGeometry,
@@ -534,7 +536,11 @@ fn einstein_radius_on_wider_maps(
             center: geometry.center,
         };
         let maps = LensMaps::from_lens(lens, wide);
-        let curves = critical_curves(&maps, f, z_source, None);
+        let about = LensRegion {
+            center: geometry.center,
+            radius_arcsec: 0.5 * geometry.size_arcsec,
+        };
+        let curves = critical_curves_about(&maps, f, z_source, None, about);
         radius = curves.einstein_radius_arcsec;
         if !curves.tangential_leaves_map {
             return (radius, Some(wide.size_arcsec));

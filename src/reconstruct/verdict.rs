@@ -16,7 +16,7 @@ use serde::{Deserialize, Serialize};
 use super::summary::median_arcsec;
 use super::{ImageReport, SourceReport};
 use crate::catalog::CatalogRow;
-use crate::curves::{signed_area_arcsec2, CriticalCurves};
+use crate::curves::{polygon_contains, signed_area_arcsec2, CriticalCurves};
 use crate::ds9::polyline_is_open;
 use crate::map::MapGeometry;
 
@@ -313,22 +313,8 @@ pub fn members_with_own_curves(
         .collect();
     members
         .iter()
-        .filter(|&&m| own.iter().any(|c| inside(c, m)))
+        .filter(|&&m| own.iter().any(|c| polygon_contains(c, m)))
         .count()
-}
-
-/// Point in polygon by the even-odd rule.
-fn inside(poly: &[DVec2], p: DVec2) -> bool {
-    let mut odd = false;
-    let mut j = poly.len() - 1;
-    for i in 0..poly.len() {
-        let (a, b) = (poly[i], poly[j]);
-        if (a.y > p.y) != (b.y > p.y) && p.x < (b.x - a.x) * (p.y - a.y) / (b.y - a.y) + a.x {
-            odd = !odd;
-        }
-        j = i;
-    }
-    odd
 }
 
 impl Verdict {

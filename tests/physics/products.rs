@@ -656,3 +656,92 @@ fn an_einstein_curve_larger_than_the_map_is_measured_on_a_wider_one() {
         0.1 * EINSTEIN_MAP_WIDENING[0] * pixel,
     );
 }
+
+/// The Einstein radius is the lens's at the map's centre: another structure whose curve lies
+/// wholly beyond half the map's side (a group in a corner, as beside Abell 2744 in its CATS
+/// model) neither counts nor, cut by the border, sends the measurement to a wider map where it
+/// would be counted whole (41" instead of 22.8" for that model).
+#[cfg_attr(not(target_arch = "wasm32"), test)]
+#[cfg_attr(target_arch = "wasm32", wasm_bindgen_test::wasm_bindgen_test)]
+fn a_second_structure_beyond_half_the_map_is_not_the_lens() {
+    use wslap::{critical_curves_about, LensRegion, ProductOptions, Products};
+    let plane = LensPlane::new(Cosmology::default(), 0.3).expect("plane");
+    let f = plane.distance_ratio(2.0).expect("f");
+    let r_true = f * THETA_E_ARCSEC;
+    let products = |lens: &dyn MassComponent, size_arcsec: f64| {
+        let opts = ProductOptions {
+            size_arcsec,
+            pixels: 256,
+            ..ProductOptions::default()
+        };
+        Products::from_lens(lens, plane, None, &opts).expect("products")
+    };
+    // sqrt(area / pi) of the tangential loop around the centre, by the shoelace formula.
+    let central = |curves: &[Polyline]| {
+        let around = |c: &Polyline| (c.iter().copied().sum::<DVec2>() / c.len() as f64).length();
+        let c = curves
+            .iter()
+            .min_by(|a, b| around(a).total_cmp(&around(b)))
+            .expect("a curve");
+        let twice: f64 = (0..c.len())
+            .map(|k| c[k].perp_dot(c[(k + 1) % c.len()]))
+            .sum();
+        (0.5 * twice.abs() / std::f64::consts::PI).sqrt()
+    };
+    let group = |at: DVec2, theta_e: f64| {
+        let g = Sis::from_theta_e(at, theta_e).expect("group SIS");
+        wslap::Lens::new(vec![Box::new(sis()), Box::new(g)])
+    };
+    let everything = LensRegion {
+        center: DVec2::ZERO,
+        radius_arcsec: 10.0 * r_true,
+    };
+    // A group in the corner of an 8 r_E map, its curve (radius about 0.6 r_E) 4.5 - 5.7 r_E
+    // from the centre and cut by the border: the map holds the lens's curve, no wider map.
+    let size = 8.0 * r_true;
+    let lens = group(DVec2::splat(0.45 * size), 0.6 * THETA_E_ARCSEC);
+    let p = products(&lens, size);
+    assert!(
+        p.curves.tangential.len() >= 2,
+        "the group's curve is traced"
+    );
+    assert!(!p.curves.tangential_leaves_map);
+    assert_eq!(p.einstein_radius_map_arcsec, Some(size));
+    let r = p.curves.einstein_radius_arcsec;
+    assert_abs(
+        "the lens's loop only",
+        r,
+        central(&p.curves.tangential),
+        1e-9,
+    );
+    assert_rel("near the lone SIS's radius", r, r_true, 0.1);
+    let whole_map = MapGeometry {
+        pixels: 256,
+        size_arcsec: size,
+        center: DVec2::ZERO,
+    };
+    let maps = LensMaps::from_lens(&lens, whole_map);
+    let with_group = critical_curves_about(&maps, f, 2.0, None, everything);
+    assert!(with_group.tangential_leaves_map, "the group's curve leaves");
+    // The lens's curve leaves a 1.9 r_E map; on the 3.8 r_E map that holds it a group's closed
+    // loop (about 2.1 r_E from the centre, beyond the first map's 0.95 r_E) does not count.
+    let lens = group(DVec2::splat(1.5 * r_true), 0.1 * THETA_E_ARCSEC);
+    let narrow = products(&lens, 1.9 * r_true);
+    assert!(narrow.curves.tangential_leaves_map);
+    assert_eq!(narrow.einstein_radius_map_arcsec, Some(3.8 * r_true));
+    let wide = MapGeometry {
+        pixels: 256,
+        size_arcsec: 3.8 * r_true,
+        center: DVec2::ZERO,
+    };
+    let all = critical_curves_about(&LensMaps::from_lens(&lens, wide), f, 2.0, None, everything);
+    assert_eq!(all.tangential.len(), 2, "the lens's loop and the group's");
+    let r_lens = central(&all.tangential);
+    assert!(all.einstein_radius_arcsec > 1.01 * r_lens, "both count");
+    assert_abs(
+        "the lens's loop only, on the wider map",
+        narrow.curves.einstein_radius_arcsec,
+        r_lens,
+        1e-9,
+    );
+}
