@@ -467,6 +467,35 @@ pub(crate) fn member_halo(
 /// with a warning each. Layers are split by brightness (lowest magnitude first, ties by
 /// catalogue order); empty layers are not made.
 ///
+/// One warning for the members `outside` the field (none when there are none): a lone member
+/// by line, id and position; several by their lines, so that a catalogue of the whole cluster
+/// (AS1063's has 60 beyond a 108 arcsec field) gives one line, not sixty.
+fn outside_warning(
+    catalog: &MemberCatalog,
+    outside: &[&Member],
+    width_arcsec: f64,
+    margin_arcsec: f64,
+) -> Option<String> {
+    let field = format!("(grid of {width_arcsec:.1} arcsec plus {margin_arcsec:.1} arcsec margin)");
+    match outside {
+        [] => None,
+        [m] => Some(format!(
+            "{}: line {}: member {} at ({:.2}, {:.2}) arcsec lies outside the field {field}: \
+             not used",
+            catalog.source_name, m.line, m.id, m.position.x, m.position.y
+        )),
+        many => {
+            let lines: Vec<String> = many.iter().map(|m| m.line.to_string()).collect();
+            Some(format!(
+                "{}: {} members lie outside the field {field} and are not used: lines {}",
+                catalog.source_name,
+                many.len(),
+                lines.join(", ")
+            ))
+        }
+    }
+}
+
 /// [method §4]: crate::method#4-member-galaxies
 pub fn build_member_layers(
     catalog: &MemberCatalog,
@@ -477,7 +506,7 @@ pub fn build_member_layers(
     config.validate()?;
     let mag_star = config.mag_star_on(plane);
     let margin = config.outside_margin_fraction * grid.width_arcsec;
-    let mut warnings = Vec::new();
+    let mut outside = Vec::new();
     let mut halos = Vec::new();
     let mut components: Vec<Box<dyn MassComponent>> = Vec::new();
     for (index, m) in catalog.members.iter().enumerate() {
@@ -503,17 +532,7 @@ pub fn build_member_layers(
             ));
         }
         if !grid.contains(m.position, margin) {
-            warnings.push(format!(
-                "{}: line {}: member {} at ({:.2}, {:.2}) arcsec lies outside the field \
-                 (grid of {:.1} arcsec plus {:.1} arcsec margin): not used",
-                catalog.source_name,
-                m.line,
-                m.id,
-                m.position.x,
-                m.position.y,
-                grid.width_arcsec,
-                margin
-            ));
+            outside.push(m);
             continue;
         }
         let mass_msun = config.mass_msun(m.mag, mag_star);
@@ -540,6 +559,9 @@ pub fn build_member_layers(
             r_trunc_arcsec,
         });
     }
+    let warnings = outside_warning(catalog, &outside, grid.width_arcsec, margin)
+        .into_iter()
+        .collect();
     let layers = split_layers(config.layers, &halos, components, config.c_prior_sigma);
     Ok(MemberModel {
         halos,

@@ -944,8 +944,8 @@ fn reconstruct_limited(
         (x, status, iterations) = (outcome.x, outcome.status, iterations + outcome.iterations);
     }
     let iterates = thin_iterates(iterates, config.solver.keep_iterates);
-    // First: they bear on the whole result, and a long list of members outside the field
-    // would hide them. Timed with the system, whose matrix they factorise.
+    // First: they bear on the whole result, and the catalogues' warnings would hide them.
+    // Timed with the system, whose matrix they factorise.
     let t = crate::products::Clock::start();
     warnings.splice(0..0, system.measurability_warnings());
     timings.system_ms += t.ms();

@@ -6,9 +6,9 @@
 use crate::common::{assert_abs, assert_rel};
 use crate::fixtures::{member, members, plane};
 use glam::DVec2;
-use wslap::MemberCatalog;
 use wslap::{build_member_layers, CellGrid, Layer, LayerSplit, MemberConfig};
 use wslap::{MassComponent, TruncatedNfw};
+use wslap::{Member, MemberCatalog};
 
 /// Member halo rebuilt from its M200, c200 (the concentration is found by bisection to
 /// double precision; the TNFW total-mass formula rounds at ~1e-13).
@@ -202,4 +202,17 @@ fn members_outside_the_field_are_warned_and_left_out() {
     assert!(model.warnings[0].contains("member far") && model.warnings[0].contains("members.cat"));
     assert!(!model.layers[0].members.contains(&6));
     assert!(model.layers[0].members.contains(&7));
+    // Several members outside: one warning naming their lines.
+    for (id, x, y, line) in [("far2", -200.0, 50.0, 20), ("far3", 0.0, -90.0, 21)] {
+        cat.members.push(Member {
+            line,
+            ..member(id, x, y, 18.0)
+        });
+    }
+    let model = build_member_layers(&cat, &config, &plane(), &grid).unwrap();
+    assert_eq!(model.halos.len(), 7);
+    assert_eq!(model.warnings.len(), 1, "{:?}", model.warnings);
+    let expected = "members.cat: 3 members lie outside the field (grid of 60.0 arcsec plus \
+                    6.0 arcsec margin) and are not used: lines 3, 20, 21";
+    assert_eq!(model.warnings[0], expected);
 }
