@@ -105,7 +105,8 @@ impl Session {
         warnings.append(&mut parsed.warnings);
         parsed.warnings = warnings;
         if self.settings.members_from_model {
-            if let Some(par) = self.data.model_par(&self.settings.par_options())? {
+            let options = self.settings.par_options().for_galaxies();
+            if let Some(par) = self.data.model_par(&options)? {
                 let notes = parsed
                     .add_par_galaxies(&par)
                     .map_err(|e| AppError::File(e.to_string()))?;
@@ -166,7 +167,10 @@ impl Session {
         if self.settings.members_from_model {
             return Vec::new();
         }
-        match self.data.model_par(&self.settings.par_options()) {
+        match self
+            .data
+            .model_par(&self.settings.par_options().for_galaxies())
+        {
             Ok(Some(par)) => par.galaxies().map(|g| g.members).unwrap_or_default(),
             _ => Vec::new(),
         }

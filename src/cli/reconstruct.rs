@@ -7,8 +7,8 @@ use clap::Args;
 use serde::Serialize;
 use wslap::{
     check_ensemble_size, check_memory, cross_validate, export_system, fold_groups, image_regions,
-    parse_par, reconstruct, run_ensemble, ColorScale, Control, ConvergenceRecord, Cosmology,
-    CrossValidation, Dataset, InputKind, InputText, InputTexts, Inputs, LensPlane,
+    parse_par_with, reconstruct, run_ensemble, ColorScale, Control, ConvergenceRecord, Cosmology,
+    CrossValidation, Dataset, InputKind, InputText, InputTexts, Inputs, LensPlane, ParOptions,
     ReconstructConfig, ReconstructError, Reconstruction, SolverMethod,
 };
 
@@ -228,8 +228,9 @@ pub fn run(args: &ReconstructArgs) -> Result<(), String> {
         Dataset::read(&files, config.constraints.pixel_arcsec).map_err(|e| e.to_string())?;
     if let Some(path) = &args.par {
         let par_name = name(path);
-        let par =
-            parse_par(&read_text(path, InputKind::Model)?, &par_name).map_err(|e| e.to_string())?;
+        let text = read_text(path, InputKind::Model)?;
+        let par = parse_par_with(&text, &par_name, &ParOptions::default().for_galaxies())
+            .map_err(|e| e.to_string())?;
         for note in data.add_par_galaxies(&par).map_err(|e| e.to_string())? {
             eprintln!("note: {note}");
         }

@@ -120,6 +120,16 @@ pub struct ParOptions {
     pub single_plane: bool,
 }
 
+impl ParOptions {
+    /// How a `.par` is read for the galaxies it models on its own ([`LenstoolPar::galaxies`]):
+    /// with the single-plane approximation, since only the galaxies at the first block's
+    /// redshift are taken, so a model with a group at another redshift (Abell 370's CATS model
+    /// has one at z = 1.05) gives its cluster galaxies without the setting.
+    pub fn for_galaxies(self) -> Self {
+        Self { single_plane: true }
+    }
+}
+
 /// Something in a `.par` file that Lenstool accepts and the model is built without, or an
 /// approximation asked for, worth telling the user.
 #[derive(Debug, Clone, PartialEq, Eq)]
@@ -164,6 +174,9 @@ pub struct ParGalaxies {
     pub members: Vec<Member>,
     /// Those without one: each block's name and line.
     pub without_mag: Vec<(String, usize)>,
+    /// Galaxies at another redshift than [`LenstoolPar::z_lens`] (read with the single-plane
+    /// approximation), not the cluster's: each block's name, line and `z_lens`.
+    pub other_plane: Vec<(String, usize, f64)>,
 }
 
 /// One mass component of a `potentiel` block (positions in arcsec, angles in degrees
@@ -196,6 +209,8 @@ pub struct ParPotential {
     /// The block's `mag`, when it gives one (Lenstool scales a galaxy's dPIE with it; a BCG
     /// modelled on its own usually has it).
     pub mag: Option<f64>,
+    /// The block's own `z_lens` (before a single-plane approximation moved it).
+    pub z_lens: f64,
 }
 
 /// A `potfile` block: the member catalogue and the `L*` galaxy of the scaling relations.
@@ -307,10 +322,11 @@ impl LenstoolPar {
     /// at most [`GALAXY_MAX_CORE_KPC`] (a BCG's is below a kpc; a group or cluster halo's tens
     /// of kpc), as member rows in the file's frame (id: the block's name, e.g. `O3`; a and b
     /// from the ellipticity `(a^2 - b^2)/(a^2 + b^2)`; line: the block's). Those without a
-    /// `mag`, which a member needs, come second, by block name and line.
+    /// `mag`, which a member needs, come second, by block name and line; those at another
+    /// redshift (a single-plane read, [`ParOptions::for_galaxies`]) third.
     pub fn galaxies(&self) -> Result<ParGalaxies, ParError> {
         let plane = self.lens_plane()?;
-        let (mut rows, mut without_mag) = (Vec::new(), Vec::new());
+        let (mut rows, mut without_mag, mut other_plane) = (Vec::new(), Vec::new(), Vec::new());
         for p in &self.potentials {
             let ParComponent::Dpie {
                 center_arcsec,
@@ -324,6 +340,10 @@ impl LenstoolPar {
             };
             let core_kpc = r_core.arcsec(&plane) * plane.mpc_per_arcsec * 1.0e3;
             if core_kpc > GALAXY_MAX_CORE_KPC {
+                continue;
+            }
+            if (p.z_lens - self.z_lens).abs() > Z_MATCH_TOL {
+                other_plane.push((p.block.clone(), p.line, p.z_lens));
                 continue;
             }
             let id = p.block.split_whitespace().last().unwrap_or("potentiel");
@@ -346,6 +366,7 @@ impl LenstoolPar {
         Ok(ParGalaxies {
             members: rows,
             without_mag,
+            other_plane,
         })
     }
 

@@ -636,6 +636,7 @@ impl Ctx<'_> {
             line: b.line,
             component,
             mag: self.opt(b, "mag", 0)?,
+            z_lens: z,
         };
         Ok((p, z))
     }

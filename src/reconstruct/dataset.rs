@@ -132,6 +132,7 @@ impl Dataset {
         let ParGalaxies {
             members: rows,
             without_mag,
+            other_plane,
         } = par.galaxies()?;
         let name = &par.source_name;
         let mut notes: Vec<String> = without_mag
@@ -144,6 +145,13 @@ impl Dataset {
                 )
             })
             .collect();
+        notes.extend(other_plane.iter().map(|(block, line, z)| {
+            format!(
+                "{name}: line {line}: `{block}` is a galaxy at z = {z}, not at the cluster's \
+                 z_lens = {}: not fitted",
+                par.z_lens
+            )
+        }));
         if rows.is_empty() {
             return Ok(notes);
         }

@@ -143,6 +143,44 @@ fn a_stray_end_before_fini_is_skipped_as_by_lenstool() {
     );
 }
 
+/// The galaxies a `.par` models on its own are read from a model with a group at another
+/// redshift (A370's CATS model has one at z = 1.05, and `wslap reconstruct --par` refused it):
+/// the cluster's galaxies are fitted, a galaxy at the other redshift is named and not.
+#[cfg_attr(not(target_arch = "wasm32"), test)]
+#[cfg_attr(target_arch = "wasm32", wasm_bindgen_test::wasm_bindgen_test)]
+fn the_galaxies_of_a_multi_plane_model_are_the_cluster_planes() {
+    let options = ParOptions::default().for_galaxies();
+    let par = parse_par_with(MULTIPLANE, "multiplane.par", &options).expect("read");
+    let found = par.galaxies().unwrap();
+    let ids: Vec<&str> = found.members.iter().map(|m| m.id.as_str()).collect();
+    assert_eq!(ids, ["O2"]);
+    assert!(found.other_plane.is_empty() && found.without_mag.is_empty());
+    // A galaxy of the background group modelled on its own (core 0.2 kpc, a `mag`).
+    let background = "potentiel O3\n\tprofil       81\n\tx_centre     30.0\n\ty_centre     \
+                      -20.0\n\tellipticite     0.1\n\tangle_pos       10.0\n\t\
+                      core_radius_kpc     0.2\n\tcut_radius_kpc     20.0\n\tv_disp     \
+                      150.0\n\tmag\t\t  20.5\n\tz_lens     1.0500\n\tend\npotfile0\n";
+    let text = MULTIPLANE.replacen("potfile0\n", background, 1);
+    let line = 1 + text[..text.find("potentiel O3").unwrap()]
+        .matches('\n')
+        .count();
+    let par = parse_par_with(&text, "group.par", &options).expect("read");
+    let found = par.galaxies().unwrap();
+    assert_eq!(found.members.len(), 1);
+    assert_eq!(
+        found.other_plane,
+        [("potentiel O3".to_string(), line, 1.05)]
+    );
+    let mut data = wslap::Dataset::default();
+    let notes = data.add_par_galaxies(&par).unwrap();
+    let expected = format!(
+        "group.par: line {line}: `potentiel O3` is a galaxy at z = 1.05, not at the \
+         cluster's z_lens = 0.375: not fitted"
+    );
+    assert!(notes.contains(&expected), "{notes:?}");
+    assert_eq!(data.members.unwrap().members.len(), 1);
+}
+
 #[cfg_attr(not(target_arch = "wasm32"), test)]
 #[cfg_attr(target_arch = "wasm32", wasm_bindgen_test::wasm_bindgen_test)]
 fn a_background_group_is_refused_or_moved_by_the_single_plane_option() {
