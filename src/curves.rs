@@ -129,8 +129,8 @@ impl LensRegion {
 
 /// [`critical_curves`] with the lens at `about` (e.g. a wider map's curves, measured for the
 /// lens of a narrower one): the Einstein radius counts the closed tangential loops that enter
-/// the region (a vertex in it, or around it) and the loops nested inside those (a hole, or a member's loop inside
-/// the cluster's curve, may lie beyond); the curve leaves the map
+/// the region (a vertex in it, or around it) and the loops nested inside those (a hole, or a
+/// member's loop inside the cluster's curve, may lie beyond); the curve leaves the map
 /// ([`CriticalCurves::tangential_leaves_map`]) only where the region `lambda_t < 0` that
 /// crosses the border reaches into `about`. Every curve is traced and returned either way.
 pub fn critical_curves_about(
