@@ -215,13 +215,18 @@ pub fn critical_curves_about(
 /// The closed loops of `contours` that belong to the lens at `about`: those that enter it, and
 /// those nested inside one of these.
 fn lens_loops(contours: &[Contour], about: LensRegion) -> impl Iterator<Item = &Contour> {
-    let closed = || contours.iter().filter(|c| c.closed);
-    let near: Vec<&Contour> = closed().filter(|c| about.reaches(&c.points)).collect();
-    closed().filter(move |c| {
-        about.reaches(&c.points)
-            || near
-                .iter()
+    let closed: Vec<(&Contour, bool)> = contours
+        .iter()
+        .filter(|c| c.closed)
+        .map(|c| (c, about.reaches(&c.points)))
+        .collect();
+    let near: Vec<&Contour> = closed.iter().filter(|(_, n)| *n).map(|(c, _)| *c).collect();
+    closed.into_iter().filter_map(move |(c, reaches)| {
+        let nested = || {
+            near.iter()
                 .any(|outer| polygon_contains(&outer.points, c.points[0]))
+        };
+        (reaches || nested()).then_some(c)
     })
 }
 

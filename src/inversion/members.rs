@@ -469,7 +469,7 @@ pub(crate) fn member_halo(
 ///
 /// One warning for the members `outside` the field (none when there are none): a lone member
 /// by line, id and position; several by their lines, so that a catalogue of the whole cluster
-/// (AS1063's has 60 beyond a 108 arcsec field) gives one line, not sixty.
+/// (AS1063's has 99 beyond its 108 arcsec field) gives one line, not 99.
 fn outside_warning(
     catalog: &MemberCatalog,
     outside: &[&Member],
