@@ -128,6 +128,7 @@ pub fn parse_member_catalog(
     let mut warnings = Vec::new();
     let mut extra_lines = Vec::new();
     let mut seen: HashMap<&str, usize> = HashMap::new();
+    let mut rows_by_id: HashMap<&str, &Row<'_>> = HashMap::new();
     let mut members = Vec::with_capacity(table.rows.len());
     let mut positions = Vec::with_capacity(table.rows.len());
     for row in &table.rows {
@@ -138,14 +139,27 @@ pub fn parse_member_catalog(
         };
         f.require(MEMBER_LAYOUT, &mut extra_lines)?;
         let id = row.fields[0];
-        warn_repeated_id(
-            &mut seen,
-            id,
-            row.line,
-            "member",
-            source_name,
-            &mut warnings,
-        );
+        match rows_by_id.insert(id, row) {
+            // A row written twice is two galaxies to Lenstool, and here: say so plainly.
+            Some(first) if first.fields == row.fields => warnings.push(CatalogWarning {
+                source_name: source_name.into(),
+                line: row.line,
+                message: format!(
+                    "member '{id}' repeats line {} exactly: both rows are fitted (as Lenstool \
+                     reads them), which doubles that galaxy's mass; delete one if that is not \
+                     meant",
+                    first.line
+                ),
+            }),
+            _ => warn_repeated_id(
+                &mut seen,
+                id,
+                row.line,
+                "member",
+                source_name,
+                &mut warnings,
+            ),
+        }
         let shape = f.shape(table.coords)?;
         let mag_text = row.fields[6];
         let mag = if mag_text.eq_ignore_ascii_case("nan") {

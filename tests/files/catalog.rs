@@ -388,6 +388,31 @@ fn members_without_lum_and_absolute_members() {
     assert!(lo.x < hi.x && lo.y < hi.y);
 }
 
+/// A member row written twice (as in MACS J1149's published member catalogues, four rows
+/// each) is two galaxies, as Lenstool reads it, and the warning says the mass is doubled; a
+/// reused id on another galaxy keeps the plain warning.
+#[cfg_attr(not(target_arch = "wasm32"), test)]
+#[cfg_attr(target_arch = "wasm32", wasm_bindgen_test::wasm_bindgen_test)]
+fn a_repeated_member_row_is_fitted_twice_and_said_so() {
+    let text = "#REFERENCE 3 10 20\n\
+                95 -6.77 -100.72 0.7 0.4 7.9 22.97 0.01\n\
+                95 -6.77 -100.72 0.7 0.4 7.9 22.97 0.01\n\
+                7 1 2 0.5 0.4 0 20\n\
+                7 3 4 0.5 0.4 0 21\n";
+    let (cat, warnings) = parse_member_catalog(text, "m.cat", None).unwrap();
+    assert_eq!(cat.members.len(), 4, "every row is a galaxy");
+    let texts: Vec<String> = warnings.iter().map(ToString::to_string).collect();
+    assert_eq!(
+        texts,
+        [
+            "m.cat: line 3: member '95' repeats line 2 exactly: both rows are fitted (as \
+             Lenstool reads them), which doubles that galaxy's mass; delete one if that is not \
+             meant",
+            "m.cat: line 5: member id '7' is already used on line 4",
+        ]
+    );
+}
+
 #[cfg_attr(not(target_arch = "wasm32"), test)]
 #[cfg_attr(target_arch = "wasm32", wasm_bindgen_test::wasm_bindgen_test)]
 fn image_catalog_helpers() {
