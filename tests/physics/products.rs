@@ -571,24 +571,31 @@ fn radial_profile_rejects_bad_requests() {
     );
 }
 
+/// The lens plane of the Einstein-radius tests (z = 0.3).
+fn einstein_plane() -> LensPlane {
+    LensPlane::new(Cosmology::default(), 0.3).expect("plane")
+}
+
+/// Products of `lens` on [`einstein_plane`] (sources at z = 2 by default) on a square map of
+/// side `size_arcsec` and `pixels` per side, centred on the origin.
+fn products_at_z2(lens: &dyn MassComponent, size_arcsec: f64, pixels: usize) -> wslap::Products {
+    let opts = wslap::ProductOptions {
+        size_arcsec,
+        pixels,
+        ..wslap::ProductOptions::default()
+    };
+    wslap::Products::from_lens(lens, einstein_plane(), None, &opts).expect("products")
+}
+
 /// When the tangential curve leaves the products' map, the Einstein radius is measured on a
 /// wider map (and said so); when it leaves every map tried, the summary says it is a lower
 /// bound. Before, such a lens reported 0.
 #[cfg_attr(not(target_arch = "wasm32"), test)]
 #[cfg_attr(target_arch = "wasm32", wasm_bindgen_test::wasm_bindgen_test)]
 fn an_einstein_curve_larger_than_the_map_is_measured_on_a_wider_one() {
-    use wslap::{ProductOptions, Products, EINSTEIN_MAP_WIDENING};
-    let plane = LensPlane::new(Cosmology::default(), 0.3).expect("plane");
-    let f = plane.distance_ratio(2.0).expect("f");
-    let r_true = f * THETA_E_ARCSEC;
-    let products_of = |lens: &dyn MassComponent, size_arcsec: f64| {
-        let opts = ProductOptions {
-            size_arcsec,
-            pixels: 128,
-            ..ProductOptions::default()
-        };
-        Products::from_lens(lens, plane, None, &opts).expect("products")
-    };
+    use wslap::EINSTEIN_MAP_WIDENING;
+    let r_true = einstein_plane().distance_ratio(2.0).expect("f") * THETA_E_ARCSEC;
+    let products_of = |lens: &dyn MassComponent, size: f64| products_at_z2(lens, size, 128);
     let products = |size_arcsec: f64| products_of(&sis(), size_arcsec);
     // The map holds the circle: measured on it.
     let inside = products(3.0 * r_true);
@@ -664,18 +671,10 @@ fn an_einstein_curve_larger_than_the_map_is_measured_on_a_wider_one() {
 #[cfg_attr(not(target_arch = "wasm32"), test)]
 #[cfg_attr(target_arch = "wasm32", wasm_bindgen_test::wasm_bindgen_test)]
 fn a_second_structure_beyond_half_the_map_is_not_the_lens() {
-    use wslap::{critical_curves_about, LensRegion, ProductOptions, Products};
-    let plane = LensPlane::new(Cosmology::default(), 0.3).expect("plane");
-    let f = plane.distance_ratio(2.0).expect("f");
+    use wslap::{critical_curves_about, LensRegion};
+    let f = einstein_plane().distance_ratio(2.0).expect("f");
     let r_true = f * THETA_E_ARCSEC;
-    let products = |lens: &dyn MassComponent, size_arcsec: f64| {
-        let opts = ProductOptions {
-            size_arcsec,
-            pixels: 256,
-            ..ProductOptions::default()
-        };
-        Products::from_lens(lens, plane, None, &opts).expect("products")
-    };
+    let products = |lens: &dyn MassComponent, size: f64| products_at_z2(lens, size, 256);
     // sqrt(area / pi) of the tangential loop around the centre, by the shoelace formula.
     let central = |curves: &[Polyline]| {
         let around = |c: &Polyline| (c.iter().copied().sum::<DVec2>() / c.len() as f64).length();
