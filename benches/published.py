@@ -1,8 +1,9 @@
 #!/usr/bin/env python3
 """Real clusters the defaults never saw, against their published Lenstool models.
 
-The HFF CATS models of Abell 2744, Abell 370 and MACS J1149 (image catalogue, member catalogue
-and the published `bestopt.par`) are in github.com/cerschae/Lenstool-HPC (GPL-3, commit
+The HFF CATS models of Abell 2744, Abell 370 and MACS J1149, and Jauzac et al. (2016)'s of
+MACS J1149 (image catalogue, member catalogue and the published `bestopt.par`, for the last
+`best.par.20170201103232`) are in github.com/cerschae/Lenstool-HPC (GPL-3, commit
 af57aacf74d3bf8841cea1a113f8d863f9d003c9), `Benchmarks/ConfigFiles/hff_slmodels/`. They are
 not copied into this repository; clone that one and point this script at the folder:
 
@@ -15,9 +16,10 @@ For each cluster it runs, with target/release/wslap:
   - `wslap reconstruct --images I --members M --z-lens Z --folds 5 --out OUT/NAME/ours`, the
     defaults (the published model's galaxies that the member catalogue leaves out, e.g. the
     BCGs, are then missing: the run warns);
-  - the same with `--par bestopt.par` (those galaxies fitted as members), OUT/NAME/with-par;
-  - `wslap maps --lenstool bestopt.par --z-source 2 --out OUT/NAME/published` (A370's group at
-    z = 1.05 in the single-plane approximation);
+  - the same with `--par` the published model (those galaxies fitted as members),
+    OUT/NAME/with-par;
+  - `wslap maps --lenstool` the published model `--z-source 2 --out OUT/NAME/published`
+    (A370's group at z = 1.05 in the single-plane approximation);
 and compares: the Einstein radius at z_s = 2 (summary.json, the same definition for both),
 the held-out images' median offset (crossval.json), the fitted images' median, the tangential
 curves, and the deflection difference from the published model (D_ls/D_s = 1, both maps
@@ -43,13 +45,19 @@ from scipy.ndimage import map_coordinates
 ROOT = Path(__file__).resolve().parent.parent
 WSLAP = ROOT / "target" / "release" / "wslap"
 
-# name, folder under --models, images, members, z_lens, extra `wslap maps` arguments
+# name, folder under --models, images, members, z_lens, extra `wslap maps` arguments, the
+# published model
 CLUSTERS = [
-    ("A2744", "A2744", "img_mul_constraints.cat", "new_potfile_with_ASTRODEEP_data.txt", 0.308, []),
+    ("A2744", "A2744", "img_mul_constraints.cat", "new_potfile_with_ASTRODEEP_data.txt", 0.308, [],
+     "bestopt.par"),
     ("A370", "A370", "mul_a370_specMosaic.cat", "galsortcutI_mosaicBright_noBCGsV2.5.cat", 0.375,
-     ["--single-plane"]),
+     ["--single-plane"], "bestopt.par"),
     ("M1149", "M1149/m1149_catsv4", "imawcs_spiral_secured.mul", "m1149_newgal_cc-muse_arsec.cat",
-     0.542, []),
+     0.542, [], "bestopt.par"),
+    # Jauzac et al. 2016's model of the same cluster: its own catalogues, 43 of 145 images
+    # without a redshift (the model fits theirs).
+    ("M1149-J16", "M1149/m1149_jauzac16", "imawcs_spiral_secured.mul", "galaxies_v2.cat", 0.544,
+     [], "best.par.20170201103232"),
 ]
 RADIUS_ARCSEC = 40.0
 
@@ -123,16 +131,16 @@ def main():
     ap.add_argument("--wslap", type=Path, default=WSLAP, help="the binary (default: %(default)s)")
     a = ap.parse_args()
     rows = []
-    for name, sub, images, members, z, maps_args in CLUSTERS:
+    for name, sub, images, members, z, maps_args, model in CLUSTERS:
         if a.only and a.only != name:
             continue
         src, out = a.models / sub, a.out / name
         out.mkdir(parents=True, exist_ok=True)
-        par = src / "bestopt.par"
+        par = src / model
         run(a.wslap, ["maps", "--lenstool", par, *maps_args, "--z-source", 2, "--out", out / "published"],
             out / "published.log")
         pub = json.loads((out / "published" / "summary.json").read_text())
-        row = dict(name=name, z_lens=z, theta_e_published=pub["einstein_radius_arcsec"],
+        row = dict(name=name, model=model, z_lens=z, theta_e_published=pub["einstein_radius_arcsec"],
                    published_tangential=pub["tangential_curves"])
         for kind, extra in [("ours", []), ("with-par", ["--par", par])]:
             secs = run(a.wslap, ["reconstruct", "--images", src / images, "--members", src / members,
@@ -153,7 +161,7 @@ def main():
         for kind in ("ours", "with-par"):
             k = r[kind]
             lines.append(
-                f"| {r['name']} | {'defaults' if kind == 'ours' else '--par bestopt.par'} "
+                f"| {r['name']} | {'defaults' if kind == 'ours' else '--par ' + r['model']} "
                 f"| {k['theta_e']:.2f} / {r['theta_e_published']:.2f} "
                 f"| {100 * (k['theta_e'] / r['theta_e_published'] - 1):+.1f}% "
                 f"| {k['held_out']:.2f} / {k['held_out_rms']:.2f} | {k['fitted']:.2f} "
