@@ -592,8 +592,12 @@
 //! alpha(theta_k)`, `M_k` the capped inverse Jacobian of §9 (image-plane offsets), `beta` the
 //! `M`-weighted mean source, and `sigma` the held-out image error of the cross-validation.
 //! The system is then fitted with the others at the most probable `z`; the 68% interval is
-//! the narrowest holding 68% of `exp(-chi2/2)`. Details in `crate::reconstruct`'s `free_z`
-//! module.
+//! the narrowest holding 68% of `exp(-chi2/2)`. With an "auto" strength that posterior is
+//! averaged over the chosen map and the maps the best candidate of each other regulariser
+//! draws from the same systems: beyond the systems with a redshift the map is the
+//! regulariser's (least mass falls off, the smoothest stays level), which the held-out
+//! systems cannot judge, and the estimate must not lean on one of them. Details in
+//! `crate::reconstruct`'s `free_z` module.
 //!
 //! # References
 //!

@@ -427,7 +427,7 @@ pub(crate) fn reconstruct_free_z(
         None => crate::threads::with_limit(config.system.threads, || {
             let first = reconstruct_limited(inputs, config, progress)?;
             match free_z {
-                true => free_z::add_free_systems(inputs, config, first, None, progress),
+                true => free_z::add_free_systems(inputs, config, first, None, &[], progress),
                 false => Ok(first),
             }
         }),
@@ -609,6 +609,37 @@ impl StrengthChoice {
         Some(median * (2.0 / (2.0 * std::f64::consts::LN_2)).sqrt())
     }
 
+    /// For each regulariser among the candidates other than the chosen one, its best
+    /// candidate by the choice's own rule (the fewest unmatched, then the smallest median
+    /// offset of held-out images), in the candidates' order: the other ways of drawing the
+    /// map that the run tried. Held-out systems lie among the others, so they hardly tell how
+    /// each regulariser extends the map beyond them (least mass lets it fall off, smoothest
+    /// keeps it level); a redshift estimated out there is averaged over these maps.
+    pub fn best_of_other_regularisers(&self) -> Vec<Candidate> {
+        let score = |c: &StrengthCandidate| {
+            (
+                c.holdout_unmatched,
+                c.holdout_median_arcsec.unwrap_or(f64::INFINITY),
+            )
+        };
+        let mut best: Vec<&StrengthCandidate> = Vec::new();
+        for c in &self.candidates {
+            if c.regulariser == self.chosen_regulariser {
+                continue;
+            }
+            match best.iter_mut().find(|b| b.regulariser == c.regulariser) {
+                Some(b) => {
+                    let (a, d) = (score(c), score(b));
+                    if a.0.cmp(&d.0).then(a.1.total_cmp(&d.1)).is_lt() {
+                        *b = c;
+                    }
+                }
+                None => best.push(c),
+            }
+        }
+        best.into_iter().map(StrengthCandidate::candidate).collect()
+    }
+
     /// The choice in words, e.g. "curvature at strength 0.1 on 24 x 24 cells, chosen by
     /// 4-fold cross-validation of 27 candidates".
     pub fn describe(&self) -> String {
@@ -769,7 +800,12 @@ fn with_choice(
         let mut r = reconstruct_limited(inputs, &fixed, progress)?;
         if free_z {
             let sigma = choice.holdout_sigma_arcsec();
-            r = free_z::add_free_systems(inputs, &fixed, r, sigma, progress)?;
+            let others: Vec<ReconstructConfig> = choice
+                .best_of_other_regularisers()
+                .iter()
+                .map(|c| c.apply(config))
+                .collect();
+            r = free_z::add_free_systems(inputs, &fixed, r, sigma, &others, progress)?;
         }
         r.config = config.clone();
         r.strength_choice = Some(choice);
@@ -1425,6 +1461,37 @@ mod tests {
             choice.best_for(|id| usize::from(id == "1")),
             Some(pick(g, 0.01, 24))
         );
+    }
+
+    /// The other regularisers' best candidates, by the choice's own rule (unmatched images
+    /// first), one per regulariser in the candidates' order; the chosen one's never.
+    #[test]
+    fn each_other_regulariser_gives_its_best_candidate() {
+        let (g, c, d) = (
+            Regulariser::Gradient,
+            Regulariser::Curvature,
+            Regulariser::Density,
+        );
+        let scored = |kind, strength, median, unmatched| StrengthCandidate {
+            holdout_median_arcsec: Some(median),
+            holdout_unmatched: unmatched,
+            ..candidate(kind, strength, &[])
+        };
+        let choice = choice(vec![
+            scored(d, 0.01, 0.4, 1),
+            scored(g, 1.0, 0.1, 0),
+            scored(c, 0.1, 0.9, 0),
+            scored(d, 0.1, 0.8, 0),
+            scored(c, 1.0, 0.5, 0),
+            scored(d, 1.0, 0.6, 0),
+        ]);
+        assert_eq!(
+            choice.best_of_other_regularisers(),
+            [pick(d, 1.0, 32), pick(c, 1.0, 32)]
+        );
+        let only_chosen =
+            super::tests::choice(vec![scored(g, 1.0, 0.1, 0), scored(g, 0.1, 0.2, 0)]);
+        assert!(only_chosen.best_of_other_regularisers().is_empty());
     }
 
     /// Each grid once (scales that round to the same cells give one grid), coarsest first,
