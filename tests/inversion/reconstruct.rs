@@ -503,6 +503,33 @@ fn c_smooth_inputs(catalog: &ImageCatalog) -> Inputs<'_> {
     }
 }
 
+/// Per system of `free`: its catalogue redshift, the estimate `r` fitted it at and the
+/// estimate's interval, which holds it.
+#[cfg(not(target_arch = "wasm32"))]
+fn estimates_against_truth(
+    catalog: &ImageCatalog,
+    r: &wslap::Reconstruction,
+    free: &[String],
+) -> Vec<(f64, f64, [f64; 2])> {
+    free.iter()
+        .map(|id| {
+            let truth = catalog
+                .systems
+                .iter()
+                .find(|s| &s.id == id)
+                .unwrap()
+                .z
+                .unwrap();
+            let s = r.sources.iter().find(|s| &s.id == id).unwrap();
+            let (z, [lo, hi]) = (s.z_estimate.unwrap(), s.z_interval.unwrap());
+            assert_eq!(s.z, z, "system {id} is fitted at its estimate");
+            assert!(lo <= z && z <= hi, "system {id}: {z} outside {lo} - {hi}");
+            println!("system {id}: z {truth}, estimate {z:.3} ({lo:.3} - {hi:.3})");
+            (truth, z, [lo, hi])
+        })
+        .collect()
+}
+
 /// Redshifts blanked on a synthetic cluster made with lenstronomy (tests/data/fidelity,
 /// `c_smooth`: 25 systems, no members): every third system is estimated (`free_z_systems`)
 /// and compared with its true redshift. The bars: median |dz|/(1+z) below 0.1, the
@@ -536,19 +563,7 @@ fn blanked_redshifts_of_a_synthetic_cluster_are_found_again() {
     );
     let mut dz = Vec::new();
     let mut inside = 0;
-    for id in &free {
-        let truth = catalog
-            .systems
-            .iter()
-            .find(|s| &s.id == id)
-            .unwrap()
-            .z
-            .unwrap();
-        let s = r.sources.iter().find(|s| &s.id == id).unwrap();
-        let (z, [lo, hi]) = (s.z_estimate.unwrap(), s.z_interval.unwrap());
-        assert_eq!(s.z, z, "system {id} is fitted at its estimate");
-        assert!(lo <= z && z <= hi, "system {id}: {z} outside {lo} - {hi}");
-        println!("system {id}: z {truth}, estimate {z:.3} ({lo:.3} - {hi:.3})");
+    for (truth, z, [lo, hi]) in estimates_against_truth(&catalog, &r, &free) {
         dz.push((z - truth).abs() / (1.0 + truth));
         inside += usize::from(lo <= truth && truth <= hi);
     }
@@ -598,21 +613,10 @@ fn outer_redshifts_are_estimated_over_the_regularisers_tried() {
     let r = reconstruct(&inputs, &config, &mut quiet).unwrap();
     let choice = r.strength_choice.as_ref().expect("an auto choice");
     assert_eq!(choice.best_of_other_regularisers().len(), 2);
-    let mut inside = 0;
-    for id in &free {
-        let truth = catalog
-            .systems
-            .iter()
-            .find(|s| &s.id == id)
-            .unwrap()
-            .z
-            .unwrap();
-        let s = r.sources.iter().find(|s| &s.id == id).unwrap();
-        let (z, [lo, hi]) = (s.z_estimate.unwrap(), s.z_interval.unwrap());
-        assert!(lo <= z && z <= hi, "system {id}: {z} outside {lo} - {hi}");
-        println!("system {id}: z {truth}, estimate {z:.3} ({lo:.3} - {hi:.3})");
-        inside += usize::from(lo <= truth && truth <= hi);
-    }
+    let inside = estimates_against_truth(&catalog, &r, &free)
+        .iter()
+        .filter(|(truth, _, [lo, hi])| lo <= truth && truth <= hi)
+        .count();
     assert!(
         inside >= 5,
         "the truth inside the interval for {inside} of 8"
