@@ -324,15 +324,14 @@ pub fn estimate_redshift_over(
         .collect();
     let (&chosen, others) = lenses.split_first()?;
     let first = posterior(chosen, plane, images, &zs, sigma_arcsec, max_stretch)?;
-    let mut posteriors: Vec<Posterior> = others
+    let rest: Vec<Posterior> = others
         .iter()
         .filter_map(|&lens| posterior(lens, plane, images, &zs, sigma_arcsec, max_stretch))
         .collect();
-    posteriors.push(first);
-    let first = posteriors.last()?;
     let (reduced, scale) = (first.reduced_chi2, first.scale);
+    let count = (1 + rest.len()) as f64;
     let weights: Vec<f64> = (0..zs.len())
-        .map(|i| posteriors.iter().map(|p| p.weights[i]).sum::<f64>() / posteriors.len() as f64)
+        .map(|i| (first.weights[i] + rest.iter().map(|p| p.weights[i]).sum::<f64>()) / count)
         .collect();
     let median = quantiles(&zs, &weights)(0.5);
     // The peak of the first lens's posterior, refined on its logarithm (a parabola through

@@ -616,24 +616,14 @@ impl StrengthChoice {
     /// each regulariser extends the map beyond them (least mass lets it fall off, smoothest
     /// keeps it level); a redshift estimated out there is averaged over these maps.
     pub fn best_of_other_regularisers(&self) -> Vec<Candidate> {
-        let score = |c: &StrengthCandidate| {
-            (
-                c.holdout_unmatched,
-                c.holdout_median_arcsec.unwrap_or(f64::INFINITY),
-            )
-        };
         let mut best: Vec<&StrengthCandidate> = Vec::new();
         for c in &self.candidates {
             if c.regulariser == self.chosen_regulariser {
                 continue;
             }
             match best.iter_mut().find(|b| b.regulariser == c.regulariser) {
-                Some(b) => {
-                    let (a, d) = (score(c), score(b));
-                    if a.0.cmp(&d.0).then(a.1.total_cmp(&d.1)).is_lt() {
-                        *b = c;
-                    }
-                }
+                Some(b) if predicts_better(c, b).is_lt() => *b = c,
+                Some(_) => {}
                 None => best.push(c),
             }
         }
@@ -745,16 +735,7 @@ impl StrengthChoice {
                 rule: "too few fitted systems to hold any out, so the middle candidate".to_string(),
             };
         }
-        let score = |c: &StrengthCandidate| {
-            (
-                c.holdout_unmatched,
-                c.holdout_median_arcsec.unwrap_or(f64::INFINITY),
-            )
-        };
-        let best = trials.iter().min_by(|p, q| {
-            let (a, b) = (score(p), score(q));
-            a.0.cmp(&b.0).then(a.1.total_cmp(&b.1))
-        });
+        let best = trials.iter().min_by(|p, q| predicts_better(p, q));
         let chosen = best.map_or(
             Candidate {
                 regulariser: config.objective.regulariser,
@@ -775,6 +756,16 @@ impl StrengthChoice {
             ),
         }
     }
+}
+
+/// The order of an "auto" choice: `Less` when `p` predicted the held-out images better than
+/// `q` (fewer with no predicted image, then a smaller median offset; no median counts as an
+/// infinite one).
+fn predicts_better(p: &StrengthCandidate, q: &StrengthCandidate) -> std::cmp::Ordering {
+    let median = |c: &StrengthCandidate| c.holdout_median_arcsec.unwrap_or(f64::INFINITY);
+    p.holdout_unmatched
+        .cmp(&q.holdout_unmatched)
+        .then(median(p).total_cmp(&median(q)))
 }
 
 /// [`reconstruct`] with an "auto" strength already chosen (e.g. by trials run elsewhere):
