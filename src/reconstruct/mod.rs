@@ -260,6 +260,15 @@ impl Candidate {
         }
         c
     }
+
+    /// [`Self::apply`] for a fit whose lens alone serves (a trial of the "auto" choice): its
+    /// maps at most [`CHOICE_MAP_PIXELS`] a side and no curves.
+    pub fn apply_for_trial(&self, config: &ReconstructConfig) -> ReconstructConfig {
+        let mut c = self.apply(config);
+        c.products.pixels = c.products.pixels.min(CHOICE_MAP_PIXELS);
+        c.products.maps_only = true;
+        c
+    }
 }
 
 /// One candidate (regulariser, strength, grid) of an "auto" strength and how well it
@@ -567,9 +576,7 @@ pub fn strength_trial(
     folds: usize,
     progress: &mut dyn FnMut(&ConvergenceRecord) -> Control,
 ) -> Result<StrengthCandidate, ReconstructError> {
-    let mut trial = candidate.apply(config);
-    trial.products.pixels = trial.products.pixels.min(CHOICE_MAP_PIXELS);
-    trial.products.maps_only = true;
+    let trial = candidate.apply_for_trial(config);
     let mut cancelled = false;
     let cv = cross_validate(inputs, &trial, folds, None, &mut |_, record| {
         let control = progress(record);
@@ -791,10 +798,11 @@ fn with_choice(
         let mut r = reconstruct_limited(inputs, &fixed, progress)?;
         if free_z {
             let sigma = choice.holdout_sigma_arcsec();
+            // Only their lenses serve: the small maps of the trials, no curves.
             let others: Vec<ReconstructConfig> = choice
                 .best_of_other_regularisers()
                 .iter()
-                .map(|c| c.apply(config))
+                .map(|c| c.apply_for_trial(config))
                 .collect();
             r = free_z::add_free_systems(inputs, &fixed, r, sigma, &others, progress)?;
         }
