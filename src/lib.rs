@@ -117,7 +117,7 @@ pub use fits::{
 pub use lenstool_par::load_lenstool_model;
 pub use lenstool_par::{
     parse_par, parse_par_with, LenstoolModel, LenstoolPar, ParComponent, ParError, ParGalaxies,
-    ParOptions, ParWarning, Radius, GALAXY_MAX_CORE_KPC,
+    ParOptions, ParRedshiftPrior, ParWarning, Radius, GALAXY_MAX_CORE_KPC,
 };
 pub use limits::{
     with_line_feeds, InputKind, TooLarge, MAX_ARCS_BYTES, MAX_ARC_PIXELS, MAX_CATALOG_BYTES,
@@ -131,8 +131,9 @@ pub use inversion::{
     ConstraintConfig, ConstraintError, ConstraintMode, ConstraintPixel, ConstraintSet,
     ConstraintSource, ConstraintSystem, ExcludedSystem, Exclusion, GridConfig, GridError, GridMass,
     HaloProfile, Layer, LayerSplit, LinearSystem, MapPlan, MemberConfig, MemberHalo, MemberModel,
-    MembersError, NpyError, ObjectiveConfig, ObjectiveTerms, Regulariser, RowBlock, ScaledLens,
-    Strength, SystemConfig, SystemError, Weighting, LAYER_SHARE_WARN, MAX_SINGLE_LAYERS,
+    MembersError, NpyError, ObjectiveConfig, ObjectiveTerms, RedshiftPrior, Regulariser, RowBlock,
+    ScaledLens, Strength, SystemConfig, SystemError, Weighting, LAYER_SHARE_WARN,
+    MAX_SINGLE_LAYERS,
 };
 pub use inversion::{
     kappa_gamma, with_ring, ShearConfig, ShearPoint, ShearSet, MIN_ONE_MINUS_KAPPA,

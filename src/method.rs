@@ -283,10 +283,10 @@
 //! near the images is fitted (one BCG per core of a cluster with several) and the run's
 //! warnings name the lines ([`crate::Dataset::fit_commented_bcgs`]; the setting
 //! `members.fit_commented_bcg` turns it off); without one the run warns and asks for the BCG's
-//! row. Given the `.par` (`wslap
-//! reconstruct --par`, or the app's setting "Members from the .par"), its dPIE potentials with
-//! a core of at most 5 kpc and a `mag` become members, placed through the sky from the `.par`'s
-//! frame ([`crate::Dataset::add_par_galaxies`]), before commented rows are looked for. The run
+//! row. Given the `.par` (`wslap reconstruct --par`, or the app's setting "Galaxies and
+//! redshift priors from the .par"), its dPIE potentials with a core of at most 5 kpc and a
+//! `mag` become members, placed through the sky from the `.par`'s frame
+//! ([`crate::Dataset::add_par_galaxies`]), before commented rows are looked for. The run
 //! does not guess a position: a galaxy of ten `L*` put at the peak of a grid-only first
 //! solution helps the synthetic clusters but misses the real BCGs by 1 - 5 arcsec and makes
 //! both real catalogues worse (BENCHMARKS.md); a commented row is the catalogue's own position
@@ -435,7 +435,10 @@
 //! by name and line. A model with potentials at several redshifts (multi-plane) is refused,
 //! or on request evaluated in the single-plane approximation: every potential on the first
 //! one's plane with its angular sizes and velocity dispersion, each moved block named in a
-//! warning.
+//! warning. A reconstruction given the `.par` also takes the `z_m_limit n id flag v1 v2 prec`
+//! lines of its `image` block: system `id`'s redshift fixed at `v1` (flag 0, as a `best.par`
+//! writes the fitted value), uniform on `[v1, v2]` (1) or normal of mean `v1` and width `v2`
+//! (3, a `bestopt.par`'s posterior); an id matches a catalogue system as text or as a number.
 //!
 //! **HFF-style lens-model FITS maps.** One 2-D image per quantity, at the reference
 //! normalisation except the magnification: the HFF names are `<model>_kappa.fits`,
@@ -596,8 +599,11 @@
 //! averaged over the chosen map and the maps the best candidate of each other regulariser
 //! draws from the same systems: beyond the systems with a redshift the map is the
 //! regulariser's (least mass falls off, the smoothest stays level), which the held-out
-//! systems cannot judge, and the estimate must not lean on one of them. Details in
-//! `crate::reconstruct`'s `free_z` module.
+//! systems cannot judge, and the estimate must not lean on one of them. A system's own prior
+//! (`constraints.z_priors`; a `.par`'s `z_m_limit` lines, as its modeller set them for
+//! Lenstool: fixed, uniform or normal) overrides its catalogue redshift: fixed, the system
+//! is fitted at it; uniform, the grid of `z` is its range; normal, `exp(-chi2/2)` is
+//! multiplied by its density. Details in `crate::reconstruct`'s `free_z` module.
 //!
 //! # References
 //!

@@ -520,6 +520,87 @@ fn reconstruct_bad_inputs_name_the_problem() {
     assert!(!dir.join("e").exists());
 }
 
+/// `--par` gives the reconstruction the redshift priors of the model's `image` block: a
+/// `z_m_limit` range that leaves out the truth (system 2 of the teaching catalogue is at
+/// z = 2.5) bounds the estimate, a fixed one (flag 0) replaces the catalogue's redshift; the
+/// run says both, and `summary.json` keeps them with the settings.
+#[test]
+fn reconstruct_takes_the_redshift_priors_of_a_par() {
+    let dir = temp_dir("z-priors");
+    let images = dir.join("images.cat");
+    fs::write(
+        &images,
+        wslap::app::examples::teaching_image_catalog().unwrap(),
+    )
+    .unwrap();
+    let par = dir.join("model.par");
+    fs::write(
+        &par,
+        "runmode\n\treference 3 150.0 2.2\n\tend\nimage\n\tmultfile 1 images.cat\n\
+         \tz_m_limit 1 2 1 2.0 2.3 0.1\n\tz_m_limit 2 4.0 0 2.2 0.0 0.0\n\tend\n\
+         potentiel O1\n\tprofil 81\n\tx_centre 0\n\ty_centre 0\n\tellipticite 0.2\n\
+         \tangle_pos 0\n\tcore_radius_kpc 50\n\tcut_radius_kpc 1000\n\tv_disp 1000\n\
+         \tz_lens 0.3\n\tend\ncosmologie\n\tH0 70\n\tomegaM 0.3\n\tomegaX 0.7\n\tend\n\
+         fini\n",
+    )
+    .unwrap();
+    let config = dir.join("fixed.json");
+    fs::write(
+        &config,
+        r#"{"grid": {"cells": 16}, "objective": {"strength": 0.01}, "products": {"pixels": 64}}"#,
+    )
+    .unwrap();
+    let out_dir = dir.join("out");
+    let out = wslap(&[
+        "reconstruct",
+        "--images",
+        images.to_str().unwrap(),
+        "--par",
+        par.to_str().unwrap(),
+        "--z-lens",
+        "0.3",
+        "--config",
+        config.to_str().unwrap(),
+        "--out",
+        out_dir.to_str().unwrap(),
+    ]);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "{stderr}");
+    for said in [
+        "model.par: line 6: system 2's redshift is estimated under the model's prior, uniform 2 - 2.3",
+        "model.par: line 7: system 4's redshift is taken as 2.2",
+        "system 2: redshift estimated z = ",
+        "under its own prior (uniform 2 - 2.3)",
+    ] {
+        assert!(stderr.contains(said), "{said}: {stderr}");
+    }
+    let sources: serde_json::Value =
+        serde_json::from_str(&fs::read_to_string(out_dir.join("sources.json")).unwrap()).unwrap();
+    let system = |id: &str| {
+        sources
+            .as_array()
+            .unwrap()
+            .iter()
+            .find(|s| s["id"] == id)
+            .unwrap()
+            .clone()
+    };
+    let two = system("2");
+    let z = two["z_estimate"].as_f64().unwrap();
+    assert!((2.0..=2.3).contains(&z), "{two}");
+    let [lo, hi] = [0, 1].map(|i| two["z_interval"][i].as_f64().unwrap());
+    assert!(lo >= 2.0 && hi <= 2.3 && lo <= z && z <= hi, "{two}");
+    assert!(z > 2.2, "the end nearer the truth, 2.5: {two}");
+    let four = system("4");
+    assert_eq!(four["z"], 2.2);
+    assert!(four["z_estimate"].is_null(), "{four}");
+    let s = summary(&out_dir);
+    assert_eq!(
+        s["settings"]["constraints"]["z_priors"],
+        serde_json::json!({"2": {"range": [2.0, 2.3]}, "4": {"fixed": 2.2}})
+    );
+}
+
 #[test]
 fn reconstruct_from_arc_pixels() {
     let dir = temp_dir("arcs");

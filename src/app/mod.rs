@@ -94,8 +94,8 @@ impl Session {
     }
 
     /// The loaded files parsed into one frame (see [`LoadedData::parse`]); its warnings
-    /// begin with [`Self::sky_warnings`]. The galaxies of the loaded `.par` are members when
-    /// the setting `members_from_model` is on, and commented-out BCG rows are fitted when
+    /// begin with [`Self::sky_warnings`]. The galaxies and redshift priors of the loaded `.par`
+    /// are taken ([`Dataset::add_par`]) when the setting `members_from_model` is on, and commented-out BCG rows are fitted when
     /// `reconstruct.members.fit_commented_bcg` is ([`Dataset::fit_commented_bcgs`]).
     pub fn parsed(&self) -> Result<Dataset, AppError> {
         let mut parsed = self
@@ -108,7 +108,7 @@ impl Session {
             let options = self.settings.par_options().for_galaxies();
             if let Some(par) = self.data.model_par(&options)? {
                 let notes = parsed
-                    .add_par_galaxies(&par)
+                    .add_par(&par)
                     .map_err(|e| AppError::File(e.to_string()))?;
                 parsed.warnings.extend(notes);
             }

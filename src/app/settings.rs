@@ -35,9 +35,10 @@ pub struct AppSettings {
     /// single-plane approximation ([`ParOptions::single_plane`], `wslap maps --single-plane`);
     /// default `false`: such a model is refused.
     pub lenstool_single_plane: bool,
-    /// The galaxies a loaded Lenstool `.par` models on its own (dPIE potentials with a core of
-    /// at most 5 kpc and a `mag`: typically the BCG, which its member catalogue then leaves
-    /// out) are fitted as members, as `wslap reconstruct --par` does; default `false`.
+    /// What `wslap reconstruct --par` takes from a loaded Lenstool `.par`: the galaxies it
+    /// models on its own (dPIE potentials with a core of at most 5 kpc and a `mag`: typically
+    /// the BCG, which its member catalogue then leaves out), fitted as members, and the
+    /// redshift priors of its `image` block ([`crate::Dataset::add_par`]); default `false`.
     pub members_from_model: bool,
     /// After each reconstruction, an ensemble of that many more (0, the default: none), as
     /// `wslap reconstruct --ensemble N --seed S` runs it.

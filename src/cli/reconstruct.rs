@@ -50,7 +50,9 @@ pub struct ReconstructArgs {
     members: Option<PathBuf>,
     /// A Lenstool .par of the same cluster (e.g. the published model's bestopt.par): the
     /// galaxies it models on its own, dPIE potentials with a core of at most 5 kpc and a `mag`
-    /// (typically the BCG, which the member catalogue then leaves out), are fitted as members.
+    /// (typically the BCG, which the member catalogue then leaves out), are fitted as members,
+    /// and the `z_m_limit` lines of its image block set the redshift priors of the systems they
+    /// name (flag 0 fixed, 1 uniform, 3 normal; over the catalogue's redshift, as in Lenstool).
     /// Its cluster-scale potentials are not used.
     #[arg(long, value_name = "MODEL.par")]
     par: Option<PathBuf>,
@@ -231,7 +233,7 @@ pub fn run(args: &ReconstructArgs) -> Result<(), String> {
         let text = read_text(path, InputKind::Model)?;
         let par = parse_par_with(&text, &par_name, &ParOptions::default().for_galaxies())
             .map_err(|e| e.to_string())?;
-        for note in data.add_par_galaxies(&par).map_err(|e| e.to_string())? {
+        for note in data.add_par(&par).map_err(|e| e.to_string())? {
             eprintln!("note: {note}");
         }
     }

@@ -18,11 +18,15 @@
 //! Systems without a redshift (and those named in `free_z_systems`) have it estimated when
 //! `free_z_prior` is set (the default): they are left out of a first fit and their redshift
 //! is then found on its lens (`crate::reconstruct`'s `free_z` module), after which they are
-//! fitted at it (`z_estimates`). With `default_z` given instead, systems without a redshift
+//! fitted at it (`z_estimates`). A system's own prior in `z_priors` (a `.par`'s `z_m_limit`
+//! lines) overrides its catalogue redshift as Lenstool does: a range or a normal prior makes
+//! it estimated within that prior, a fixed value fits it at that redshift. With `default_z` given instead, systems without a redshift
 //! take it; with neither, they are left out. Systems with a single image and held-out systems
 //! are left out too. Each system left out is listed in [`ConstraintSet::excluded`].
 //!
 //! [method §3]: crate::method#3-the-linear-system
+
+use std::collections::BTreeMap;
 
 use glam::DVec2;
 use serde::{Deserialize, Serialize};
@@ -62,6 +66,8 @@ pub enum ConstraintError {
     UnknownHoldOut { source_name: String, id: String },
     #[error("constraints: free_z_systems: system \"{id}\" is not in {source_name}")]
     UnknownFreeZ { source_name: String, id: String },
+    #[error("constraints: z_priors: system \"{id}\" is not in {source_name}")]
+    UnknownZPrior { source_name: String, id: String },
     #[error("{source_name}: no system is left to constrain the model (excluded: {excluded})")]
     NoSystems {
         source_name: String,
@@ -120,6 +126,12 @@ pub struct ConstraintConfig {
     /// low end is raised to just behind the lens). `null`: systems without a redshift are left
     /// out (unless `default_z` is given). Allowed 0 < low < high <= 20.
     pub free_z_prior: Option<[f64; 2]>,
+    /// A redshift prior of a system's own, by id, overriding its catalogue redshift (default
+    /// none; a `.par`'s `z_m_limit` lines give them): `{"range": [low, high]}` estimates it
+    /// within that range (and within `free_z_prior`), `{"normal": [mean, sigma]}` weighs the
+    /// estimate by that normal, `{"fixed": z}` fits the system at `z`. Redshifts allowed
+    /// (0, 20).
+    pub z_priors: BTreeMap<String, RedshiftPrior>,
     /// Redshifts estimated for the systems above, by id: these systems are fitted at them
     /// (set by the reconstruction, never read from a settings file).
     #[serde(skip)]
@@ -139,9 +151,62 @@ impl Default for ConstraintConfig {
             default_z: None,
             free_z_systems: Vec::new(),
             free_z_prior: Some(DEFAULT_FREE_Z_PRIOR),
+            z_priors: BTreeMap::new(),
             z_estimates: Vec::new(),
             max_pixels_per_image: 10_000,
         }
+    }
+}
+
+/// A system's own redshift prior (`constraints.z_priors`), as a Lenstool `z_m_limit` line
+/// gives it (its flag 1, 3 and 0).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case", deny_unknown_fields)]
+pub enum RedshiftPrior {
+    /// Uniform over `[low, high]`.
+    Range([f64; 2]),
+    /// A normal of `[mean, sigma]`.
+    Normal([f64; 2]),
+    /// Known: the system is fitted at it.
+    Fixed(f64),
+}
+
+impl RedshiftPrior {
+    /// Whether the system's redshift is estimated under this prior (not fixed).
+    pub fn is_estimated(self) -> bool {
+        !matches!(self, Self::Fixed(_))
+    }
+
+    /// In words, for messages: "uniform 2.5 - 4", "normal 2.91 +- 0.35", "fixed at 2.82".
+    pub fn describe(self) -> String {
+        match self {
+            Self::Range([lo, hi]) => format!("uniform {lo} - {hi}"),
+            Self::Normal([mean, sigma]) => format!("normal {mean} +- {sigma}"),
+            Self::Fixed(z) => format!("fixed at {z}"),
+        }
+    }
+
+    /// The first value that cannot be used, and what is allowed, if any.
+    fn invalid(self) -> Option<(f64, &'static str)> {
+        let z_ok = |z: f64| z.is_finite() && z > 0.0 && z < 20.0;
+        let (values, reason) = match self {
+            Self::Range([lo, hi]) => (
+                [(lo, z_ok(lo)), (hi, z_ok(hi) && hi > lo)],
+                "a range [low, high] with 0 < low < high < 20",
+            ),
+            Self::Normal([mean, sigma]) => (
+                [
+                    (mean, z_ok(mean)),
+                    (sigma, sigma.is_finite() && sigma > 0.0),
+                ],
+                "a normal [mean, sigma] with 0 < mean < 20 and sigma > 0",
+            ),
+            Self::Fixed(z) => ([(z, z_ok(z)); 2], "a source redshift in (0, 20)"),
+        };
+        values
+            .iter()
+            .find(|(_, ok)| !ok)
+            .map(|&(value, _)| (value, reason))
     }
 }
 
@@ -154,9 +219,20 @@ impl ConstraintConfig {
     /// named in `free_z_systems`, or without one while neither `default_z` is given nor
     /// estimation switched off (`free_z_prior` null).
     pub fn is_free_z(&self, id: &str, z: Option<f64>) -> bool {
+        if let Some(p) = self.z_priors.get(id) {
+            return p.is_estimated() && self.free_z_prior.is_some();
+        }
         self.free_z_prior.is_some()
             && (self.free_z_systems.iter().any(|s| s == id)
                 || (z.is_none() && self.default_z.is_none()))
+    }
+
+    /// The redshift `z_priors` fixes for `id`, if it does.
+    fn z_fixed(&self, id: &str) -> Option<f64> {
+        match self.z_priors.get(id) {
+            Some(&RedshiftPrior::Fixed(z)) => Some(z),
+            _ => None,
+        }
     }
 
     /// The redshift estimated for `id`, once there is one.
@@ -209,6 +285,11 @@ impl ConstraintConfig {
                     high,
                     "the upper end must lie above the lower and at most at 20",
                 ));
+            }
+        }
+        for (id, prior) in &self.z_priors {
+            if let Some((value, reason)) = prior.invalid() {
+                return Err(bad(&format!("z_priors.{id}"), value, reason));
             }
         }
         if !(1..=crate::limits::MAX_ARC_PIXELS).contains(&self.max_pixels_per_image) {
@@ -477,6 +558,16 @@ pub fn build_constraints(
             id: id.clone(),
         });
     }
+    if let Some(id) = config
+        .z_priors
+        .keys()
+        .find(|f| !candidates.iter().any(|c| &c.id == *f))
+    {
+        return Err(ConstraintError::UnknownZPrior {
+            source_name,
+            id: id.clone(),
+        });
+    }
     let mut set = ConstraintSet {
         systems: Vec::new(),
         pixels: Vec::new(),
@@ -486,10 +577,11 @@ pub fn build_constraints(
     for c in candidates {
         let free = config.is_free_z(&c.id, c.z);
         let estimate = config.z_estimate(&c.id).filter(|_| free);
+        let fixed = config.z_fixed(&c.id);
         let z = if free {
             estimate
         } else {
-            c.z.or(config.default_z)
+            fixed.or(c.z).or(config.default_z)
         };
         let exclusion = if hold_out.contains(&c.id) {
             Err(Exclusion::HeldOut)
@@ -512,13 +604,13 @@ pub fn build_constraints(
         };
         match exclusion {
             Ok(z) => {
-                if c.z.is_none() && estimate.is_none() {
+                let assumed = c.z.is_none() && estimate.is_none() && fixed.is_none();
+                if assumed {
                     set.warnings.push(format!(
                         "{source_name}: system {} has no redshift: default_z = {z} assumed",
                         c.id
                     ));
                 }
-                let assumed = c.z.is_none() && estimate.is_none();
                 add_system(&mut set, c, z, assumed, config);
             }
             Err(reason) => set.excluded.push(ExcludedSystem { id: c.id, reason }),

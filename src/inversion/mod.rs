@@ -20,7 +20,7 @@ pub use cells_fft::MapPlan;
 pub use constraints::{
     build_constraints, ellipse_pixels, ConstraintConfig, ConstraintError, ConstraintMode,
     ConstraintPixel, ConstraintSet, ConstraintSource, ConstraintSystem, ExcludedSystem, Exclusion,
-    Weighting,
+    RedshiftPrior, Weighting,
 };
 pub(crate) use members::member_halo;
 pub(crate) use members::MAX_MAG_FROM_L_STAR;

@@ -1,9 +1,11 @@
 //! Lenstool parameter files (`.par`) of parametric cluster models, read far enough to evaluate
 //! the published models: `runmode` (`reference`), `potentiel` blocks of profile 81 (dPIE,
 //! [`Dpie`]) and 14 (external shear, [`ExternalShear`]), `potfile` blocks (cluster members
-//! from a catalogue, scaled with luminosity) and `cosmologie`. Every other block (`limit`,
-//! `image`, `grille`, `cline`, ...) is skipped: a model is evaluated with the values written in
-//! its `potentiel` blocks, which in a `bestopt.par` are the fitted ones.
+//! from a catalogue, scaled with luminosity), `cosmologie`, and the `z_m_limit` lines of the
+//! `image` block (the priors on the redshifts of multiple-image systems, which a
+//! reconstruction takes: [`ParRedshiftPrior`]). Every other block (`limit`, `grille`,
+//! `cline`, ...) and keyword is skipped: a model is evaluated with the values written in its
+//! `potentiel` blocks, which in a `bestopt.par` are the fitted ones.
 //!
 //! The file is read as Lenstool reads it ([`parse_par_with`]): `#` comments anywhere, any
 //! whitespace, CR line ends; lines between blocks that do not open a Lenstool block (the stray
@@ -293,9 +295,22 @@ pub struct LenstoolPar {
     pub z_lens: f64,
     pub potentials: Vec<ParPotential>,
     pub potfiles: Vec<ParPotfile>,
+    /// The redshift priors of multiple-image systems, from the `image` block's `z_m_limit`
+    /// lines, in the file's order.
+    pub redshift_priors: Vec<ParRedshiftPrior>,
     /// What was skipped or approximated while reading (unknown blocks and keywords, blocks
     /// moved by the single-plane approximation).
     pub warnings: Vec<ParWarning>,
+}
+
+/// One `z_m_limit` line: the prior a Lenstool model put on a system's redshift.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ParRedshiftPrior {
+    /// 1-based line.
+    pub line: usize,
+    /// The system's id as the line writes it (`6` or `6.0`).
+    pub system: String,
+    pub prior: crate::inversion::RedshiftPrior,
 }
 
 /// A model ready to evaluate: the lens (reference normalisation) and its plane.

@@ -7,10 +7,11 @@ use std::collections::HashMap;
 use glam::DVec2;
 
 use super::{
-    LenstoolPar, ParComponent, ParError, ParOptions, ParPotential, ParPotfile, ParWarning, Radius,
-    Z_MATCH_TOL,
+    LenstoolPar, ParComponent, ParError, ParOptions, ParPotential, ParPotfile, ParRedshiftPrior,
+    ParWarning, Radius, Z_MATCH_TOL,
 };
 use crate::cosmology::{Cosmology, LensPlane};
+use crate::inversion::RedshiftPrior;
 use crate::sky::SkyReference;
 
 /// One `keyword values...` line of a block.
@@ -20,13 +21,18 @@ struct Entry {
     values: Vec<String>,
 }
 
-/// A block: header words, first line, entries by keyword (the last one wins, as in Lenstool).
+/// A block: header words, first line, entries by keyword (the last one wins, as in Lenstool),
+/// and the lines of keywords a block may repeat (`z_m_limit`), in order.
 #[derive(Debug, Clone)]
 struct Block {
     header: String,
     line: usize,
     entries: HashMap<String, Entry>,
+    repeated: Vec<Entry>,
 }
+
+/// The keyword of a line an `image` block repeats, one per system.
+const Z_M_LIMIT: &str = "z_m_limit";
 
 /// Parses the text of a `.par` file (`source_name` is used in messages) with the default
 /// [`ParOptions`]: a model with potentials at several redshifts is refused.
@@ -60,6 +66,7 @@ pub fn parse_par_with(
     let mut cosmology = None;
     let mut potentials = Vec::new();
     let mut potfiles = Vec::new();
+    let mut redshift_priors = Vec::new();
     // (z, block, index in potentials or potfiles, is a potfile)
     let mut z_values: Vec<(f64, &Block, usize, bool)> = Vec::new();
     for b in &blocks {
@@ -74,6 +81,8 @@ pub fn parse_par_with(
             let (p, z) = cx.potfile(b)?;
             z_values.push((z, b, potfiles.len(), true));
             potfiles.push(p);
+        } else if name.starts_with("image") {
+            redshift_priors.extend(b.repeated.iter().filter_map(|e| cx.redshift_prior(e)));
         }
     }
     let cosmology = cosmology.ok_or_else(|| cx.model("no `cosmologie` block"))?;
@@ -127,6 +136,7 @@ pub fn parse_par_with(
         z_lens,
         potentials,
         potfiles,
+        redshift_priors,
         warnings: cx.warnings.into_inner(),
     })
 }
@@ -180,6 +190,7 @@ fn read_blocks(
                     header,
                     line,
                     entries: HashMap::new(),
+                    repeated: Vec::new(),
                 });
             }
             None => {
@@ -197,8 +208,14 @@ fn read_blocks(
             }
             Some(_) if first == "end" => blocks.extend(open.take()),
             Some(b) => {
-                let values = words.map(str::to_string).collect();
-                b.entries.insert(first.to_string(), Entry { line, values });
+                let entry = Entry {
+                    line,
+                    values: words.map(str::to_string).collect(),
+                };
+                if first == Z_M_LIMIT {
+                    b.repeated.push(entry.clone());
+                }
+                b.entries.insert(first.to_string(), entry);
             }
         }
     }
@@ -366,6 +383,49 @@ fn lenstool_reads(k: &str, what: &str) -> bool {
 }
 
 impl Ctx<'_> {
+    /// A `z_m_limit n id flag v1 v2 precision` line of an `image` block: system `id`'s
+    /// redshift fixed at `v1` (flag 0, as a `best.par` writes the fitted value), uniform on
+    /// `[v1, v2]` (flag 1) or a normal of mean `v1` and width `v2` (flag 3, a `bestopt.par`'s
+    /// posterior). A line that says none of these is skipped with a warning: the image block
+    /// is not the model's, so it is never a reason to refuse the file.
+    fn redshift_prior(&self, e: &Entry) -> Option<ParRedshiftPrior> {
+        let skip = |why: String| {
+            self.warn(e.line, format!("`{Z_M_LIMIT}` {why}: skipped"));
+            None
+        };
+        let [_, id, flag, v1, v2, ..] = e.values.as_slice() else {
+            return skip("needs `n id flag value1 value2`".into());
+        };
+        let number = |text: &str| text.parse::<f64>().ok().filter(|v| v.is_finite());
+        let (Some(v1), Some(v2)) = (number(v1), number(v2)) else {
+            return skip(format!("values `{v1}` and `{v2}` must be numbers"));
+        };
+        let z_ok = |z: f64| z > 0.0 && z < 20.0;
+        let prior = match flag.as_str() {
+            "0" if z_ok(v1) => RedshiftPrior::Fixed(v1),
+            "1" if z_ok(v1) && z_ok(v2) && v2 > v1 => RedshiftPrior::Range([v1, v2]),
+            "3" if z_ok(v1) && v2 > 0.0 => RedshiftPrior::Normal([v1, v2]),
+            "0" | "1" | "3" => {
+                return skip(format!(
+                    "of system {id}: flag {flag} with values {v1} and {v2} is not a redshift \
+                     prior (flag 0: a redshift in (0, 20); 1: low < high; 3: a mean and a \
+                     width above 0)"
+                ))
+            }
+            _ => {
+                return skip(format!(
+                    "of system {id}: flag `{flag}` is not read here (0 fixed, 1 uniform, 3 \
+                     normal)"
+                ))
+            }
+        };
+        Some(ParRedshiftPrior {
+            line: e.line,
+            system: id.clone(),
+            prior,
+        })
+    }
+
     fn warn(&self, line: usize, message: String) {
         self.warnings.borrow_mut().push(ParWarning {
             file: self.file.into(),

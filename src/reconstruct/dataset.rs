@@ -15,6 +15,8 @@
 //!   catalogue (a warning says that the arcs are not fitted). Arcs alone are fitted as arcs
 //!   whatever the mode says.
 
+use std::collections::BTreeMap;
+
 use thiserror::Error;
 
 use super::{image_centres, with_luminosity, Inputs, LayerSource, ReconstructConfig};
@@ -26,7 +28,9 @@ use crate::catalog::{
     CatalogRow, CommentedBcgs, ImageCatalog, Member, MemberCatalog,
 };
 use crate::cosmology::LensPlane;
-use crate::inversion::{build_constraints, missing_bcg_warning, ConstraintMode, ConstraintSource};
+use crate::inversion::{
+    build_constraints, missing_bcg_warning, ConstraintMode, ConstraintSource, RedshiftPrior,
+};
 use crate::lenstool_par::{LenstoolPar, ParError, ParGalaxies, GALAXY_MAX_CORE_KPC};
 use crate::sky::SkyReference;
 
@@ -81,6 +85,10 @@ pub struct Dataset {
     pub arcs_reference: Option<SkyReference>,
     /// What the reading noticed, one sentence each, naming the file.
     pub warnings: Vec<String>,
+    /// Redshift priors of the systems by their catalogue id, from a `.par`
+    /// ([`Self::add_par`]); [`Self::inputs`] adds them to `constraints.z_priors` (where a
+    /// settings file's own prior for a system wins).
+    pub z_priors: BTreeMap<String, RedshiftPrior>,
 }
 
 impl Dataset {
@@ -121,6 +129,59 @@ impl Dataset {
             });
         }
         Ok(out)
+    }
+
+    /// What a reconstruction takes from a Lenstool `.par` of the same cluster: the galaxies it
+    /// models on its own ([`Self::add_par_galaxies`]) and the redshift priors of its `image`
+    /// block ([`Self::add_par_redshift_priors`]). One sentence per thing taken or not.
+    pub fn add_par(&mut self, par: &LenstoolPar) -> Result<Vec<String>, DatasetError> {
+        let mut notes = self.add_par_galaxies(par)?;
+        notes.extend(self.add_par_redshift_priors(par));
+        Ok(notes)
+    }
+
+    /// Takes the `.par`'s `z_m_limit` priors ([`LenstoolPar::redshift_priors`]) for the
+    /// systems of the image catalogue (or arcs) they name, as Lenstool does: over the
+    /// catalogue's redshift. An id matches a system's by its text or as a number (`6.0` is
+    /// system `6`). One sentence per line: taken, or naming no system.
+    pub fn add_par_redshift_priors(&mut self, par: &LenstoolPar) -> Vec<String> {
+        let ids: Vec<String> = match (&self.images, &self.arcs) {
+            (Some(c), _) => c.systems.iter().map(|s| s.id.clone()).collect(),
+            (None, Some(a)) => a.systems.iter().map(|s| s.id.clone()).collect(),
+            (None, None) => Vec::new(),
+        };
+        let number = |id: &str| id.parse::<f64>().ok();
+        let name = &par.source_name;
+        par.redshift_priors
+            .iter()
+            .map(|p| {
+                let found = ids.iter().find(|id| {
+                    **id == p.system
+                        || matches!((number(id), number(&p.system)), (Some(a), Some(b)) if a == b)
+                });
+                match found {
+                    Some(id) => {
+                        self.z_priors.insert(id.clone(), p.prior);
+                        format!(
+                            "{name}: line {}: system {id}'s redshift {}",
+                            p.line,
+                            match p.prior {
+                                RedshiftPrior::Fixed(z) => format!("is taken as {z}"),
+                                other => format!(
+                                    "is estimated under the model's prior, {}",
+                                    other.describe()
+                                ),
+                            }
+                        )
+                    }
+                    None => format!(
+                        "{name}: line {}: `z_m_limit` names system {}, which no catalogue \
+                         loaded has: not used",
+                        p.line, p.system
+                    ),
+                }
+            })
+            .collect()
     }
 
     /// Adds the galaxies a Lenstool `.par` models on its own ([`LenstoolPar::galaxies`]: e.g.
@@ -307,6 +368,13 @@ impl Dataset {
     ) -> Result<Inputs<'a>, DatasetError> {
         let (images, mode) = self.constraints(config.constraints.mode)?;
         config.constraints.mode = mode;
+        for (id, prior) in &self.z_priors {
+            config
+                .constraints
+                .z_priors
+                .entry(id.clone())
+                .or_insert(*prior);
+        }
         let inputs = Inputs {
             images,
             layers: self

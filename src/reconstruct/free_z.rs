@@ -23,7 +23,10 @@
 //!    leaves a reduced chi2 above 1 (`2N - 3` degrees of freedom), `sigma` is scaled up by its
 //!    square root (the images disagree with the lens more than its typical error, so the
 //!    interval must widen).
-//! 4. The posterior `p(z) ~ exp(-chi2 / 2)` (a flat prior in `z` over the range):
+//! 4. The posterior `p(z) ~ exp(-chi2 / 2)` (a flat prior in `z` over the range, or the
+//!    system's own prior when it has one, `constraints.z_priors`: a range narrows the range,
+//!    a normal multiplies the posterior by its density; a `.par`'s `z_m_limit` lines give
+//!    them, as the modeller set them for Lenstool):
 //!    `z_estimate` is its peak (the smallest chi2), `z_interval` the narrowest interval that
 //!    holds 68% of it. On the six synthetic clusters of `tests/data/fidelity`, a third of
 //!    their systems blanked, the peak is closer to the truth than the posterior median
@@ -65,7 +68,7 @@ use super::{
     Reconstruction,
 };
 use crate::cosmology::LensPlane;
-use crate::inversion::{capped_inverse_jacobian, Exclusion};
+use crate::inversion::{capped_inverse_jacobian, Exclusion, RedshiftPrior};
 use crate::profiles::MassComponent;
 use crate::solver::{Control, SolveStatus};
 
@@ -179,6 +182,7 @@ pub(super) fn add_free_systems(
             &inputs.plane,
             &images,
             prior,
+            config.constraints.z_priors.get(id).copied(),
             sigma_arcsec,
             config.objective.max_stretch,
         ) {
@@ -223,11 +227,15 @@ pub(super) fn add_free_systems(
         .iter()
         .map(|(id, e)| {
             format!(
-                "system {id}: redshift estimated z = {:.2} (68%: {:.2} - {:.2}) on the lens of \
-                 the systems with a known one{}, and fitted at it",
+                "system {id}: redshift estimated z = {:.2} (68%: {:.2} - {:.2}){} on the lens \
+                 of the systems with a known one{}, and fitted at it",
                 e.z,
                 e.interval[0],
                 e.interval[1],
+                match config.constraints.z_priors.get(id) {
+                    Some(p) => format!(" under its own prior ({})", p.describe()),
+                    None => String::new(),
+                },
                 match lenses.len() {
                     1 => String::new(),
                     n => format!(" (the interval over the maps of {n} regularisers)"),
@@ -295,7 +303,15 @@ pub fn estimate_redshift(
     sigma_arcsec: f64,
     max_stretch: f64,
 ) -> Option<RedshiftEstimate> {
-    estimate_redshift_over(&[lens], plane, images, prior, sigma_arcsec, max_stretch)
+    estimate_redshift_over(
+        &[lens],
+        plane,
+        images,
+        prior,
+        None,
+        sigma_arcsec,
+        max_stretch,
+    )
 }
 
 /// [`estimate_redshift`] on several lenses at once (the maps of the same systems drawn with
@@ -305,16 +321,22 @@ pub fn estimate_redshift(
 /// (how far the maps part where the images lie), the interval widened to hold `z`.
 /// `reduced_chi2` and `sigma_arcsec` are the first lens's. `None` as for one lens, or when
 /// the first lens gives no finite misfit.
+///
+/// `own` is the system's own prior, if it has one (`constraints.z_priors`): a range narrows
+/// `prior`'s, a normal multiplies the posterior (of each lens) by its density.
 pub fn estimate_redshift_over(
     lenses: &[&dyn MassComponent],
     plane: &LensPlane,
     images: &[DVec2],
     prior: [f64; 2],
+    own: Option<RedshiftPrior>,
     sigma_arcsec: f64,
     max_stretch: f64,
 ) -> Option<RedshiftEstimate> {
-    let low = prior[0].max(plane.z_lens + BEHIND_LENS);
-    let high = prior[1];
+    let (mut low, mut high) = (prior[0].max(plane.z_lens + BEHIND_LENS), prior[1]);
+    if let Some(RedshiftPrior::Range([lo, hi])) = own {
+        (low, high) = (low.max(lo), high.min(hi));
+    }
     let usable = high > low && sigma_arcsec > 0.0;
     if images.len() < 2 || !usable {
         return None;
@@ -322,11 +344,27 @@ pub fn estimate_redshift_over(
     let zs: Vec<f64> = (0..Z_GRID_POINTS)
         .map(|i| low + (high - low) * i as f64 / (Z_GRID_POINTS - 1) as f64)
         .collect();
+    // The system's own prior's -ln density on the grid (a constant but for a normal).
+    let minus_log_prior: Vec<f64> = zs
+        .iter()
+        .map(|&z| match own {
+            Some(RedshiftPrior::Normal([mean, sigma])) => 0.5 * ((z - mean) / sigma).powi(2),
+            _ => 0.0,
+        })
+        .collect();
+    let search = Search {
+        plane,
+        images,
+        zs: &zs,
+        minus_log_prior: &minus_log_prior,
+        sigma_arcsec,
+        max_stretch,
+    };
     let (&chosen, others) = lenses.split_first()?;
-    let first = posterior(chosen, plane, images, &zs, sigma_arcsec, max_stretch)?;
+    let first = search.posterior(chosen)?;
     let rest: Vec<Posterior> = others
         .iter()
-        .filter_map(|&lens| posterior(lens, plane, images, &zs, sigma_arcsec, max_stretch))
+        .filter_map(|&lens| search.posterior(lens))
         .collect();
     let (reduced, scale) = (first.reduced_chi2, first.scale);
     let count = (1 + rest.len()) as f64;
@@ -362,50 +400,63 @@ struct Posterior {
     scale: f64,
 }
 
-fn posterior(
-    lens: &dyn MassComponent,
-    plane: &LensPlane,
-    images: &[DVec2],
-    zs: &[f64],
+/// What a system's posterior is computed from, whatever the lens.
+struct Search<'a> {
+    plane: &'a LensPlane,
+    images: &'a [DVec2],
+    /// The redshifts tried.
+    zs: &'a [f64],
+    /// The prior's -ln density at each of `zs`, up to a constant.
+    minus_log_prior: &'a [f64],
     sigma_arcsec: f64,
     max_stretch: f64,
-) -> Option<Posterior> {
-    let lensing: Vec<(DVec2, DVec2, [f64; 3])> = images
-        .iter()
-        .map(|&theta| {
-            let (alpha, h) = lens.deflection_hessian(theta);
-            (theta, alpha, h)
+}
+
+impl Search<'_> {
+    fn posterior(&self, lens: &dyn MassComponent) -> Option<Posterior> {
+        let lensing: Vec<(DVec2, DVec2, [f64; 3])> = self
+            .images
+            .iter()
+            .map(|&theta| {
+                let (alpha, h) = lens.deflection_hessian(theta);
+                (theta, alpha, h)
+            })
+            .collect();
+        // Sum of |d_k|^2 (arcsec^2) at each z.
+        let offsets2: Vec<f64> = self
+            .zs
+            .iter()
+            .map(|&z| {
+                self.plane.distance_ratio(z).map_or(f64::INFINITY, |f| {
+                    image_offsets2(&lensing, f, self.max_stretch)
+                })
+            })
+            .collect();
+        let least = offsets2.iter().copied().fold(f64::INFINITY, f64::min);
+        if !least.is_finite() {
+            return None;
+        }
+        let dof = (2 * self.images.len()).saturating_sub(3).max(1) as f64;
+        let axis_var = 0.5 * self.sigma_arcsec * self.sigma_arcsec;
+        let reduced_chi2 = least / axis_var / dof;
+        let scale = reduced_chi2.max(1.0);
+        let var = axis_var * scale;
+        // -ln of the posterior up to a constant, shifted so that its peak weighs 1.
+        let minus_log: Vec<f64> = offsets2
+            .iter()
+            .zip(self.minus_log_prior)
+            .map(|(&o, &p)| (o - least) / (2.0 * var) + p)
+            .collect();
+        let lowest = minus_log.iter().copied().fold(f64::INFINITY, f64::min);
+        let mut weights: Vec<f64> = minus_log.iter().map(|&m| (lowest - m).exp()).collect();
+        let total: f64 = weights.iter().sum();
+        weights.iter_mut().for_each(|w| *w /= total);
+        Some(Posterior {
+            weights,
+            reduced_chi2,
+            scale,
         })
-        .collect();
-    // Sum of |d_k|^2 (arcsec^2) at each z.
-    let offsets2: Vec<f64> = zs
-        .iter()
-        .map(|&z| {
-            plane
-                .distance_ratio(z)
-                .map_or(f64::INFINITY, |f| image_offsets2(&lensing, f, max_stretch))
-        })
-        .collect();
-    let least = offsets2.iter().copied().fold(f64::INFINITY, f64::min);
-    if !least.is_finite() {
-        return None;
     }
-    let dof = (2 * images.len()).saturating_sub(3).max(1) as f64;
-    let axis_var = 0.5 * sigma_arcsec * sigma_arcsec;
-    let reduced_chi2 = least / axis_var / dof;
-    let scale = reduced_chi2.max(1.0);
-    let var = axis_var * scale;
-    let mut weights: Vec<f64> = offsets2
-        .iter()
-        .map(|&o| (-(o - least) / (2.0 * var)).exp())
-        .collect();
-    let total: f64 = weights.iter().sum();
-    weights.iter_mut().for_each(|w| *w /= total);
-    Some(Posterior {
-        weights,
-        reduced_chi2,
-        scale,
-    })
 }
 
 /// The minimum of `values` on the even grid `zs` near its smallest sample `best`, from the
@@ -558,9 +609,16 @@ mod tests {
             on_light.interval[0] > on_heavy.interval[1],
             "the two do not overlap"
         );
-        let both =
-            estimate_redshift_over(&[&light, &heavy], &plane, &images, [0.5, 8.0], 0.3, 10.0)
-                .expect("estimate");
+        let both = estimate_redshift_over(
+            &[&light, &heavy],
+            &plane,
+            &images,
+            [0.5, 8.0],
+            None,
+            0.3,
+            10.0,
+        )
+        .expect("estimate");
         assert!(
             both.interval[0] <= on_heavy.z && both.interval[1] >= on_light.z,
             "{both:?}"
@@ -569,11 +627,66 @@ mod tests {
             (both.z - on_light.z).abs() < 1e-9,
             "the first map's estimate: {both:?}"
         );
-        let same =
-            estimate_redshift_over(&[&light, &light], &plane, &images, [0.5, 8.0], 0.3, 10.0)
-                .expect("estimate");
+        let same = estimate_redshift_over(
+            &[&light, &light],
+            &plane,
+            &images,
+            [0.5, 8.0],
+            None,
+            0.3,
+            10.0,
+        )
+        .expect("estimate");
         assert!((same.z - on_light.z).abs() < 1e-9, "{same:?} {on_light:?}");
         assert_eq!(same.interval, on_light.interval);
+    }
+
+    /// A system's own prior: a range the truth lies outside pins the estimate to the range's
+    /// nearer end and keeps the interval inside it; a normal about the truth leaves the
+    /// estimate there and narrows the interval; a wide normal elsewhere does not move a
+    /// well-measured estimate far, a narrow one does.
+    #[test]
+    fn a_system_s_own_prior_bounds_and_weighs_the_estimate() {
+        let lens = Lens::new(vec![Box::new(
+            Sis::from_theta_e(DVec2::ZERO, 20.0).unwrap(),
+        )]);
+        let plane = LensPlane::new(Cosmology::default(), 0.3).unwrap();
+        let f = plane.distance_ratio(2.5).unwrap();
+        let images = [
+            DVec2::new(3.0 + 20.0 * f, 0.0),
+            DVec2::new(3.0 - 20.0 * f, 0.0),
+        ];
+        let with = |own: Option<RedshiftPrior>| {
+            estimate_redshift_over(&[&lens], &plane, &images, [0.5, 8.0], own, 0.3, 10.0)
+                .expect("estimate")
+        };
+        let flat = with(None);
+        assert!((flat.z - 2.5).abs() < 0.02, "{flat:?}");
+        let above = with(Some(RedshiftPrior::Range([3.0, 5.0])));
+        assert!((above.z - 3.0).abs() < 0.01, "{above:?}");
+        assert!(
+            above.interval[0] >= 3.0 && above.interval[1] <= 5.0,
+            "{above:?}"
+        );
+        let about = with(Some(RedshiftPrior::Normal([2.5, 0.05])));
+        assert!((about.z - 2.5).abs() < 0.02, "{about:?}");
+        let width = |e: &RedshiftEstimate| e.interval[1] - e.interval[0];
+        assert!(width(&about) < width(&flat), "{about:?} {flat:?}");
+        let wide = with(Some(RedshiftPrior::Normal([4.0, 3.0])));
+        assert!((wide.z - 2.5).abs() < 0.1, "{wide:?}");
+        let narrow = with(Some(RedshiftPrior::Normal([4.0, 0.01])));
+        assert!((narrow.z - 4.0).abs() < 0.05, "{narrow:?}");
+        // A range wholly in front of the lens leaves nothing to estimate.
+        let lens_z = estimate_redshift_over(
+            &[&lens],
+            &plane,
+            &images,
+            [0.5, 8.0],
+            Some(RedshiftPrior::Range([0.1, 0.25])),
+            0.3,
+            10.0,
+        );
+        assert!(lens_z.is_none());
     }
 
     #[test]

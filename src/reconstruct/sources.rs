@@ -137,7 +137,8 @@ pub struct SourceReport {
     /// estimate it was fitted at (`z` is the same; the `free_z` module says how); else `null`.
     #[serde(default)]
     pub z_estimate: Option<f64>,
-    /// The 68% interval (16th and 84th percentiles) of `z_estimate`.
+    /// The narrowest interval holding 68% of `z_estimate`'s posterior (it contains
+    /// `z_estimate`).
     #[serde(default)]
     pub z_interval: Option<[f64; 2]>,
     /// True when the system was left out of the fit and is predicted.

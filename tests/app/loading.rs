@@ -459,3 +459,56 @@ fn the_bcg_of_a_loaded_par_is_offered_then_fitted_as_a_member() {
     // Fitted, it is no longer offered.
     assert!(s.model_galaxies().is_empty());
 }
+
+/// The redshift priors of a loaded `.par` (AS1063 silver's starting model: uniform ranges for
+/// the eight systems its catalogue gives no redshift) are taken with its galaxies once
+/// `members_from_model` is on, and reach the run's settings; off, the catalogue alone counts.
+#[cfg(not(target_arch = "wasm32"))]
+#[test]
+fn the_redshift_priors_of_a_loaded_par_are_taken_with_its_galaxies() {
+    let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../shared/data/AS1063/lenstool_cats");
+    let read = |f: &str| std::fs::read_to_string(dir.join(f)).unwrap();
+    let mut s = Session::new();
+    s.load_text(
+        DataRole::Images,
+        "silver.cat",
+        &read("cats_silver_mul_silver.cat"),
+    )
+    .unwrap();
+    s.load_text(
+        DataRole::Model,
+        "start.par",
+        &read("cats_silver_SMACS2248_HFF_NE.par"),
+    )
+    .unwrap();
+    assert!(s.parsed().unwrap().z_priors.is_empty());
+    s.set_field("members_from_model", json!(true)).unwrap();
+    let parsed = s.parsed().unwrap();
+    let priors: Vec<(&str, wslap::RedshiftPrior)> = parsed
+        .z_priors
+        .iter()
+        .map(|(id, p)| (id.as_str(), *p))
+        .collect();
+    let range = |lo, hi| wslap::RedshiftPrior::Range([lo, hi]);
+    assert_eq!(
+        priors,
+        [
+            ("141", range(2.4, 4.0)),
+            ("142", range(2.4, 4.0)),
+            ("143", range(2.4, 4.0)),
+            ("144", range(2.4, 4.0)),
+            ("3", range(1.5, 2.7)),
+            ("43", range(1.4, 1.8)),
+            ("8", range(2.4, 3.2)),
+            ("9", range(2.4, 3.2)),
+        ]
+    );
+    assert!(
+        parsed.warnings.iter().any(|w| w
+            == "start.par: line 10: system 43's redshift is estimated under the model's prior, \
+                uniform 1.4 - 1.8"),
+        "{:?}",
+        parsed.warnings
+    );
+}

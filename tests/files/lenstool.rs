@@ -3,8 +3,8 @@
 //! or says precisely (file, line, block, value) why not.
 
 use glam::DVec2;
+use wslap::{parse_image_catalog, ParComponent, Radius, RedshiftPrior};
 use wslap::{parse_par, parse_par_with, Dpie, LensPlane, MassComponent, ParOptions};
-use wslap::{ParComponent, Radius};
 
 const SINGULAR_CORE: &str = include_str!("../data/lenstool/singular_core.par");
 const MEMBERS: &str = include_str!("../data/lenstool/members.cat");
@@ -179,6 +179,110 @@ fn the_galaxies_of_a_multi_plane_model_are_the_cluster_planes() {
     );
     assert!(notes.contains(&expected), "{notes:?}");
     assert_eq!(data.members.unwrap().members.len(), 1);
+}
+
+/// The `z_m_limit` lines of a `.par`'s `image` block (as the CATS and Jauzac et al. models
+/// write them: `n id flag value1 value2 precision`) are the priors a reconstruction takes for
+/// the systems they name: flag 0 fixed (a `best.par`'s fitted value), 1 uniform, 3 normal (a
+/// `bestopt.par`'s posterior). A line that is none of these is skipped with a warning naming
+/// it; an id is matched as a number (`14.0` is system 14); an id no catalogue has is named.
+#[cfg_attr(not(target_arch = "wasm32"), test)]
+#[cfg_attr(target_arch = "wasm32", wasm_bindgen_test::wasm_bindgen_test)]
+fn a_par_s_redshift_priors_are_taken_for_the_systems_they_name() {
+    let image = "image\n\tmultfile 1 mul.cat\n\tforme -2\n\
+                 \tz_m_limit 1 6 1 2.0 3.0 0.1\n\
+                 \tz_m_limit 2 14.0 3 2.842 0.403 0.0100\n\
+                 \tz_m_limit 3 8.0 0 2.888 0.000 0.0000\n\
+                 \tz_m_limit 4 9 2 1.0 2.0 0.1\n\
+                 \tz_m_limit 5 10 1 3.0\n\
+                 \tz_m_limit 6 11 1 3.0 2.0 0.1\n\
+                 \tz_m_limit 7 99 1 1.0 2.0 0.1\n\tend\n";
+    let text = MULTIPLANE.replacen("potentiel O1\n", &format!("{image}potentiel O1\n"), 1);
+    let line_of = |needle: &str| 1 + text[..text.find(needle).unwrap()].matches('\n').count();
+    let options = ParOptions::default().for_galaxies();
+    let par = parse_par_with(&text, "priors.par", &options).expect("read");
+    let got: Vec<(usize, &str, RedshiftPrior)> = par
+        .redshift_priors
+        .iter()
+        .map(|p| (p.line, p.system.as_str(), p.prior))
+        .collect();
+    assert_eq!(
+        got,
+        [
+            (
+                line_of("z_m_limit 1 "),
+                "6",
+                RedshiftPrior::Range([2.0, 3.0])
+            ),
+            (
+                line_of("z_m_limit 2 "),
+                "14.0",
+                RedshiftPrior::Normal([2.842, 0.403])
+            ),
+            (line_of("z_m_limit 3 "), "8.0", RedshiftPrior::Fixed(2.888)),
+            (
+                line_of("z_m_limit 7 "),
+                "99",
+                RedshiftPrior::Range([1.0, 2.0])
+            ),
+        ]
+    );
+    let warnings: Vec<String> = par.warnings.iter().map(ToString::to_string).collect();
+    for (n, why) in [
+        ("4", "of system 9: flag `2` is not read here"),
+        ("5", "needs `n id flag value1 value2`"),
+        (
+            "6",
+            "of system 11: flag 1 with values 3 and 2 is not a redshift prior",
+        ),
+    ] {
+        let head = format!(
+            "priors.par:{}: `z_m_limit` {why}",
+            line_of(&format!("z_m_limit {n} "))
+        );
+        assert!(
+            warnings
+                .iter()
+                .any(|w| w.starts_with(&head) && w.ends_with(": skipped")),
+            "{head}: {warnings:?}"
+        );
+    }
+    let catalogue = "#REFERENCE 3 39.971340 -1.582260\n\
+                     6.1 10.0 5.0 0.5 0.5 0 0 25\n6.2 -8.0 3.0 0.5 0.5 0 0 25\n\
+                     8.1 4.0 -9.0 0.5 0.5 0 2.5 25\n8.2 -4.0 9.0 0.5 0.5 0 2.5 25\n\
+                     14.1 20.0 1.0 0.5 0.5 0 0 25\n14.2 -19.0 2.0 0.5 0.5 0 0 25\n";
+    let (images, _) = parse_image_catalog(catalogue, "mul.cat", None).unwrap();
+    let mut data = wslap::Dataset {
+        images: Some(images),
+        ..Default::default()
+    };
+    let notes = data.add_par_redshift_priors(&par);
+    assert_eq!(
+        notes,
+        [
+            format!(
+                "priors.par: line {}: system 6's redshift is estimated under the model's prior, \
+                 uniform 2 - 3",
+                line_of("z_m_limit 1 ")
+            ),
+            format!(
+                "priors.par: line {}: system 14's redshift is estimated under the model's \
+                 prior, normal 2.842 +- 0.403",
+                line_of("z_m_limit 2 ")
+            ),
+            format!(
+                "priors.par: line {}: system 8's redshift is taken as 2.888",
+                line_of("z_m_limit 3 ")
+            ),
+            format!(
+                "priors.par: line {}: `z_m_limit` names system 99, which no catalogue loaded \
+                 has: not used",
+                line_of("z_m_limit 7 ")
+            ),
+        ]
+    );
+    let ids: Vec<&str> = data.z_priors.keys().map(String::as_str).collect();
+    assert_eq!(ids, ["14", "6", "8"]);
 }
 
 #[cfg_attr(not(target_arch = "wasm32"), test)]

@@ -9,7 +9,7 @@ use glam::DVec2;
 use wslap::parse_arcs;
 use wslap::{
     build_constraints, ellipse_pixels, ConstraintConfig, ConstraintError, ConstraintMode,
-    ConstraintSet, ConstraintSource, Exclusion, Weighting,
+    ConstraintSet, ConstraintSource, Exclusion, RedshiftPrior, Weighting,
 };
 
 /// Ellipse pixel count vs `pi a b / pixel^2` (lattice-point count error ~ perimeter / pixel).
@@ -207,6 +207,102 @@ fn systems_are_excluded_for_redshift_single_image_and_hold_out() {
     let all: Vec<String> = ["1", "2", "3", "4"].iter().map(|s| s.to_string()).collect();
     let err = build_constraints(ConstraintSource::Catalog(&cat), &config, &all).unwrap_err();
     assert!(matches!(err, ConstraintError::NoSystems { .. }), "{err}");
+}
+
+/// A system's own redshift prior (`z_priors`, a `.par`'s `z_m_limit`) overrides its catalogue
+/// redshift as Lenstool does: fixed, it is fitted at that redshift; a range or a normal makes
+/// it estimated, catalogue redshift or none. Bad priors and unknown systems are named.
+#[cfg_attr(not(target_arch = "wasm32"), test)]
+#[cfg_attr(target_arch = "wasm32", wasm_bindgen_test::wasm_bindgen_test)]
+fn a_system_s_own_redshift_prior_overrides_the_catalogue() {
+    let mut cat = three_systems();
+    cat.systems[1].z = None;
+    let priors = |list: &[(&str, RedshiftPrior)]| ConstraintConfig {
+        z_priors: list.iter().map(|(id, p)| (id.to_string(), *p)).collect(),
+        ..ConstraintConfig::default()
+    };
+    let config = priors(&[
+        ("1", RedshiftPrior::Range([2.0, 3.0])),
+        ("2", RedshiftPrior::Fixed(2.7)),
+        ("3", RedshiftPrior::Normal([1.2, 0.1])),
+    ]);
+    let set = build_constraints(ConstraintSource::Catalog(&cat), &config, &[]).unwrap();
+    let zs: Vec<(&str, f64, bool)> = set
+        .systems
+        .iter()
+        .map(|s| (s.id.as_str(), s.z, s.z_assumed))
+        .collect();
+    assert_eq!(zs, [("2", 2.7, false)]);
+    assert_eq!(
+        exclusions(&set),
+        [
+            ("1", Exclusion::FreeRedshift),
+            ("3", Exclusion::FreeRedshift)
+        ]
+    );
+    assert!(set.warnings.is_empty(), "{:?}", set.warnings);
+    // Once estimated, they are fitted at the estimates.
+    let estimated = ConstraintConfig {
+        z_estimates: vec![("1".to_string(), 2.4), ("3".to_string(), 1.25)],
+        ..config.clone()
+    };
+    let set = build_constraints(ConstraintSource::Catalog(&cat), &estimated, &[]).unwrap();
+    let zs: Vec<(&str, f64)> = set.systems.iter().map(|s| (s.id.as_str(), s.z)).collect();
+    assert_eq!(zs, [("1", 2.4), ("2", 2.7), ("3", 1.25)]);
+    for (prior, field, message) in [
+        (
+            RedshiftPrior::Range([3.0, 2.0]),
+            "2",
+            "a range [low, high] with 0 < low < high < 20",
+        ),
+        (
+            RedshiftPrior::Normal([2.0, 0.0]),
+            "0",
+            "a normal [mean, sigma] with 0 < mean < 20 and sigma > 0",
+        ),
+        (
+            RedshiftPrior::Fixed(-1.0),
+            "-1",
+            "a source redshift in (0, 20)",
+        ),
+    ] {
+        let err = build_constraints(
+            ConstraintSource::Catalog(&cat),
+            &priors(&[("2", prior)]),
+            &[],
+        )
+        .unwrap_err();
+        let text = err.to_string();
+        assert!(
+            text.contains("constraints.z_priors.2")
+                && text.contains(field)
+                && text.contains(message),
+            "{text}"
+        );
+    }
+    let err = build_constraints(
+        ConstraintSource::Catalog(&cat),
+        &priors(&[("8", RedshiftPrior::Fixed(2.0))]),
+        &[],
+    )
+    .unwrap_err();
+    assert_eq!(
+        err.to_string(),
+        "constraints: z_priors: system \"8\" is not in test.cat"
+    );
+    // From a settings file.
+    let read: ConstraintConfig = serde_json::from_str(
+        r#"{"z_priors": {"1": {"range": [2, 3]}, "2": {"normal": [2.9, 0.3]}, "3": {"fixed": 1.1}}}"#,
+    )
+    .unwrap();
+    assert_eq!(
+        read.z_priors.into_iter().collect::<Vec<_>>(),
+        [
+            ("1".to_string(), RedshiftPrior::Range([2.0, 3.0])),
+            ("2".to_string(), RedshiftPrior::Normal([2.9, 0.3])),
+            ("3".to_string(), RedshiftPrior::Fixed(1.1))
+        ]
+    );
 }
 
 #[cfg_attr(not(target_arch = "wasm32"), test)]
