@@ -16,8 +16,12 @@ For each cluster it runs, with target/release/wslap:
   - `wslap reconstruct --images I --members M --z-lens Z --folds 5 --out OUT/NAME/ours`, the
     defaults (the published model's galaxies that the member catalogue leaves out, e.g. the
     BCGs, are then missing: the run warns);
-  - the same with `--par` the published model (those galaxies fitted as members),
+  - the same with `--par` the published model (those galaxies fitted as members; its
+    `z_m_limit` lines, the model's fitted redshifts, set those systems' redshifts),
     OUT/NAME/with-par;
+  - where the modeller's starting `.par` is there too, the same with `--par` it: its
+    `z_m_limit` lines are the priors the model's redshifts were fitted under, and the
+    systems without a catalogue redshift are estimated within them, OUT/NAME/with-priors;
   - `wslap maps --lenstool` the published model `--z-source 2 --out OUT/NAME/published`
     (A370's group at z = 1.05 in the single-plane approximation);
 and compares: the Einstein radius at z_s = 2 (summary.json, the same definition for both),
@@ -46,18 +50,19 @@ ROOT = Path(__file__).resolve().parent.parent
 WSLAP = ROOT / "target" / "release" / "wslap"
 
 # name, folder under --models, images, members, z_lens, extra `wslap maps` arguments, the
-# published model
+# published model, the modeller's starting .par whose `z_m_limit` lines set the redshift priors
+# (None: no such file)
 CLUSTERS = [
     ("A2744", "A2744", "img_mul_constraints.cat", "new_potfile_with_ASTRODEEP_data.txt", 0.308, [],
-     "bestopt.par"),
+     "bestopt.par", None),
     ("A370", "A370", "mul_a370_specMosaic.cat", "galsortcutI_mosaicBright_noBCGsV2.5.cat", 0.375,
-     ["--single-plane"], "bestopt.par"),
+     ["--single-plane"], "bestopt.par", None),
     ("M1149", "M1149/m1149_catsv4", "imawcs_spiral_secured.mul", "m1149_newgal_cc-muse_arsec.cat",
-     0.542, [], "bestopt.par"),
+     0.542, [], "bestopt.par", "m1149.par"),
     # Jauzac et al. 2016's model of the same cluster: its own catalogues, 43 of 145 images
     # without a redshift (the model fits theirs).
     ("M1149-J16", "M1149/m1149_jauzac16", "imawcs_spiral_secured.mul", "galaxies_v2.cat", 0.544,
-     [], "best.par.20170201103232"),
+     [], "best.par.20170201103232", "mod.par"),
 ]
 RADIUS_ARCSEC = 40.0
 
@@ -83,26 +88,36 @@ def sample(maps, ra, dec):
 
 def deflection_difference(published, ours):
     """Median and 90th percentile (arcsec) of |alpha_ours - alpha_published - mean| at the observed
-    images and within RADIUS_ARCSEC of their centre."""
+    images, within RADIUS_ARCSEC of their centre, and at the images of the systems whose redshift
+    the run estimated (the mean taken over all the observed images for the first and the last)."""
     p, o = load(published), load(ours)
     ra0, dec0 = o[3]["CRVAL1"], o[3]["CRVAL2"]
     sources = json.loads((ours / "sources.json").read_text())
     images = np.array([im["position_arcsec"] for s in sources for im in s["observed"]])
+    estimated = np.array([im["position_arcsec"] for s in sources if s.get("z_estimate")
+                          for im in s["observed"]]).reshape(-1, 2)
 
-    def stats(xy):
+    def difference(xy):
         # The frame's +x is West: RA falls with x.
         ra = ra0 - xy[:, 0] / 3600.0 / np.cos(np.radians(dec0))
         dec = dec0 + xy[:, 1] / 3600.0
         d = sample(o, ra, dec) - sample(p, ra, dec)
-        d = d[np.all(np.isfinite(d), axis=1)]
-        e = np.hypot(*(d - d.mean(axis=0)).T)
+        return d[np.all(np.isfinite(d), axis=1)]
+
+    def stats(d, mean):
+        if len(d) == 0:
+            return None
+        e = np.hypot(*(d - mean).T)
         return float(np.median(e)), float(np.percentile(e, 90))
 
     g = np.arange(-RADIUS_ARCSEC, RADIUS_ARCSEC + 0.5, 1.0)
     gx, gy = np.meshgrid(g, g)
     inside = np.hypot(gx, gy) <= RADIUS_ARCSEC
-    lattice = np.c_[gx[inside], gy[inside]] + images.mean(axis=0)
-    return dict(at_images=stats(images), region=stats(lattice))
+    lattice = difference(np.c_[gx[inside], gy[inside]] + images.mean(axis=0))
+    at_images = difference(images)
+    mean = at_images.mean(axis=0)
+    return dict(at_images=stats(at_images, mean), region=stats(lattice, lattice.mean(axis=0)),
+                at_estimated=stats(difference(estimated), mean))
 
 
 def scores(folder, published):
@@ -115,6 +130,8 @@ def scores(folder, published):
         held_out=cv["holdout_image_offset_median_arcsec"],
         held_out_rms=cv["holdout_image_plane_rms_arcsec"],
         fitted=s["image_offset_median_arcsec"],
+        z_estimates={src["id"]: src["z_estimate"] for src in
+                     json.loads((folder / "sources.json").read_text()) if src.get("z_estimate")},
         c=s["c_per_layer"],
         tangential=len(curves["tangential"]),
         main_share=v.get("main_curve_share"),
@@ -131,7 +148,7 @@ def main():
     ap.add_argument("--wslap", type=Path, default=WSLAP, help="the binary (default: %(default)s)")
     a = ap.parse_args()
     rows = []
-    for name, sub, images, members, z, maps_args, model in CLUSTERS:
+    for name, sub, images, members, z, maps_args, model, start in CLUSTERS:
         if a.only and a.only != name:
             continue
         src, out = a.models / sub, a.out / name
@@ -140,9 +157,13 @@ def main():
         run(a.wslap, ["maps", "--lenstool", par, *maps_args, "--z-source", 2, "--out", out / "published"],
             out / "published.log")
         pub = json.loads((out / "published" / "summary.json").read_text())
-        row = dict(name=name, model=model, z_lens=z, theta_e_published=pub["einstein_radius_arcsec"],
+        row = dict(name=name, model=model, start=start, z_lens=z,
+                   theta_e_published=pub["einstein_radius_arcsec"],
                    published_tangential=pub["tangential_curves"])
-        for kind, extra in [("ours", []), ("with-par", ["--par", par])]:
+        kinds = [("ours", []), ("with-par", ["--par", par])]
+        if start:
+            kinds.append(("with-priors", ["--par", src / start]))
+        for kind, extra in kinds:
             secs = run(a.wslap, ["reconstruct", "--images", src / images, "--members", src / members,
                         "--z-lens", z, "--folds", 5, *extra, "--out", out / kind],
                        out / f"{kind}.log")
@@ -153,19 +174,24 @@ def main():
     (a.out / "published.json").write_text(json.dumps(rows, indent=1))
     lines = [
         "| cluster | run | θE(z=2) ours / published (\") | ΔθE | held-out median / rms (\") "
-        "| fitted median (\") | Δα at images / within 40\" (median, \") | tangential curves "
-        "ours / published | main share | C | s |",
+        "| fitted median (\") | Δα at images / within 40\" / at estimated-z images (median, \") "
+        "| tangential curves ours / published | main share | C | s |",
         "|---|---|---|---:|---|---:|---|---|---:|---:|---:|",
     ]
     for r in rows:
-        for kind in ("ours", "with-par"):
+        for kind in ("ours", "with-par", "with-priors"):
+            if kind not in r:
+                continue
             k = r[kind]
+            run_name = {"ours": "defaults", "with-par": f"--par {r['model']}",
+                        "with-priors": f"--par {r['start']} (its z priors)"}[kind]
             lines.append(
-                f"| {r['name']} | {'defaults' if kind == 'ours' else '--par ' + r['model']} "
+                f"| {r['name']} | {run_name} "
                 f"| {k['theta_e']:.2f} / {r['theta_e_published']:.2f} "
                 f"| {100 * (k['theta_e'] / r['theta_e_published'] - 1):+.1f}% "
                 f"| {k['held_out']:.2f} / {k['held_out_rms']:.2f} | {k['fitted']:.2f} "
-                f"| {k['deflection']['at_images'][0]:.2f} / {k['deflection']['region'][0]:.2f} "
+                f"| {k['deflection']['at_images'][0]:.2f} / {k['deflection']['region'][0]:.2f} / "
+                f"{'—' if (est := k['deflection']['at_estimated']) is None else f'{est[0]:.2f}'} "
                 f"| {k['tangential']} / {r['published_tangential']} "
                 f"| {k['main_share']:.2f} | {', '.join(f'{c:.2f}' for c in k['c'])} "
                 f"| {k['seconds']:.0f} |")

@@ -19,7 +19,7 @@ export const offsetsCell = (observed) => `<td>${observed.map((o) => `${esc(o.id)
  * fit with its 68% interval. */
 const zCell = (s) => (s.z_estimate == null
   ? `<td>${fmt(s.z, 3)}${s.z_assumed ? '*' : ''}</td>`
-  : `<td class="z-estimated" title="no redshift given: estimated on the lens of the systems with one (averaged over the regularisers tried), 68% interval">${fmt(s.z_estimate, 2)} est.<br><small>${fmt(s.z_interval[0], 2)}–${fmt(s.z_interval[1], 2)}</small></td>`);
+  : `<td class="z-estimated" title="estimated on the lens of the systems with a redshift, 68% interval (the run's warnings say under which prior and over the maps of which regularisers)">${fmt(s.z_estimate, 2)} est.<br><small>${fmt(s.z_interval[0], 2)}–${fmt(s.z_interval[1], 2)}</small></td>`);
 
 /** Ids in natural order: "2" before "10", "2.1" before "2.10". */
 const byId = new Intl.Collator('en', { numeric: true }).compare;
