@@ -20,9 +20,10 @@
 //! is then found on its lens (`crate::reconstruct`'s `free_z` module), after which they are
 //! fitted at it (`z_estimates`). A system's own prior in `z_priors` (a `.par`'s `z_m_limit`
 //! lines) overrides its catalogue redshift as Lenstool does: a range or a normal prior makes
-//! it estimated within that prior, a fixed value fits it at that redshift. With `default_z` given instead, systems without a redshift
-//! take it; with neither, they are left out. Systems with a single image and held-out systems
-//! are left out too. Each system left out is listed in [`ConstraintSet::excluded`].
+//! it estimated within that prior, a fixed value fits it at that redshift. With `default_z`
+//! given instead, systems without a redshift take it; with neither, they are left out.
+//! Systems with a single image and held-out systems are left out too. Each system left out is
+//! listed in [`ConstraintSet::excluded`].
 //!
 //! [method §3]: crate::method#3-the-linear-system
 

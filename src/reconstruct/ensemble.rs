@@ -610,7 +610,11 @@ impl EnsemblePlan {
                     fitted: pick(true),
                     left_out: pick(false),
                     grid_shift_arcsec: shift,
-                    redshifts: super::free_z::draw(&estimated, &mut z_rng),
+                    redshifts: super::free_z::draw(
+                        &estimated,
+                        |id| super::free_z::search_range(config, id),
+                        &mut z_rng,
+                    ),
                     regulariser: choice.map(|c| c.regulariser),
                     strength: choice.map(|c| c.strength),
                     cells: choice.and_then(|c| c.cells),

@@ -275,10 +275,12 @@ pub(super) fn most_probable_of(estimated: &[(String, f64, [f64; 2])]) -> Vec<(St
 
 /// A redshift for each of `estimated` drawn from its estimate: a normal on each side of the
 /// most probable `z` whose width is the interval's on that side (a split normal holding 68%
-/// inside the interval), kept within `[z_lo, 2 z_hi - z]`: not below the interval, whose low
-/// end lies inside the prior and behind the lens.
+/// inside the interval), kept within `[z_lo, 2 z_hi - z]` (not below the interval, whose low
+/// end lies inside the prior and behind the lens) and within the range the system's redshift
+/// was searched in, `range(id)` (the prior range, narrowed by a system's own).
 pub(super) fn draw(
     estimated: &[(String, f64, [f64; 2])],
+    range: impl Fn(&str) -> [f64; 2],
     rng: &mut crate::simulate::rng::Rng,
 ) -> Vec<(String, f64)> {
     estimated
@@ -286,10 +288,20 @@ pub(super) fn draw(
         .map(|(id, z, [lo, hi])| {
             let n = rng.normal();
             let width = if n < 0.0 { z - lo } else { hi - z };
-            let drawn = (z + n * width).clamp(*lo, (2.0 * hi - z).max(*lo));
-            (id.clone(), drawn)
+            let top = (2.0 * hi - z).min(range(id)[1]).max(*lo);
+            (id.clone(), (z + n * width).clamp(*lo, top))
         })
         .collect()
+}
+
+/// The range the redshift of system `id` is searched in: `constraints.free_z_prior` (no
+/// redshift is estimated when it is off), narrowed by the system's own range if it has one.
+pub(super) fn search_range(config: &ReconstructConfig, id: &str) -> [f64; 2] {
+    let [mut low, mut high] = config.constraints.free_z_prior.unwrap_or([0.0, 20.0]);
+    if let Some(RedshiftPrior::Range([lo, hi])) = config.constraints.z_priors.get(id) {
+        (low, high) = (low.max(*lo), high.min(*hi));
+    }
+    [low, high]
 }
 
 /// The estimate of the redshift of the source of `images` (arcsec) on `lens` (deflection at
@@ -562,8 +574,16 @@ mod tests {
     fn drawn_redshifts_follow_the_interval() {
         let mut rng = crate::simulate::rng::Rng::stream(7, 1);
         let estimated = [("1".to_string(), 3.0, [2.5, 4.0])];
-        let draws: Vec<f64> = (0..4000).map(|_| draw(&estimated, &mut rng)[0].1).collect();
+        let draws: Vec<f64> = (0..4000)
+            .map(|_| draw(&estimated, |_| [0.5, 8.0], &mut rng)[0].1)
+            .collect();
         assert!(draws.iter().all(|&z| (2.5..=5.0).contains(&z)));
+        // Never beyond the range searched (a system's own prior up to 4.5, say).
+        let capped: Vec<f64> = (0..4000)
+            .map(|_| draw(&estimated, |_| [0.5, 4.5], &mut rng)[0].1)
+            .collect();
+        assert!(capped.iter().all(|&z| (2.5..=4.5).contains(&z)));
+        assert!(capped.iter().any(|&z| z > 4.4), "the cap is reached");
         let inside = draws.iter().filter(|&&z| z > 2.5 && z < 4.0).count() as f64 / 4000.0;
         assert!((inside - 0.68).abs() < 0.1, "{inside}");
         let above = draws.iter().filter(|&&z| z > 3.0).count() as f64 / 4000.0;
