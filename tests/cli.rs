@@ -52,6 +52,17 @@ fn quick_config(dir: &Path) -> PathBuf {
     config
 }
 
+/// A CONFIG.json in `dir` with a fixed regularisation strength ("auto" would run its
+/// candidates, tested in tests/inversion/objective.rs): 16 x 16 cells, 64-pixel maps.
+fn fixed_strength_config(dir: &Path, strength: f64) -> PathBuf {
+    let config = dir.join("fixed.json");
+    let text = format!(
+        r#"{{"grid": {{"cells": 16}}, "objective": {{"strength": {strength}}}, "products": {{"pixels": 64}}}}"#
+    );
+    fs::write(&config, text).unwrap();
+    config
+}
+
 fn summary(dir: &Path) -> serde_json::Value {
     serde_json::from_str(&fs::read_to_string(dir.join("summary.json")).expect("summary"))
         .expect("summary is JSON")
@@ -544,12 +555,7 @@ fn reconstruct_takes_the_redshift_priors_of_a_par() {
          fini\n",
     )
     .unwrap();
-    let config = dir.join("fixed.json");
-    fs::write(
-        &config,
-        r#"{"grid": {"cells": 16}, "objective": {"strength": 0.01}, "products": {"pixels": 64}}"#,
-    )
-    .unwrap();
+    let config = fixed_strength_config(&dir, 0.01);
     let out_dir = dir.join("out");
     let out = wslap(&[
         "reconstruct",
@@ -613,13 +619,7 @@ fn reconstruct_from_arc_pixels() {
         ]}"#,
     )
     .unwrap();
-    // A fixed strength: "auto" would run its candidates (tested in tests/inversion/objective.rs).
-    let config = dir.join("fixed.json");
-    fs::write(
-        &config,
-        r#"{"grid": {"cells": 16}, "objective": {"strength": 0.1}, "products": {"pixels": 64}}"#,
-    )
-    .unwrap();
+    let config = fixed_strength_config(&dir, 0.1);
     let out_dir = dir.join("out");
     let out = wslap(&[
         "reconstruct",

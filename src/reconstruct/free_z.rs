@@ -629,16 +629,11 @@ mod tests {
             on_light.interval[0] > on_heavy.interval[1],
             "the two do not overlap"
         );
-        let both = estimate_redshift_over(
-            &[&light, &heavy],
-            &plane,
-            &images,
-            [0.5, 8.0],
-            None,
-            0.3,
-            10.0,
-        )
-        .expect("estimate");
+        let over = |lenses: &[&dyn MassComponent]| {
+            estimate_redshift_over(lenses, &plane, &images, [0.5, 8.0], None, 0.3, 10.0)
+                .expect("estimate")
+        };
+        let both = over(&[&light, &heavy]);
         assert!(
             both.interval[0] <= on_heavy.z && both.interval[1] >= on_light.z,
             "{both:?}"
@@ -647,16 +642,7 @@ mod tests {
             (both.z - on_light.z).abs() < 1e-9,
             "the first map's estimate: {both:?}"
         );
-        let same = estimate_redshift_over(
-            &[&light, &light],
-            &plane,
-            &images,
-            [0.5, 8.0],
-            None,
-            0.3,
-            10.0,
-        )
-        .expect("estimate");
+        let same = over(&[&light, &light]);
         assert!((same.z - on_light.z).abs() < 1e-9, "{same:?} {on_light:?}");
         assert_eq!(same.interval, on_light.interval);
     }

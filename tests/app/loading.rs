@@ -410,32 +410,41 @@ fn a_commented_member_row_is_fitted_on_request_and_nothing_else_is() {
     assert!(err.contains("load a member catalogue first"), "{err}");
 }
 
+/// A file of the published AS1063 models (`../shared/data`, read in place).
+#[cfg(not(target_arch = "wasm32"))]
+fn read_as1063(name: &str) -> String {
+    let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../shared/data/AS1063/lenstool_cats");
+    std::fs::read_to_string(dir.join(name)).unwrap()
+}
+
 /// A Lenstool `.par` loaded as the model: the galaxies it models on its own are offered, and
 /// fitted as members once `members_from_model` is on (the published AS1063 files).
 #[cfg(not(target_arch = "wasm32"))]
 #[test]
 fn the_bcg_of_a_loaded_par_is_offered_then_fitted_as_a_member() {
-    let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("../shared/data/AS1063/lenstool_cats");
-    let read = |f: &str| std::fs::read_to_string(dir.join(f)).unwrap();
     let mut s = Session::new();
     s.load_text(
         DataRole::Images,
         "gold.cat",
-        &read("cats_gold_mul_gold.cat"),
+        &read_as1063("cats_gold_mul_gold.cat"),
     )
     .unwrap();
     s.load_text(
         DataRole::Members,
         "members.cat",
-        &read("cats_gold_ref_potential_w_clumpNE.cat"),
+        &read_as1063("cats_gold_ref_potential_w_clumpNE.cat"),
     )
     .unwrap();
     // Before a .par is loaded there is nothing to offer, and the members are the catalogue's.
     assert!(s.model_galaxies().is_empty());
     let n = s.parsed().unwrap().members.unwrap().members.len();
-    s.load_text(DataRole::Model, "best.par", &read("cats_gold_bestopt.par"))
-        .unwrap();
+    s.load_text(
+        DataRole::Model,
+        "best.par",
+        &read_as1063("cats_gold_bestopt.par"),
+    )
+    .unwrap();
     let offered: Vec<(String, usize, f64)> = s
         .model_galaxies()
         .into_iter()
@@ -466,20 +475,17 @@ fn the_bcg_of_a_loaded_par_is_offered_then_fitted_as_a_member() {
 #[cfg(not(target_arch = "wasm32"))]
 #[test]
 fn the_redshift_priors_of_a_loaded_par_are_taken_with_its_galaxies() {
-    let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("../shared/data/AS1063/lenstool_cats");
-    let read = |f: &str| std::fs::read_to_string(dir.join(f)).unwrap();
     let mut s = Session::new();
     s.load_text(
         DataRole::Images,
         "silver.cat",
-        &read("cats_silver_mul_silver.cat"),
+        &read_as1063("cats_silver_mul_silver.cat"),
     )
     .unwrap();
     s.load_text(
         DataRole::Model,
         "start.par",
-        &read("cats_silver_SMACS2248_HFF_NE.par"),
+        &read_as1063("cats_silver_SMACS2248_HFF_NE.par"),
     )
     .unwrap();
     assert!(s.parsed().unwrap().z_priors.is_empty());
