@@ -534,7 +534,8 @@ fn reconstruct_bad_inputs_name_the_problem() {
 /// `--par` gives the reconstruction the redshift priors of the model's `image` block: a
 /// `z_m_limit` range that leaves out the truth (system 2 of the teaching catalogue is at
 /// z = 2.5) bounds the estimate, a fixed one (flag 0) replaces the catalogue's redshift; the
-/// run says both, and `summary.json` keeps them with the settings.
+/// run says both, `sources.json` marks each system with its prior, and `summary.json` keeps
+/// them with the settings.
 #[test]
 fn reconstruct_takes_the_redshift_priors_of_a_par() {
     let dir = temp_dir("z-priors");
@@ -600,6 +601,9 @@ fn reconstruct_takes_the_redshift_priors_of_a_par() {
     let four = system("4");
     assert_eq!(four["z"], 2.2);
     assert!(four["z_estimate"].is_null(), "{four}");
+    assert_eq!(two["z_prior"], serde_json::json!({"range": [2.0, 2.3]}));
+    assert_eq!(four["z_prior"], serde_json::json!({"fixed": 2.2}));
+    assert!(system("1")["z_prior"].is_null());
     let s = summary(&out_dir);
     assert_eq!(
         s["settings"]["constraints"]["z_priors"],

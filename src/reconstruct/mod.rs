@@ -431,7 +431,7 @@ pub(crate) fn reconstruct_free_z(
     let choice = crate::threads::with_limit(config.system.threads, || {
         choose_strength(inputs, config, progress)
     })?;
-    match choice {
+    let mut r = match choice {
         Some(choice) => with_choice(inputs, config, choice, free_z, progress),
         None => crate::threads::with_limit(config.system.threads, || {
             let first = reconstruct_limited(inputs, config, progress)?;
@@ -440,6 +440,15 @@ pub(crate) fn reconstruct_free_z(
                 false => Ok(first),
             }
         }),
+    }?;
+    with_own_priors(&mut r, config);
+    Ok(r)
+}
+
+/// Marks each source that has a redshift prior of its own with it (`sources.json`).
+fn with_own_priors(r: &mut Reconstruction, config: &ReconstructConfig) {
+    for s in &mut r.sources {
+        s.z_prior = config.constraints.z_priors.get(&s.id).copied();
     }
 }
 
@@ -783,7 +792,9 @@ pub fn reconstruct_with_choice(
     choice: StrengthChoice,
     progress: &mut dyn FnMut(&ConvergenceRecord) -> Control,
 ) -> Result<Reconstruction, ReconstructError> {
-    with_choice(inputs, config, choice, true, progress)
+    let mut r = with_choice(inputs, config, choice, true, progress)?;
+    with_own_priors(&mut r, config);
+    Ok(r)
 }
 
 fn with_choice(

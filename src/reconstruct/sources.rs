@@ -9,7 +9,7 @@ use crate::ds9::{write_marks, Mark};
 use crate::image_search::{
     find_images, magnification_at, source_position, ImageError, ImageSearch, SearchGrid,
 };
-use crate::inversion::{capped_inverse_jacobian, ConstraintSource, LinearSystem};
+use crate::inversion::{capped_inverse_jacobian, ConstraintSource, LinearSystem, RedshiftPrior};
 use crate::map::{LensMaps, Map};
 use crate::potential::{arrival_time_days, potential_at, potential_map};
 use crate::products::Products;
@@ -141,6 +141,10 @@ pub struct SourceReport {
     /// `z_estimate`).
     #[serde(default)]
     pub z_interval: Option<[f64; 2]>,
+    /// The system's own redshift prior (`constraints.z_priors`, e.g. a `.par`'s `z_m_limit`
+    /// line), if it has one: `z_estimate` was found under it, or, fixed, `z` is its value.
+    #[serde(default)]
+    pub z_prior: Option<RedshiftPrior>,
     /// True when the system was left out of the fit and is predicted.
     pub held_out: bool,
     /// Source position (arcsec): the solved beta of a fitted system, or for a held-out one
@@ -516,6 +520,7 @@ fn finish(
         z_assumed,
         z_estimate: None,
         z_interval: None,
+        z_prior: None,
         held_out,
         beta_arcsec: beta,
         scatter_arcsec: scatter,

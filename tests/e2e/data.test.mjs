@@ -264,6 +264,37 @@ test('both BCGs of a cluster with two cores are fitted, or offered together', as
   }
 });
 
+test("a loaded .par's redshift priors bound the estimates once the setting takes them", async () => {
+  const app = await openApp();
+  try {
+    const { page } = app;
+    await waitStatus(page, /^Ready/);
+    // AS1063 silver: eight systems without a redshift, each with a range in the starting .par.
+    await page.setInputFiles('#file-images', join(AS1063, 'cats_silver_mul_silver.cat'));
+    await page.waitForFunction(() => /systems/.test(document.getElementById('status-images').textContent));
+    await page.setInputFiles('#file-model', join(AS1063, 'cats_silver_SMACS2248_HFF_NE.par'));
+    await page.waitForFunction(() => /Lenstool model/.test(document.getElementById('status-model').textContent));
+    await setField(page, '#set-z_lens', 0.348);
+    await setField(page, '#set-reconstruct-objective-strength', 0.1);
+    await setField(page, '#set-members_from_model', 'true');
+    await runToMap(page, '#reconstruct', 120_000);
+    const warnings = await page.locator('#run-warnings li').allTextContents();
+    assert.ok(warnings.includes("cats_silver_SMACS2248_HFF_NE.par: line 10: system 43's redshift is estimated under the model's prior, uniform 1.4 - 1.8"), warnings.slice(0, 12).join(' | '));
+    await page.click('#tab-systems');
+    await page.waitForSelector('#systems table');
+    const cells = await page.locator('#systems tbody td.z-estimated').allTextContents();
+    assert.equal(cells.length, 8, cells.join(' | '));
+    for (const cell of cells) {
+      const [z, lo, hi, plo, phi] = cell.match(/^([\d.]+) est\.([\d.]+)–([\d.]+)prior ([\d.]+)–([\d.]+)$/).slice(1).map(Number);
+      assert.ok(plo <= lo && lo <= z && z <= hi && hi <= phi, cell);
+    }
+    await page.screenshot({ path: join(ARTIFACTS, 'app-par-redshift-priors.png'), fullPage: true });
+    assert.deepEqual(app.consoleErrors, []);
+  } finally {
+    await app.close();
+  }
+});
+
 test('the BCG a loaded .par models on its own is offered, and fitted on a click', async () => {
   const app = await openApp();
   try {

@@ -15,11 +15,26 @@ const fmt = (v, d = 2) => (v == null ? '–' : Number(v).toFixed(d));
 export const offsetsCell = (observed) => `<td>${observed.map((o) => `${esc(o.id)}: ${fmt(o.offset_arcsec)}${
   o.magnification == null ? '' : ` (μ ${fmt(o.magnification, 1)})`}`).join('<br>')}</td>`;
 
-/** A system's redshift: as given, assumed (`*`, the default redshift), or estimated by the
- * fit with its 68% interval. */
-const zCell = (s) => (s.z_estimate == null
-  ? `<td>${fmt(s.z, 3)}${s.z_assumed ? '*' : ''}</td>`
-  : `<td class="z-estimated" title="estimated on the lens of the systems with a redshift, 68% interval (the run's warnings say under which prior and over the maps of which regularisers)">${fmt(s.z_estimate, 2)} est.<br><small>${fmt(s.z_interval[0], 2)}–${fmt(s.z_interval[1], 2)}</small></td>`);
+/** A system's own redshift prior (sources.json `z_prior`, from a .par's z_m_limit line) in
+ * words, or '' without one. */
+const priorText = (p) => {
+  if (p == null) return '';
+  if (p.range) return `uniform ${fmt(p.range[0], 2)}–${fmt(p.range[1], 2)}`;
+  if (p.normal) return `normal ${fmt(p.normal[0], 2)} ± ${fmt(p.normal[1], 2)}`;
+  return `fixed at ${fmt(p.fixed, 3)}`;
+};
+
+/** A system's redshift: as given, assumed (`*`, the default redshift), fixed by its own
+ * prior, or estimated by the fit with its 68% interval (and its own prior, if any). */
+const zCell = (s) => {
+  const prior = priorText(s.z_prior);
+  if (s.z_estimate == null) {
+    const title = prior ? ` title="its own prior (a .par's z_m_limit line): ${prior}"` : '';
+    return `<td${title}>${fmt(s.z, 3)}${s.z_assumed ? '*' : ''}</td>`;
+  }
+  const under = prior ? `, under its own prior (${prior})` : '';
+  return `<td class="z-estimated" title="estimated on the lens of the systems with a redshift${under}, 68% interval (the run's warnings say over the maps of which regularisers)">${fmt(s.z_estimate, 2)} est.<br><small>${fmt(s.z_interval[0], 2)}–${fmt(s.z_interval[1], 2)}</small>${prior ? `<br><small>prior ${prior.replace(/^uniform /, '').replace(/^normal /, '')}</small>` : ''}</td>`;
+};
 
 /** Ids in natural order: "2" before "10", "2.1" before "2.10". */
 const byId = new Intl.Collator('en', { numeric: true }).compare;
