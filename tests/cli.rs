@@ -52,6 +52,18 @@ fn quick_config(dir: &Path) -> PathBuf {
     config
 }
 
+/// The teaching catalogue (the app's built-in example: four systems behind a known model)
+/// written to `dir`/images.cat.
+fn teaching_images(dir: &Path) -> PathBuf {
+    let images = dir.join("images.cat");
+    fs::write(
+        &images,
+        wslap::app::examples::teaching_image_catalog().unwrap(),
+    )
+    .unwrap();
+    images
+}
+
 /// A CONFIG.json in `dir` with a fixed regularisation strength ("auto" would run its
 /// candidates, tested in tests/inversion/objective.rs): 16 x 16 cells, 64-pixel maps.
 fn fixed_strength_config(dir: &Path, strength: f64) -> PathBuf {
@@ -539,12 +551,7 @@ fn reconstruct_bad_inputs_name_the_problem() {
 #[test]
 fn reconstruct_takes_the_redshift_priors_of_a_par() {
     let dir = temp_dir("z-priors");
-    let images = dir.join("images.cat");
-    fs::write(
-        &images,
-        wslap::app::examples::teaching_image_catalog().unwrap(),
-    )
-    .unwrap();
+    let images = teaching_images(&dir);
     let par = dir.join("model.par");
     fs::write(
         &par,
@@ -646,12 +653,7 @@ fn reconstruct_from_arc_pixels() {
     assert_eq!(s["settings"]["constraints"]["mode"], "arcs");
     // With a catalogue too, the mode chooses (the rule itself: `reconstruct::Dataset`'s tests):
     // the default fits the catalogue and says that the arcs are not fitted.
-    let images = dir.join("images.cat");
-    fs::write(
-        &images,
-        wslap::app::examples::teaching_image_catalog().unwrap(),
-    )
-    .unwrap();
+    let images = teaching_images(&dir);
     let out = wslap(&[
         "reconstruct",
         "--arcs",
@@ -677,12 +679,7 @@ fn reconstruct_from_arc_pixels() {
 #[test]
 fn reconstruct_folds_writes_crossval_json() {
     let dir = temp_dir("folds");
-    let images = dir.join("images.cat");
-    fs::write(
-        &images,
-        wslap::app::examples::teaching_image_catalog().unwrap(),
-    )
-    .unwrap();
+    let images = teaching_images(&dir);
     let config = quick_config(&dir);
     let out_dir = dir.join("out");
     let args = [
@@ -1482,12 +1479,7 @@ fn images_match_lenstronomy_from_a_model_and_from_maps() {
 #[test]
 fn reconstruct_ensemble_writes_its_statistics() {
     let dir = temp_dir("ensemble");
-    let images = dir.join("images.cat");
-    fs::write(
-        &images,
-        wslap::app::examples::teaching_image_catalog().unwrap(),
-    )
-    .unwrap();
+    let images = teaching_images(&dir);
     let config = dir.join("config.json");
     fs::write(
         &config,

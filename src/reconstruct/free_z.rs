@@ -297,11 +297,16 @@ pub(super) fn draw(
 /// The range the redshift of system `id` is searched in: `constraints.free_z_prior` (no
 /// redshift is estimated when it is off), narrowed by the system's own range if it has one.
 pub(super) fn search_range(config: &ReconstructConfig, id: &str) -> [f64; 2] {
-    let [mut low, mut high] = config.constraints.free_z_prior.unwrap_or([0.0, 20.0]);
-    if let Some(RedshiftPrior::Range([lo, hi])) = config.constraints.z_priors.get(id) {
-        (low, high) = (low.max(*lo), high.min(*hi));
+    let prior = config.constraints.free_z_prior.unwrap_or([0.0, 20.0]);
+    narrowed(prior, config.constraints.z_priors.get(id).copied())
+}
+
+/// `prior` narrowed by a system's own range, if `own` is one.
+fn narrowed(prior: [f64; 2], own: Option<RedshiftPrior>) -> [f64; 2] {
+    match own {
+        Some(RedshiftPrior::Range([lo, hi])) => [prior[0].max(lo), prior[1].min(hi)],
+        _ => prior,
     }
-    [low, high]
 }
 
 /// The estimate of the redshift of the source of `images` (arcsec) on `lens` (deflection at
@@ -345,10 +350,8 @@ pub fn estimate_redshift_over(
     sigma_arcsec: f64,
     max_stretch: f64,
 ) -> Option<RedshiftEstimate> {
-    let (mut low, mut high) = (prior[0].max(plane.z_lens + BEHIND_LENS), prior[1]);
-    if let Some(RedshiftPrior::Range([lo, hi])) = own {
-        (low, high) = (low.max(lo), high.min(hi));
-    }
+    let [low, high] = narrowed(prior, own);
+    let low = low.max(plane.z_lens + BEHIND_LENS);
     let usable = high > low && sigma_arcsec > 0.0;
     if images.len() < 2 || !usable {
         return None;
