@@ -502,6 +502,16 @@ fn catalog_candidates(
     Ok(out)
 }
 
+/// The first of `ids` that names none of `candidates`' systems.
+fn first_unknown<'a>(
+    ids: impl IntoIterator<Item = &'a String>,
+    candidates: &[Candidate],
+) -> Option<String> {
+    ids.into_iter()
+        .find(|id| !candidates.iter().any(|c| &c.id == *id))
+        .cloned()
+}
+
 /// Constraint pixels and weights from `source` (see the module documentation). Systems whose
 /// id is in `hold_out` are left out (every id must exist).
 pub fn build_constraints(
@@ -540,34 +550,15 @@ pub fn build_constraints(
             })
         }
     };
-    if let Some(id) = hold_out
-        .iter()
-        .find(|h| !candidates.iter().any(|c| &c.id == *h))
-    {
-        return Err(ConstraintError::UnknownHoldOut {
-            source_name,
-            id: id.clone(),
-        });
+    // Every system the settings name must be one of the data's.
+    if let Some(id) = first_unknown(hold_out, &candidates) {
+        return Err(ConstraintError::UnknownHoldOut { source_name, id });
     }
-    if let Some(id) = config
-        .free_z_systems
-        .iter()
-        .find(|f| !candidates.iter().any(|c| &c.id == *f))
-    {
-        return Err(ConstraintError::UnknownFreeZ {
-            source_name,
-            id: id.clone(),
-        });
+    if let Some(id) = first_unknown(&config.free_z_systems, &candidates) {
+        return Err(ConstraintError::UnknownFreeZ { source_name, id });
     }
-    if let Some(id) = config
-        .z_priors
-        .keys()
-        .find(|f| !candidates.iter().any(|c| &c.id == *f))
-    {
-        return Err(ConstraintError::UnknownZPrior {
-            source_name,
-            id: id.clone(),
-        });
+    if let Some(id) = first_unknown(config.z_priors.keys(), &candidates) {
+        return Err(ConstraintError::UnknownZPrior { source_name, id });
     }
     let mut set = ConstraintSet {
         systems: Vec::new(),
