@@ -616,6 +616,41 @@ fn reconstruct_takes_the_redshift_priors_of_a_par() {
         s["settings"]["constraints"]["z_priors"],
         serde_json::json!({"2": {"range": [2.0, 2.3]}, "4": {"fixed": 2.2}})
     );
+    // With estimation switched off, the range still has system 2 estimated, within it.
+    let off = dir.join("off.json");
+    let mut settings: serde_json::Value =
+        serde_json::from_str(&fs::read_to_string(&config).unwrap()).unwrap();
+    settings["constraints"] = serde_json::json!({"free_z_prior": null});
+    fs::write(&off, settings.to_string()).unwrap();
+    let off_dir = dir.join("off");
+    let out = wslap(&[
+        "reconstruct",
+        "--images",
+        images.to_str().unwrap(),
+        "--par",
+        par.to_str().unwrap(),
+        "--z-lens",
+        "0.3",
+        "--config",
+        off.to_str().unwrap(),
+        "--out",
+        off_dir.to_str().unwrap(),
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let sources: serde_json::Value =
+        serde_json::from_str(&fs::read_to_string(off_dir.join("sources.json")).unwrap()).unwrap();
+    let two = sources
+        .as_array()
+        .unwrap()
+        .iter()
+        .find(|s| s["id"] == "2")
+        .unwrap();
+    let z = two["z_estimate"].as_f64().unwrap();
+    assert!((2.0..=2.3).contains(&z), "{two}");
 }
 
 #[test]

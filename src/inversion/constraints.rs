@@ -125,13 +125,15 @@ pub struct ConstraintConfig {
     pub free_z_systems: Vec<String>,
     /// The range an unknown redshift is estimated in, `[low, high]` (default `[0.5, 8]`; the
     /// low end is raised to just behind the lens). `null`: systems without a redshift are left
-    /// out (unless `default_z` is given). Allowed 0 < low < high <= 20.
+    /// out (unless `default_z` is given), and only a system with a range or normal prior of
+    /// its own in `z_priors` is estimated, under that prior alone. Allowed 0 < low < high <=
+    /// 20.
     pub free_z_prior: Option<[f64; 2]>,
     /// A redshift prior of a system's own, by id, overriding its catalogue redshift (default
     /// none; a `.par`'s `z_m_limit` lines give them): `{"range": [low, high]}` estimates it
     /// within that range (and within `free_z_prior`), `{"normal": [mean, sigma]}` weighs the
-    /// estimate by that normal, `{"fixed": z}` fits the system at `z`. Redshifts allowed
-    /// (0, 20).
+    /// estimate by that normal, `{"fixed": z}` fits the system at `z` (also when
+    /// `free_z_systems` names it). Redshifts allowed (0, 20).
     pub z_priors: BTreeMap<String, RedshiftPrior>,
     /// Redshifts estimated for the systems above, by id: these systems are fitted at them
     /// (set by the reconstruction, never read from a settings file).
@@ -216,12 +218,13 @@ impl RedshiftPrior {
 pub const DEFAULT_FREE_Z_PRIOR: [f64; 2] = [0.5, 8.0];
 
 impl ConstraintConfig {
-    /// Whether the system `id` with catalogue redshift `z` has its redshift estimated:
-    /// named in `free_z_systems`, or without one while neither `default_z` is given nor
+    /// Whether the system `id` with catalogue redshift `z` has its redshift estimated: under
+    /// a range or normal prior of its own (`z_priors`, which also decide when they fix it),
+    /// or named in `free_z_systems`, or without one while neither `default_z` is given nor
     /// estimation switched off (`free_z_prior` null).
     pub fn is_free_z(&self, id: &str, z: Option<f64>) -> bool {
         if let Some(p) = self.z_priors.get(id) {
-            return p.is_estimated() && self.free_z_prior.is_some();
+            return p.is_estimated();
         }
         self.free_z_prior.is_some()
             && (self.free_z_systems.iter().any(|s| s == id)
@@ -566,6 +569,14 @@ pub fn build_constraints(
         excluded: Vec::new(),
         warnings: Vec::new(),
     };
+    for id in &config.free_z_systems {
+        if let Some(z) = config.z_fixed(id) {
+            set.warnings.push(format!(
+                "{source_name}: system {id} is named to have its redshift estimated, but its \
+                 own prior fixes it at z = {z}: fitted at {z}"
+            ));
+        }
+    }
     for c in candidates {
         let free = config.is_free_z(&c.id, c.z);
         let estimate = config.z_estimate(&c.id).filter(|_| free);

@@ -143,9 +143,7 @@ pub(super) fn add_free_systems(
         .filter(|e| e.reason == Exclusion::FreeRedshift)
         .map(|e| e.id.clone())
         .collect();
-    let Some(prior) = config.constraints.free_z_prior else {
-        return Ok(first);
-    };
+    let prior = config.constraints.free_z_prior.unwrap_or(OPEN_RANGE);
     if free.is_empty() || first.status == SolveStatus::Cancelled {
         return Ok(first);
     }
@@ -294,10 +292,15 @@ pub(super) fn draw(
         .collect()
 }
 
-/// The range the redshift of system `id` is searched in: `constraints.free_z_prior` (no
-/// redshift is estimated when it is off), narrowed by the system's own range if it has one.
+/// The range searched when `constraints.free_z_prior` is off (then only systems with a prior
+/// of their own are estimated, within it): every redshift a setting allows (the low end is
+/// raised to just behind the lens like any other).
+const OPEN_RANGE: [f64; 2] = [0.0, 20.0];
+
+/// The range the redshift of system `id` is searched in: `constraints.free_z_prior` (or
+/// [`OPEN_RANGE`] when it is off), narrowed by the system's own range if it has one.
 pub(super) fn search_range(config: &ReconstructConfig, id: &str) -> [f64; 2] {
-    let prior = config.constraints.free_z_prior.unwrap_or([0.0, 20.0]);
+    let prior = config.constraints.free_z_prior.unwrap_or(OPEN_RANGE);
     narrowed(prior, config.constraints.z_priors.get(id).copied())
 }
 

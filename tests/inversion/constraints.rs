@@ -249,6 +249,33 @@ fn a_system_s_own_redshift_prior_overrides_the_catalogue() {
     let set = build_constraints(ConstraintSource::Catalog(&cat), &estimated, &[]).unwrap();
     let zs: Vec<(&str, f64)> = set.systems.iter().map(|s| (s.id.as_str(), s.z)).collect();
     assert_eq!(zs, [("1", 2.4), ("2", 2.7), ("3", 1.25)]);
+    // With estimation switched off, a system's own range or normal still has it estimated
+    // (the system without a redshift and without a prior is left out); a fixed prior wins
+    // over `free_z_systems`, and says so.
+    let mut off = priors(&[
+        ("1", RedshiftPrior::Range([2.0, 3.0])),
+        ("3", RedshiftPrior::Fixed(1.1)),
+    ]);
+    off.free_z_prior = None;
+    off.free_z_systems = vec!["3".to_string()];
+    let set = build_constraints(ConstraintSource::Catalog(&cat), &off, &[]).unwrap();
+    let zs: Vec<(&str, f64)> = set.systems.iter().map(|s| (s.id.as_str(), s.z)).collect();
+    assert_eq!(zs, [("3", 1.1)]);
+    assert_eq!(
+        exclusions(&set),
+        [
+            ("1", Exclusion::FreeRedshift),
+            ("2", Exclusion::UnknownRedshift)
+        ]
+    );
+    assert_eq!(
+        set.warnings,
+        [
+            "test.cat: system 3 is named to have its redshift estimated, but its own prior \
+             fixes it at z = 1.1: fitted at 1.1",
+            "test.cat: system 2 has no redshift and no default_z is set: not used"
+        ]
+    );
     for (prior, field, message) in [
         (
             RedshiftPrior::Range([3.0, 2.0]),
