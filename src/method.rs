@@ -396,11 +396,12 @@
 //! # 7. File formats
 //!
 //! **Lenstool image catalogue.** One image per row: `id x y a b theta z [mag]`. The id is
-//! `system.image` (e.g. `4.2`): everything before the first `.` names the system. `a`, `b` are
-//! the ellipse semi-axes in arcsec, `theta` its position angle in degrees (§1), `z` the source
-//! redshift with `0` meaning unknown, `mag` optional. Lines starting with `#` are comments,
-//! anywhere; fields are separated by any whitespace. The images of a system must agree in
-//! redshift to `(z_max - z_min) / (1 + z_min) <= 1e-3`.
+//! `system.image` (e.g. `4.2`): everything before the first `.` names the system; an id
+//! without a `.` names it by all but its last character, as Lenstool does (`4b`, `A3c`).
+//! `a`, `b` are the ellipse semi-axes in arcsec, `theta` its position angle in degrees (§1),
+//! `z` the source redshift with `0` meaning unknown, `mag` optional. Lines starting with `#`
+//! are comments, anywhere; fields are separated by any whitespace. The images of a system
+//! must agree in redshift to `(z_max - z_min) / (1 + z_min) <= 1e-3`.
 //!
 //! **Lenstool member catalogue** (potfile). One galaxy per row: `id x y a b theta mag [lum]`,
 //! with the same position rules; `mag` sets the mass (§4), `lum` is kept but not used.

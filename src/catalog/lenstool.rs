@@ -41,7 +41,9 @@ const MEMBER_LAYOUT: &str = "id x y a b theta mag [lum]";
 /// through (RA, Dec). `a`, `b` are arcsec (>= 0), `theta` degrees, `mag` 0 when missing.
 ///
 /// Ids are `system.image`: the system is the text before the first '.' (`4.2a` and `14c.1`
-/// are systems `4` and `14c`). `z = 0` means unknown (`None`); images of one system must agree
+/// are systems `4` and `14c`); an id without a '.' is grouped as Lenstool groups it, by all
+/// but its last character (`1a`, `1b`: system `1`; `A3c`: system `A3`; said in a warning).
+/// `z = 0` means unknown (`None`); images of one system must agree
 /// within [`Z_AGREEMENT_TOL`] (their mean is used, with a warning when they differ or some are
 /// unknown). Warnings: single-image systems, extra columns (ignored). Positions that do not
 /// fit one lensing field in the header's unit are refused or warned about (`units.rs`).
@@ -59,6 +61,8 @@ pub fn parse_image_catalog(
     let mut seen: HashMap<&str, usize> = HashMap::new();
     let mut parsed = Vec::with_capacity(table.rows.len());
     let mut positions = Vec::with_capacity(table.rows.len());
+    // The first row whose id has no '.' (its system is the id but its last character).
+    let mut undotted: Option<(usize, String, String)> = None;
     for row in &table.rows {
         let f = Fields {
             row,
@@ -67,7 +71,10 @@ pub fn parse_image_catalog(
         };
         f.require(IMAGE_LAYOUT, &mut extra_lines)?;
         let id = row.fields[0];
-        let system = f.system_id()?;
+        let (system, no_dot) = f.system_id()?;
+        if no_dot && undotted.is_none() {
+            undotted = Some((row.line, id.to_string(), system.clone()));
+        }
         if let Some(&first_line) = seen.get(id) {
             return Err(CatalogError::DuplicateId {
                 source_name: source_name.into(),
@@ -93,6 +100,16 @@ pub fn parse_image_catalog(
         parsed.push((system, z, image));
     }
     warn_extra_columns(&extra_lines, source_name, &mut warnings);
+    if let Some((line, id, system)) = undotted {
+        warnings.push(CatalogWarning {
+            source_name: source_name.into(),
+            line,
+            message: format!(
+                "image ids without a '.' are grouped as Lenstool groups them, by all but their \
+                 last character: '{id}' is an image of system {system}"
+            ),
+        });
+    }
     check_field(table.coords, &positions, source_name, &mut warnings)?;
     let raw: Vec<DVec2> = parsed.iter().map(|(_, _, im)| im.position).collect();
     let (frame_ref, positions) = table.coords.into_frame(&raw, requested);

@@ -499,17 +499,53 @@ fn duplicate_image_ids() {
     );
 }
 
+/// Ids without a '.' are grouped as Lenstool groups them (its manual's example: `C1a`, `C1b`,
+/// `C1c` are one source), by all but their last character; the rows here are of the form
+/// public catalogues use (`1A 1B`, `A3a A3b`, `1a 1b`), mixed with dotted ids. A file of
+/// them says once how it was read; a one-character id names no system.
 #[cfg_attr(not(target_arch = "wasm32"), test)]
 #[cfg_attr(target_arch = "wasm32", wasm_bindgen_test::wasm_bindgen_test)]
-fn id_without_dot() {
-    let err = image_err("1.1 342.1 -44.5 0 0 0 1.2 0\n12 342.2 -44.5 0 0 0 1.2 0\n");
-    assert_contains(
-        &err,
-        &[
-            "bad.cat: line 2, column 1 (id): '12'",
-            "system.image",
-            "no '.'",
-        ],
+fn ids_without_a_dot_are_grouped_as_lenstool_groups_them() {
+    let text = "5.1 342.1 -44.5 0 0 0 1.5 0\n\
+                1A 342.101 -44.5 0 0 0 1.2 0\n\
+                1B 342.102 -44.5 0 0 0 1.2 0\n\
+                A3a 342.103 -44.5 0 0 0 0 0\n\
+                5.2 342.104 -44.5 0 0 0 1.5 0\n\
+                A3b 342.105 -44.5 0 0 0 0 0\n\
+                A3c 342.106 -44.5 0 0 0 0 0\n\
+                2a 342.107 -44.5 0 0 0 3.1 0\n\
+                2b 342.108 -44.5 0 0 0 3.1 0\n";
+    let (cat, warnings) = parse_image_catalog(text, "w.cat", None).unwrap();
+    let systems: Vec<(&str, Vec<&str>, Option<f64>)> = cat
+        .systems
+        .iter()
+        .map(|s| {
+            let ids = s.images.iter().map(|im| im.id.as_str()).collect();
+            (s.id.as_str(), ids, s.z)
+        })
+        .collect();
+    assert_eq!(
+        systems,
+        [
+            ("5", vec!["5.1", "5.2"], Some(1.5)),
+            ("1", vec!["1A", "1B"], Some(1.2)),
+            ("A3", vec!["A3a", "A3b", "A3c"], None),
+            ("2", vec!["2a", "2b"], Some(3.1)),
+        ]
+    );
+    let messages: Vec<String> = warnings.iter().map(ToString::to_string).collect();
+    assert_eq!(
+        messages,
+        [
+            "w.cat: line 2: image ids without a '.' are grouped as Lenstool groups them, by all \
+          but their last character: '1A' is an image of system 1"
+        ]
+    );
+    let err = image_err("1.1 342.1 -44.5 0 0 0 1.2 0\n7 342.2 -44.5 0 0 0 1.2 0\n");
+    assert_eq!(
+        err,
+        "bad.cat: line 2, column 1 (id): '7' is not an image id: name an image by its system \
+         and then the image, as '4.2' or '4b'"
     );
 }
 
