@@ -32,6 +32,20 @@ pub const MAG_NO_MEASUREMENT: f64 = 90.0;
 const IMAGE_LAYOUT: &str = "id x y a b theta z [mag]";
 const MEMBER_LAYOUT: &str = "id x y a b theta mag [lum]";
 
+/// The system an image id names, as this reader and Lenstool group images: the text before
+/// the first '.' (`4.2`: `4`), or for an id without one all but its last character (`4b`:
+/// `4`; `A3c`: `A3`). `None` when that leaves nothing on either side.
+pub fn system_of_image(id: &str) -> Option<&str> {
+    match id.split_once('.') {
+        Some((system, image)) => (!system.is_empty() && !image.is_empty()).then_some(system),
+        None => id
+            .char_indices()
+            .last()
+            .map(|(i, _)| &id[..i])
+            .filter(|system| !system.is_empty()),
+    }
+}
+
 /// Parses a Lenstool multiple-image catalogue: rows `id x y a b theta z [mag]`.
 ///
 /// Positions end in the arcsec frame (+x West, +y North) of `reference` when given; otherwise
@@ -217,6 +231,7 @@ pub fn parse_member_catalog(
         members,
         commented,
         fitted_bcgs: None,
+        par_galaxies: Vec::new(),
     };
     Ok((catalog, warnings))
 }

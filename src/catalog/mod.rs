@@ -22,9 +22,10 @@ mod units;
 
 pub use arclets::{arclet_ellipticity, parse_arclet_catalog, Arclet, ArcletCatalog};
 pub use error::{CatalogError, CatalogWarning};
-pub(crate) use frame::{mean_position, sexagesimal};
+pub(crate) use frame::{mean_position, reframe, sexagesimal};
 pub use lenstool::{
-    parse_image_catalog, parse_member_catalog, redshifts_agree, MAG_NO_MEASUREMENT, Z_AGREEMENT_TOL,
+    parse_image_catalog, parse_member_catalog, redshifts_agree, system_of_image,
+    MAG_NO_MEASUREMENT, Z_AGREEMENT_TOL,
 };
 pub use units::{DEGREE_LOOKALIKE, FIELD_ERROR_DEG, FIELD_WARN_DEG};
 
@@ -117,6 +118,13 @@ pub struct MemberCatalog {
     /// (`Dataset::fit_commented_bcgs`); a run's warnings carry their note.
     #[serde(default)]
     pub fitted_bcgs: Option<CommentedBcgs>,
+    /// Ids of the members a Lenstool `.par` models on its own (`Dataset::add_par_galaxies`:
+    /// added from it, already members, or commented-out rows it names): the set-up's own
+    /// choice of the galaxies that need it, its BCGs among them. One near the multiple images
+    /// counts as their BCG, whatever its magnitude: none is then said to be missing or looked
+    /// for among the commented rows.
+    #[serde(default)]
+    pub par_galaxies: Vec<String>,
 }
 
 impl ImageCatalog {
@@ -177,6 +185,13 @@ impl ImageCatalog {
 }
 
 impl MemberCatalog {
+    /// Records member `id` as one the `.par` models on its own ([`Self::par_galaxies`]), once.
+    pub fn note_par_galaxy(&mut self, id: String) {
+        if !self.par_galaxies.contains(&id) {
+            self.par_galaxies.push(id);
+        }
+    }
+
     /// The catalogue in the arcsec frame of `to` (see [`ImageCatalog::reframed`]).
     pub fn reframed(mut self, to: SkyReference) -> Result<Self, CatalogError> {
         let (from, to) = reframe_pair(self.reference, to, &self.source_name)?;

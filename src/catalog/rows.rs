@@ -212,27 +212,19 @@ impl Fields<'_, '_> {
         }
     }
 
-    /// The system part of an image id: the text before the first '.' of `system.image`
-    /// (`4.2`: system 4), or, for an id without a '.', all but its last character, as Lenstool
-    /// groups the images of one source (`4a`, `4b`: system 4; `A3c`: system A3). The flag
-    /// says which: `true` for an id without a '.'.
+    /// The system part of an image id ([`super::system_of_image`]), and whether the id has
+    /// no '.' (its system is all but its last character).
     pub(super) fn system_id(&self) -> Result<(String, bool), CatalogError> {
-        match self.row.fields[0].split_once('.') {
-            None => {
-                let id = self.row.fields[0];
-                let last = id.char_indices().last().map_or(0, |(i, _)| i);
-                match &id[..last] {
-                    "" => Err(self.bad(
-                        0,
-                        "is not an image id: name an image by its system and then the image, \
-                         as '4.2' or '4b'",
-                    )),
-                    system => Ok((system.into(), true)),
-                }
-            }
-            Some(("", _)) => Err(self.bad(0, "has no system part before the '.'")),
-            Some((_, "")) => Err(self.bad(0, "has no image part after the '.'")),
-            Some((system, _)) => Ok((system.into(), false)),
+        let id = self.row.fields[0];
+        match (super::system_of_image(id), id.split_once('.')) {
+            (Some(system), dotted) => Ok((system.into(), dotted.is_none())),
+            (None, Some(("", _))) => Err(self.bad(0, "has no system part before the '.'")),
+            (None, Some(_)) => Err(self.bad(0, "has no image part after the '.'")),
+            (None, None) => Err(self.bad(
+                0,
+                "is not an image id: name an image by its system and then the image, as '4.2' \
+                 or '4b'",
+            )),
         }
     }
 }

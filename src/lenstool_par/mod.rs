@@ -174,8 +174,8 @@ pub const GALAXY_MAX_CORE_KPC: f64 = 5.0;
 pub struct ParGalaxies {
     /// Those with a `mag`, as member rows in the file's frame.
     pub members: Vec<Member>,
-    /// Those without one: each block's name and line.
-    pub without_mag: Vec<(String, usize)>,
+    /// Those without one: each block's name, line and centre (arcsec, the file's frame).
+    pub without_mag: Vec<(String, usize, DVec2)>,
     /// Galaxies at another redshift than [`LenstoolPar::z_lens`] (read with the single-plane
     /// approximation), not the cluster's: each block's name, line and `z_lens`.
     pub other_plane: Vec<(String, usize, f64)>,
@@ -337,8 +337,8 @@ impl LenstoolPar {
     /// at most [`GALAXY_MAX_CORE_KPC`] (a BCG's is below a kpc; a group or cluster halo's tens
     /// of kpc), as member rows in the file's frame (id: the block's name, e.g. `O3`; a and b
     /// from the ellipticity `(a^2 - b^2)/(a^2 + b^2)`; line: the block's). Those without a
-    /// `mag`, which a member needs, come second, by block name and line; those at another
-    /// redshift (a single-plane read, [`ParOptions::for_galaxies`]) third.
+    /// `mag`, which a member needs, come second, by block name, line and centre; those at
+    /// another redshift (a single-plane read, [`ParOptions::for_galaxies`]) third.
     pub fn galaxies(&self) -> Result<ParGalaxies, ParError> {
         let plane = self.lens_plane()?;
         let (mut rows, mut without_mag, mut other_plane) = (Vec::new(), Vec::new(), Vec::new());
@@ -363,7 +363,7 @@ impl LenstoolPar {
             }
             let id = p.block.split_whitespace().last().unwrap_or("potentiel");
             let Some(mag) = p.mag else {
-                without_mag.push((p.block.clone(), p.line));
+                without_mag.push((p.block.clone(), p.line, center_arcsec));
                 continue;
             };
             let e = ellipticity.clamp(0.0, 0.99);

@@ -82,7 +82,7 @@ pub fn parse_par_with(
             z_values.push((z, b, potfiles.len(), true));
             potfiles.push(p);
         } else if name.starts_with("image") {
-            redshift_priors.extend(b.repeated.iter().filter_map(|e| cx.redshift_prior(e)));
+            redshift_priors.extend(b.repeated.iter().flat_map(|e| cx.redshift_priors(e)));
         }
     }
     let cosmology = cosmology.ok_or_else(|| cx.model("no `cosmologie` block"))?;
@@ -386,16 +386,24 @@ impl Ctx<'_> {
     /// A `z_m_limit n id flag v1 v2 precision` line of an `image` block: system `id`'s
     /// redshift fixed at `v1` (flag 0, as a `best.par` writes the fitted value), uniform on
     /// `[v1, v2]` (flag 1) or a normal of mean `v1` and width `v2` (flag 3, a `bestopt.par`'s
-    /// posterior). A line that says none of these is skipped with a warning: the image block
-    /// is not the model's, so it is never a reason to refuse the file.
-    fn redshift_prior(&self, e: &Entry) -> Option<ParRedshiftPrior> {
+    /// posterior). Lenstool's own output files may list several ids before the flag (`n A3a
+    /// A4a 3 1.51 0.04 0.001`: families of one source, sharing its redshift): each is given the
+    /// prior. A line that says none of these is skipped with a warning: the image block is
+    /// not the model's, so it is never a reason to refuse the file.
+    fn redshift_priors(&self, e: &Entry) -> Vec<ParRedshiftPrior> {
         let skip = |why: String| {
             self.warn(e.line, format!("`{Z_M_LIMIT}` {why}: skipped"));
-            None
+            Vec::new()
         };
-        let [_, id, flag, v1, v2, ..] = e.values.as_slice() else {
+        let values = e.values.as_slice();
+        // With a precision after the values the flag is fourth from the end, whatever the
+        // number of ids; without one (five words) it is third.
+        let flag_at = values.len().saturating_sub(4).max(2);
+        let (Some(ids), Some([flag, v1, v2, ..])) = (values.get(1..flag_at), values.get(flag_at..))
+        else {
             return skip("needs `n id flag value1 value2`".into());
         };
+        let id = ids.join(" ");
         let number = |text: &str| text.parse::<f64>().ok().filter(|v| v.is_finite());
         let (Some(v1), Some(v2)) = (number(v1), number(v2)) else {
             return skip(format!("values `{v1}` and `{v2}` must be numbers"));
@@ -419,11 +427,13 @@ impl Ctx<'_> {
                 ))
             }
         };
-        Some(ParRedshiftPrior {
-            line: e.line,
-            system: id.clone(),
-            prior,
-        })
+        ids.iter()
+            .map(|id| ParRedshiftPrior {
+                line: e.line,
+                system: id.clone(),
+                prior,
+            })
+            .collect()
     }
 
     fn warn(&self, line: usize, message: String) {

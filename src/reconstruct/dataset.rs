@@ -17,15 +17,18 @@
 
 use std::collections::BTreeMap;
 
+use glam::DVec2;
 use thiserror::Error;
 
-use super::{image_centres, with_luminosity, Inputs, LayerSource, ReconstructConfig};
+use super::{
+    bcg_candidates, image_centres, with_luminosity, Inputs, LayerSource, ReconstructConfig,
+};
 use crate::arcs::{
     arcs_from_regions, is_region_file, parse_arcs, ArcCatalog, ArcsError, RegionArcs,
 };
 use crate::catalog::{
-    parse_arclet_catalog, parse_image_catalog, parse_member_catalog, ArcletCatalog, CatalogError,
-    CatalogRow, CommentedBcgs, ImageCatalog, Member, MemberCatalog,
+    parse_arclet_catalog, parse_image_catalog, parse_member_catalog, reframe, system_of_image,
+    ArcletCatalog, CatalogError, CatalogRow, CommentedBcgs, ImageCatalog, Member, MemberCatalog,
 };
 use crate::cosmology::LensPlane;
 use crate::inversion::{
@@ -142,8 +145,12 @@ impl Dataset {
 
     /// Takes the `.par`'s `z_m_limit` priors ([`LenstoolPar::redshift_priors`]) for the
     /// systems of the image catalogue (or arcs) they name, as Lenstool does: over the
-    /// catalogue's redshift. An id matches a system's by its text or as a number (`6.0` is
-    /// system `6`). One sentence per line: taken, or naming no system.
+    /// catalogue's redshift. An id matches a system's by its text, as a number (`6.0` is
+    /// system `6`), or as the id of one of its images (`6.1` or `6a`, grouped as the image
+    /// catalogue groups them). A prior that puts the source in front of the `.par`'s lens (a
+    /// fixed redshift, the top of a range or a normal's mean at or below `z_lens`: an
+    /// optimiser that hit its floor) is not taken. One sentence per line: taken, not taken,
+    /// or naming no system.
     pub fn add_par_redshift_priors(&mut self, par: &LenstoolPar) -> Vec<String> {
         let ids: Vec<String> = match (&self.images, &self.arcs) {
             (Some(c), _) => c.systems.iter().map(|s| s.id.clone()).collect(),
@@ -155,40 +162,56 @@ impl Dataset {
         par.redshift_priors
             .iter()
             .map(|p| {
-                let found = ids.iter().find(|id| {
+                let named = |id: &&String| {
                     **id == p.system
                         || matches!((number(id), number(&p.system)), (Some(a), Some(b)) if a == b)
-                });
-                match found {
-                    Some(id) => {
-                        self.z_priors.insert(id.clone(), p.prior);
-                        format!(
-                            "{name}: line {}: system {id}'s redshift {}",
-                            p.line,
-                            match p.prior {
-                                RedshiftPrior::Fixed(z) => format!("is taken as {z}"),
-                                other => format!(
-                                    "is estimated under the model's prior, {}",
-                                    other.describe()
-                                ),
-                            }
-                        )
-                    }
-                    None => format!(
+                };
+                let Some(id) = ids.iter().find(named).or_else(|| {
+                    ids.iter()
+                        .find(|id| Some(id.as_str()) == system_of_image(&p.system))
+                }) else {
+                    return format!(
                         "{name}: line {}: `z_m_limit` names system {}, which no catalogue \
                          loaded has: not used",
                         p.line, p.system
-                    ),
+                    );
+                };
+                let nearest = match p.prior {
+                    RedshiftPrior::Fixed(z) => z,
+                    RedshiftPrior::Range([_, high]) => high,
+                    RedshiftPrior::Normal([mean, _]) => mean,
+                };
+                if nearest <= par.z_lens {
+                    return format!(
+                        "{name}: line {}: system {id}'s prior ({}) puts it in front of the lens \
+                         (z_lens = {}): not used",
+                        p.line,
+                        p.prior.describe(),
+                        par.z_lens
+                    );
                 }
+                self.z_priors.insert(id.clone(), p.prior);
+                format!(
+                    "{name}: line {}: system {id}'s redshift {}",
+                    p.line,
+                    match p.prior {
+                        RedshiftPrior::Fixed(z) => format!("is taken as {z}"),
+                        other =>
+                            format!("is estimated under the model's prior, {}", other.describe()),
+                    }
+                )
             })
             .collect()
     }
 
     /// Adds the galaxies a Lenstool `.par` models on its own ([`LenstoolPar::galaxies`]: e.g.
     /// the BCG a potfile catalogue leaves out) to the members, in the data's frame (a member
-    /// catalogue is made when there is none). One sentence per galaxy says what became of it:
-    /// added; already a member (one lies within 1 arcsec); or left out for want
-    /// of a `mag`.
+    /// catalogue is made when there is none). A galaxy without a `mag` (a starting `.par`
+    /// gives a BCG a velocity dispersion to fit, not a magnitude) is fitted when the member
+    /// catalogue comments out a row within 1 arcsec of it, as Lenstool set-ups do with the
+    /// galaxies their `.par` models: that row, with its magnitude, becomes a member. One
+    /// sentence per galaxy says what became of it: added; already a member (one lies within
+    /// 1 arcsec); its commented row fitted; or left out for want of a `mag`.
     pub fn add_par_galaxies(&mut self, par: &LenstoolPar) -> Result<Vec<String>, DatasetError> {
         let ParGalaxies {
             members: rows,
@@ -196,14 +219,15 @@ impl Dataset {
             other_plane,
         } = par.galaxies()?;
         let name = &par.source_name;
+        let frame = self.reference();
         let mut notes: Vec<String> = without_mag
             .iter()
-            .map(|(block, line)| {
-                format!(
-                    "{name}: line {line}: `{block}` is a galaxy (core at most \
-                     {GALAXY_MAX_CORE_KPC} kpc) without a `mag`, which a member needs: not \
-                     fitted; give its row in the member catalogue"
-                )
+            .map(|(block, line, centre)| {
+                let at = match (par.reference, frame) {
+                    (Some(from), Some(to)) => reframe(*centre, from, to),
+                    _ => *centre,
+                };
+                self.galaxy_without_mag(name, block, *line, at)
             })
             .collect();
         notes.extend(other_plane.iter().map(|(block, line, z)| {
@@ -216,13 +240,13 @@ impl Dataset {
         if rows.is_empty() {
             return Ok(notes);
         }
-        let frame = self.reference();
         let mut found = MemberCatalog {
             source_name: name.clone(),
             reference: par.reference,
             members: rows,
             commented: Vec::new(),
             fitted_bcgs: None,
+            par_galaxies: Vec::new(),
         };
         match (par.reference, frame) {
             (Some(_), Some(to)) => found = found.reframed(to)?,
@@ -238,6 +262,7 @@ impl Dataset {
             members: Vec::new(),
             commented: Vec::new(),
             fitted_bcgs: None,
+            par_galaxies: Vec::new(),
         });
         for g in found.members {
             let (x, y) = (g.position.x, g.position.y);
@@ -257,11 +282,46 @@ impl Dataset {
                     g.line, g.id, g.mag
                 ),
             });
+            let id = near.map_or(&g.id, |m| &m.id).clone();
             if near.is_none() {
                 members.members.push(g);
             }
+            members.note_par_galaxy(id);
         }
         Ok(notes)
+    }
+
+    /// What becomes of the `.par`'s galaxy `block` (at `line`) without a `mag`, centred at `at`
+    /// (arcsec, the data's frame): the member there already, or the commented-out row of the
+    /// member catalogue there moved to the members, or nothing.
+    fn galaxy_without_mag(&mut self, name: &str, block: &str, line: usize, at: DVec2) -> String {
+        let near = |m: &&Member| m.position.distance(at) <= SAME_GALAXY_ARCSEC;
+        if let Some(members) = self.members.as_mut() {
+            if let Some(id) = members.members.iter().find(near).map(|m| m.id.clone()) {
+                let note = format!(
+                    "{name}: line {line}: `{block}` (no `mag`) is member {id} of {} already",
+                    members.source_name
+                );
+                members.note_par_galaxy(id);
+                return note;
+            }
+            if let Some(k) = members.commented.iter().position(|m| near(&m)) {
+                let row = members.commented.remove(k);
+                members.note_par_galaxy(row.id.clone());
+                let note = format!(
+                    "{name}: line {line}: `{block}` has no `mag`; the row {} comments out \
+                     there (line {}, galaxy {}, mag {:.2}) is fitted as a member",
+                    members.source_name, row.line, row.id, row.mag
+                );
+                members.members.push(row);
+                return note;
+            }
+        }
+        format!(
+            "{name}: line {line}: `{block}` is a galaxy (core at most {GALAXY_MAX_CORE_KPC} kpc) \
+             without a `mag`, which a member needs, and no member catalogue row (commented out \
+             or not) lies there: not fitted; give its row in the member catalogue"
+        )
     }
 
     /// Fits the member catalogue's commented-out rows that are most likely the cluster's
@@ -311,7 +371,7 @@ impl Dataset {
         let constraints = build_constraints(source, &config.constraints, &[]).ok()?;
         missing_bcg_warning(
             &members.source_name,
-            &with_luminosity(&members.members, &config.members, plane),
+            &bcg_candidates(members, &config.members, plane),
             &image_centres(&constraints),
             &with_luminosity(&members.commented, &config.members, plane),
         )?

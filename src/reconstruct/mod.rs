@@ -1100,7 +1100,7 @@ pub(crate) fn member_layers(
     let images = image_centres(constraints);
     let bcg = missing_bcg_warning(
         &catalog.source_name,
-        &with_luminosity(&catalog.members, config, plane),
+        &bcg_candidates(catalog, config, plane),
         &images,
         &with_luminosity(&catalog.commented, config, plane),
     );
@@ -1141,6 +1141,23 @@ fn with_luminosity<'a>(
         .iter()
         .map(|m| (m, config.luminosity_lstar(m.mag, mag_star)))
         .collect()
+}
+
+/// The members of `catalog` with their luminosity in L* as `missing_bcg_warning` weighs them:
+/// a galaxy the `.par` models on its own ([`MemberCatalog::par_galaxies`]) counts as at least
+/// as bright as a BCG, since the set-up chose it as one that needs its own model.
+fn bcg_candidates<'a>(
+    catalog: &'a MemberCatalog,
+    config: &MemberConfig,
+    plane: &LensPlane,
+) -> Vec<(&'a Member, f64)> {
+    let mut members = with_luminosity(&catalog.members, config, plane);
+    for (m, lstar) in &mut members {
+        if catalog.par_galaxies.contains(&m.id) {
+            *lstar = lstar.max(crate::inversion::BCG_MIN_LSTAR);
+        }
+    }
+    members
 }
 
 /// The centre (mean of its pixels) of each image of the fitted systems, in arcsec.

@@ -185,7 +185,10 @@ fn the_galaxies_of_a_multi_plane_model_are_the_cluster_planes() {
 /// write them: `n id flag value1 value2 precision`) are the priors a reconstruction takes for
 /// the systems they name: flag 0 fixed (a `best.par`'s fitted value), 1 uniform, 3 normal (a
 /// `bestopt.par`'s posterior). A line that is none of these is skipped with a warning naming
-/// it; an id is matched as a number (`14.0` is system 14); an id no catalogue has is named.
+/// it; an id is matched as a number (`14.0` is system 14) or as an image's (`A3a` of system
+/// `A3`); several ids before the flag (as Lenstool's output files write families of one
+/// source) each take the prior; an id no catalogue has is named, and a prior in front of the
+/// lens (an optimiser at its floor, as in a public `best.par`) is not taken.
 #[cfg_attr(not(target_arch = "wasm32"), test)]
 #[cfg_attr(target_arch = "wasm32", wasm_bindgen_test::wasm_bindgen_test)]
 fn a_par_s_redshift_priors_are_taken_for_the_systems_they_name() {
@@ -196,7 +199,9 @@ fn a_par_s_redshift_priors_are_taken_for_the_systems_they_name() {
                  \tz_m_limit 4 9 2 1.0 2.0 0.1\n\
                  \tz_m_limit 5 10 1 3.0\n\
                  \tz_m_limit 6 11 1 3.0 2.0 0.1\n\
-                 \tz_m_limit 7 99 1 1.0 2.0 0.1\n\tend\n";
+                 \tz_m_limit 7 99 1 1.0 2.0 0.1\n\
+                 \tz_m_limit 8 A3a A4a 3 1.509576 0.038857 0.0010\n\
+                 \tz_m_limit 9 16.0 0 0.100000  0.000000  0.0000\n\tend\n";
     let text = MULTIPLANE.replacen("potentiel O1\n", &format!("{image}potentiel O1\n"), 1);
     let line_of = |needle: &str| 1 + text[..text.find(needle).unwrap()].matches('\n').count();
     let options = ParOptions::default().for_galaxies();
@@ -225,6 +230,17 @@ fn a_par_s_redshift_priors_are_taken_for_the_systems_they_name() {
                 "99",
                 RedshiftPrior::Range([1.0, 2.0])
             ),
+            (
+                line_of("z_m_limit 8 "),
+                "A3a",
+                RedshiftPrior::Normal([1.509576, 0.038857])
+            ),
+            (
+                line_of("z_m_limit 8 "),
+                "A4a",
+                RedshiftPrior::Normal([1.509576, 0.038857])
+            ),
+            (line_of("z_m_limit 9 "), "16.0", RedshiftPrior::Fixed(0.1)),
         ]
     );
     let warnings: Vec<String> = par.warnings.iter().map(ToString::to_string).collect();
@@ -250,7 +266,10 @@ fn a_par_s_redshift_priors_are_taken_for_the_systems_they_name() {
     let catalogue = "#REFERENCE 3 39.971340 -1.582260\n\
                      6.1 10.0 5.0 0.5 0.5 0 0 25\n6.2 -8.0 3.0 0.5 0.5 0 0 25\n\
                      8.1 4.0 -9.0 0.5 0.5 0 2.5 25\n8.2 -4.0 9.0 0.5 0.5 0 2.5 25\n\
-                     14.1 20.0 1.0 0.5 0.5 0 0 25\n14.2 -19.0 2.0 0.5 0.5 0 0 25\n";
+                     14.1 20.0 1.0 0.5 0.5 0 0 25\n14.2 -19.0 2.0 0.5 0.5 0 0 25\n\
+                     A3a 1.0 12.0 0.5 0.5 0 0 25\nA3b -1.0 -12.0 0.5 0.5 0 0 25\n\
+                     A4a 2.0 12.0 0.5 0.5 0 0 25\nA4b -2.0 -12.0 0.5 0.5 0 0 25\n\
+                     16.1 7.0 7.0 0.5 0.5 0 3.0 25\n16.2 -7.0 -7.0 0.5 0.5 0 3.0 25\n";
     let (images, _) = parse_image_catalog(catalogue, "mul.cat", None).unwrap();
     let mut data = wslap::Dataset {
         images: Some(images),
@@ -279,10 +298,25 @@ fn a_par_s_redshift_priors_are_taken_for_the_systems_they_name() {
                  has: not used",
                 line_of("z_m_limit 7 ")
             ),
+            format!(
+                "priors.par: line {}: system A3's redshift is estimated under the model's \
+                 prior, normal 1.509576 +- 0.038857",
+                line_of("z_m_limit 8 ")
+            ),
+            format!(
+                "priors.par: line {}: system A4's redshift is estimated under the model's \
+                 prior, normal 1.509576 +- 0.038857",
+                line_of("z_m_limit 8 ")
+            ),
+            format!(
+                "priors.par: line {}: system 16's prior (fixed at 0.1) puts it in front of the \
+                 lens (z_lens = 0.375): not used",
+                line_of("z_m_limit 9 ")
+            ),
         ]
     );
     let ids: Vec<&str> = data.z_priors.keys().map(String::as_str).collect();
-    assert_eq!(ids, ["14", "6", "8"]);
+    assert_eq!(ids, ["14", "6", "8", "A3", "A4"]);
 }
 
 #[cfg_attr(not(target_arch = "wasm32"), test)]
@@ -611,6 +645,7 @@ mod galaxies_of_a_par {
             notes[0].contains("is member O3 of members.cat already: not added twice"),
             "{notes:?}"
         );
+        assert_eq!(data.members.as_ref().unwrap().par_galaxies, ["O3"]);
         // Without a member catalogue it makes one, in the images' frame.
         let mut alone = as1063(false);
         alone.add_par_galaxies(&par).unwrap();
@@ -620,22 +655,63 @@ mod galaxies_of_a_par {
     }
 
     #[test]
-    fn a_galaxy_without_a_magnitude_is_named_and_left_out() {
-        // MACS1931's .par is a starting model: its BCG (potential 3, core 0.115 kpc) has a
-        // velocity dispersion to fit and no `mag`.
+    fn a_galaxy_without_a_magnitude_takes_its_commented_row_or_is_left_out() {
+        // MACS1931's .par is a starting model: its BCG (potential 3, core 0.115 kpc, at the
+        // reference) has a velocity dispersion to fit and no `mag`; m1931.cat comments its row
+        // out (`#1009.0 0.0 0.0 ... 17.325`).
         let par = parse_par(&read("MACS1931/lenstool_cats/m1931.par"), "m1931.par").unwrap();
         let found = par.galaxies().unwrap();
         assert!(found.members.is_empty());
-        assert_eq!(found.without_mag, [("potentiel 3".to_string(), 66)]);
+        assert_eq!(
+            found.without_mag,
+            [("potentiel 3".to_string(), 66, DVec2::ZERO)]
+        );
+        // Without a member catalogue there is no magnitude to take.
         let mut data = Dataset::default();
         let notes = data.add_par_galaxies(&par).unwrap();
         assert_eq!(
             notes,
             [
                 "m1931.par: line 66: `potentiel 3` is a galaxy (core at most 5 kpc) without a \
-              `mag`, which a member needs: not fitted; give its row in the member catalogue"
+                 `mag`, which a member needs, and no member catalogue row (commented out or \
+                 not) lies there: not fitted; give its row in the member catalogue"
             ]
         );
         assert!(data.members.is_none());
+        // With it, the commented row there becomes a member, once; and the set-up's own
+        // galaxy is recorded, so no BCG is looked for among the commented rows.
+        let cat = read("MACS1931/lenstool_cats/m1931.cat");
+        let mut data = Dataset::read(
+            &InputTexts {
+                members: Some(InputText {
+                    name: "m1931.cat",
+                    text: &cat,
+                }),
+                ..InputTexts::default()
+            },
+            0.2,
+        )
+        .unwrap();
+        let before = data.members.as_ref().unwrap().members.len();
+        let notes = data.add_par_galaxies(&par).unwrap();
+        assert_eq!(
+            notes,
+            [
+                "m1931.par: line 66: `potentiel 3` has no `mag`; the row m1931.cat comments out \
+                 there (line 10, galaxy 1009.0, mag 17.32) is fitted as a member"
+            ]
+        );
+        let members = data.members.as_ref().unwrap();
+        assert_eq!(members.members.len(), before + 1);
+        let bcg = members.members.last().unwrap();
+        assert_eq!((bcg.id.as_str(), bcg.mag, bcg.line), ("1009.0", 17.325, 10));
+        assert!(!members.commented.iter().any(|m| m.id == "1009.0"));
+        assert_eq!(members.par_galaxies, ["1009.0"]);
+        let notes = data.add_par_galaxies(&par).unwrap();
+        assert!(
+            notes[0].ends_with("`potentiel 3` (no `mag`) is member 1009.0 of m1931.cat already"),
+            "{notes:?}"
+        );
+        assert_eq!(data.members.as_ref().unwrap().members.len(), before + 1);
     }
 }

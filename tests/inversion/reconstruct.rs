@@ -994,6 +994,22 @@ fn a_commented_out_bcg_row_is_fitted_unless_the_settings_say_not() {
     // Not twice.
     assert!(data.fit_commented_bcgs(&plane, &config).is_empty());
     assert_eq!(data.members.as_ref().unwrap().members.len(), members + 1);
+    // A `.par` that models a galaxy near the images on its own has chosen the cluster's BCG,
+    // however faint: no commented row is taken for a missing one.
+    let par = wslap::parse_par(
+        "runmode\n\treference 3 292.95682 -26.575718\n\tend\n\
+         potentiel G1\n\tprofil 81\n\tx_centre 3.0\n\ty_centre 3.0\n\tellipticite 0.1\n\
+         \tangle_pos 0\n\tcore_radius_kpc 0.2\n\tcut_radius_kpc 50\n\tv_disp 150\n\
+         \tmag 20.5\n\tz_lens 0.352\n\tend\n\
+         cosmologie\n\tH0 70\n\tomegaM 0.3\n\tomegaX 0.7\n\tend\nfini\n",
+        "one.par",
+    )
+    .unwrap();
+    let mut data = read_macs();
+    data.add_par_galaxies(&par).unwrap();
+    assert_eq!(data.members.as_ref().unwrap().par_galaxies, ["G1"]);
+    assert!(data.fit_commented_bcgs(&plane, &config).is_empty());
+    assert_eq!(data.members.as_ref().unwrap().members.len(), members + 1);
     // Off, the catalogue stays as written.
     config.members.fit_commented_bcg = false;
     let mut data = read_macs();
