@@ -412,7 +412,8 @@ impl LenstoolPar {
         Ok((self.build(&catalogs)?, warnings))
     }
 
-    /// Builds the lens: one component per `potentiel` block, then one dPIE per member of
+    /// Builds the lens: one component per `potentiel` block (but a dPIE with `v_disp 0`,
+    /// which has no mass), then one dPIE per member of
     /// `member_catalogs[k]` for the `k`-th `potfile` block (read them with
     /// [`crate::catalog::parse_member_catalog`] in the frame of [`Self::reference`]).
     pub fn build(&self, member_catalogs: &[MemberCatalog]) -> Result<LenstoolModel, ParError> {
@@ -444,6 +445,11 @@ impl LenstoolPar {
                     ellipticity,
                     pa_deg,
                 } => {
+                    // Massless, as Lenstool evaluates it: the nodes of a non-parametric grid
+                    // (`nmsgrid`) start at zero.
+                    if sigma_v_km_s == 0.0 {
+                        continue;
+                    }
                     let (core, cut) = (r_core.arcsec(&plane), r_cut.arcsec(&plane));
                     let d = Dpie::new(center_arcsec, sigma_v_km_s, core, cut, ellipticity, pa_deg);
                     components.push(Box::new(d.map_err(profile)?));

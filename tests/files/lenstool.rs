@@ -48,6 +48,20 @@ fn singular_cores_load_and_no_measurement_members_are_skipped() {
             "{text}"
         );
     }
+    // A dPIE of `v_disp 0` (a node of a Lenstool non-parametric grid, which starts at zero
+    // mass) is massless: left out, the same lens.
+    let node = "potentiel 0\n\tprofil 81\n\tx_centre 5.0\n\ty_centre 5.0\n\tellipticite 0\n\
+                \tangle_pos 0\n\tcore_radius_kpc 10\n\tcut_radius_kpc 100\n\tv_disp 0.0\n\
+                \tz_lens 0.3080\n\tend\npotfile0\n";
+    let with_node = SINGULAR_CORE.replacen("potfile0\n", node, 1);
+    assert_ne!(with_node, SINGULAR_CORE);
+    let (same, _) = parse_par(&with_node, "node.par")
+        .expect("loads")
+        .build_from_texts(&[("members.cat", MEMBERS)])
+        .expect("builds");
+    assert_eq!((same.potentials, same.members), (1, 3));
+    let at = glam::DVec2::new(3.0, -7.0);
+    assert_eq!(same.lens.deflection(at), model.lens.deflection(at));
     // The build's error when the potfile's mag0 is `mag0` instead of 19.44: it must name the
     // member catalogue, the value and the band.
     let refused_with_mag0 = |mag0: &str| {
