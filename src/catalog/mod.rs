@@ -119,7 +119,8 @@ pub struct MemberCatalog {
     #[serde(default)]
     pub fitted_bcgs: Option<CommentedBcgs>,
     /// Ids of the members a Lenstool `.par` models on its own (`Dataset::add_par_galaxies`:
-    /// added from it, already members, or commented-out rows it names): the set-up's own
+    /// added from it, or named by a galaxy of it without a `mag`, commented-out rows
+    /// included; not the potfile members a `best.par` writes out again): the set-up's own
     /// choice of the galaxies that need it, its BCGs among them. One near the multiple images
     /// counts as their BCG, whatever its magnitude: none is then said to be missing or looked
     /// for among the commented rows.

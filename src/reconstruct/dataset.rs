@@ -206,7 +206,8 @@ impl Dataset {
 
     /// Adds the galaxies a Lenstool `.par` models on its own ([`LenstoolPar::galaxies`]: e.g.
     /// the BCG a potfile catalogue leaves out) to the members, in the data's frame (a member
-    /// catalogue is made when there is none). A galaxy without a `mag` (a starting `.par`
+    /// catalogue is made when there is none); those it adds are recorded in
+    /// [`MemberCatalog::par_galaxies`]. A galaxy without a `mag` (a starting `.par`
     /// gives a BCG a velocity dispersion to fit, not a magnitude) is fitted when the member
     /// catalogue comments out a row within 1 arcsec of it, as Lenstool set-ups do with the
     /// galaxies their `.par` models: that row, with its magnitude, becomes a member. One
@@ -264,29 +265,48 @@ impl Dataset {
             fitted_bcgs: None,
             par_galaxies: Vec::new(),
         });
+        // Galaxies the catalogue lists already (a `best.par` writes every potfile member out
+        // as a `potentiel` of its own): one sentence for all of them.
+        let mut already = Vec::new();
         for g in found.members {
             let (x, y) = (g.position.x, g.position.y);
             let near = members
                 .members
                 .iter()
                 .find(|m| m.position.distance(g.position) <= SAME_GALAXY_ARCSEC);
-            notes.push(match near {
-                Some(m) => format!(
-                    "{name}: line {}: galaxy {} at ({x:.2}, {y:.2}) arcsec is member {} of \
-                     {} already: not added twice",
-                    g.line, g.id, m.id, members.source_name
-                ),
-                None => format!(
-                    "{name}: line {}: galaxy {} at ({x:.2}, {y:.2}) arcsec, mag {:.2}, fitted \
-                     as a member",
-                    g.line, g.id, g.mag
-                ),
-            });
-            let id = near.map_or(&g.id, |m| &m.id).clone();
-            if near.is_none() {
-                members.members.push(g);
+            if let Some(m) = near {
+                already.push((
+                    g.line,
+                    format!(
+                        "line {}: galaxy {} at ({x:.2}, {y:.2}) arcsec is member {}",
+                        g.line, g.id, m.id
+                    ),
+                ));
+                continue;
             }
-            members.note_par_galaxy(id);
+            notes.push(format!(
+                "{name}: line {}: galaxy {} at ({x:.2}, {y:.2}) arcsec, mag {:.2}, fitted as a \
+                 member",
+                g.line, g.id, g.mag
+            ));
+            members.note_par_galaxy(g.id.clone());
+            members.members.push(g);
+        }
+        match &already[..] {
+            [] => {}
+            [(_, one)] => notes.push(format!(
+                "{name}: {one} of {} already: not added twice",
+                members.source_name
+            )),
+            many => notes.push(format!(
+                "{name}: {} galaxies (lines {}) are members of {} already: not added twice",
+                many.len(),
+                many.iter()
+                    .map(|(line, _)| line.to_string())
+                    .collect::<Vec<_>>()
+                    .join(", "),
+                members.source_name
+            )),
         }
         Ok(notes)
     }

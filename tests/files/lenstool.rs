@@ -729,3 +729,66 @@ mod galaxies_of_a_par {
         assert_eq!(data.members.as_ref().unwrap().members.len(), before + 1);
     }
 }
+
+/// A real set-up from outside this project (tests/data/lenstool/smacs0723, CC0): its
+/// `best.par` loads with the images and members, the three priors its optimiser left at
+/// z = 0.1 (in front of the lens) are said and not used, every other prior is taken, and
+/// its BCG (`potentiel O2`, no `mag`) takes the row `galcat.cat` comments out.
+#[cfg_attr(not(target_arch = "wasm32"), test)]
+#[cfg_attr(target_arch = "wasm32", wasm_bindgen_test::wasm_bindgen_test)]
+fn a_published_set_up_s_par_gives_its_priors_and_bcg() {
+    use wslap::{Dataset, InputText, InputTexts};
+    let images = include_str!("../data/lenstool/smacs0723/arcs.dat");
+    let members = include_str!("../data/lenstool/smacs0723/galcat.cat");
+    let text = include_str!("../data/lenstool/smacs0723/best.par");
+    let mut data = Dataset::read(
+        &InputTexts {
+            images: Some(InputText {
+                name: "arcs.dat",
+                text: images,
+            }),
+            members: Some(InputText {
+                name: "galcat.cat",
+                text: members,
+            }),
+            ..InputTexts::default()
+        },
+        0.2,
+    )
+    .expect("the catalogues load");
+    let par = parse_par_with(text, "best.par", &ParOptions::default().for_galaxies())
+        .expect("the .par loads");
+    let priors = par.redshift_priors.len();
+    let notes = data.add_par(&par).expect("its galaxies are added");
+    let in_front: Vec<&String> = notes
+        .iter()
+        .filter(|n| n.contains("puts it in front of the lens (z_lens = 0.39): not used"))
+        .collect();
+    assert_eq!(in_front.len(), 3, "{notes:?}");
+    for (note, system) in in_front.iter().zip(["16", "19", "20"]) {
+        assert!(
+            note.contains(&format!("system {system}'s prior (fixed at 0.1)")),
+            "{note}"
+        );
+    }
+    assert_eq!(data.z_priors.len(), priors - 3);
+    assert!(
+        notes.contains(
+            &"best.par: line 69: `potentiel O2` has no `mag`; the row galcat.cat comments out \
+              there (line 5, galaxy 4, mag 18.87) is fitted as a member"
+                .to_string()
+        ),
+        "{notes:?}"
+    );
+    // The 141 potfile members the best.par writes out again are members already, in one note.
+    assert!(
+        notes.iter().any(
+            |n| n.starts_with("best.par: 141 galaxies (lines 108, 122, 136, ")
+                && n.ends_with(") are members of galcat.cat already: not added twice")
+        ),
+        "{notes:?}"
+    );
+    let m = data.members.as_ref().unwrap();
+    assert_eq!(m.par_galaxies, ["4"]);
+    assert!(m.members.iter().any(|g| g.id == "4" && g.line == 5));
+}
