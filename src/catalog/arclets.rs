@@ -75,6 +75,11 @@ pub fn arclet_ellipticity(a: f64, b: f64, theta_deg: f64) -> DVec2 {
     modulus * DVec2::new(two_theta.cos(), two_theta.sin())
 }
 
+/// Why an arclet row with `z = 0` is refused, and what to do.
+const UNKNOWN_Z: &str = "is 0 (unknown): an arclet needs its redshift (> 0). Lenstool takes \
+                         unknown ones from the .par's `source` block; write a redshift in this \
+                         column (a photometric one, or the background's median)";
+
 /// Parses a Lenstool arclet catalogue: rows `id x y a b theta z`.
 ///
 /// Same `#REFERENCE` rules and frame as [`super::parse_image_catalog`]: positions end in the
@@ -116,9 +121,8 @@ pub fn parse_arclet_catalog(
         if shape.a + shape.b <= 0.0 {
             return Err(f.bad(4, "is 0 as is a: an arclet needs a shape (a + b > 0)"));
         }
-        let z = match f.redshift(6)? {
-            Some(z) => z,
-            None => return Err(f.bad(6, "is 0 (unknown): an arclet needs its redshift (> 0)")),
+        let Some(z) = f.redshift(6)? else {
+            return Err(f.bad(6, UNKNOWN_Z));
         };
         positions.push(RowPosition::of(row, shape.raw));
         arclets.push(Arclet {
@@ -180,7 +184,8 @@ mod tests {
             ),
             (
                 "1 0 0 1 0.5 10 0\n",
-                "line 2, column 7 (z): '0' is 0 (unknown)",
+                "line 2, column 7 (z): '0' is 0 (unknown): an arclet needs its redshift (> 0). \
+                 Lenstool takes unknown ones from the .par's `source` block",
             ),
             ("1 0 0 0 0 10 1\n", "line 2, column 5 (b): '0' is 0 as is a"),
             (
