@@ -564,22 +564,30 @@ fn reconstruct_takes_the_redshift_priors_of_a_par() {
     )
     .unwrap();
     let config = fixed_strength_config(&dir, 0.01);
+    // A run of the teaching catalogue with the .par and the settings `config`, into `out`:
+    // its stderr and its sources.json.
+    let run = |config: &Path, out: &Path| {
+        let done = wslap(&[
+            "reconstruct",
+            "--images",
+            images.to_str().unwrap(),
+            "--par",
+            par.to_str().unwrap(),
+            "--z-lens",
+            "0.3",
+            "--config",
+            config.to_str().unwrap(),
+            "--out",
+            out.to_str().unwrap(),
+        ]);
+        let stderr = String::from_utf8_lossy(&done.stderr).to_string();
+        assert!(done.status.success(), "{stderr}");
+        let sources: serde_json::Value =
+            serde_json::from_str(&fs::read_to_string(out.join("sources.json")).unwrap()).unwrap();
+        (stderr, sources)
+    };
     let out_dir = dir.join("out");
-    let out = wslap(&[
-        "reconstruct",
-        "--images",
-        images.to_str().unwrap(),
-        "--par",
-        par.to_str().unwrap(),
-        "--z-lens",
-        "0.3",
-        "--config",
-        config.to_str().unwrap(),
-        "--out",
-        out_dir.to_str().unwrap(),
-    ]);
-    let stderr = String::from_utf8_lossy(&out.stderr);
-    assert!(out.status.success(), "{stderr}");
+    let (stderr, sources) = run(&config, &out_dir);
     for said in [
         "model.par: line 6: system 2's redshift is estimated under the model's prior, uniform 2 - 2.3",
         "model.par: line 7: system 4's redshift is taken as 2.2",
@@ -588,9 +596,7 @@ fn reconstruct_takes_the_redshift_priors_of_a_par() {
     ] {
         assert!(stderr.contains(said), "{said}: {stderr}");
     }
-    let sources: serde_json::Value =
-        serde_json::from_str(&fs::read_to_string(out_dir.join("sources.json")).unwrap()).unwrap();
-    let system = |id: &str| {
+    let system = |sources: &serde_json::Value, id: &str| {
         sources
             .as_array()
             .unwrap()
@@ -599,18 +605,18 @@ fn reconstruct_takes_the_redshift_priors_of_a_par() {
             .unwrap()
             .clone()
     };
-    let two = system("2");
+    let two = system(&sources, "2");
     let z = two["z_estimate"].as_f64().unwrap();
     assert!((2.0..=2.3).contains(&z), "{two}");
     let [lo, hi] = [0, 1].map(|i| two["z_interval"][i].as_f64().unwrap());
     assert!(lo >= 2.0 && hi <= 2.3 && lo <= z && z <= hi, "{two}");
     assert!(z > 2.2, "the end nearer the truth, 2.5: {two}");
-    let four = system("4");
+    let four = system(&sources, "4");
     assert_eq!(four["z"], 2.2);
     assert!(four["z_estimate"].is_null(), "{four}");
     assert_eq!(two["z_prior"], serde_json::json!({"range": [2.0, 2.3]}));
     assert_eq!(four["z_prior"], serde_json::json!({"fixed": 2.2}));
-    assert!(system("1")["z_prior"].is_null());
+    assert!(system(&sources, "1")["z_prior"].is_null());
     let s = summary(&out_dir);
     assert_eq!(
         s["settings"]["constraints"]["z_priors"],
@@ -622,33 +628,8 @@ fn reconstruct_takes_the_redshift_priors_of_a_par() {
         serde_json::from_str(&fs::read_to_string(&config).unwrap()).unwrap();
     settings["constraints"] = serde_json::json!({"free_z_prior": null});
     fs::write(&off, settings.to_string()).unwrap();
-    let off_dir = dir.join("off");
-    let out = wslap(&[
-        "reconstruct",
-        "--images",
-        images.to_str().unwrap(),
-        "--par",
-        par.to_str().unwrap(),
-        "--z-lens",
-        "0.3",
-        "--config",
-        off.to_str().unwrap(),
-        "--out",
-        off_dir.to_str().unwrap(),
-    ]);
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    let sources: serde_json::Value =
-        serde_json::from_str(&fs::read_to_string(off_dir.join("sources.json")).unwrap()).unwrap();
-    let two = sources
-        .as_array()
-        .unwrap()
-        .iter()
-        .find(|s| s["id"] == "2")
-        .unwrap();
+    let (_, sources) = run(&off, &dir.join("off"));
+    let two = system(&sources, "2");
     let z = two["z_estimate"].as_f64().unwrap();
     assert!((2.0..=2.3).contains(&z), "{two}");
 }
