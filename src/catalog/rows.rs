@@ -230,7 +230,7 @@ impl Fields<'_, '_> {
 }
 
 /// Records `id` as seen on `line`; a warning when an earlier row used it (`what`: "member",
-/// "arclet", the kind of row).
+/// "arclet", the kind of row), which says that both rows are kept.
 pub(super) fn warn_repeated_id<'t>(
     seen: &mut HashMap<&'t str, usize>,
     id: &'t str,
@@ -243,7 +243,10 @@ pub(super) fn warn_repeated_id<'t>(
         warnings.push(CatalogWarning {
             source_name: source_name.into(),
             line,
-            message: format!("{what} id '{id}' is already used on line {first_line}"),
+            message: format!(
+                "{what} id '{id}' is already used on line {first_line}: both rows are used (ids \
+                 only name rows in messages)"
+            ),
         });
     }
 }

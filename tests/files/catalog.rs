@@ -408,7 +408,8 @@ fn a_repeated_member_row_is_fitted_twice_and_said_so() {
             "m.cat: line 3: member '95' repeats line 2 exactly: both rows are fitted (as \
              Lenstool reads them), which doubles that galaxy's mass; delete one if that is not \
              meant",
-            "m.cat: line 5: member id '7' is already used on line 4",
+            "m.cat: line 5: member id '7' is already used on line 4: both rows are used (ids only \
+             name rows in messages)",
         ]
     );
 }
