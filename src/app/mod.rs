@@ -95,8 +95,9 @@ impl Session {
 
     /// The loaded files parsed into one frame (see [`LoadedData::parse`]); its warnings
     /// begin with [`Self::sky_warnings`]. The galaxies and redshift priors of the loaded `.par`
-    /// are taken ([`Dataset::add_par`]) when the setting `members_from_model` is on, and commented-out BCG rows are fitted when
-    /// `reconstruct.members.fit_commented_bcg` is ([`Dataset::fit_commented_bcgs`]).
+    /// are taken ([`Dataset::add_par`]) when the setting `members_from_model` is on, and
+    /// commented-out BCG rows are fitted when `reconstruct.members.fit_commented_bcg` is
+    /// ([`Dataset::fit_commented_bcgs`]).
     pub fn parsed(&self) -> Result<Dataset, AppError> {
         let mut parsed = self
             .data
@@ -159,21 +160,35 @@ impl Session {
         self.data.reload(role, pixel, &par)
     }
 
-    /// The galaxies of the loaded Lenstool `.par` that a run could fit as members
-    /// ([`crate::lenstool_par::LenstoolPar::galaxies`] with a `mag`, in the `.par`'s frame),
-    /// when the setting `members_from_model` is off: what the verdict of a run that lacks its
-    /// BCG offers to fit. Empty without a `.par`, or when it cannot be read.
+    /// The galaxies the loaded Lenstool `.par` would add to the members
+    /// ([`Dataset::add_par_galaxies`]: its galaxies with a `mag` the member catalogue lacks,
+    /// and the commented-out rows its galaxies without one name), when the setting
+    /// `members_from_model` is off: what the verdict of a run that lacks its BCG offers to
+    /// fit. Not the members a `best.par` lists again. Empty without a `.par`, or when it or
+    /// the data cannot be read.
     pub fn model_galaxies(&self) -> Vec<Member> {
         if self.settings.members_from_model {
             return Vec::new();
         }
-        match self
-            .data
-            .model_par(&self.settings.par_options().for_galaxies())
-        {
-            Ok(Some(par)) => par.galaxies().map(|g| g.members).unwrap_or_default(),
-            _ => Vec::new(),
+        let options = self.settings.par_options().for_galaxies();
+        let (Ok(Some(par)), Ok(mut trial)) = (self.data.model_par(&options), self.parsed()) else {
+            return Vec::new();
+        };
+        let before = trial
+            .members
+            .as_ref()
+            .map(|m| m.members.clone())
+            .unwrap_or_default();
+        if trial.add_par_galaxies(&par).is_err() {
+            return Vec::new();
         }
+        trial
+            .members
+            .map(|m| m.members)
+            .unwrap_or_default()
+            .into_iter()
+            .filter(|g| !before.contains(g))
+            .collect()
     }
 
     /// Fits the commented-out rows on `lines` of the loaded member catalogue (e.g. the BCGs a

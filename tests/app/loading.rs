@@ -518,3 +518,43 @@ fn the_redshift_priors_of_a_loaded_par_are_taken_with_its_galaxies() {
         parsed.warnings
     );
 }
+
+/// A published `best.par` that lists every potfile member again (SMACS J0723, Mahler et al.
+/// 2023, tests/data/lenstool/smacs0723): the verdict's offer is the one galaxy it would add,
+/// its BCG (no `mag`; the row the member catalogue comments out), not the 141 members.
+#[cfg_attr(not(target_arch = "wasm32"), test)]
+#[cfg_attr(target_arch = "wasm32", wasm_bindgen_test::wasm_bindgen_test)]
+fn a_best_par_offers_its_bcg_and_not_the_members_it_lists_again() {
+    let mut s = Session::new();
+    for (role, name, text) in [
+        (
+            DataRole::Images,
+            "arcs.dat",
+            include_str!("../data/lenstool/smacs0723/arcs.dat"),
+        ),
+        (
+            DataRole::Members,
+            "galcat.cat",
+            include_str!("../data/lenstool/smacs0723/galcat.cat"),
+        ),
+        (
+            DataRole::Model,
+            "best.par",
+            include_str!("../data/lenstool/smacs0723/best.par"),
+        ),
+    ] {
+        s.load_text(role, name, text).unwrap();
+    }
+    let offered: Vec<(String, usize, f64)> = s
+        .model_galaxies()
+        .into_iter()
+        .map(|g| (g.id, g.line, g.mag))
+        .collect();
+    assert_eq!(offered, [("4".to_string(), 5, 18.8654)]);
+    let n = s.parsed().unwrap().members.unwrap().members.len();
+    s.set_field("members_from_model", json!(true)).unwrap();
+    let members = s.parsed().unwrap().members.unwrap().members;
+    assert_eq!(members.len(), n + 1);
+    assert_eq!((members[n].id.as_str(), members[n].line), ("4", 5));
+    assert!(s.model_galaxies().is_empty());
+}

@@ -94,7 +94,7 @@ export function showVerdict(verdict, { fitRows = null, modelGalaxies = [], fitMo
   } else if (last.bcg?.missing && modelGalaxies.length && fitModel) {
     const names = modelGalaxies.map((g) => `${g.id}, mag ${g.mag.toFixed(2)}`).join('; ');
     offer('fit-model-galaxies', `Fit the .par's galaxy (${names}) and reconstruct again`,
-      'The loaded Lenstool .par models this galaxy on its own (a core of at most 5 kpc and a magnitude): fits it as a member (the setting "Galaxies and redshift priors from the .par", which also takes the redshift priors of its z_m_limit lines), as wslap reconstruct --par does, and runs the reconstruction again.',
+      'The loaded Lenstool .par models this galaxy on its own (a core of at most 5 kpc, with its magnitude, or without one where the member catalogue comments out its row): fits it as a member (the setting "Galaxies and redshift priors from the .par", which also takes the redshift priors of its z_m_limit lines), as wslap reconstruct --par does, and runs the reconstruction again.',
       fitModel);
   }
 }
