@@ -57,8 +57,8 @@ pub fn system_of_image(id: &str) -> Option<&str> {
 /// Ids are `system.image`: the system is the text before the first '.' (`4.2a` and `14c.1`
 /// are systems `4` and `14c`); an id without a '.' is grouped as Lenstool groups it, by all
 /// but its last character (`1a`, `1b`: system `1`; `A3c`: system `A3`; said in a warning).
-/// `z = 0` means unknown (`None`); images of one system must agree
-/// within [`Z_AGREEMENT_TOL`] (their mean is used, with a warning when they differ or some are
+/// `z = 0` means unknown (`None`); images of one system must agree within
+/// [`Z_AGREEMENT_TOL`] (their mean is used, with a warning when they differ or some are
 /// unknown). Warnings: single-image systems, extra columns (ignored). Positions that do not
 /// fit one lensing field in the header's unit are refused or warned about (`units.rs`).
 pub fn parse_image_catalog(

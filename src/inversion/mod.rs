@@ -23,11 +23,12 @@ pub use constraints::{
     RedshiftPrior, Weighting,
 };
 pub(crate) use members::member_halo;
+pub(crate) use members::BCG_MIN_LSTAR;
 pub(crate) use members::MAX_MAG_FROM_L_STAR;
 pub(crate) use members::MAX_MASS_TO_LIGHT;
 pub use members::{
     build_member_layers, missing_bcg_warning, HaloProfile, Layer, LayerSplit, MemberConfig,
-    MemberHalo, MemberModel, MembersError, BCG_MIN_LSTAR, MAX_SINGLE_LAYERS,
+    MemberHalo, MemberModel, MembersError, MAX_SINGLE_LAYERS,
 };
 pub use npy::{export_system, npy_header, write_f64s, write_npy, NpyError};
 pub use regularise::{

@@ -221,14 +221,15 @@ impl Dataset {
         } = par.galaxies()?;
         let name = &par.source_name;
         let frame = self.reference();
+        // A position of the .par's frame in the data's (the same without a reference).
+        let to_data = |p: DVec2| match (par.reference, frame) {
+            (Some(from), Some(to)) => reframe(p, from, to),
+            _ => p,
+        };
         let mut notes: Vec<String> = without_mag
             .iter()
             .map(|(block, line, centre)| {
-                let at = match (par.reference, frame) {
-                    (Some(from), Some(to)) => reframe(*centre, from, to),
-                    _ => *centre,
-                };
-                self.galaxy_without_mag(name, block, *line, at)
+                self.galaxy_without_mag(name, block, *line, to_data(*centre))
             })
             .collect();
         notes.extend(other_plane.iter().map(|(block, line, z)| {
@@ -241,21 +242,11 @@ impl Dataset {
         if rows.is_empty() {
             return Ok(notes);
         }
-        let mut found = MemberCatalog {
-            source_name: name.clone(),
-            reference: par.reference,
-            members: rows,
-            commented: Vec::new(),
-            fitted_bcgs: None,
-            par_galaxies: Vec::new(),
-        };
-        match (par.reference, frame) {
-            (Some(_), Some(to)) => found = found.reframed(to)?,
-            (None, Some(_)) => notes.push(format!(
+        if par.reference.is_none() && frame.is_some() {
+            notes.push(format!(
                 "{name}: no `runmode reference`: its galaxies' positions are taken in the \
                  catalogues' frame"
-            )),
-            _ => {}
+            ));
         }
         let members = self.members.get_or_insert_with(|| MemberCatalog {
             source_name: name.clone(),
@@ -268,7 +259,8 @@ impl Dataset {
         // Galaxies the catalogue lists already (a `best.par` writes every potfile member out
         // as a `potentiel` of its own): one sentence for all of them.
         let mut already = Vec::new();
-        for g in found.members {
+        for mut g in rows {
+            g.position = to_data(g.position);
             let (x, y) = (g.position.x, g.position.y);
             let near = members
                 .members
