@@ -232,6 +232,7 @@ pub fn parse_member_catalog(
         commented,
         fitted_bcgs: None,
         par_galaxies: Vec::new(),
+        par_source: None,
     };
     Ok((catalog, warnings))
 }

@@ -126,6 +126,11 @@ pub struct MemberCatalog {
     /// for among the commented rows.
     #[serde(default)]
     pub par_galaxies: Vec<String>,
+    /// The name of the `.par` whose galaxies were looked for (`Dataset::add_par_galaxies`),
+    /// if one was: a missing BCG's warning then says that file models none near the images,
+    /// rather than asking for a `.par`.
+    #[serde(default)]
+    pub par_source: Option<String>,
 }
 
 impl ImageCatalog {

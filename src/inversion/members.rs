@@ -646,8 +646,13 @@ pub const BCG_MAX_LSTAR: f64 = 50.0;
 /// models the BCG in the `.par` often keeps its row commented out in the catalogue, one row
 /// for each core of a cluster with several, and a run fits them by default
 /// ([`MemberConfig::fit_commented_bcg`], `Dataset::fit_commented_bcgs`).
+///
+/// `par` names the `.par` whose galaxies were added to the members, if one was given: with no
+/// commented row to offer, the warning then says that file models none there, instead of
+/// asking for a `.par`.
 pub fn missing_bcg_warning(
     catalog_name: &str,
+    par: Option<&str>,
     members: &[(&Member, f64)],
     images: &[DVec2],
     commented: &[(&Member, f64)],
@@ -720,18 +725,23 @@ pub fn missing_bcg_warning(
             "those are the BCGs",
         )
     };
-    let cure = if rows.is_empty() {
-        "If the cluster has one, add its row (id x y a b theta mag lum) to the member catalogue, \
-         or give the .par that models it (wslap reconstruct --par; in the app, load it as the \
-         model file)"
-            .to_string()
-    } else {
-        let mut said = format!(
+    let cure = match (rows.is_empty(), par) {
+        (true, None) => "If the cluster has one, add its row (id x y a b theta mag lum) to the \
+                         member catalogue, or give the .par that models it (wslap reconstruct \
+                         --par; in the app, load it as the model file)"
+            .to_string(),
+        (true, Some(par)) => format!(
+            "The .par given ({par}) models no galaxy near the images either: if the cluster has a \
+             BCG there, add its row (id x y a b theta mag lum) to the member catalogue"
+        ),
+        (false, _) => {
+            let mut said = format!(
             "{line_s} {lines} {comment_s} out {member_s} {ids}: if {if_that}, remove the '#' to \
              fit {it}"
         );
-        said[..1].make_ascii_uppercase();
-        said
+            said[..1].make_ascii_uppercase();
+            said
+        }
     };
     let warning = format!(
         "{finding}. Lenstool set-ups often model the BCG as its own `potentiel` in the .par and \
@@ -787,10 +797,31 @@ mod tests {
     }
 
     #[test]
+    fn a_par_already_given_is_not_asked_for() {
+        let halos = [halo("7", 12.0, -3.0, 1.0)];
+        let asks = missing_bcg_warning("m.cat", None, &lum(&halos), &ring(), &[])
+            .expect("a warning")
+            .warning;
+        assert!(asks.contains("or give the .par that models it"), "{asks}");
+        let given = missing_bcg_warning("m.cat", Some("best.par"), &lum(&halos), &ring(), &[])
+            .expect("a warning")
+            .warning;
+        assert!(!given.contains("give the .par"), "{given}");
+        assert!(
+            given.ends_with(
+                "The .par given (best.par) models no galaxy near the images either: if the \
+                 cluster has a BCG there, add its row (id x y a b theta mag lum) to the member \
+                 catalogue"
+            ),
+            "{given}"
+        );
+    }
+
+    #[test]
     fn a_core_without_a_bright_member_is_named() {
         // The brightest member of the catalogue lies far outside the images; inside, an L*.
         let halos = [halo("far", 150.0, 0.0, 20.0), halo("7", 12.0, -3.0, 1.0)];
-        let w = missing_bcg_warning("m.cat", &lum(&halos), &ring(), &[])
+        let w = missing_bcg_warning("m.cat", None, &lum(&halos), &ring(), &[])
             .expect("a warning")
             .warning;
         assert!(w.starts_with("m.cat: no member within 20 arcsec of the multiple images' centre is as bright as a brightest cluster galaxy (4 L* or more)"), "{w}");
@@ -798,8 +829,8 @@ mod tests {
         // The centre is (10, -5): a bright member 20.1 arcsec from it is not counted, and
         // alone it leaves no member there at all.
         let halos = [halo("edge", 10.0, 15.1, 8.0), halo("7", 12.0, -3.0, 1.0)];
-        assert!(missing_bcg_warning("m.cat", &lum(&halos), &ring(), &[]).is_some());
-        let w = missing_bcg_warning("m.cat", &lum(&halos[..1]), &ring(), &[])
+        assert!(missing_bcg_warning("m.cat", None, &lum(&halos), &ring(), &[]).is_some());
+        let w = missing_bcg_warning("m.cat", None, &lum(&halos[..1]), &ring(), &[])
             .expect("a warning")
             .warning;
         assert!(w.contains("there is none there"), "{w}");
@@ -827,7 +858,8 @@ mod tests {
         );
         let far = commented("far", 30, 150.0, 0.0, 16.0);
         let rows = [(&faint, 0.02), (&bcg, 9.5), (&far, 20.0)];
-        let found = missing_bcg_warning("m.cat", &lum(&halos), &ring(), &rows).expect("a warning");
+        let found =
+            missing_bcg_warning("m.cat", None, &lum(&halos), &ring(), &rows).expect("a warning");
         let row = CatalogRow {
             line: 10,
             id: "1009".to_string(),
@@ -859,13 +891,14 @@ mod tests {
         // Too bright to be a galaxy of the cluster: a star, say, is passed over for the BCG.
         let star = commented("star", 5, 9.0, -4.0, 12.0);
         let with_star = [rows[0], (&star, 400.0), rows[1], rows[2]];
-        let found = missing_bcg_warning("m.cat", &lum(&halos), &ring(), &with_star).unwrap();
+        let found = missing_bcg_warning("m.cat", None, &lum(&halos), &ring(), &with_star).unwrap();
         assert_eq!(found.commented.map(|c| c.rows[0].line), Some(10));
-        let found = missing_bcg_warning("m.cat", &lum(&halos), &ring(), &with_star[..2]).unwrap();
+        let found =
+            missing_bcg_warning("m.cat", None, &lum(&halos), &ring(), &with_star[..2]).unwrap();
         assert_eq!(found.commented, None);
         // Faint or far commented rows are not offered: the generic advice stays.
         let found =
-            missing_bcg_warning("m.cat", &lum(&halos), &ring(), &[rows[0], rows[2]]).unwrap();
+            missing_bcg_warning("m.cat", None, &lum(&halos), &ring(), &[rows[0], rows[2]]).unwrap();
         assert_eq!(found.commented, None);
         let w = found.warning;
         assert!(w.ends_with(
@@ -883,7 +916,8 @@ mod tests {
         let west = commented("2", 73, 24.0, 0.0, 17.9);
         let far = commented("far", 80, 150.0, 0.0, 17.0);
         let rows = [(&west, 7.0), (&far, 9.0), (&east, 6.0)];
-        let found = missing_bcg_warning("m.cat", &lum(&halos), &ring(), &rows).expect("a warning");
+        let found =
+            missing_bcg_warning("m.cat", None, &lum(&halos), &ring(), &rows).expect("a warning");
         let named = found.commented.expect("the rows are named");
         let lines: Vec<(usize, &str)> =
             named.rows.iter().map(|r| (r.line, r.id.as_str())).collect();
@@ -915,16 +949,19 @@ mod tests {
     fn a_bright_central_member_or_no_members_need_no_warning() {
         let halos = [halo("far", 150.0, 0.0, 20.0), halo("bcg", 9.0, -4.0, 8.0)];
         assert_eq!(
-            missing_bcg_warning("m.cat", &lum(&halos), &ring(), &[]),
+            missing_bcg_warning("m.cat", None, &lum(&halos), &ring(), &[]),
             None
         );
         // Just at the threshold, and just inside the radius.
         let halos = [halo("bcg", 10.0, 14.9, BCG_MIN_LSTAR)];
         assert_eq!(
-            missing_bcg_warning("m.cat", &lum(&halos), &ring(), &[]),
+            missing_bcg_warning("m.cat", None, &lum(&halos), &ring(), &[]),
             None
         );
-        assert_eq!(missing_bcg_warning("m.cat", &[], &ring(), &[]), None);
-        assert_eq!(missing_bcg_warning("m.cat", &lum(&halos), &[], &[]), None);
+        assert_eq!(missing_bcg_warning("m.cat", None, &[], &ring(), &[]), None);
+        assert_eq!(
+            missing_bcg_warning("m.cat", None, &lum(&halos), &[], &[]),
+            None
+        );
     }
 }

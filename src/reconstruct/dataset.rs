@@ -239,6 +239,9 @@ impl Dataset {
                 par.z_lens
             )
         }));
+        if let Some(members) = self.members.as_mut() {
+            members.par_source = Some(name.clone());
+        }
         if rows.is_empty() {
             return Ok(notes);
         }
@@ -255,7 +258,9 @@ impl Dataset {
             commented: Vec::new(),
             fitted_bcgs: None,
             par_galaxies: Vec::new(),
+            par_source: None,
         });
+        members.par_source = Some(name.clone());
         // Galaxies the catalogue lists already (a `best.par` writes every potfile member out
         // as a `potentiel` of its own): one sentence for all of them.
         let mut already = Vec::new();
@@ -383,6 +388,7 @@ impl Dataset {
         let constraints = build_constraints(source, &config.constraints, &[]).ok()?;
         missing_bcg_warning(
             &members.source_name,
+            members.par_source.as_deref(),
             &bcg_candidates(members, &config.members, plane),
             &image_centres(&constraints),
             &with_luminosity(&members.commented, &config.members, plane),

@@ -1100,6 +1100,7 @@ pub(crate) fn member_layers(
     let images = image_centres(constraints);
     let bcg = missing_bcg_warning(
         &catalog.source_name,
+        catalog.par_source.as_deref(),
         &bcg_candidates(catalog, config, plane),
         &images,
         &with_luminosity(&catalog.commented, config, plane),

@@ -96,5 +96,6 @@ pub fn members() -> MemberCatalog {
         commented: Vec::new(),
         fitted_bcgs: None,
         par_galaxies: Vec::new(),
+        par_source: None,
     }
 }

@@ -989,7 +989,7 @@ fn a_commented_out_bcg_row_is_fitted_unless_the_settings_say_not() {
     assert!(m.commented.iter().all(|c| c.line != 10));
     assert_eq!(
         m.fitted_bcgs.as_ref().map(|b| &b.rows[..]),
-        Some(&[row][..])
+        Some(std::slice::from_ref(&row))
     );
     // Not twice.
     assert!(data.fit_commented_bcgs(&plane, &config).is_empty());
@@ -1010,6 +1010,29 @@ fn a_commented_out_bcg_row_is_fitted_unless_the_settings_say_not() {
     assert_eq!(data.members.as_ref().unwrap().par_galaxies, ["G1"]);
     assert!(data.fit_commented_bcgs(&plane, &config).is_empty());
     assert_eq!(data.members.as_ref().unwrap().members.len(), members + 1);
+    assert_eq!(
+        data.members.as_ref().unwrap().par_source.as_deref(),
+        Some("one.par")
+    );
+    // A `.par` of cluster-scale halos only is remembered too (a missing BCG's warning then
+    // does not ask for a `.par`), and leaves the commented BCG row to be looked for.
+    let halo = wslap::parse_par(
+        "runmode\n\treference 3 292.95682 -26.575718\n\tend\n\
+         potentiel 1\n\tprofil 81\n\tx_centre 0.0\n\ty_centre 0.0\n\tellipticite 0.2\n\
+         \tangle_pos 0\n\tcore_radius_kpc 50\n\tcut_radius_kpc 1000\n\tv_disp 1000\n\
+         \tz_lens 0.352\n\tend\n\
+         cosmologie\n\tH0 70\n\tomegaM 0.3\n\tomegaX 0.7\n\tend\nfini\n",
+        "halo.par",
+    )
+    .unwrap();
+    let mut data = read_macs();
+    assert!(data.add_par_galaxies(&halo).unwrap().is_empty());
+    let m = data.members.as_ref().unwrap();
+    assert_eq!(
+        (m.par_source.as_deref(), m.par_galaxies.len()),
+        (Some("halo.par"), 0)
+    );
+    assert_eq!(data.fit_commented_bcgs(&plane, &config), [row]);
     // Off, the catalogue stays as written.
     config.members.fit_commented_bcg = false;
     let mut data = read_macs();

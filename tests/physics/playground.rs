@@ -57,6 +57,7 @@ fn member_galaxies_are_the_inversions_halos() {
         commented: Vec::new(),
         fitted_bcgs: None,
         par_galaxies: Vec::new(),
+        par_source: None,
     };
     let grid = CellGrid::regular(DVec2::ZERO, 40.0, 8, 1.0).expect("grid");
     let members =
