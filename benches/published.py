@@ -5,7 +5,9 @@ The HFF CATS models of Abell 2744, Abell 370 and MACS J1149, and Jauzac et al. (
 MACS J1149 (image catalogue, member catalogue and the published `bestopt.par`, for the last
 `best.par.20170201103232`) are in github.com/cerschae/Lenstool-HPC (GPL-3, commit
 af57aacf74d3bf8841cea1a113f8d863f9d003c9), `Benchmarks/ConfigFiles/hff_slmodels/`. They are
-not copied into this repository; clone that one and point this script at the folder:
+not copied into this repository; clone that one and point this script at the folder.
+Mahler et al. (2023)'s first JWST model of SMACS J0723 (CC0) is read from this repository's
+tests/data/lenstool/smacs0723 (`--only SMACS0723` needs no clone, but `--models` all the same):
 
     git clone https://github.com/cerschae/Lenstool-HPC /tmp/lenstool-hpc
     cargo build --release
@@ -63,6 +65,10 @@ CLUSTERS = [
     # without a redshift (the model fits theirs).
     ("M1149-J16", "M1149/m1149_jauzac16", "imawcs_spiral_secured.mul", "galaxies_v2.cat", 0.544,
      [], "best.par.20170201103232", "mod.par"),
+    # Mahler et al. (2023)'s first JWST model of SMACS J0723 (CC0), kept in this repository:
+    # 21 systems, 16 of them without a spectroscopic redshift. Any --models reaches it.
+    ("SMACS0723", ROOT / "tests" / "data" / "lenstool" / "smacs0723", "arcs.dat", "galcat.cat",
+     0.39, [], "best.par", None),
 ]
 RADIUS_ARCSEC = 40.0
 

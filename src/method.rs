@@ -596,7 +596,11 @@
 //! alpha(theta_k)`, `M_k` the capped inverse Jacobian of §9 (image-plane offsets), `beta` the
 //! `M`-weighted mean source, and `sigma` the held-out image error of the cross-validation.
 //! The system is then fitted with the others at the most probable `z`; the 68% interval is
-//! the narrowest holding 68% of `exp(-chi2/2)`. With an "auto" strength that posterior is
+//! the narrowest holding 68% of `exp(-chi2/2)`. Its images are fitted with the position
+//! error `sqrt(sigma_pos^2 + e^2)`, where `e` is how far (rms per image) they move on the
+//! first lens between the most probable `z` and the interval's ends: the redshift's
+//! uncertainty carried into the image plane, so that a poorly fixed redshift cannot bend the
+//! map towards a biased estimate. With an "auto" strength that posterior is
 //! averaged over the chosen map and the maps the best candidate of each other regulariser
 //! draws from the same systems: beyond the systems with a redshift the map is the
 //! regulariser's (least mass falls off, the smoothest stays level), which the held-out

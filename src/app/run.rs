@@ -277,15 +277,15 @@ impl Session {
             // Systems whose redshift the result estimated are fitted in every fold at it, when
             // the result was made from these images.
             let observed = parsed.marks().observed;
-            let estimates = self
+            let mut config = config.clone();
+            if let Some(r) = self
                 .result()
                 .ok()
                 .filter(|r| r.marks.observed == observed)
                 .and_then(|r| r.reconstruction())
-                .map(|r| r.z_estimates())
-                .unwrap_or_default();
-            let mut config = config.clone();
-            config.constraints.z_estimates = estimates;
+            {
+                r.fit_estimates_in(&mut config.constraints);
+            }
             cross_validate(inputs, &config, folds, Some(geometry), progress).map_err(run_error)
         })
     }
@@ -346,6 +346,7 @@ impl Session {
             .iter()
             .filter_map(|s| Some((s.id.clone(), s.z_estimate?)))
             .collect();
+        config.constraints.z_estimate_errors = crate::reconstruct::position_errors_of(&sources);
         let constraints = build_constraints(source, &config.constraints, &self.settings.holdout)
             .map_err(|e| run(&e))?;
         let (shear, shear_warning) = shear_set(parsed.shear.as_ref(), &config, &plane);

@@ -382,7 +382,7 @@ fn run_crossval(
     let geometry = result.products.maps.geometry();
     // Systems whose redshift the run estimated are fitted in every fold at it.
     let mut config = config.clone();
-    config.constraints.z_estimates = result.z_estimates();
+    result.fit_estimates_in(&mut config.constraints);
     let cv = cross_validate(inputs, &config, folds, Some(geometry), &mut progress)
         .map_err(|e| e.to_string())?;
     let write = |file: &str, bytes: &[u8]| -> Result<(), String> {

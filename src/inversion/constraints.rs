@@ -139,6 +139,11 @@ pub struct ConstraintConfig {
     /// (set by the reconstruction, never read from a settings file).
     #[serde(skip)]
     pub z_estimates: Vec<(String, f64)>,
+    /// The image-plane error (arcsec) each estimated redshift's uncertainty adds to its
+    /// system's images, by id (set by the reconstruction, never read from a settings file):
+    /// their weights are `1 / (sigma_pos_arcsec^2 + error^2)`.
+    #[serde(skip)]
+    pub z_estimate_errors: Vec<(String, f64)>,
     /// Largest number of pixels one ellipse may hold (default 10000). Allowed 1 to
     /// [`crate::limits::MAX_ARC_PIXELS`].
     pub max_pixels_per_image: usize,
@@ -156,6 +161,7 @@ impl Default for ConstraintConfig {
             free_z_prior: Some(DEFAULT_FREE_Z_PRIOR),
             z_priors: BTreeMap::new(),
             z_estimates: Vec::new(),
+            z_estimate_errors: Vec::new(),
             max_pixels_per_image: 10_000,
         }
     }
@@ -663,7 +669,12 @@ fn add_system(
 ) {
     let system = set.systems.len();
     let n_pixels: usize = c.images.iter().map(Vec::len).sum();
-    let inv_var = 1.0 / (config.sigma_pos_arcsec * config.sigma_pos_arcsec);
+    let added = config
+        .z_estimate_errors
+        .iter()
+        .find(|(id, _)| *id == c.id)
+        .map_or(0.0, |&(_, e)| e);
+    let inv_var = 1.0 / (config.sigma_pos_arcsec * config.sigma_pos_arcsec + added * added);
     for (image, pixels) in c.images.iter().enumerate() {
         let w = match config.weighting {
             Weighting::EqualPerPixel => 1.0,

@@ -533,6 +533,10 @@ pub struct EnsemblePlan {
     pub strength_choice: Option<StrengthChoice>,
     /// The radii of the main run's `summary.json` masses (arcsec).
     pub radii_arcsec: Vec<f64>,
+    /// The image-plane error each system whose redshift the main run estimated was fitted
+    /// with (`constraints.z_estimate_errors`): every member fits it so too.
+    #[serde(default)]
+    pub z_position_errors: Vec<(String, f64)>,
     pub draws: Vec<MemberDraw>,
 }
 
@@ -637,6 +641,7 @@ impl EnsemblePlan {
                 .iter()
                 .map(|(r, _)| *r)
                 .collect(),
+            z_position_errors: super::free_z::position_errors_of(&main.sources),
             draws,
         })
     }
@@ -676,6 +681,10 @@ impl EnsemblePlan {
             .constraints
             .z_estimates
             .clone_from(&draw.redshifts);
+        member_config
+            .constraints
+            .z_estimate_errors
+            .clone_from(&self.z_position_errors);
         // Within the law's allowed range (a draw far in the tail of a wide scatter).
         member_config.members.mass_to_light = (config.members.mass_to_light
             * draw.member_mass_factor)

@@ -32,6 +32,7 @@ pub use ensemble::{
     EnsemblePlan, LeftOutImage, MemberDraw, MemberRun, CALIBRATION_MIN_IMAGES,
     CALIBRATION_MIN_PREDICTIONS, MAX_ENSEMBLE_MEMBERS,
 };
+pub(crate) use free_z::position_errors_of;
 pub use free_z::{estimate_redshift, FreeZSummary, RedshiftEstimate, FALLBACK_SIGMA_ARCSEC};
 pub use memory::{
     layer_count, Bytes, Heap, MemoryEstimate, MemoryLimit, RunSize, TooMuchMemory,
@@ -373,6 +374,15 @@ impl Reconstruction {
     /// these fits those systems in every fold ([`cross_validate`]).
     pub fn z_estimates(&self) -> Vec<(String, f64)> {
         free_z::most_probable_of(&free_z::estimates_of(&self.sources))
+    }
+
+    /// Fits the systems whose redshift this run estimated as it did, in runs with
+    /// `constraints` (a cross-validation of the same data): at their estimates
+    /// ([`Self::z_estimates`]), with the image-plane error their redshifts' uncertainty adds
+    /// (`constraints.z_estimate_errors`).
+    pub fn fit_estimates_in(&self, constraints: &mut crate::inversion::ConstraintConfig) {
+        constraints.z_estimates = self.z_estimates();
+        constraints.z_estimate_errors = free_z::position_errors_of(&self.sources);
     }
 
     /// The verdict on the map ([`Verdict::assess`]), with the curves at the products'

@@ -141,6 +141,11 @@ pub struct SourceReport {
     /// `z_estimate`).
     #[serde(default)]
     pub z_interval: Option<[f64; 2]>,
+    /// The image-plane error (arcsec) `z_interval` means for the system's images
+    /// (`position_error_arcsec` of the estimate): it is fitted with it added to the position
+    /// error in quadrature, so a redshift the images hardly fix weighs little in the map.
+    #[serde(default)]
+    pub z_position_error_arcsec: Option<f64>,
     /// The system's own redshift prior (`constraints.z_priors`, e.g. a `.par`'s `z_m_limit`
     /// line), if it has one: `z_estimate` was found under it, or, fixed, `z` is its value.
     #[serde(default)]
@@ -520,6 +525,7 @@ fn finish(
         z_assumed,
         z_estimate: None,
         z_interval: None,
+        z_position_error_arcsec: None,
         z_prior: None,
         held_out,
         beta_arcsec: beta,

@@ -574,6 +574,7 @@ mod tests {
             z_assumed: false,
             z_estimate: None,
             z_interval: None,
+            z_position_error_arcsec: None,
             z_prior: None,
             held_out,
             beta_arcsec: DVec2::ZERO,

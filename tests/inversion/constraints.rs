@@ -189,6 +189,25 @@ fn systems_are_excluded_for_redshift_single_image_and_hold_out() {
         zs,
         [("1", 1.7, false), ("2", 3.1, false), ("3", 1.2, false)]
     );
+    // The image-plane error an estimated redshift's uncertainty adds joins the position
+    // error in quadrature: each of system 2's images weighs 1 / (0.5^2 + 1.2^2), the others'
+    // 1 / 0.5^2.
+    let uncertain = ConstraintConfig {
+        z_estimate_errors: vec![("2".to_string(), 1.2)],
+        ..estimated.clone()
+    };
+    let set = build_constraints(ConstraintSource::Catalog(&cat), &uncertain, &[]).unwrap();
+    let (_, per_image) = weight_sums(&set);
+    let sigma2 = free.sigma_pos_arcsec.powi(2);
+    for (s, images) in set.systems.iter().zip(&per_image) {
+        let want = match s.id.as_str() {
+            "2" => 1.0 / (sigma2 + 1.2 * 1.2),
+            _ => 1.0 / sigma2,
+        };
+        for &w in images {
+            assert_rel("image weight", w, want, 1e-12);
+        }
+    }
     let unknown = ConstraintConfig {
         free_z_systems: vec!["8".to_string()],
         ..ConstraintConfig::default()
