@@ -341,12 +341,8 @@ impl Session {
             .constraints(config.constraints.mode)
             .map_err(dataset_error)?;
         config.constraints.mode = mode;
-        // Systems whose redshift the run estimated were fitted at it.
-        config.constraints.z_estimates = sources
-            .iter()
-            .filter_map(|s| Some((s.id.clone(), s.z_estimate?)))
-            .collect();
-        config.constraints.z_estimate_errors = crate::reconstruct::position_errors_of(&sources);
+        // Systems whose redshift the run estimated were fitted at it, with its error.
+        crate::reconstruct::fit_estimates_in(&sources, &mut config.constraints);
         let constraints = build_constraints(source, &config.constraints, &self.settings.holdout)
             .map_err(|e| run(&e))?;
         let (shear, shear_warning) = shear_set(parsed.shear.as_ref(), &config, &plane);

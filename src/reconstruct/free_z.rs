@@ -284,9 +284,20 @@ pub(super) fn estimates_of(sources: &[super::SourceReport]) -> Vec<(String, f64,
         .collect()
 }
 
+/// Sets `constraints` to fit the systems of `sources` whose redshift was estimated as the run
+/// that reported them did: at their estimates, with the image-plane error their redshifts'
+/// uncertainty adds.
+pub(crate) fn fit_estimates_in(
+    sources: &[super::SourceReport],
+    constraints: &mut crate::inversion::ConstraintConfig,
+) {
+    constraints.z_estimates = most_probable_of(&estimates_of(sources));
+    constraints.z_estimate_errors = position_errors_of(sources);
+}
+
 /// The image-plane error each estimated system of `sources` is fitted with, as
 /// `constraints.z_estimate_errors` takes them.
-pub(crate) fn position_errors_of(sources: &[super::SourceReport]) -> Vec<(String, f64)> {
+pub(super) fn position_errors_of(sources: &[super::SourceReport]) -> Vec<(String, f64)> {
     sources
         .iter()
         .filter_map(|s| Some((s.id.clone(), s.z_position_error_arcsec?)))

@@ -32,7 +32,7 @@ pub use ensemble::{
     EnsemblePlan, LeftOutImage, MemberDraw, MemberRun, CALIBRATION_MIN_IMAGES,
     CALIBRATION_MIN_PREDICTIONS, MAX_ENSEMBLE_MEMBERS,
 };
-pub(crate) use free_z::position_errors_of;
+pub(crate) use free_z::fit_estimates_in;
 pub use free_z::{estimate_redshift, FreeZSummary, RedshiftEstimate, FALLBACK_SIGMA_ARCSEC};
 pub use memory::{
     layer_count, Bytes, Heap, MemoryEstimate, MemoryLimit, RunSize, TooMuchMemory,
@@ -381,8 +381,7 @@ impl Reconstruction {
     /// ([`Self::z_estimates`]), with the image-plane error their redshifts' uncertainty adds
     /// (`constraints.z_estimate_errors`).
     pub fn fit_estimates_in(&self, constraints: &mut crate::inversion::ConstraintConfig) {
-        constraints.z_estimates = self.z_estimates();
-        constraints.z_estimate_errors = free_z::position_errors_of(&self.sources);
+        free_z::fit_estimates_in(&self.sources, constraints);
     }
 
     /// The verdict on the map ([`Verdict::assess`]), with the curves at the products'
