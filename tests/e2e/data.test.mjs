@@ -132,7 +132,8 @@ test('systems without a redshift have it estimated, or take the one the settings
     const found = free.warnings.filter((t) => /^system \S+: redshift estimated z = [\d.]+ \(68%: [\d.]+ - [\d.]+\)/.test(t));
     assert.ok(found.length >= 1, free.warnings.join(' | '));
     assert.equal(free.estimated.length, found.length, free.estimated.join(' | '));
-    for (const cell of free.estimated) assert.match(cell, /^[\d.]+ est\.[\d.]+–[\d.]+$/);
+    // ... and, ± ″, how far that interval moves its images (added to their position error).
+    for (const cell of free.estimated) assert.match(cell, /^[\d.]+ est\.[\d.]+–[\d.]+± [\d.]+″$/);
     assert.deepEqual(free.warnings.filter((t) => /not used/.test(t)), []);
     // The cross-validation fits those systems in every fold at their estimate and predicts
     // the others (a fixed strength keeps it quick).
@@ -285,8 +286,9 @@ test("a loaded .par's redshift priors bound the estimates once the setting takes
     const cells = await page.locator('#systems tbody td.z-estimated').allTextContents();
     assert.equal(cells.length, 8, cells.join(' | '));
     for (const cell of cells) {
-      const [z, lo, hi, plo, phi] = cell.match(/^([\d.]+) est\.([\d.]+)–([\d.]+)prior ([\d.]+)–([\d.]+)$/).slice(1).map(Number);
+      const [z, lo, hi, plo, phi, e] = cell.match(/^([\d.]+) est\.([\d.]+)–([\d.]+)prior ([\d.]+)–([\d.]+)± ([\d.]+)″$/).slice(1).map(Number);
       assert.ok(plo <= lo && lo <= z && z <= hi && hi <= phi, cell);
+      assert.ok(e > 0, cell);
     }
     await page.screenshot({ path: join(ARTIFACTS, 'app-par-redshift-priors.png'), fullPage: true });
     assert.deepEqual(app.consoleErrors, []);
