@@ -20,13 +20,13 @@ import sys
 from pathlib import Path
 
 import numpy as np
+from lenstronomy.LensModel.Profiles.pseudo_jaffe import PseudoJaffe
 from lenstronomy.LensModel.Profiles.tnfw import TNFW
 
-sys.path.insert(0, str(Path(__file__).resolve().parent.parent / "tests" / "data" / "fidelity"))
+DATA = Path(__file__).resolve().parent.parent / "tests" / "data"
+sys.path[:0] = [str(DATA / "fidelity"), str(DATA)]
 import make_clusters as mc  # noqa: E402  (wslap's member law, written independently of it)
-
-C_KMS = 299792.458
-ARCSEC_PER_RAD = 180 / np.pi * 3600
+from dpie_reference import b0_arcsec  # noqa: E402  (Lenstool's dPIE strength, 6 pi (sigma/c)^2)
 
 # name, z_l, mag0, sigma (km/s), r_cut (kpc; None: given in arcsec), r_core (kpc), where
 MODELS = [
@@ -45,8 +45,10 @@ RADII_KPC = np.array([1, 2, 5, 10, 20, 50])
 
 
 def dpie_alpha(r, b0, a, s):
-    """Deflection of a circular dPIE (Lenstool's: b0 = 6 pi (sigma/c)^2) at radius r."""
-    return b0 * s / (s - a) * r * (1 / (np.sqrt(r**2 + a**2) + a) - 1 / (np.sqrt(r**2 + s**2) + s))
+    """Deflection at radius r of Lenstool's circular dPIE of strength b0, core a and cut s
+    (lenstronomy's PJAFFE, as in tests/data/dpie_reference.py: sigma0 = b0 / (2 a))."""
+    fx, fy = PseudoJaffe().derivatives(r, 0 * r, sigma0=b0 / (2 * a), Ra=a, Rs=s)
+    return np.hypot(fx, fy)
 
 
 def main():
@@ -61,7 +63,7 @@ def main():
             cut0 = cut0[1] / arcsec_per_kpc
         lum = 10 ** (-0.4 * (plane.mag_star - mag0))  # L* / L(mag0)
         sig, cut, core = sig0 * lum**0.25, cut0 * lum**0.5, core0 * lum**0.5
-        b0 = 6 * np.pi * (sig / C_KMS) ** 2 * ARCSEC_PER_RAD
+        b0 = b0_arcsec(sig)
         r = RADII_KPC * arcsec_per_kpc
         ours = mc.tnfw_kwargs(plane, mc.M_STAR, 0.0, 0.0)
         fx, fy = TNFW().derivatives(r, 0 * r, Rs=ours["Rs"], alpha_Rs=ours["alpha_Rs"],
