@@ -669,9 +669,6 @@ mod tests {
         assert!((q(0.16) - 1.6).abs() < 1e-12);
     }
 
-    /// Two maps of one lens that part where a system's images lie (one 15% more massive): the
-    /// estimate over both is the first map's, its interval holding each map's own; over two
-    /// copies of one map it is that map's estimate.
     #[test]
     fn the_position_error_is_how_far_the_interval_moves_the_images() {
         // On an SIS the images of a source at beta on the x axis lie at beta +- theta_E f;
@@ -705,6 +702,9 @@ mod tests {
         }
     }
 
+    /// Two maps of one lens that part where a system's images lie (one 15% more massive): the
+    /// estimate over both is the first map's, its interval holding each map's own; over two
+    /// copies of one map it is that map's estimate.
     #[test]
     fn the_estimate_over_two_maps_holds_both() {
         let sis = |theta_e: f64| {
