@@ -304,10 +304,10 @@ pub fn fold_groups(
 /// Reconstructs the lens `folds` times, each time without one group of [`fold_groups`], and
 /// predicts the images of the group left out. Systems in `inputs.holdout` stay out of every
 /// fit and of the result. Systems without a redshift are left out of every fold, unless
-/// `constraints.z_estimates` gives them one (a reconstruction's
-/// [`Reconstruction::z_estimates`]): then every fold fits them at it, and none holds them out
-/// (their redshift was found with the other systems' help, so predicting them would not be a
-/// test). On a catalogue with many such systems (MACS1931: 4 of 10) the folds then have the
+/// `constraints.z_estimates` gives them one (as a reconstruction's
+/// [`Reconstruction::fit_estimates_in`] sets it): then every fold fits them at it, and none
+/// holds them out (their redshift was found with the other systems' help, so predicting them
+/// would not be a test). On a catalogue with many such systems (MACS1931: 4 of 10) the folds then have the
 /// constraints the reconstruction had, less the group. With `kappa_on`, also the mean and
 /// spread of the folds' convergence on that map ([`KappaSpread`]; the map of the
 /// reconstruction from all the systems, say). `progress` sees the fold number (1-based) and

@@ -369,17 +369,10 @@ impl Reconstruction {
         self.solved().image_offset_median_arcsec(held_out)
     }
 
-    /// The systems whose redshift this run estimated, each with its most probable redshift,
-    /// as `constraints.z_estimates` takes them: a cross-validation of the same data given
-    /// these fits those systems in every fold ([`cross_validate`]).
-    pub fn z_estimates(&self) -> Vec<(String, f64)> {
-        free_z::most_probable_of(&free_z::estimates_of(&self.sources))
-    }
-
     /// Fits the systems whose redshift this run estimated as it did, in runs with
-    /// `constraints` (a cross-validation of the same data): at their estimates
-    /// ([`Self::z_estimates`]), with the image-plane error their redshifts' uncertainty adds
-    /// (`constraints.z_estimate_errors`).
+    /// `constraints` (a cross-validation of the same data fits them in every fold,
+    /// [`cross_validate`]): at their most probable redshifts (`constraints.z_estimates`), with
+    /// the image-plane error their redshifts' uncertainty adds (`constraints.z_estimate_errors`).
     pub fn fit_estimates_in(&self, constraints: &mut crate::inversion::ConstraintConfig) {
         free_z::fit_estimates_in(&self.sources, constraints);
     }
