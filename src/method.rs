@@ -604,7 +604,11 @@
 //! averaged over the chosen map and the maps the best candidate of each other regulariser
 //! draws from the same systems: beyond the systems with a redshift the map is the
 //! regulariser's (least mass falls off, the smoothest stays level), which the held-out
-//! systems cannot judge, and the estimate must not lean on one of them. A system's own prior
+//! systems cannot judge, and the estimate must not lean on one of them. The "auto" choice
+//! is then made a second time with the estimated systems fitted in every fold (at their
+//! estimates, with their errors) and the others held out as before, since the grid and
+//! strength that suit a few systems need not suit many more; when it changes, the map is
+//! fitted again with it at the same estimates. A system's own prior
 //! (`constraints.z_priors`; a `.par`'s `z_m_limit` lines, as its modeller set them for
 //! Lenstool: fixed, uniform or normal) overrides its catalogue redshift: fixed, the system
 //! is fitted at it; uniform, the grid of `z` is its range; normal, `exp(-chi2/2)` is

@@ -353,16 +353,41 @@ const trialCost = (candidate) => (candidate?.cells ?? 32) ** 0.75;
 
 /** An "auto" regulariser strength: each candidate of `plan` is cross-validated in a pool
  * worker (js/pool.js) on the main session's project, then the main worker reconstructs with
- * the strength their rows choose. `onProgress` gets `{elapsed_ms, units, total, words}`: the
- * folds done of every candidate's folds, each weighted by its cost (`trialCost`), plus the
- * final solve (weighted as a fold of the costliest candidate). */
+ * the strength their rows choose. When that run estimated redshifts, the candidates are tried
+ * again with those systems fitted in every fold (the core's second round), and the main worker
+ * keeps its map or fits the one they choose now. `onProgress` gets `{elapsed_ms, units, total,
+ * words}`: the folds done of every candidate's folds, each weighted by its cost
+ * (`trialCost`), plus each final solve (weighted as a fold of the costliest candidate); the
+ * second round, when there is one, adds its own to the total as it starts. */
 async function autoStrength(plan, iterations, onProgress) {
   const t0 = performance.now();
-  const n = plan.candidates.length;
   const trialsWork = plan.candidates.reduce((w, c) => w + plan.folds * trialCost(c), 0);
   const last = Math.max(...plan.candidates.map(trialCost));
-  const total = trialsWork + last;
   const project = projectForTrials(await ask('textFile', { name: 'project.json' }));
+  const report = (units, total, words) => onProgress({ elapsed_ms: performance.now() - t0, units, total, words });
+  const trials = await poolTrials(project, plan, (work, words) => report(work, trialsWork + last,
+    `Choosing the regulariser: ${words}`));
+  const info = await ask('runWithTrials', { trials, folds: plan.folds }, (p) => report(
+    trialsWork + last * Math.min(1, p.iteration / iterations), trialsWork + last,
+    `Reconstructing with the chosen strength: iteration ${p.iteration} / ${iterations}`));
+  const { round } = await ask('secondStrengthRound');
+  if (!round) return info;
+  const first = trialsWork + last;
+  const total = 2 * first;
+  const estimated = round.estimates.z_estimates.length;
+  const again = await poolTrials(project, round, (work, words) => report(first + work, total,
+    `Choosing again with the ${estimated} estimated redshift${estimated === 1 ? '' : 's'} fitted: ${words}`));
+  return ask('chooseAgainWithTrials', { trials: again }, (p) => report(
+    first + trialsWork + last * Math.min(1, p.iteration / iterations), total,
+    `Reconstructing with the strength chosen again: iteration ${p.iteration} / ${iterations}`));
+}
+
+/** The rows of every candidate of `plan` (`{candidates, folds, estimates?}`), tried in a new
+ * pool on `project` (`projectForTrials`); `onProgress(work, words)` gets the weighted folds
+ * done and what the workers are doing. Fails when the session's data or settings changed
+ * meanwhile (the rows would be of another project). */
+async function poolTrials(project, plan, onProgress) {
+  const n = plan.candidates.length;
   const mine = new StrengthPool(poolSize(n));
   pool = mine;
   let trials;
@@ -370,13 +395,8 @@ async function autoStrength(plan, iterations, onProgress) {
     trials = await mine.trials(project, plan, ({ done, work, running }) => {
       const at = [...running].map(([c, p]) => `${c} (${p ? `iteration ${p.iteration}` : 'starting'})`);
       const workers = `${mine.size} worker${mine.size === 1 ? '' : 's'}`;
-      onProgress({
-        elapsed_ms: performance.now() - t0,
-        units: work,
-        total,
-        words: `Choosing the regulariser: ${done} of ${n} candidates done; ${
-          at.length ? `${workers} trying ${at.join(', ')}` : `starting ${workers}`}`,
-      });
+      onProgress(work, `${done} of ${n} candidates done; ${
+        at.length ? `${workers} trying ${at.join(', ')}` : `starting ${workers}`}`);
     }, trialCost);
   } finally {
     mine.close();
@@ -386,12 +406,7 @@ async function autoStrength(plan, iterations, onProgress) {
   if (projectForTrials(await ask('textFile', { name: 'project.json' })) !== project) {
     throw new Error('The data or settings changed while the regulariser was being chosen: press Reconstruct again.');
   }
-  return ask('runWithTrials', { trials, folds: plan.folds }, (p) => onProgress({
-    elapsed_ms: performance.now() - t0,
-    units: trialsWork + last * Math.min(1, p.iteration / iterations),
-    total,
-    words: `Reconstructing with the chosen strength: iteration ${p.iteration} / ${iterations}`,
-  }));
+  return trials;
 }
 
 // The last cross-validation, shown until the data or a setting changes (it was made with them).

@@ -87,8 +87,12 @@ const handlers = {
   // strength is a number or too few systems can be held out), one candidate's
   // cross-validation (in a pool worker), then the reconstruction with the strength they choose.
   strengthPlan: () => ({ plan: session.strength_plan() }),
-  strengthTrial: (m, progress) => session.strength_trial(m.candidate, m.folds, progress),
+  strengthTrial: (m, progress) => session.strength_trial(m.candidate, m.folds, m.estimates ?? null, progress),
   runWithTrials: (m, progress) => session.run_with_trials(m.trials, m.folds, progress),
+  // The second round, after a run that estimated redshifts (`{round: null}` without one): its
+  // candidates are tried like the first's, with its `estimates`, then the choice made again.
+  secondStrengthRound: () => ({ round: session.second_strength_round() }),
+  chooseAgainWithTrials: (m, progress) => session.choose_again_with_trials(m.trials, progress),
   // An ensemble (js/ensemble.js): the plan (`{plan: null}` without one), a member (in a pool
   // worker), each member handed to the main worker, then combined.
   ensemblePlan: () => ({ plan: session.ensemble_plan() }),

@@ -9,10 +9,11 @@ use crate::inversion::{build_constraints, Layer, LinearSystem, ObjectiveTerms};
 use crate::products::{own_map_side, ProductOptions, Products};
 use crate::reconstruct::{
     check_memory, cross_validate, fitted_system_ids, grid_of, map_geometry, product_options,
-    reconstruct, reconstruct_with_choice, strength_candidates, strength_folds, Candidate,
-    ConvergenceRecord, CrossValidation, Dataset, DatasetError, Ensemble, Inputs, MemoryLimit,
-    ReconstructConfig, ReconstructError, Reconstruction, RunSize, RunStatus, SourceReport,
-    StageTimings, StrengthCandidate, StrengthChoice, DEFAULT_FOLDS,
+    reconstruct, reconstruct_with_choice, refit_for_second_choice, second_choice, second_round,
+    strength_candidates, strength_folds, Candidate, ConvergenceRecord, CrossValidation, Dataset,
+    DatasetError, Ensemble, EstimatedRedshifts, Inputs, MemoryLimit, ReconstructConfig,
+    ReconstructError, Reconstruction, RunSize, RunStatus, SecondRound, SourceReport, StageTimings,
+    StrengthCandidate, StrengthChoice, DEFAULT_FOLDS,
 };
 use crate::reconstruct::{member_layers, shear_set, BcgFacts};
 use crate::solver::{Control, Iterate};
@@ -217,17 +218,62 @@ impl Session {
     }
 
     /// The cross-validation of one `candidate` on the loaded data and settings, as a
-    /// reconstruction with "auto" runs it; the session's result is not touched.
+    /// reconstruction with "auto" runs it, with `estimates` fitted in every fold when given
+    /// (a trial of a [`SecondRound`]); the session's result is not touched.
     pub fn strength_trial(
         &self,
         candidate: &Candidate,
         folds: usize,
+        estimates: Option<&EstimatedRedshifts>,
         progress: &mut dyn FnMut(&ConvergenceRecord) -> Control,
     ) -> Result<StrengthCandidate, AppError> {
         self.with_inputs(|inputs, config, _| {
-            crate::reconstruct::strength_trial(inputs, config, candidate, folds, progress)
+            let mut config = config.clone();
+            if let Some(e) = estimates {
+                e.fit_in(&mut config.constraints);
+            }
+            crate::reconstruct::strength_trial(inputs, &config, candidate, folds, progress)
                 .map_err(run_error)
         })
+    }
+
+    /// The second round the result's "auto" choice needs, if it does ([`second_round`]: it
+    /// estimated redshifts after choosing): its trials are run like the first round's, with
+    /// its estimates, then [`Self::choose_again_with_trials`].
+    pub fn second_strength_round(&self) -> Option<SecondRound> {
+        second_round(self.result.as_ref()?.reconstruction()?)
+    }
+
+    /// The result's "auto" choice made again from the `trials` of its [`SecondRound`]: the
+    /// result keeps its map when the choice stands, else is the fit with the new choice (the
+    /// estimated redshifts kept). Replaces the result on success.
+    pub fn choose_again_with_trials(
+        &mut self,
+        trials: Vec<StrengthCandidate>,
+        progress: &mut dyn FnMut(&ConvergenceRecord) -> Control,
+    ) -> Result<(), AppError> {
+        let t = crate::products::Clock::start();
+        let missing = || AppError::Missing("no reconstruction to choose again for".into());
+        let r = self
+            .result
+            .as_ref()
+            .and_then(SessionResult::reconstruction)
+            .ok_or_else(missing)?;
+        let choice = second_choice(r, trials).ok_or_else(missing)?;
+        let refit = self.with_inputs(|inputs, _, parsed| {
+            let refit = refit_for_second_choice(inputs, r, &choice, progress).map_err(run_error)?;
+            Ok(refit.map(|r| reconstruction_result(r, parsed)))
+        })?;
+        let before_ms = self.result.as_ref().map_or(0.0, |x| x.elapsed_ms);
+        let Some(mut result) = refit else {
+            if let Some(Outcome::Reconstruction(r)) = self.result.as_mut().map(|x| &mut x.outcome) {
+                r.strength_choice = Some(choice);
+            }
+            return Ok(());
+        };
+        result.elapsed_ms = before_ms + t.ms();
+        self.result = Some(result);
+        Ok(())
     }
 
     /// The reconstruction of an "auto" strength whose candidates were tried elsewhere

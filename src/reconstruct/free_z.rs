@@ -49,7 +49,9 @@
 //! inside the interval for 52% of them on the chosen map alone, 74% over the maps.
 //!
 //! The systems are then fitted with the others, each at its `z_estimate`, with the settings
-//! (and the regulariser's strength) of the first fit, and with the image-plane error its
+//! (and the regulariser's strength) of the first fit (an "auto" strength then chooses again
+//! with them fitted in every fold, and refits at the same estimates when its choice changes:
+//! `super::second_round`), and with the image-plane error its
 //! redshift's uncertainty means added to the position error in quadrature
 //! ([`RedshiftEstimate::position_error_arcsec`]: how far its images move on the first lens
 //! between the estimate and the interval's ends), so that a redshift the images hardly fix
@@ -130,10 +132,18 @@ pub struct FreeZSummary {
     pub sigma_arcsec: f64,
     /// Where `sigma_arcsec` came from, in words.
     pub sigma_from: String,
+    /// How many maps the intervals were taken over (the chosen one and the best of each other
+    /// regulariser tried; module documentation).
+    #[serde(default = "one_map")]
+    pub maps: usize,
     /// The fitted median image offset (arcsec) of the systems with a known redshift, in the
     /// fit without the estimated systems and in the final one with them.
     pub known_fit_median_without_arcsec: Option<f64>,
     pub known_fit_median_with_arcsec: Option<f64>,
+}
+
+fn one_map() -> usize {
+    1
 }
 
 /// The final reconstruction from `first`, a fit that left out the systems whose redshift is to
@@ -204,18 +214,35 @@ pub(super) fn add_free_systems(
             None => not_estimated.push(id.clone()),
         }
     }
-    let left_out = (!not_estimated.is_empty()).then(|| {
-        format!(
-            "no redshift could be estimated for system(s) {}: not used",
-            not_estimated.join(", ")
-        )
-    });
     if estimates.is_empty() {
         let mut first = first;
-        first.warnings.extend(left_out);
+        first.warnings.extend(not_estimated_note(&not_estimated));
         return Ok(first);
     }
-    let known_without = first.image_offset_median_arcsec(false);
+    let free = FreeZSummary {
+        systems: estimates,
+        not_estimated,
+        sigma_arcsec,
+        sigma_from,
+        maps: lenses.len(),
+        known_fit_median_without_arcsec: first.image_offset_median_arcsec(false),
+        known_fit_median_with_arcsec: None,
+    };
+    fit_at_estimates(inputs, config, free, progress)
+}
+
+/// The fit of every system, those of `free` each at its estimated redshift with the error its
+/// uncertainty adds, with `config` (whose strength is a number); the result's `free_z` is
+/// `free` with the fitted median of the systems with a known redshift, and its warnings say
+/// what was estimated. [`add_free_systems`] ends with it, and an "auto" strength chosen again
+/// with the estimates in (`super::refit_with_choice`) fits the same estimates with it.
+pub(super) fn fit_at_estimates(
+    inputs: &Inputs<'_>,
+    config: &ReconstructConfig,
+    mut free: FreeZSummary,
+    progress: &mut dyn FnMut(&ConvergenceRecord) -> Control,
+) -> Result<Reconstruction, ReconstructError> {
+    let estimates = &free.systems;
     let mut second = config.clone();
     second.constraints.z_estimates = estimates.iter().map(|(id, e)| (id.clone(), e.z)).collect();
     second.constraints.z_estimate_errors = estimates
@@ -230,17 +257,11 @@ pub(super) fn add_free_systems(
             s.z_position_error_arcsec = Some(e.position_error_arcsec);
         }
     }
-    let known: Vec<&str> = first
-        .system
-        .constraints
-        .systems
-        .iter()
-        .map(|s| s.id.as_str())
-        .collect();
-    let known_with = median_arcsec(image_offsets_arcsec(
+    let estimated = |id: &str| estimates.iter().any(|(e, _)| e == id);
+    free.known_fit_median_with_arcsec = median_arcsec(image_offsets_arcsec(
         r.sources
             .iter()
-            .filter(|s| !s.held_out && known.contains(&s.id.as_str())),
+            .filter(|s| !s.held_out && !estimated(&s.id)),
     ));
     let mut notes: Vec<String> = estimates
         .iter()
@@ -255,24 +276,27 @@ pub(super) fn add_free_systems(
                     Some(p) => format!(" under its own prior ({})", p.describe()),
                     None => String::new(),
                 },
-                match lenses.len() {
-                    1 => String::new(),
+                match free.maps {
+                    0 | 1 => String::new(),
                     n => format!(" (the interval over the maps of {n} regularisers)"),
                 }
             )
         })
         .collect();
-    notes.extend(left_out);
+    notes.extend(not_estimated_note(&free.not_estimated));
     r.warnings.extend(notes);
-    r.free_z = Some(FreeZSummary {
-        systems: estimates,
-        not_estimated,
-        sigma_arcsec,
-        sigma_from,
-        known_fit_median_without_arcsec: known_without,
-        known_fit_median_with_arcsec: known_with,
-    });
+    r.free_z = Some(free);
     Ok(r)
+}
+
+/// The warning for the systems no redshift could be estimated for, if any.
+fn not_estimated_note(ids: &[String]) -> Option<String> {
+    (!ids.is_empty()).then(|| {
+        format!(
+            "no redshift could be estimated for system(s) {}: not used",
+            ids.join(", ")
+        )
+    })
 }
 
 /// The systems of `sources` whose redshift was estimated: id, most probable redshift and 68%
@@ -284,15 +308,39 @@ pub(super) fn estimates_of(sources: &[super::SourceReport]) -> Vec<(String, f64,
         .collect()
 }
 
+/// The redshifts a run estimated, as a later fit takes them (`constraints.z_estimates` and
+/// `constraints.z_estimate_errors`, by system id): e.g. the second round of an "auto" choice
+/// run in other workers, which do not have the run.
+#[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
+pub struct EstimatedRedshifts {
+    pub z_estimates: Vec<(String, f64)>,
+    pub z_estimate_errors: Vec<(String, f64)>,
+}
+
+impl EstimatedRedshifts {
+    /// The systems of `sources` whose redshift was estimated: at their estimates, with the
+    /// image-plane error their redshifts' uncertainty adds.
+    pub fn of(sources: &[super::SourceReport]) -> Self {
+        Self {
+            z_estimates: most_probable_of(&estimates_of(sources)),
+            z_estimate_errors: position_errors_of(sources),
+        }
+    }
+
+    /// Sets `constraints` to fit these systems so.
+    pub fn fit_in(&self, constraints: &mut crate::inversion::ConstraintConfig) {
+        constraints.z_estimates = self.z_estimates.clone();
+        constraints.z_estimate_errors = self.z_estimate_errors.clone();
+    }
+}
+
 /// Sets `constraints` to fit the systems of `sources` whose redshift was estimated as the run
-/// that reported them did: at their estimates, with the image-plane error their redshifts'
-/// uncertainty adds.
+/// that reported them did ([`EstimatedRedshifts::of`]).
 pub(crate) fn fit_estimates_in(
     sources: &[super::SourceReport],
     constraints: &mut crate::inversion::ConstraintConfig,
 ) {
-    constraints.z_estimates = most_probable_of(&estimates_of(sources));
-    constraints.z_estimate_errors = position_errors_of(sources);
+    EstimatedRedshifts::of(sources).fit_in(constraints);
 }
 
 /// The image-plane error each estimated system of `sources` is fitted with, as

@@ -33,7 +33,9 @@ pub use ensemble::{
     CALIBRATION_MIN_PREDICTIONS, MAX_ENSEMBLE_MEMBERS,
 };
 pub(crate) use free_z::fit_estimates_in;
-pub use free_z::{estimate_redshift, FreeZSummary, RedshiftEstimate, FALLBACK_SIGMA_ARCSEC};
+pub use free_z::{
+    estimate_redshift, EstimatedRedshifts, FreeZSummary, RedshiftEstimate, FALLBACK_SIGMA_ARCSEC,
+};
 pub use memory::{
     layer_count, Bytes, Heap, MemoryEstimate, MemoryLimit, RunSize, TooMuchMemory,
     FALLBACK_MEMORY_LIMIT_BYTES, WASM_MEMORY_LIMIT_BYTES,
@@ -330,6 +332,11 @@ pub struct StrengthChoice {
     pub chosen_cells: Option<usize>,
     /// Why it was chosen, in words.
     pub rule: String,
+    /// What the systems with a redshift of their own chose before the others' redshifts were
+    /// estimated on its map, when the choice was then made again with those fitted too
+    /// ([`second_round`]); `None` when no redshift was estimated.
+    #[serde(default)]
+    pub before_estimates: Option<Candidate>,
 }
 
 impl Reconstruction {
@@ -434,7 +441,11 @@ pub(crate) fn reconstruct_free_z(
         choose_strength(inputs, config, progress)
     })?;
     let mut r = match choice {
-        Some(choice) => with_choice(inputs, config, choice, free_z, progress),
+        Some(choice) => with_choice(inputs, config, choice, free_z, progress).and_then(|r| {
+            crate::threads::with_limit(config.system.threads, || {
+                choose_again_with_estimates(inputs, r, progress)
+            })
+        }),
         None => crate::threads::with_limit(config.system.threads, || {
             let first = reconstruct_limited(inputs, config, progress)?;
             match free_z {
@@ -525,19 +536,134 @@ fn choose_strength(
     if folds < 2 {
         return Ok(Some(StrengthChoice::from_trials(config, folds, Vec::new())));
     }
-    let rows: Vec<StrengthCandidate> = if crate::threads::available() > 1 {
-        crate::threads::map_items(&candidates, |c| {
+    let rows = run_trials(inputs, config, &candidates, folds, progress)?;
+    Ok(Some(StrengthChoice::from_trials(config, folds, rows)))
+}
+
+/// [`strength_trial`] of each of `candidates`: natively side by side (each trial on one
+/// thread; their iterations are not reported), elsewhere one after another with every report.
+fn run_trials(
+    inputs: &Inputs<'_>,
+    config: &ReconstructConfig,
+    candidates: &[Candidate],
+    folds: usize,
+    progress: &mut dyn FnMut(&ConvergenceRecord) -> Control,
+) -> Result<Vec<StrengthCandidate>, ReconstructError> {
+    if crate::threads::available() > 1 {
+        crate::threads::map_items(candidates, |c| {
             strength_trial(inputs, config, c, folds, &mut |_| Control::Continue)
         })
         .into_iter()
-        .collect::<Result<_, _>>()?
+        .collect()
     } else {
         candidates
             .iter()
             .map(|c| strength_trial(inputs, config, c, folds, progress))
-            .collect::<Result<_, _>>()?
+            .collect()
+    }
+}
+
+/// What the second round of an "auto" choice tries ([`second_round`]): every candidate of the
+/// first, over as many folds, with the estimated redshifts fitted in every fold.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct SecondRound {
+    pub candidates: Vec<Candidate>,
+    pub folds: usize,
+    pub estimates: EstimatedRedshifts,
+}
+
+impl SecondRound {
+    /// `config` as the second round's trials run it: the estimated systems fitted at their
+    /// redshifts, with the error each adds.
+    pub fn config(&self, config: &ReconstructConfig) -> ReconstructConfig {
+        let mut c = config.clone();
+        self.estimates.fit_in(&mut c.constraints);
+        c
+    }
+}
+
+/// The second round of `r`'s "auto" choice, when it needs one: its first round chose from
+/// the systems with a redshift alone, and it then estimated the redshifts of others and
+/// fitted them too. The grid and regulariser that predict best for a few systems are not
+/// those for many more (MACS J0717: 10 systems with a redshift chose 16 x 16 cells, and with
+/// its 41 estimated ones fitted too that grid lost an image of 11 systems, BENCHMARKS.md),
+/// so the candidates are cross-validated again with the estimated systems fitted in every
+/// fold, as the map is fitted, the systems with a redshift held out as before. `None` when
+/// no redshift was estimated, the first round had no trials, or this is done already.
+pub fn second_round(r: &Reconstruction) -> Option<SecondRound> {
+    let choice = r.strength_choice.as_ref()?;
+    let estimated = r.free_z.as_ref().is_some_and(|f| !f.systems.is_empty());
+    let pending = choice.before_estimates.is_none() && r.status != SolveStatus::Cancelled;
+    (estimated && pending && choice.folds >= 2 && !choice.candidates.is_empty()).then(|| {
+        SecondRound {
+            candidates: strength_candidates(&r.config),
+            folds: choice.folds,
+            estimates: EstimatedRedshifts::of(&r.sources),
+        }
+    })
+}
+
+/// The choice of `r` made again from the second round's `trials` ([`second_round`]), with
+/// what the first round chose kept in `before_estimates`. `None` without a first choice.
+pub fn second_choice(r: &Reconstruction, trials: Vec<StrengthCandidate>) -> Option<StrengthChoice> {
+    let first = r.strength_choice.as_ref()?;
+    let estimated = r.free_z.as_ref().map_or(0, |f| f.systems.len());
+    let mut choice = StrengthChoice::from_trials(&r.config, first.folds, trials);
+    choice.before_estimates = Some(first.chosen_candidate());
+    choice.rule = format!(
+        "{}, the {estimated} system(s) whose redshift was estimated fitted at it in every fold \
+         (the systems with a redshift alone chose {})",
+        choice.rule,
+        first.describe_chosen()
+    );
+    Some(choice)
+}
+
+/// The fit `choice` (from [`second_choice`]) asks for instead of `r`'s map: `None` when the
+/// choice stands (`r` keeps its map; only its `strength_choice` is to be replaced), else the
+/// fit of every system with the new choice, the estimated ones at the same redshifts (they
+/// were estimated on the first round's maps), carrying `choice`.
+pub fn refit_for_second_choice(
+    inputs: &Inputs<'_>,
+    r: &Reconstruction,
+    choice: &StrengthChoice,
+    progress: &mut dyn FnMut(&ConvergenceRecord) -> Control,
+) -> Result<Option<Reconstruction>, ReconstructError> {
+    let free = match &r.free_z {
+        Some(free) if choice.before_estimates != Some(choice.chosen_candidate()) => free.clone(),
+        _ => return Ok(None),
     };
-    Ok(Some(StrengthChoice::from_trials(config, folds, rows)))
+    let fixed = choice.chosen_candidate().apply(&r.config);
+    let mut refit = free_z::fit_at_estimates(inputs, &fixed, free, progress)?;
+    refit.config = r.config.clone();
+    refit.strength_choice = Some(choice.clone());
+    Ok(Some(refit))
+}
+
+/// [`second_round`], [`second_choice`] and [`refit_for_second_choice`] in one, the trials run as
+/// the first round's ([`run_trials`]); `r` itself when it needs no second round.
+fn choose_again_with_estimates(
+    inputs: &Inputs<'_>,
+    r: Reconstruction,
+    progress: &mut dyn FnMut(&ConvergenceRecord) -> Control,
+) -> Result<Reconstruction, ReconstructError> {
+    let Some(round) = second_round(&r) else {
+        return Ok(r);
+    };
+    let config = round.config(&r.config);
+    let trials = run_trials(inputs, &config, &round.candidates, round.folds, progress)?;
+    let Some(choice) = second_choice(&r, trials) else {
+        return Ok(r);
+    };
+    Ok(
+        match refit_for_second_choice(inputs, &r, &choice, progress)? {
+            Some(refit) => refit,
+            None => Reconstruction {
+                strength_choice: Some(choice),
+                ..r
+            },
+        },
+    )
 }
 
 /// The candidates an "auto" strength tries: every grid of `objective.auto_grid_scales`
@@ -651,21 +777,29 @@ impl StrengthChoice {
     /// The choice in words, e.g. "curvature at strength 0.1 on 24 x 24 cells, chosen by
     /// 4-fold cross-validation of 27 candidates".
     pub fn describe(&self) -> String {
-        let grid = self
-            .chosen_cells
-            .map_or(String::new(), |n| format!(" on {n} x {n} cells"));
-        let what = format!(
-            "{} at strength {}{grid}",
-            self.chosen_regulariser.name(),
-            self.chosen
-        );
+        let what = self.describe_chosen();
+        let again = match self.before_estimates {
+            Some(first) if first == self.chosen_candidate() => {
+                " (chosen again with the estimated redshifts fitted: the same)".to_string()
+            }
+            Some(first) => format!(
+                " with the estimated redshifts fitted (before them: {})",
+                describe_candidate(&first)
+            ),
+            None => String::new(),
+        };
         match self.candidates.len() {
             0 => format!("{what} ({})", self.rule),
             n => format!(
-                "{what}, chosen by {}-fold cross-validation of {n} candidates",
+                "{what}, chosen by {}-fold cross-validation of {n} candidates{again}",
                 self.folds
             ),
         }
+    }
+
+    /// The chosen candidate in words, e.g. "curvature at strength 0.1 on 24 x 24 cells".
+    pub fn describe_chosen(&self) -> String {
+        describe_candidate(&self.chosen_candidate())
     }
 
     /// Whether `c` is the chosen candidate.
@@ -751,6 +885,7 @@ impl StrengthChoice {
                 chosen_regulariser: config.objective.regulariser,
                 chosen_cells: None,
                 rule: "too few fitted systems to hold any out, so the middle candidate".to_string(),
+                before_estimates: None,
             };
         }
         let best = trials.iter().min_by(|p, q| predicts_better(p, q));
@@ -772,8 +907,17 @@ impl StrengthChoice {
                 "the fewest unmatched, then the smallest median offset of held-out images \
                  over {folds} folds"
             ),
+            before_estimates: None,
         }
     }
+}
+
+/// A candidate in words, e.g. "curvature at strength 0.1 on 24 x 24 cells".
+fn describe_candidate(c: &Candidate) -> String {
+    let grid = c
+        .cells
+        .map_or(String::new(), |n| format!(" on {n} x {n} cells"));
+    format!("{} at strength {}{grid}", c.regulariser.name(), c.strength)
 }
 
 /// The order of an "auto" choice: `Less` when `p` predicted the held-out images better than
@@ -1433,6 +1577,7 @@ mod tests {
             chosen_regulariser: Regulariser::Gradient,
             chosen_cells: None,
             rule: String::new(),
+            before_estimates: None,
         }
     }
 

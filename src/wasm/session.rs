@@ -208,6 +208,7 @@ impl AppSession {
         &self,
         candidate: JsValue,
         folds: usize,
+        estimates: JsValue,
         progress: &js_sys::Function,
     ) -> Result<JsValue, JsError> {
         #[derive(serde::Deserialize)]
@@ -231,11 +232,45 @@ impl AppSession {
             throttle.report(r, &[("strength", candidate.strength)]);
             Control::Continue
         };
+        let estimates: Option<crate::reconstruct::EstimatedRedshifts> =
+            serde_wasm_bindgen::from_value(estimates)
+                .map_err(|e| JsError::new(&format!("estimates: {e}")))?;
         let row = self
             .inner
-            .strength_trial(&candidate, folds, &mut report)
+            .strength_trial(&candidate, folds, estimates.as_ref(), &mut report)
             .map_err(err)?;
         to_js(&row)
+    }
+
+    /// The second round the result's "auto" choice needs (it estimated redshifts after
+    /// choosing): `{candidates, folds, estimates}`, each candidate to be tried by
+    /// [`AppSession::strength_trial`] with `estimates`, then
+    /// [`AppSession::choose_again_with_trials`]; `null` when it needs none.
+    pub fn second_strength_round(&self) -> Result<JsValue, JsError> {
+        match self.inner.second_strength_round() {
+            Some(round) => to_js(&round),
+            None => Ok(JsValue::NULL),
+        }
+    }
+
+    /// The result's "auto" choice made again from the second round's `trials` (rows of
+    /// [`AppSession::strength_trial`]): the map is fitted again only when the choice changes;
+    /// as [`AppSession::run`] otherwise.
+    pub fn choose_again_with_trials(
+        &mut self,
+        trials: JsValue,
+        progress: &js_sys::Function,
+    ) -> Result<JsValue, JsError> {
+        let trials = trials_of(trials)?;
+        let mut throttle = Throttle::new(progress);
+        let mut report = |r: &ConvergenceRecord| {
+            throttle.report(r, &[]);
+            Control::Continue
+        };
+        self.inner
+            .choose_again_with_trials(trials, &mut report)
+            .map_err(err)?;
+        self.result_info()
     }
 
     /// The reconstruction with the strength chosen from `trials` (the rows of
@@ -247,9 +282,7 @@ impl AppSession {
         folds: usize,
         progress: &js_sys::Function,
     ) -> Result<JsValue, JsError> {
-        let trials: Vec<crate::reconstruct::StrengthCandidate> =
-            serde_wasm_bindgen::from_value(trials)
-                .map_err(|e| JsError::new(&format!("trials: {e}")))?;
+        let trials = trials_of(trials)?;
         let mut throttle = Throttle::new(progress);
         let mut report = |r: &ConvergenceRecord| {
             throttle.report(r, &[]);
@@ -460,4 +493,9 @@ impl AppSession {
             "sky_warnings": self.inner.sky_warnings(),
         }))
     }
+}
+
+/// The rows of [`AppSession::strength_trial`] the page hands back, one per candidate.
+fn trials_of(trials: JsValue) -> Result<Vec<crate::reconstruct::StrengthCandidate>, JsError> {
+    serde_wasm_bindgen::from_value(trials).map_err(|e| JsError::new(&format!("trials: {e}")))
 }

@@ -332,6 +332,76 @@ fn a_refined_grid_runs_and_its_project_asks_for_a_new_solve() {
     assert_eq!(report.result, "solve_needed", "{}", report.message);
 }
 
+/// A run that estimates a redshift chooses its strength twice: from the systems with a
+/// redshift, then again with the estimated one fitted in every fold. In pieces, as the app's
+/// workers run it (the first round's trials, the reconstruction, the second round's trials
+/// with its estimates, the choice made again), it gives what one "auto" run gives. Natively
+/// only, as the test above.
+#[cfg(not(target_arch = "wasm32"))]
+#[test]
+fn second_round_in_pieces_equals_one_auto_run() {
+    let mut s = teaching_session();
+    for (path, value) in [
+        ("reconstruct.objective.strength", json!("auto")),
+        ("reconstruct.objective.candidates", json!([0.01, 1.0])),
+        ("reconstruct.objective.auto_grid_scales", json!([0.5, 1.0])),
+        (
+            "reconstruct.objective.auto_regularisers",
+            json!(["gradient"]),
+        ),
+        ("reconstruct.constraints.free_z_systems", json!(["4"])),
+    ] {
+        s.set_field(path, value).unwrap();
+    }
+    let (candidates, folds) = s.strength_plan().unwrap().expect("auto has a plan");
+    assert_eq!((candidates.len(), folds), (4, 3));
+    let trials = |s: &Session, e: Option<&wslap::EstimatedRedshifts>| -> Vec<_> {
+        candidates
+            .iter()
+            .map(|c| {
+                s.strength_trial(c, folds, e, &mut |_| Control::Continue)
+                    .unwrap()
+            })
+            .collect()
+    };
+    let first = trials(&s, None);
+    s.run_with_trials(first, folds, &mut |_| Control::Continue)
+        .unwrap();
+    let round = s.second_strength_round().expect("a redshift was estimated");
+    assert_eq!((&round.candidates, round.folds), (&candidates, folds));
+    let ids: Vec<&str> = round
+        .estimates
+        .z_estimates
+        .iter()
+        .map(|(id, _)| id.as_str())
+        .collect();
+    assert_eq!(ids, ["4"]);
+    assert_eq!(round.estimates.z_estimate_errors.len(), 1);
+    let again = trials(&s, Some(&round.estimates));
+    // The second round's folds fit system 4 and hold out only the others: its rows differ.
+    assert_ne!(again, trials(&s, None));
+    s.choose_again_with_trials(again, &mut |_| Control::Continue)
+        .unwrap();
+    assert!(s.second_strength_round().is_none(), "chosen twice already");
+    let (pieces, whole) = summaries_before_and_after_one_run(&mut s);
+    let choice = &whole["strength_choice"];
+    assert_eq!(pieces["strength_choice"], *choice);
+    // Here the second round moves to a finer grid (8 -> 16 cells a side), so what the pieces
+    // and the whole run compare is the refit at the estimated redshift.
+    let first = &choice["before_estimates"];
+    assert!(first["strength"].is_f64(), "{choice}");
+    assert_ne!(first["cells"], choice["chosen_cells"], "{choice}");
+    assert!(
+        choice["rule"].as_str().unwrap().contains("estimated"),
+        "{choice}"
+    );
+    for key in ["grid_mass_msun", "free_redshifts", "grid_cells"] {
+        assert_eq!(pieces[key], whole[key], "{key}");
+    }
+    let cells = choice["chosen_cells"].as_u64().unwrap();
+    assert_eq!(whole["grid_cells"].as_u64().unwrap(), cells * cells);
+}
+
 /// An "auto" strength in pieces, as the app's parallel workers run it: the plan, one trial
 /// per candidate, then the reconstruction with the trials gives what one "auto" run gives.
 /// Natively only: the pieces are the same code on wasm32, and eighteen reconstructions in a
@@ -373,18 +443,13 @@ fn auto_strength_in_pieces_equals_one_auto_run() {
     let trials: Vec<_> = candidates
         .iter()
         .map(|c| {
-            s.strength_trial(c, folds, &mut |_| Control::Continue)
+            s.strength_trial(c, folds, None, &mut |_| Control::Continue)
                 .unwrap()
         })
         .collect();
     s.run_with_trials(trials, folds, &mut |_| Control::Continue)
         .unwrap();
-    let pieces: serde_json::Value =
-        serde_json::from_str(&s.result().unwrap().summary_json().unwrap()).unwrap();
-    s.run(RunKind::Reconstruct, &mut |_| Control::Continue)
-        .unwrap();
-    let whole: serde_json::Value =
-        serde_json::from_str(&s.result().unwrap().summary_json().unwrap()).unwrap();
+    let (pieces, whole) = summaries_before_and_after_one_run(&mut s);
     assert_eq!(pieces["strength_choice"], whole["strength_choice"]);
     assert_eq!(pieces["grid_mass_msun"], whole["grid_mass_msun"]);
     assert_eq!(pieces["settings"]["objective"]["strength"], "auto");
@@ -445,4 +510,17 @@ fn deflection_maps_with_blank_borders_read_no_data_there() {
         .unwrap_err()
         .to_string();
     assert!(err.contains("no data there"), "{err}");
+}
+
+/// `summary.json` of `s`'s result, then of the result of one whole reconstruction run with the
+/// same data and settings.
+#[cfg(not(target_arch = "wasm32"))]
+fn summaries_before_and_after_one_run(s: &mut Session) -> (serde_json::Value, serde_json::Value) {
+    let summary = |s: &Session| -> serde_json::Value {
+        serde_json::from_str(&s.result().unwrap().summary_json().unwrap()).unwrap()
+    };
+    let pieces = summary(s);
+    s.run(RunKind::Reconstruct, &mut |_| Control::Continue)
+        .unwrap();
+    (pieces, summary(s))
 }

@@ -38,7 +38,8 @@ export class StrengthPool {
 
   get size() { return this.workers.length; }
 
-  /** Cross-validates every candidate of `plan` (`{candidates, folds}`) on `project` (see
+  /** Cross-validates every candidate of `plan` (`{candidates, folds}`, and `estimates` for a
+   * second round: the redshifts each fold fits) on `project` (see
    * `projectForTrials`); resolves with the rows in the order of the candidates. `onProgress`
    * gets `{done, total, folds, running}` at every report and when a candidate is done:
    * `running` maps each candidate being tried (`candidateLabel`) to its worker's last progress
@@ -51,6 +52,7 @@ export class StrengthPool {
    * run with a message naming the candidate; the caller closes the pool in any case. */
   async trials(project, plan, onProgress, weight = () => 1) {
     const { candidates, folds } = plan;
+    const estimates = plan.estimates ?? null;
     const rows = new Array(candidates.length);
     const running = new Map();
     const foldsSeen = new Map(); // candidate -> folds of it seen to end
@@ -83,7 +85,7 @@ export class StrengthPool {
         foldsSeen.set(label, 0);
         report();
         try {
-          rows[i] = await worker.request('strengthTrial', { candidate, folds }, (p) => {
+          rows[i] = await worker.request('strengthTrial', { candidate, folds, estimates }, (p) => {
             const last = running.get(label);
             if (last && last.level > 0 && p.level === 0) foldsSeen.set(label, foldsSeen.get(label) + 1);
             running.set(label, p);

@@ -208,13 +208,34 @@ export function showStrengthChoice(choice, estimated = []) {
     the systems and predicts their images, so the held-out offsets say how well the map finds images it was not
     given (smaller is better), while the fitted median says how closely it reproduces those it was given.
     Offsets from the predictions in arcsec${unmatched ? '; unmatched: held-out images with no predicted image, which count first' : ''}.${
-  estimated.length ? ` ${estimated.length === 1 ? 'System' : 'Systems'} ${estimated.map(esc).join(', ')} had no redshift and ${estimated.length === 1 ? 'is' : 'are'} not in
-    these folds (the redshift is estimated on the chosen map), so these offsets come from fewer systems than the result and its cross-validation.` : ''}</p>
+  estimatedNote(choice, estimated, byKind, byGrid)}</p>
     <div class="table-scroll"><table id="strength-table">
     <thead><tr><th scope="col">${byKind || byGrid ? 'candidate' : 'strength'}</th><th scope="col">held-out median</th>
     <th scope="col">held-out rms</th><th scope="col">fitted median</th>${unmatched ? '<th scope="col">unmatched</th>' : ''}</tr></thead>
     <tbody>${body}</tbody></table></div>`;
   box.hidden = false;
+}
+
+/** What the strength choice's caption says of the systems whose redshift was estimated
+ * (`estimated`, ids): with a second round (`choice.before_estimates`), that the candidates
+ * were tried again with them fitted in every fold, and what the first round had chosen. */
+function estimatedNote(choice, estimated, byKind, byGrid) {
+  if (!estimated.length) return '';
+  const one = estimated.length === 1;
+  const which = `${one ? 'System' : 'Systems'} ${estimated.map(esc).join(', ')}`;
+  const first = choice.before_estimates;
+  if (!first) {
+    return ` ${which} had no redshift and ${one ? 'is' : 'are'} not in these folds (the redshift is estimated on the
+      chosen map), so these offsets come from fewer systems than the result and its cross-validation.`;
+  }
+  const same = first.strength === choice.chosen && first.regulariser === choice.chosen_regulariser
+    && first.cells === choice.chosen_cells;
+  const named = `${byKind ? `${esc(first.regulariser)} at strength ` : 'strength '}${esc(first.strength)}${
+    byGrid && first.cells != null ? ` on ${esc(first.cells)} × ${esc(first.cells)} cells` : ''}`;
+  return ` ${which} had no redshift: ${one ? 'its redshift was' : 'their redshifts were'} estimated on the map the
+    systems with one chose (${named}), then every candidate was tried again with ${one ? 'it' : 'them'} fitted in
+    every fold at ${one ? 'that redshift' : 'those redshifts'}, as the map fits ${one ? 'it' : 'them'}, and only the
+    others held out: these are the offsets of that second round, ${same ? 'which chose the same' : 'which chose this one instead'}.`;
 }
 
 // The object URL of the cross-validation's spread figure on screen (revoked when it goes).
