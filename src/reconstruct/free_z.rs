@@ -59,7 +59,8 @@
 //! itself: on the ten synthetic clusters with only their five innermost systems' redshifts
 //! kept (a real catalogue with few spectroscopic redshifts), the Einstein radius was off by
 //! 13.9% (median) and the deflection by 3.91″, against 11.7% and 3.32″ with the error added
-//! (6.9% and 3.57″ with the systems left out altogether; BENCHMARKS.md). `sources.json`
+//! (6.9% and 3.57″ with the systems left out altogether; BENCHMARKS.md), and 5.6% and
+//! 2.55″ once "auto" chose again with them fitted. `sources.json`
 //! gives the estimate, the interval and that error per system; `summary.json` the fitted
 //! median offset of the systems with a redshift before and after they were added (adding
 //! them must not spoil those). A cross-validation of the run and an ensemble fit them alike.

@@ -611,8 +611,8 @@ pub fn second_choice(r: &Reconstruction, trials: Vec<StrengthCandidate>) -> Opti
     let mut choice = StrengthChoice::from_trials(&r.config, first.folds, trials);
     choice.before_estimates = Some(first.chosen_candidate());
     choice.rule = format!(
-        "{}, the {estimated} system(s) whose redshift was estimated fitted at it in every fold \
-         (the systems with a redshift alone chose {})",
+        "{}, the {estimated} system(s) whose redshift was estimated fitted at their estimates \
+         in every fold (the systems with a redshift alone chose {})",
         choice.rule,
         first.describe_chosen()
     );
