@@ -228,11 +228,9 @@ impl Session {
         progress: &mut dyn FnMut(&ConvergenceRecord) -> Control,
     ) -> Result<StrengthCandidate, AppError> {
         self.with_inputs(|inputs, config, _| {
-            let mut config = config.clone();
-            if let Some(e) = estimates {
-                e.fit_in(&mut config.constraints);
-            }
-            crate::reconstruct::strength_trial(inputs, &config, candidate, folds, progress)
+            let fitting = estimates.map(|e| e.fitted_by(config));
+            let config = fitting.as_ref().unwrap_or(config);
+            crate::reconstruct::strength_trial(inputs, config, candidate, folds, progress)
                 .map_err(run_error)
         })
     }

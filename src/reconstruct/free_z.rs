@@ -333,6 +333,13 @@ impl EstimatedRedshifts {
         constraints.z_estimates = self.z_estimates.clone();
         constraints.z_estimate_errors = self.z_estimate_errors.clone();
     }
+
+    /// `config` fitting these systems so (as a second round's trials run it).
+    pub fn fitted_by(&self, config: &ReconstructConfig) -> ReconstructConfig {
+        let mut c = config.clone();
+        self.fit_in(&mut c.constraints);
+        c
+    }
 }
 
 /// Sets `constraints` to fit the systems of `sources` whose redshift was estimated as the run

@@ -572,16 +572,6 @@ pub struct SecondRound {
     pub estimates: EstimatedRedshifts,
 }
 
-impl SecondRound {
-    /// `config` as the second round's trials run it: the estimated systems fitted at their
-    /// redshifts, with the error each adds.
-    pub fn config(&self, config: &ReconstructConfig) -> ReconstructConfig {
-        let mut c = config.clone();
-        self.estimates.fit_in(&mut c.constraints);
-        c
-    }
-}
-
 /// The second round of `r`'s "auto" choice, when it needs one: its first round chose from
 /// the systems with a redshift alone, and it then estimated the redshifts of others and
 /// fitted them too. The grid and regulariser that predict best for a few systems are not
@@ -650,7 +640,7 @@ fn choose_again_with_estimates(
     let Some(round) = second_round(&r) else {
         return Ok(r);
     };
-    let config = round.config(&r.config);
+    let config = round.estimates.fitted_by(&r.config);
     let trials = run_trials(inputs, &config, &round.candidates, round.folds, progress)?;
     let Some(choice) = second_choice(&r, trials) else {
         return Ok(r);
