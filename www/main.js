@@ -376,7 +376,7 @@ async function autoStrength(plan, iterations, onProgress) {
   const total = 2 * first;
   const estimated = round.estimates.z_estimates.length;
   const again = await poolTrials(project, round, (work, words) => report(first + work, total,
-    `Choosing again with the ${estimated} estimated redshift${estimated === 1 ? '' : 's'} fitted: ${words}`));
+    `Choosing again with the ${estimated} estimated redshift${estimated === 1 ? '' : 's'} fitted: ${words}`), true);
   return ask('chooseAgainWithTrials', { trials: again }, (p) => report(
     first + trialsWork + last * Math.min(1, p.iteration / iterations), total,
     `Reconstructing with the strength chosen again: iteration ${p.iteration} / ${iterations}`));
@@ -384,11 +384,13 @@ async function autoStrength(plan, iterations, onProgress) {
 
 /** The rows of every candidate of `plan` (`{candidates, folds, estimates?}`), tried in a new
  * pool on `project` (`projectForTrials`); `onProgress(work, words)` gets the weighted folds
- * done and what the workers are doing. Fails when the session's data or settings changed
- * meanwhile (the rows would be of another project). */
-async function poolTrials(project, plan, onProgress) {
+ * done and what the workers are doing. `unshown`: the main worker holds a result the page has
+ * not shown yet (a Cancel then restores the session). Fails when the session's data or
+ * settings changed meanwhile (the rows would be of another project). */
+async function poolTrials(project, plan, onProgress, unshown = false) {
   const n = plan.candidates.length;
   const mine = new StrengthPool(poolSize(n));
+  mine.holdsUnshownResult = unshown;
   pool = mine;
   let trials;
   try {
@@ -450,12 +452,18 @@ async function restoreSession(send, message) {
 
 async function cancel() {
   // While the candidates run, the main worker waits with the session as it was: stopping the
-  // pool is enough.
+  // pool is enough. In the second round of an "auto" choice it already holds the first
+  // round's result, which the page never showed: the session as last saved is put back.
   if (pool) {
     const text = pool.cancelledText ?? 'Cancelled. The loaded data and the previous result are kept.';
+    const restore = pool.holdsUnshownResult && lastProject;
     pool.close();
     pool = null;
     showProgress(false);
+    if (restore) {
+      setStatus('Cancelled; restoring the session…');
+      await openProject(lastProject, 'the session', true);
+    }
     setStatus(text);
     return;
   }

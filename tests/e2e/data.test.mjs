@@ -175,6 +175,39 @@ test('systems without a redshift have it estimated, or take the one the settings
   }
 });
 
+test('Cancel in the second round of the choice stops it, and the page keeps working', async () => {
+  const app = await openApp();
+  try {
+    const { page } = app;
+    await waitStatus(page, /^Ready/);
+    await loadCatalogues(page, { images: join(MACS1931, 'immul_ongoing.cat'), members: join(MACS1931, 'm1931.cat'),
+      membersSay: /198 members/, zLens: 0.352 });
+    await page.click('#reconstruct');
+    // The first round is done and the main worker holds its map; the pool tries again.
+    await page.waitForFunction(() => /^Choosing again with the 4 estimated redshifts fitted: /
+      .test(document.getElementById('progress-text').textContent), null, { timeout: 300_000 });
+    await page.click('#cancel');
+    await waitStatus(page, /^Cancelled\. The loaded data and the previous result are kept\./);
+    assert.equal(await page.isHidden('#progress-box'), true);
+    assert.equal(await page.isHidden('#strength-box'), true);
+    // The session saved after the next change (and reopened by a reload) holds no result
+    // either: the first round's map, never shown, is not kept behind the page's back.
+    await setField(page, '#set-reconstruct-solver-iterations', 150);
+    await page.reload();
+    await waitStatus(page, /^Restored your project from this browser/, 120_000);
+    const description = await page.textContent('#project-description');
+    assert.doesNotMatch(description, /stored solution/, description);
+    // A fixed strength (no pool) then runs to a map with curves.
+    await setField(page, '#set-reconstruct-objective-strength', 0.1);
+    await runToMap(page, '#reconstruct', 300_000);
+    const stats = await imageStats(page, '#view-image');
+    assert.ok(stats.reddish > 20, `only ${stats.reddish} red curve pixels after the cancel`);
+    assert.deepEqual(app.consoleErrors, []);
+  } finally {
+    await app.close();
+  }
+});
+
 test('a BCG the member catalogue comments out is fitted, or offered when the setting is off', async () => {
   const app = await openApp();
   try {
