@@ -317,12 +317,18 @@ impl Session {
                             format!("; its stored iterates were not used ({e})"),
                         ),
                     };
+                    // An "auto" strength's choice, when summary.json has one that reads.
+                    let choice = r
+                        .summary
+                        .get("strength_choice")
+                        .and_then(|c| serde_json::from_value(c.clone()).ok());
                     match next.restore_reconstruction(
                         x,
                         r.iterations,
                         r.convergence,
                         r.sources,
                         iterates,
+                        choice,
                     ) {
                         Ok(()) => {
                             let ensemble = next.restore_ensemble(r.ensemble);

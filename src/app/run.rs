@@ -361,7 +361,9 @@ impl Session {
     /// Rebuilds a reconstruction from a stored solution `x` without iterating: the same
     /// constraints, grid, layers and linear system as the run that found `x` (no grid
     /// refinements), the lens of `x` and its products. Sources, convergence and the kept
-    /// `iterates` (for the iteration slider; none: no slider) come from the project.
+    /// `iterates` (for the iteration slider; none: no slider) come from the project. An
+    /// "auto" strength's `choice` (the project's `summary.json`) sets the grid and regulariser
+    /// the run used, and the result keeps it.
     pub fn restore_reconstruction(
         &mut self,
         x: Vec<f64>,
@@ -369,6 +371,7 @@ impl Session {
         convergence: Vec<ConvergenceRecord>,
         sources: Vec<SourceReport>,
         iterates: Vec<Iterate>,
+        choice: Option<StrengthChoice>,
     ) -> Result<(), AppError> {
         let t = crate::products::Clock::start();
         let run = |e: &dyn std::fmt::Display| AppError::Run(e.to_string());
@@ -387,6 +390,12 @@ impl Session {
         config.constraints.mode = mode;
         // Systems whose redshift the run estimated were fitted at it, with its error.
         crate::reconstruct::fit_estimates_in(&sources, &mut config.constraints);
+        // An "auto" run was made on the grid its choice took; the result says "auto" as a
+        // run's does.
+        let kept = config.clone();
+        if let Some(c) = &choice {
+            config = c.chosen_candidate().apply(&config);
+        }
         let constraints = build_constraints(source, &config.constraints, &self.settings.holdout)
             .map_err(|e| run(&e))?;
         let (shear, shear_warning) = shear_set(parsed.shear.as_ref(), &config, &plane);
@@ -423,7 +432,7 @@ impl Session {
         self.result = Some(SessionResult {
             kind: RunKind::Reconstruct,
             outcome: Outcome::Reconstruction(Box::new(Reconstruction {
-                config,
+                config: kept,
                 system,
                 x,
                 status: RunStatus::Restored,
@@ -435,7 +444,7 @@ impl Session {
                 sources,
                 warnings,
                 timings: StageTimings::default(),
-                strength_choice: None,
+                strength_choice: choice,
                 free_z: None,
                 member_positions_arcsec: parsed.members_arcsec(),
                 bcg,

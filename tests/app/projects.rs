@@ -78,6 +78,46 @@ fn a_project_reopens_with_the_maps_rebuilt_from_x() {
     assert!(t.result.is_some());
 }
 
+/// An "auto" result made on a grid other than the settings' (its choice took 8 cells a side,
+/// the settings say 16) reopens on that grid, with its choice: it used to be refused ("X has
+/// 277 values, expected 1045") and had to be solved again.
+#[cfg(not(target_arch = "wasm32"))]
+#[test]
+fn an_auto_project_reopens_on_the_grid_its_choice_took() {
+    let mut s = crate::fixtures::teaching_session();
+    for (path, value) in [
+        ("reconstruct.objective.strength", json!("auto")),
+        ("reconstruct.objective.candidates", json!([0.1])),
+        ("reconstruct.objective.auto_grid_scales", json!([0.5])),
+        (
+            "reconstruct.objective.auto_regularisers",
+            json!(["gradient"]),
+        ),
+    ] {
+        s.set_field(path, value).unwrap();
+    }
+    s.run(RunKind::Reconstruct, &mut |_| Control::Continue)
+        .unwrap();
+    let mut t = Session::new();
+    let report = t
+        .open_project(&s.project_json().unwrap(), "p.json")
+        .unwrap();
+    assert_eq!(report.result, "restored", "{}", report.message);
+    let summary = |s: &Session| -> serde_json::Value {
+        serde_json::from_str(&s.result().unwrap().summary_json().unwrap()).unwrap()
+    };
+    let (a, b) = (summary(&s), summary(&t));
+    assert_eq!(a["grid_cells"], json!(64));
+    for key in ["grid_cells", "strength_choice"] {
+        assert_eq!(a[key], b[key], "{key}");
+    }
+    // serde_json's float parsing may differ from the written value in the last bit.
+    let mass = |v: &serde_json::Value| v["grid_mass_msun"].as_f64().unwrap();
+    assert!((mass(&a) / mass(&b) - 1.0).abs() < 1e-9, "{a} / {b}");
+    assert_eq!(b["settings"]["objective"]["strength"], "auto");
+    assert_eq!(b["settings"]["grid"]["cells"], json!(16));
+}
+
 #[cfg_attr(not(target_arch = "wasm32"), test)]
 #[cfg_attr(target_arch = "wasm32", wasm_bindgen_test::wasm_bindgen_test)]
 fn a_lookup_project_keeps_its_deflection_maps() {
