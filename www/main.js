@@ -311,7 +311,14 @@ function run(kind) {
     async (onProgress) => {
       const plan = kind === 'reconstruct' ? (await ask('strengthPlan')).plan : null;
       if (!plan) return ask('run', { kind }, onProgress);
-      return autoStrength(plan, total, onProgress);
+      return autoStrength(plan, total, onProgress, async (first, estimated) => {
+        // The first round's map is a whole result: shown and kept while the choice is made again.
+        await showResult(first);
+        await persist();
+        await render();
+        setStatus(`Showing the map of the first choice; choosing again with the ${estimated} estimated redshift${
+          estimated === 1 ? '' : 's'} fitted…`);
+      });
     },
     // A report of `autoStrength` carries its own position; the others are the solver's.
     (p) => (p.words ? [p.units, p.total, p.words] : [p.iteration, total, iterations(p)]),
@@ -353,13 +360,14 @@ const trialCost = (candidate) => (candidate?.cells ?? 32) ** 0.75;
 
 /** An "auto" regulariser strength: each candidate of `plan` is cross-validated in a pool
  * worker (js/pool.js) on the main session's project, then the main worker reconstructs with
- * the strength their rows choose. When that run estimated redshifts, the candidates are tried
- * again with those systems fitted in every fold (the core's second round), and the main worker
+ * the strength their rows choose. When that run estimated redshifts, `showFirst(info,
+ * estimated)` shows its map, the candidates are tried again with those systems fitted in every
+ * fold (the core's second round; a Cancel then keeps the first map), and the main worker
  * keeps its map or fits the one they choose now. `onProgress` gets `{elapsed_ms, units, total,
  * words}`: the folds done of every candidate's folds, each weighted by its cost
  * (`trialCost`), plus each final solve (weighted as a fold of the costliest candidate); the
  * second round, when there is one, adds its own to the total as it starts. */
-async function autoStrength(plan, iterations, onProgress) {
+async function autoStrength(plan, iterations, onProgress, showFirst) {
   const t0 = performance.now();
   const trialsWork = plan.candidates.reduce((w, c) => w + plan.folds * trialCost(c), 0);
   const last = Math.max(...plan.candidates.map(trialCost));
@@ -375,8 +383,10 @@ async function autoStrength(plan, iterations, onProgress) {
   const first = trialsWork + last;
   const total = 2 * first;
   const estimated = round.estimates.z_estimates.length;
+  await showFirst(info, estimated);
   const again = await poolTrials(project, round, (work, words) => report(first + work, total,
-    `Choosing again with the ${estimated} estimated redshift${estimated === 1 ? '' : 's'} fitted: ${words}`), true);
+    `Choosing again with the ${estimated} estimated redshift${estimated === 1 ? '' : 's'} fitted: ${words}`),
+  'Cancelled the second round of the choice: the map of the first choice is kept.');
   return ask('chooseAgainWithTrials', { trials: again }, (p) => report(
     first + trialsWork + last * Math.min(1, p.iteration / iterations), total,
     `Reconstructing with the strength chosen again: iteration ${p.iteration} / ${iterations}`));
@@ -384,13 +394,13 @@ async function autoStrength(plan, iterations, onProgress) {
 
 /** The rows of every candidate of `plan` (`{candidates, folds, estimates?}`), tried in a new
  * pool on `project` (`projectForTrials`); `onProgress(work, words)` gets the weighted folds
- * done and what the workers are doing. `unshown`: the main worker holds a result the page has
- * not shown yet (a Cancel then restores the session). Fails when the session's data or
- * settings changed meanwhile (the rows would be of another project). */
-async function poolTrials(project, plan, onProgress, unshown = false) {
+ * done and what the workers are doing; `cancelledText`, what a Cancel says (if not the
+ * default). Fails when the session's data or settings changed meanwhile (the rows would be of
+ * another project). */
+async function poolTrials(project, plan, onProgress, cancelledText) {
   const n = plan.candidates.length;
   const mine = new StrengthPool(poolSize(n));
-  mine.holdsUnshownResult = unshown;
+  if (cancelledText) mine.cancelledText = cancelledText;
   pool = mine;
   let trials;
   try {
@@ -451,19 +461,14 @@ async function restoreSession(send, message) {
 }
 
 async function cancel() {
-  // While the candidates run, the main worker waits with the session as it was: stopping the
-  // pool is enough. In the second round of an "auto" choice it already holds the first
-  // round's result, which the page never showed: the session as last saved is put back.
+  // While the candidates run, the main worker waits with the session as it was (or, in the
+  // second round of an "auto" choice and during an ensemble, with the result shown and saved):
+  // stopping the pool is enough.
   if (pool) {
     const text = pool.cancelledText ?? 'Cancelled. The loaded data and the previous result are kept.';
-    const restore = pool.holdsUnshownResult && lastProject;
     pool.close();
     pool = null;
     showProgress(false);
-    if (restore) {
-      setStatus('Cancelled; restoring the session…');
-      await openProject(lastProject, 'the session', true);
-    }
     setStatus(text);
     return;
   }

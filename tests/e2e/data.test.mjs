@@ -175,7 +175,7 @@ test('systems without a redshift have it estimated, or take the one the settings
   }
 });
 
-test('Cancel in the second round of the choice stops it, and the page keeps working', async () => {
+test('the second round of the choice shows the first map, and Cancel there keeps it', async () => {
   const app = await openApp();
   try {
     const { page } = app;
@@ -183,20 +183,28 @@ test('Cancel in the second round of the choice stops it, and the page keeps work
     await loadCatalogues(page, { images: join(MACS1931, 'immul_ongoing.cat'), members: join(MACS1931, 'm1931.cat'),
       membersSay: /198 members/, zLens: 0.352 });
     await page.click('#reconstruct');
-    // The first round is done and the main worker holds its map; the pool tries again.
+    // The first round is done: its map is shown (and saved) while the pool tries again.
     await page.waitForFunction(() => /^Choosing again with the 4 estimated redshifts fitted: /
       .test(document.getElementById('progress-text').textContent), null, { timeout: 300_000 });
+    await waitStatus(page, /^Showing the map of the first choice; choosing again with the 4 estimated redshifts fitted/);
+    assert.equal(await page.isHidden('#progress-box'), false);
+    assert.equal(await page.isHidden('#strength-box'), false);
+    assert.match(await page.innerText('#strength-summary'), /Systems 2, 4, 6, 5 had no redshift and are not in these folds/);
+    const during = await imageStats(page, '#view-image');
+    assert.ok(during.reddish > 20, `only ${during.reddish} red curve pixels in the first round's map`);
+    await page.screenshot({ path: join(ARTIFACTS, 'app-second-round.png'), fullPage: true });
     await page.click('#cancel');
-    await waitStatus(page, /^Cancelled\. The loaded data and the previous result are kept\./);
+    await waitStatus(page, /^Cancelled the second round of the choice: the map of the first choice is kept\./);
     assert.equal(await page.isHidden('#progress-box'), true);
-    assert.equal(await page.isHidden('#strength-box'), true);
-    // The session saved after the next change (and reopened by a reload) holds no result
-    // either: the first round's map, never shown, is not kept behind the page's back.
-    await setField(page, '#set-reconstruct-solver-iterations', 150);
+    assert.equal(await page.isHidden('#strength-box'), false);
+    // The map kept is the session's: a reload reopens it, with its choice.
     await page.reload();
     await waitStatus(page, /^Restored your project from this browser/, 120_000);
     const description = await page.textContent('#project-description');
-    assert.doesNotMatch(description, /stored solution/, description);
+    assert.match(description, /maps rebuilt from the stored solution/, description);
+    await page.waitForFunction(() => !document.getElementById('strength-box').hidden, null, { timeout: 60_000 });
+    const after = await imageStats(page, '#view-image');
+    assert.ok(after.reddish > 20, `only ${after.reddish} red curve pixels after the reload`);
     // A fixed strength (no pool) then runs to a map with curves.
     await setField(page, '#set-reconstruct-objective-strength', 0.1);
     await runToMap(page, '#reconstruct', 300_000);
