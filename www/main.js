@@ -324,10 +324,12 @@ function run(kind) {
     (p) => (p.words ? [p.units, p.total, p.words] : [p.iteration, total, iterations(p)]),
     async (info) => {
       const wall = info.summary?.strength_choice?.candidates?.length ? performance.now() - t0 : info.elapsed_ms;
-      setStatus(`Done in ${(wall / 1000).toFixed(2)} s.`);
+      // "Done" once the result is on screen: a map shown during the run (the first round of an
+      // "auto" choice) is not mistaken for it.
       await showResult(info);
-      await persist();
       await render();
+      setStatus(`Done in ${(wall / 1000).toFixed(2)} s.`);
+      await persist();
       if (kind === 'reconstruct') await ensemble(wall);
     });
 }
