@@ -135,6 +135,11 @@ pub struct ConstraintConfig {
     /// estimate by that normal, `{"fixed": z}` fits the system at `z` (also when
     /// `free_z_systems` names it). Redshifts allowed (0, 20).
     pub z_priors: BTreeMap<String, RedshiftPrior>,
+    /// At most how many times the estimated redshifts are made again on the map fitted to
+    /// every system, and the systems fitted again at them, until no estimate moves (default
+    /// 2; 0 keeps the first estimates, made on the lens of the systems with a redshift).
+    /// Allowed 0 to 10.
+    pub free_z_passes: usize,
     /// Redshifts estimated for the systems above, by id: these systems are fitted at them
     /// (set by the reconstruction, never read from a settings file).
     #[serde(skip)]
@@ -160,6 +165,7 @@ impl Default for ConstraintConfig {
             free_z_systems: Vec::new(),
             free_z_prior: Some(DEFAULT_FREE_Z_PRIOR),
             z_priors: BTreeMap::new(),
+            free_z_passes: DEFAULT_FREE_Z_PASSES,
             z_estimates: Vec::new(),
             z_estimate_errors: Vec::new(),
             max_pixels_per_image: 10_000,
@@ -223,6 +229,10 @@ impl RedshiftPrior {
 /// arcs by clusters to the most distant lensed galaxies catalogued (the prior).
 pub const DEFAULT_FREE_Z_PRIOR: [f64; 2] = [0.5, 8.0];
 
+/// `free_z_passes`'s default: measured on the synthetic clusters with five redshifts kept
+/// (BENCHMARKS.md, "Estimated redshifts made consistent with the map").
+pub const DEFAULT_FREE_Z_PASSES: usize = 2;
+
 impl ConstraintConfig {
     /// Whether the system `id` with catalogue redshift `z` has its redshift estimated: under
     /// a range or normal prior of its own (`z_priors`, which also decide when they fix it),
@@ -280,6 +290,13 @@ impl ConstraintConfig {
             if !(z.is_finite() && z > 0.0 && z < 20.0) {
                 return Err(bad("default_z", z, "a source redshift must be in (0, 20)"));
             }
+        }
+        if self.free_z_passes > 10 {
+            return Err(bad(
+                "free_z_passes",
+                self.free_z_passes as f64,
+                "must be 0 to 10",
+            ));
         }
         if let Some([low, high]) = self.free_z_prior {
             if !(low.is_finite() && low > 0.0) {

@@ -448,10 +448,11 @@ pub(crate) fn reconstruct_free_z(
         }),
         None => crate::threads::with_limit(config.system.threads, || {
             let first = reconstruct_limited(inputs, config, progress)?;
-            match free_z {
-                true => free_z::add_free_systems(inputs, config, first, None, &[], progress),
-                false => Ok(first),
+            if !free_z {
+                return Ok(first);
             }
+            let r = free_z::add_free_systems(inputs, config, first, None, &[], progress)?;
+            Ok(free_z::fit_consistently(inputs, config, &r, None, progress)?.unwrap_or(r))
         }),
     }?;
     with_own_priors(&mut r, config);
@@ -609,25 +610,37 @@ pub fn second_choice(r: &Reconstruction, trials: Vec<StrengthCandidate>) -> Opti
     Some(choice)
 }
 
-/// The fit `choice` (from [`second_choice`]) asks for instead of `r`'s map: `None` when the
-/// choice stands (`r` keeps its map; only its `strength_choice` is to be replaced), else the
-/// fit of every system with the new choice, the estimated ones at the same redshifts (they
-/// were estimated on the first round's maps), carrying `choice`.
+/// The fit `choice` (from [`second_choice`]) asks for instead of `r`'s map: `None` when
+/// `r`'s map stands (only its `strength_choice` is to be replaced), else the fit of every
+/// system with the chosen candidate, carrying `choice`. When the choice changed, the estimated
+/// systems are first fitted at the redshifts estimated in the first round; then, whether it
+/// changed or not, their redshifts are estimated again on that map and fitted until they
+/// settle (at most `constraints.free_z_passes` times).
 pub fn refit_for_second_choice(
     inputs: &Inputs<'_>,
     r: &Reconstruction,
     choice: &StrengthChoice,
     progress: &mut dyn FnMut(&ConvergenceRecord) -> Control,
 ) -> Result<Option<Reconstruction>, ReconstructError> {
-    let free = match &r.free_z {
-        Some(free) if choice.before_estimates != Some(choice.chosen_candidate()) => free.clone(),
-        _ => return Ok(None),
+    let Some(free) = &r.free_z else {
+        return Ok(None);
     };
     let fixed = choice.chosen_candidate().apply(&r.config);
-    let mut refit = free_z::fit_at_estimates(inputs, &fixed, free, progress)?;
-    refit.config = r.config.clone();
-    refit.strength_choice = Some(choice.clone());
-    Ok(Some(refit))
+    let refit = match choice.before_estimates != Some(choice.chosen_candidate()) {
+        true => Some(free_z::fit_at_estimates(
+            inputs,
+            &fixed,
+            free.clone(),
+            progress,
+        )?),
+        false => None,
+    };
+    let last = free_z::fit_consistently(inputs, &fixed, r, refit, progress)?;
+    Ok(last.map(|mut last| {
+        last.config = r.config.clone();
+        last.strength_choice = Some(choice.clone());
+        last
+    }))
 }
 
 /// [`second_round`], [`second_choice`] and [`refit_for_second_choice`] in one, the trials run as

@@ -209,6 +209,12 @@ fn config_values_out_of_range_name_the_file_and_field() {
         ),
         (
             "constraints",
+            "free_z_passes",
+            "11",
+            "= 11 is not allowed (must be 0 to 10)",
+        ),
+        (
+            "constraints",
             "max_pixels_per_image",
             "1000001",
             "= 1000001 is not allowed (must be 1 to 10^6",

@@ -584,6 +584,82 @@ fn blanked_redshifts_of_a_synthetic_cluster_are_found_again() {
         "known systems: {without} -> {with}"
     );
     assert_eq!(known.sigma_arcsec, wslap::FALLBACK_SIGMA_ARCSEC);
+    // The estimates were made again on the map of every system until they settled: each is
+    // where that map itself puts its system, within 0.01 (1 + z), unless every pass allowed
+    // was used.
+    if known.passes < config.constraints.free_z_passes {
+        for (id, e) in &known.systems {
+            let system = catalog.systems.iter().find(|s| &s.id == id).unwrap();
+            let images: Vec<DVec2> = system.images.iter().map(|i| i.position).collect();
+            let prior = config.constraints.free_z_prior.unwrap();
+            let (sigma, stretch) = (known.sigma_arcsec, config.objective.max_stretch);
+            let again =
+                wslap::estimate_redshift(&r.lens, &inputs.plane, &images, prior, sigma, stretch)
+                    .unwrap();
+            assert!(
+                (again.z - e.z).abs() <= 0.01 * (1.0 + e.z) + 1e-9,
+                "system {id}: fitted at {} but its map puts it at {}",
+                e.z,
+                again.z
+            );
+        }
+    }
+}
+
+/// Few redshifts (`c_smooth` with only its five innermost systems' kept, as a JWST catalogue
+/// might have): the first estimates, made on the lens of those five, are made again on the
+/// map of every system and fitted again until they settle (`constraints.free_z_passes`).
+#[cfg(not(target_arch = "wasm32"))]
+#[test]
+fn few_redshifts_are_made_consistent_with_the_map_of_every_system() {
+    let catalog = c_smooth();
+    let radius = |s: &wslap::ImageSystem| {
+        let mut r: Vec<f64> = s.images.iter().map(|i| i.position.length()).collect();
+        r.sort_by(f64::total_cmp);
+        let n = r.len();
+        0.5 * (r[(n - 1) / 2] + r[n / 2])
+    };
+    let mut by_radius: Vec<&wslap::ImageSystem> = catalog.systems.iter().collect();
+    by_radius.sort_by(|a, b| radius(a).total_cmp(&radius(b)));
+    let free: Vec<String> = by_radius[5..].iter().map(|s| s.id.clone()).collect();
+    let mut config = ReconstructConfig::default();
+    config.objective.strength = wslap::Strength::Value(0.01);
+    config.products.pixels = 96;
+    config.constraints.free_z_systems.clone_from(&free);
+    let inputs = c_smooth_inputs(&catalog);
+    let median_dz = |config: &ReconstructConfig| {
+        let r = reconstruct(&inputs, config, &mut quiet).unwrap();
+        let mut dz: Vec<f64> = estimates_against_truth(&catalog, &r, &free)
+            .iter()
+            .map(|(truth, z, _)| (z - truth).abs() / (1.0 + truth))
+            .collect();
+        dz.sort_by(f64::total_cmp);
+        (dz[dz.len() / 2], r)
+    };
+    let mut first_only = config.clone();
+    first_only.constraints.free_z_passes = 0;
+    let (before, r0) = median_dz(&first_only);
+    let (after, r) = median_dz(&config);
+    assert_eq!(r0.free_z.as_ref().unwrap().passes, 0);
+    let passes = r.free_z.as_ref().unwrap().passes;
+    assert!(passes >= 1, "no estimate moved on the map of every system");
+    assert!(
+        r.warnings
+            .iter()
+            .any(|w| w.contains("on the map of every system")),
+        "{:?}",
+        r.warnings
+    );
+    // The map and the redshifts it is fitted at agree better: its images are reproduced
+    // more closely (here 0.20 -> 0.16", the estimates' median error unchanged).
+    let fit = |r: &wslap::Reconstruction| r.image_offset_median_arcsec(false).unwrap();
+    println!(
+        "median |dz|/(1+z): first {before:.3}, after {passes} passes {after:.3}; fitted {:.3} -> {:.3}",
+        fit(&r0),
+        fit(&r)
+    );
+    assert!(fit(&r) < fit(&r0), "{} -> {}", fit(&r0), fit(&r));
+    assert!(after <= before + 0.02, "{before} -> {after}");
 }
 
 /// Redshifts blanked where the lens of the others is least constrained: the outer third of
