@@ -72,8 +72,8 @@
 //! redshifts are. The interval and the position error stay those of the first estimate (the
 //! map of every system has seen the system; the interval is widened to hold the new
 //! estimate). On the ten synthetic clusters with five redshifts kept this took the median
-//! Einstein-radius error from 5.6% to 2.3%, the deflection error from 2.55 to 2.45″ and the
-//! fitted images from 0.75 to 0.51″ (BENCHMARKS.md). `sources.json`
+//! Einstein-radius error from 5.6% to 2.4%, the deflection error from 2.55 to 2.44″ and the
+//! fitted images from 0.75 to 0.48″ (BENCHMARKS.md). `sources.json`
 //! gives the estimate, the interval and that error per system; `summary.json` the fitted
 //! median offset of the systems with a redshift before and after they were added (adding
 //! them must not spoil those). A cross-validation of the run and an ensemble fit them alike.
