@@ -229,13 +229,10 @@ pub(super) fn add_free_systems(
     let mut estimates = Vec::new();
     let mut not_estimated = Vec::new();
     for id in &free {
-        let images: Vec<DVec2> = held_out_images(inputs, id)
-            .map(|(_, observed)| observed.into_iter().map(|(_, p)| p).collect())
-            .unwrap_or_default();
         match estimate_redshift_over(
             &lenses,
             &inputs.plane,
-            &images,
+            &observed_images(inputs, id),
             prior,
             config.constraints.z_priors.get(id).copied(),
             sigma_arcsec,
@@ -371,13 +368,10 @@ fn estimate_again(
     let prior = config.constraints.free_z_prior.unwrap_or(OPEN_RANGE);
     let mut moved = false;
     for (id, e) in free.systems.iter_mut() {
-        let images: Vec<DVec2> = held_out_images(inputs, id)
-            .map(|(_, observed)| observed.into_iter().map(|(_, p)| p).collect())
-            .unwrap_or_default();
         let again = estimate_redshift_over(
             &[&on.lens as &dyn MassComponent],
             &inputs.plane,
-            &images,
+            &observed_images(inputs, id),
             prior,
             config.constraints.z_priors.get(id).copied(),
             free.sigma_arcsec,
@@ -400,6 +394,13 @@ fn estimate_again(
     next.config = on.config.clone();
     next.strength_choice = on.strength_choice.clone();
     Ok(Some(next))
+}
+
+/// The observed positions (arcsec) of system `id`'s images, whether or not a fit used them.
+fn observed_images(inputs: &Inputs<'_>, id: &str) -> Vec<DVec2> {
+    held_out_images(inputs, id)
+        .map(|(_, observed)| observed.into_iter().map(|(_, p)| p).collect())
+        .unwrap_or_default()
 }
 
 /// The warning for the systems no redshift could be estimated for, if any.

@@ -606,6 +606,21 @@ fn blanked_redshifts_of_a_synthetic_cluster_are_found_again() {
     }
 }
 
+/// `catalog`'s systems by the median distance of their images from the centre, innermost
+/// first.
+#[cfg(not(target_arch = "wasm32"))]
+fn innermost_first(catalog: &ImageCatalog) -> Vec<&wslap::ImageSystem> {
+    let radius = |s: &wslap::ImageSystem| {
+        let mut r: Vec<f64> = s.images.iter().map(|i| i.position.length()).collect();
+        r.sort_by(f64::total_cmp);
+        let n = r.len();
+        0.5 * (r[(n - 1) / 2] + r[n / 2])
+    };
+    let mut systems: Vec<&wslap::ImageSystem> = catalog.systems.iter().collect();
+    systems.sort_by(|a, b| radius(a).total_cmp(&radius(b)));
+    systems
+}
+
 /// Few redshifts (`c_smooth` with only its five innermost systems' kept, as a JWST catalogue
 /// might have): the first estimates, made on the lens of those five, are made again on the
 /// map of every system and fitted again until they settle (`constraints.free_z_passes`).
@@ -613,15 +628,10 @@ fn blanked_redshifts_of_a_synthetic_cluster_are_found_again() {
 #[test]
 fn few_redshifts_are_made_consistent_with_the_map_of_every_system() {
     let catalog = c_smooth();
-    let radius = |s: &wslap::ImageSystem| {
-        let mut r: Vec<f64> = s.images.iter().map(|i| i.position.length()).collect();
-        r.sort_by(f64::total_cmp);
-        let n = r.len();
-        0.5 * (r[(n - 1) / 2] + r[n / 2])
-    };
-    let mut by_radius: Vec<&wslap::ImageSystem> = catalog.systems.iter().collect();
-    by_radius.sort_by(|a, b| radius(a).total_cmp(&radius(b)));
-    let free: Vec<String> = by_radius[5..].iter().map(|s| s.id.clone()).collect();
+    let free: Vec<String> = innermost_first(&catalog)[5..]
+        .iter()
+        .map(|s| s.id.clone())
+        .collect();
     let mut config = ReconstructConfig::default();
     config.objective.strength = wslap::Strength::Value(0.01);
     config.products.pixels = 96;
@@ -672,15 +682,11 @@ fn few_redshifts_are_made_consistent_with_the_map_of_every_system() {
 #[test]
 fn outer_redshifts_are_estimated_over_the_regularisers_tried() {
     let catalog = c_smooth();
-    let radius = |s: &wslap::ImageSystem| {
-        let mut r: Vec<f64> = s.images.iter().map(|i| i.position.length()).collect();
-        r.sort_by(f64::total_cmp);
-        let n = r.len();
-        0.5 * (r[(n - 1) / 2] + r[n / 2])
-    };
-    let mut by_radius: Vec<&wslap::ImageSystem> = catalog.systems.iter().collect();
-    by_radius.sort_by(|a, b| radius(b).total_cmp(&radius(a)));
-    let free: Vec<String> = by_radius[..8].iter().map(|s| s.id.clone()).collect();
+    let by_radius = innermost_first(&catalog);
+    let free: Vec<String> = by_radius[by_radius.len() - 8..]
+        .iter()
+        .map(|s| s.id.clone())
+        .collect();
     let mut config = ReconstructConfig::default();
     config.objective.auto_grid_scales = vec![1.0];
     config.products.pixels = 96;
