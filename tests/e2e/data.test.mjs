@@ -117,7 +117,8 @@ test('systems without a redshift have it estimated, or take the one the settings
     await setField(page, '#set-reconstruct-constraints-mode', 'point');
     await setField(page, '#set-reconstruct-solver-iterations', 300);
     const run = async () => {
-      await runToMap(page, '#reconstruct');
+      // "auto" tries every candidate twice and then fits the estimates until they settle.
+      await runToMap(page, '#reconstruct', 300_000);
       const warnings = await page.locator('#run-warnings li').allTextContents();
       await page.click('#tab-systems');
       await page.waitForSelector('#systems table');
