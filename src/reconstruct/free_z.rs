@@ -65,7 +65,8 @@
 //! **Made consistent with the map.** The estimates come from the lens of the systems with a
 //! redshift, which only the regulariser drew where the others' images lie; the map fitted
 //! to every system is drawn through them. So, at the end of the run (after the second round
-//! of an "auto" choice), each system's redshift is estimated again on that map, and if any
+//! of an "auto" choice, or after its only round when too few systems had a redshift for
+//! folds), each system's redshift is estimated again on that map, and if any
 //! moves by more than 0.01 (1 + z) every system is fitted again at the new estimates, at most
 //! `constraints.free_z_passes` times (default 2; [`fit_consistently`]): the map and the
 //! redshifts it is fitted at become a joint fit of both, as a parametric modeller's free

@@ -585,12 +585,10 @@ pub fn second_round(r: &Reconstruction) -> Option<SecondRound> {
     let choice = r.strength_choice.as_ref()?;
     let estimated = r.free_z.as_ref().is_some_and(|f| !f.systems.is_empty());
     let pending = choice.before_estimates.is_none() && r.status != SolveStatus::Cancelled;
-    (estimated && pending && choice.folds >= 2 && !choice.candidates.is_empty()).then(|| {
-        SecondRound {
-            candidates: strength_candidates(&r.config),
-            folds: choice.folds,
-            estimates: EstimatedRedshifts::of(&r.sources),
-        }
+    (estimated && pending && choice.was_cross_validated()).then(|| SecondRound {
+        candidates: strength_candidates(&r.config),
+        folds: choice.folds,
+        estimates: EstimatedRedshifts::of(&r.sources),
     })
 }
 
@@ -746,6 +744,12 @@ pub fn strength_trial(
 }
 
 impl StrengthChoice {
+    /// Whether candidates were cross-validated (at least two folds, at least one trial): a
+    /// choice without is the settings' fallback, made again by nothing.
+    pub fn was_cross_validated(&self) -> bool {
+        self.folds >= 2 && !self.candidates.is_empty()
+    }
+
     /// The image-plane error (arcsec, rms over both axes) of the chosen candidate's held-out
     /// images, from their median offset, which one image near a critical curve cannot
     /// inflate: for offsets with a Gaussian error `s` per axis the median offset is
@@ -965,6 +969,11 @@ fn with_choice(
                 .map(|c| c.apply_for_trial(config))
                 .collect();
             r = free_z::add_free_systems(inputs, &fixed, r, sigma, &others, progress)?;
+            // A choice made without folds (too few systems with a redshift) has no second
+            // round, whose refit would make the estimates consistent with the map: here.
+            if !choice.was_cross_validated() {
+                r = free_z::fit_consistently(inputs, &fixed, &r, None, progress)?.unwrap_or(r);
+            }
         }
         r.config = config.clone();
         r.strength_choice = Some(choice);
