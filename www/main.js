@@ -72,9 +72,10 @@ function clearError() { $('error').hidden = true; $('error').textContent = ''; }
 
 async function persist() {
   lastProject = await ask('textFile', { name: 'project.json' });
-  if (EMBED) return; // a demo in someone's page keeps nothing
+  if (EMBED) return null; // a demo in someone's page keeps nothing
   const problem = await saveProject(lastProject);
   if (problem) setStatus(problem);
+  return problem;
 }
 
 async function refreshLoaded() {
@@ -311,27 +312,29 @@ function run(kind) {
     async (onProgress) => {
       const plan = kind === 'reconstruct' ? (await ask('strengthPlan')).plan : null;
       if (!plan) return ask('run', { kind }, onProgress);
-      return autoStrength(plan, total, onProgress, async (first, estimated) => {
-        // The first round's map is a whole result: shown and kept while the choice is made again.
-        await showResult(first);
-        await persist();
-        await render();
-        setStatus(`Showing the map of the first choice; choosing again with the ${estimated} estimated redshift${
-          estimated === 1 ? '' : 's'} fitted…`);
-      });
+      // The first round's map is a whole result: shown and kept while the choice is made again.
+      return autoStrength(plan, total, onProgress, (first, estimated) => display(first,
+        `Showing the map of the first choice; choosing again with the ${estimated} estimated redshift${
+          estimated === 1 ? '' : 's'} fitted…`));
     },
     // A report of `autoStrength` carries its own position; the others are the solver's.
     (p) => (p.words ? [p.units, p.total, p.words] : [p.iteration, total, iterations(p)]),
     async (info) => {
       const wall = info.summary?.strength_choice?.candidates?.length ? performance.now() - t0 : info.elapsed_ms;
-      // "Done" once the result is on screen: a map shown during the run (the first round of an
-      // "auto" choice) is not mistaken for it.
-      await showResult(info);
-      await render();
-      setStatus(`Done in ${(wall / 1000).toFixed(2)} s.`);
-      await persist();
+      await display(info, `Done in ${(wall / 1000).toFixed(2)} s.`);
       if (kind === 'reconstruct') await ensemble(wall);
     });
+}
+
+/** Shows the result `info`, draws it, saves it with the project, and only then says `status`
+ * (with why it was not saved, if it was not): a status read as "this is the result" (the final
+ * "Done", or the first round's map of an "auto" choice, which a Cancel keeps) comes when the
+ * map is on screen and saved. */
+async function display(info, status) {
+  await showResult(info);
+  await render();
+  const problem = await persist();
+  setStatus(problem ? `${status} The app ${problem}.` : status);
 }
 
 /** After a reconstruction that took `mainMs`, the ensemble the settings ask for (js/ensemble.js),
