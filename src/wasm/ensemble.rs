@@ -5,10 +5,9 @@
 use wasm_bindgen::prelude::*;
 
 use crate::app::member_run;
-use crate::reconstruct::{ConvergenceRecord, EnsembleMember, EnsemblePlan};
-use crate::solver::Control;
+use crate::reconstruct::{EnsembleMember, EnsemblePlan};
 
-use super::session::{err, files_js, AppSession, Throttle};
+use super::session::{err, files_js, reporter, AppSession};
 use super::{set, to_js};
 
 /// A member as a pool worker handed it over, kept until the ensemble is combined.
@@ -47,11 +46,7 @@ impl AppSession {
         progress: &js_sys::Function,
     ) -> Result<JsValue, JsError> {
         let plan = plan_from(plan)?;
-        let mut throttle = Throttle::new(progress);
-        let mut report = |r: &ConvergenceRecord| {
-            throttle.report(r, &[("member", member as f64)]);
-            Control::Continue
-        };
+        let mut report = reporter(progress, [("member", member as f64)]);
         let run = self
             .inner
             .ensemble_member(&plan, member, &mut report)

@@ -14,14 +14,14 @@ const PROGRESS_INTERVAL_MS: f64 = 100.0;
 
 /// Passes QADP reports on to a JavaScript callback at most every [`PROGRESS_INTERVAL_MS`], with
 /// `elapsed_ms` and any extra fields.
-pub(super) struct Throttle<'a> {
+struct Throttle<'a> {
     progress: &'a js_sys::Function,
     clock: crate::products::Clock,
     last: f64,
 }
 
 impl<'a> Throttle<'a> {
-    pub(super) fn new(progress: &'a js_sys::Function) -> Self {
+    fn new(progress: &'a js_sys::Function) -> Self {
         Self {
             progress,
             clock: crate::products::Clock::start(),
@@ -29,7 +29,7 @@ impl<'a> Throttle<'a> {
         }
     }
 
-    pub(super) fn report(&mut self, r: &ConvergenceRecord, extra: &[(&str, f64)]) {
+    fn report(&mut self, r: &ConvergenceRecord, extra: &[(&str, f64)]) {
         let now = self.clock.ms();
         if now - self.last < PROGRESS_INTERVAL_MS {
             return;
@@ -44,6 +44,20 @@ impl<'a> Throttle<'a> {
             }
             let _ = self.progress.call1(&JsValue::NULL, &v);
         }
+    }
+}
+
+/// The core's progress callback for a method of the worker: each report goes on to `progress`
+/// through a new [`Throttle`], with the fields `extra`; it never cancels (a Cancel ends the
+/// worker).
+pub(super) fn reporter<'a, const N: usize>(
+    progress: &'a js_sys::Function,
+    extra: [(&'static str, f64); N],
+) -> impl FnMut(&ConvergenceRecord) -> Control + 'a {
+    let mut throttle = Throttle::new(progress);
+    move |r: &ConvergenceRecord| {
+        throttle.report(r, &extra);
+        Control::Continue
     }
 }
 
@@ -177,11 +191,7 @@ impl AppSession {
     pub fn run(&mut self, kind: &str, progress: &js_sys::Function) -> Result<JsValue, JsError> {
         let kind: RunKind = serde_json::from_value(serde_json::Value::String(kind.into()))
             .map_err(|_| JsError::new(&format!("unknown run kind '{kind}'")))?;
-        let mut throttle = Throttle::new(progress);
-        let mut report = |r: &ConvergenceRecord| {
-            throttle.report(r, &[]);
-            Control::Continue
-        };
+        let mut report = reporter(progress, []);
         self.inner.run(kind, &mut report).map_err(err)?;
         self.result_info()
     }
@@ -227,11 +237,7 @@ impl AppSession {
             },
             Given::Candidate(c) => c,
         };
-        let mut throttle = Throttle::new(progress);
-        let mut report = |r: &ConvergenceRecord| {
-            throttle.report(r, &[("strength", candidate.strength)]);
-            Control::Continue
-        };
+        let mut report = reporter(progress, [("strength", candidate.strength)]);
         let estimates: Option<crate::reconstruct::EstimatedRedshifts> =
             serde_wasm_bindgen::from_value(estimates)
                 .map_err(|e| JsError::new(&format!("estimates: {e}")))?;
@@ -262,11 +268,7 @@ impl AppSession {
         progress: &js_sys::Function,
     ) -> Result<JsValue, JsError> {
         let trials = trials_of(trials)?;
-        let mut throttle = Throttle::new(progress);
-        let mut report = |r: &ConvergenceRecord| {
-            throttle.report(r, &[]);
-            Control::Continue
-        };
+        let mut report = reporter(progress, []);
         self.inner
             .choose_again_with_trials(trials, &mut report)
             .map_err(err)?;
@@ -283,11 +285,7 @@ impl AppSession {
         progress: &js_sys::Function,
     ) -> Result<JsValue, JsError> {
         let trials = trials_of(trials)?;
-        let mut throttle = Throttle::new(progress);
-        let mut report = |r: &ConvergenceRecord| {
-            throttle.report(r, &[]);
-            Control::Continue
-        };
+        let mut report = reporter(progress, []);
         self.inner
             .run_with_trials(trials, folds, &mut report)
             .map_err(err)?;
