@@ -386,10 +386,12 @@ impl Verdict {
                 .expect("counted");
             format!(
                 "{far_more} of {n} system{}{} more than twice as many predicted images as observed \
-                 (up to {} for {}): the critical curves wind through the images' region, and the \
-                 small-scale mass there is not what the data say.",
+                 (the most: system {}, {} predicted for {} observed): the critical curves wind \
+                 through the images' region, and the small-scale mass there is not what the data \
+                 say.",
                 if n == 1 { "" } else { "s" },
                 if far_more == 1 { " has" } else { " have" },
+                c.id,
                 c.predicted,
                 c.observed
             )
@@ -722,7 +724,8 @@ mod tests {
         assert!(
             v.reasons
                 .starts_with("1 of 5 systems has more than twice as many predicted images")
-                && v.reasons.contains("(up to 6 for 2)"),
+                && v.reasons
+                    .contains("(the most: system P, 6 predicted for 2 observed)"),
             "{}",
             v.reasons
         );
@@ -732,7 +735,9 @@ mod tests {
         let v = assess(&sources);
         assert_eq!(v.trust, Trust::DoNotTrustSmallScales, "{}", v.reasons);
         assert!(
-            v.reasons.starts_with("2 of 5 systems have") && v.reasons.contains("(up to 22 for 2)"),
+            v.reasons.starts_with("2 of 5 systems have")
+                && v.reasons
+                    .contains("(the most: system Q, 22 predicted for 2 observed)"),
             "{}",
             v.reasons
         );
