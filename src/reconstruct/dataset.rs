@@ -226,12 +226,31 @@ impl Dataset {
             (Some(from), Some(to)) => reframe(p, from, to),
             _ => p,
         };
-        let mut notes: Vec<String> = without_mag
-            .iter()
-            .map(|(block, line, centre)| {
-                self.galaxy_without_mag(name, block, *line, to_data(*centre))
-            })
-            .collect();
+        let mut notes = Vec::new();
+        let mut unfitted = Vec::new();
+        for (block, line, centre) in &without_mag {
+            match self.galaxy_without_mag(name, block, *line, to_data(*centre)) {
+                Some(note) => notes.push(note),
+                None => unfitted.push((block, *line)),
+            }
+        }
+        // A best.par lists every galaxy it fitted (hundreds): one sentence for all of them.
+        match &unfitted[..] {
+            [] => {}
+            [(block, line)] => notes.push(format!(
+                "{name}: line {line}: `{block}` is a galaxy (core at most {GALAXY_MAX_CORE_KPC} \
+                 kpc) without a `mag`, which a member needs, and no member catalogue row \
+                 (commented out or not) lies there: not fitted; give its row in the member \
+                 catalogue"
+            )),
+            many => notes.push(format!(
+                "{name}: {} galaxies (core at most {GALAXY_MAX_CORE_KPC} kpc; lines {}) have no \
+                 `mag`, which a member needs, and no member catalogue row (commented out or \
+                 not) lies at them: not fitted; give their rows in the member catalogue",
+                many.len(),
+                line_list(many.iter().map(|(_, line)| *line))
+            )),
+        }
         notes.extend(other_plane.iter().map(|(block, line, z)| {
             format!(
                 "{name}: line {line}: `{block}` is a galaxy at z = {z}, not at the cluster's \
@@ -298,10 +317,7 @@ impl Dataset {
             many => notes.push(format!(
                 "{name}: {} galaxies (lines {}) are members of {} already: not added twice",
                 many.len(),
-                many.iter()
-                    .map(|(line, _)| line.to_string())
-                    .collect::<Vec<_>>()
-                    .join(", "),
+                line_list(many.iter().map(|(line, _)| *line)),
                 members.source_name
             )),
         }
@@ -310,8 +326,14 @@ impl Dataset {
 
     /// What becomes of the `.par`'s galaxy `block` (at `line`) without a `mag`, centred at `at`
     /// (arcsec, the data's frame): the member there already, or the commented-out row of the
-    /// member catalogue there moved to the members, or nothing.
-    fn galaxy_without_mag(&mut self, name: &str, block: &str, line: usize, at: DVec2) -> String {
+    /// member catalogue there moved to the members (the note says which), or nothing (`None`).
+    fn galaxy_without_mag(
+        &mut self,
+        name: &str,
+        block: &str,
+        line: usize,
+        at: DVec2,
+    ) -> Option<String> {
         let near = |m: &&Member| m.position.distance(at) <= SAME_GALAXY_ARCSEC;
         if let Some(members) = self.members.as_mut() {
             if let Some(id) = members.members.iter().find(near).map(|m| m.id.clone()) {
@@ -320,7 +342,7 @@ impl Dataset {
                     members.source_name
                 );
                 members.note_par_galaxy(id);
-                return note;
+                return Some(note);
             }
             if let Some(k) = members.commented.iter().position(|m| near(&m)) {
                 let row = members.commented.remove(k);
@@ -331,14 +353,10 @@ impl Dataset {
                     members.source_name, row.line, row.id, row.mag
                 );
                 members.members.push(row);
-                return note;
+                return Some(note);
             }
         }
-        format!(
-            "{name}: line {line}: `{block}` is a galaxy (core at most {GALAXY_MAX_CORE_KPC} kpc) \
-             without a `mag`, which a member needs, and no member catalogue row (commented out \
-             or not) lies there: not fitted; give its row in the member catalogue"
-        )
+        None
     }
 
     /// Fits the member catalogue's commented-out rows that are most likely the cluster's
@@ -482,6 +500,11 @@ fn region_arcs(
         systems.filter(|s| s.id == id).find_map(|s| s.z)
     };
     arcs_from_regions(file.text, file.name, reference, pixel_arcsec, &catalog_z)
+}
+
+/// Line numbers as a note lists them: "12, 15, 40".
+fn line_list(lines: impl Iterator<Item = usize>) -> String {
+    lines.map(|l| l.to_string()).collect::<Vec<_>>().join(", ")
 }
 
 #[cfg(test)]

@@ -668,6 +668,37 @@ mod galaxies_of_a_par {
         assert!((made.members[0].position - expected).length() < 1e-3);
     }
 
+    /// A fitted `.par` lists every galaxy it modelled (A1689's of Limousin et al.: 272), each
+    /// without a `mag`: what is not fitted is said once, with its lines, not once a galaxy.
+    #[test]
+    fn galaxies_without_a_magnitude_are_named_in_one_note() {
+        let galaxy = |n: usize, x: f64| {
+            format!(
+                "potentiel {n}\n    profil 81\n    x_centre {x}\n    y_centre 0.\n    \
+                 v_disp 150.\n    core_radius_kpc 0.1\n    cut_radius_kpc 50.\n    \
+                 z_lens 0.35\n    end\n"
+            )
+        };
+        let text = format!(
+            "runmode\n    reference 3 292.95682 -26.575718\n    end\ncosmologie\n    H0 70.\n    \
+             omega 0.3\n    lambda 0.7\n    end\n{}{}{}",
+            galaxy(1, 10.0),
+            galaxy(2, 20.0),
+            galaxy(3, 30.0)
+        );
+        let par = parse_par(&text, "fitted.par").unwrap();
+        assert_eq!(par.galaxies().unwrap().without_mag.len(), 3);
+        let notes = Dataset::default().add_par_galaxies(&par).unwrap();
+        assert_eq!(
+            notes,
+            [
+                "fitted.par: 3 galaxies (core at most 5 kpc; lines 9, 18, 27) have no `mag`, \
+                 which a member needs, and no member catalogue row (commented out or not) lies \
+                 at them: not fitted; give their rows in the member catalogue"
+            ]
+        );
+    }
+
     #[test]
     fn a_galaxy_without_a_magnitude_takes_its_commented_row_or_is_left_out() {
         // MACS1931's .par is a starting model: its BCG (potential 3, core 0.115 kpc, at the
