@@ -167,13 +167,26 @@ impl ConvergenceRecord {
     }
 }
 
-/// Wall-clock time of each stage in milliseconds.
+/// Wall-clock time of each stage in milliseconds. The first four are the final map's; an
+/// "auto" strength's trials and the redshift estimates come before it, so `total_ms` is the
+/// whole run's.
 #[derive(Debug, Clone, Copy, Default, PartialEq, Serialize, Deserialize)]
+#[serde(default)]
 pub struct StageTimings {
+    /// Building the final map's linear system (every pass of it).
     pub system_ms: f64,
+    /// Solving it.
     pub solve_ms: f64,
+    /// Its maps and curves.
     pub products_ms: f64,
+    /// Its sources, predicted images and verdict inputs.
     pub sources_ms: f64,
+    /// The cross-validated trials of an "auto" strength run in this process (both rounds; the
+    /// app runs them in other workers, which this does not count).
+    pub choice_ms: f64,
+    /// The whole run in this process, from the settings' check to the result (0 for a result
+    /// rebuilt from a project file).
+    pub total_ms: f64,
 }
 
 /// How a reconstruction's solution came about.
@@ -434,12 +447,15 @@ pub(crate) fn reconstruct_free_z(
     free_z: bool,
     progress: &mut dyn FnMut(&ConvergenceRecord) -> Control,
 ) -> Result<Reconstruction, ReconstructError> {
+    let total = crate::products::Clock::start();
     config.validate()?;
     check_source_redshifts(inputs, config)?;
     crate::threads::with_limit(config.system.threads, || check_memory(inputs, config))?;
+    let trials = crate::products::Clock::start();
     let choice = crate::threads::with_limit(config.system.threads, || {
         choose_strength(inputs, config, progress)
     })?;
+    let choice_ms = trials.ms();
     let mut r = match choice {
         Some(choice) => with_choice(inputs, config, choice, free_z, progress).and_then(|r| {
             crate::threads::with_limit(config.system.threads, || {
@@ -456,6 +472,8 @@ pub(crate) fn reconstruct_free_z(
         }),
     }?;
     with_own_priors(&mut r, config);
+    r.timings.choice_ms += choice_ms;
+    r.timings.total_ms = total.ms();
     Ok(r)
 }
 
@@ -652,19 +670,21 @@ fn choose_again_with_estimates(
         return Ok(r);
     };
     let config = round.estimates.fitted_by(&r.config);
+    let clock = crate::products::Clock::start();
     let trials = run_trials(inputs, &config, &round.candidates, round.folds, progress)?;
+    let trials_ms = clock.ms();
     let Some(choice) = second_choice(&r, trials) else {
         return Ok(r);
     };
-    Ok(
-        match refit_for_second_choice(inputs, &r, &choice, progress)? {
-            Some(refit) => refit,
-            None => Reconstruction {
-                strength_choice: Some(choice),
-                ..r
-            },
+    let mut r = match refit_for_second_choice(inputs, &r, &choice, progress)? {
+        Some(refit) => refit,
+        None => Reconstruction {
+            strength_choice: Some(choice),
+            ..r
         },
-    )
+    };
+    r.timings.choice_ms += trials_ms;
+    Ok(r)
 }
 
 /// The candidates an "auto" strength tries: every grid of `objective.auto_grid_scales`
@@ -945,8 +965,10 @@ pub fn reconstruct_with_choice(
     choice: StrengthChoice,
     progress: &mut dyn FnMut(&ConvergenceRecord) -> Control,
 ) -> Result<Reconstruction, ReconstructError> {
+    let total = crate::products::Clock::start();
     let mut r = with_choice(inputs, config, choice, true, progress)?;
     with_own_priors(&mut r, config);
+    r.timings.total_ms = total.ms();
     Ok(r)
 }
 

@@ -271,4 +271,10 @@ fn auto_strength_takes_the_best_predicting_candidate() {
     let summary = serde_json::to_value(r.summary()).unwrap();
     assert_eq!(summary["strength_choice"]["chosen"], best.2 .1);
     assert_eq!(summary["settings"]["objective"]["strength"], "auto");
+    // The trials come before the final map: the run's time counts them, and holds the stages.
+    let t = &r.timings;
+    assert!(t.choice_ms > 0.0, "{t:?}");
+    let stages = t.system_ms + t.solve_ms + t.products_ms + t.sources_ms;
+    assert!(t.total_ms >= t.choice_ms + stages, "{t:?}");
+    assert_eq!(summary["timings_ms"]["total_ms"], t.total_ms);
 }
