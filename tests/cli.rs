@@ -584,7 +584,7 @@ fn reconstruct_takes_the_redshift_priors_of_a_par() {
          potentiel O1\n\tprofil 81\n\tx_centre 0\n\ty_centre 0\n\tellipticite 0.2\n\
          \tangle_pos 0\n\tcore_radius_kpc 50\n\tcut_radius_kpc 1000\n\tv_disp 1000\n\
          \tz_lens 0.3\n\tend\ncosmologie\n\tH0 70\n\tomegaM 0.3\n\tomegaX 0.7\n\tend\n\
-         fini\n",
+         chi2: 1.5\nfini\n",
     )
     .unwrap();
     let config = fixed_strength_config(&dir, 0.01);
@@ -617,6 +617,7 @@ fn reconstruct_takes_the_redshift_priors_of_a_par() {
         "model.par: line 7: system 4's redshift is taken as 2.2",
         "system 2: redshift estimated z = ",
         "under its own prior (uniform 2 - 2.3)",
+        "model.par:25: `chi2:` is not a Lenstool block: skipped",
     ] {
         assert!(stderr.contains(said), "{said}: {stderr}");
     }

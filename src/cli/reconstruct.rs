@@ -233,6 +233,9 @@ pub fn run(args: &ReconstructArgs) -> Result<(), String> {
         let text = read_text(path, InputKind::Model)?;
         let par = parse_par_with(&text, &par_name, &ParOptions::default().for_galaxies())
             .map_err(|e| e.to_string())?;
+        for w in &par.warnings {
+            eprintln!("warning: {w}");
+        }
         for note in data.add_par(&par).map_err(|e| e.to_string())? {
             eprintln!("note: {note}");
         }

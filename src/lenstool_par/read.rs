@@ -173,7 +173,7 @@ fn read_blocks(
 ) -> Result<Vec<Block>, ParError> {
     let mut blocks = Vec::new();
     let mut open: Option<Block> = None;
-    // Inside a run of lines Lenstool skips (after an unknown word, up to an `end`).
+    // Inside a run of lines Lenstool skips (after an unknown word, up to a block or an `end`).
     let mut skipping = false;
     for (i, raw) in text.lines().enumerate() {
         let line = i + 1;
@@ -199,8 +199,8 @@ fn read_blocks(
                         file: file.into(),
                         line,
                         message: format!(
-                            "`{first}` is not a Lenstool block: skipped up to the next `end` \
-                             (Lenstool skips it too)"
+                            "`{first}` is not a Lenstool block: skipped, with the lines after \
+                             it, up to the next block or `end` (Lenstool skips it too)"
                         ),
                     });
                 }
