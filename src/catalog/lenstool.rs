@@ -131,6 +131,7 @@ pub fn parse_image_catalog(
         image.position = p;
     }
     let systems = group_systems(parsed, source_name, &mut warnings)?;
+    warn_same_positions(&systems, source_name, &mut warnings);
     let catalog = ImageCatalog {
         source_name: source_name.into(),
         reference: Some(frame_ref),
@@ -329,6 +330,68 @@ fn group_systems(
         systems.push(ImageSystem { id, z, images });
     }
     Ok(systems)
+}
+
+/// Images closer than this (arcsec) are taken for one image written twice.
+const SAME_IMAGE_ARCSEC: f64 = 0.05;
+
+/// At most this many images written twice are named (the scan stops there: a file of many
+/// rows at one place costs no more than a few).
+const SAME_IMAGE_NAMED: usize = 5;
+
+/// Warns of two rows at one position (within [`SAME_IMAGE_ARCSEC`]): an image has one source,
+/// so in two systems it asks the map for two sources at one place, and in one it is counted
+/// twice. Catalogues converted by hand or merged from two lists do this (a helper session
+/// found it in two public ones). Positions are bucketed on a lattice of that width, so the
+/// scan is linear in the rows.
+fn warn_same_positions(
+    systems: &[ImageSystem],
+    source_name: &str,
+    warnings: &mut Vec<CatalogWarning>,
+) {
+    let cell = |p: DVec2| {
+        (
+            (p.x / SAME_IMAGE_ARCSEC).floor() as i64,
+            (p.y / SAME_IMAGE_ARCSEC).floor() as i64,
+        )
+    };
+    let mut seen: HashMap<(i64, i64), Vec<(&ImageSystem, &Image)>> = HashMap::new();
+    let mut named = 0;
+    for system in systems {
+        for image in &system.images {
+            let (cx, cy) = cell(image.position);
+            let twin = (-1..=1)
+                .flat_map(|dx| (-1..=1).map(move |dy| (cx + dx, cy + dy)))
+                .filter_map(|k| seen.get(&k))
+                .flatten()
+                .find(|(_, other)| other.position.distance(image.position) <= SAME_IMAGE_ARCSEC);
+            if let Some((other_system, other)) = twin {
+                let what = match other_system.id == system.id {
+                    true => format!("in system {}: it is counted twice", system.id),
+                    false => format!(
+                        "in systems {} and {}: an image has one source, so the map is asked \
+                         for two at one place",
+                        other_system.id, system.id
+                    ),
+                };
+                warnings.push(CatalogWarning {
+                    source_name: source_name.into(),
+                    line: image.line,
+                    message: format!(
+                        "image '{}' lies where image '{}' (line {}) does, {what}; delete one row \
+                         if it is the same image",
+                        image.id, other.id, other.line
+                    ),
+                });
+                named += 1;
+                if named == SAME_IMAGE_NAMED {
+                    return;
+                }
+                continue;
+            }
+            seen.entry((cx, cy)).or_default().push((system, image));
+        }
+    }
 }
 
 /// Whether two images' redshifts can be one source's: `|a - b| <= Z_AGREEMENT_TOL (1 + min)`.

@@ -355,6 +355,33 @@ fn single_images_and_partly_unknown_redshifts_warn() {
     );
 }
 
+/// A row written twice (SDSS J1004+4112 and A1703 converted from Grale's files: two systems
+/// with an image at the very same place) is named, in two systems or in one; images 0.1"
+/// apart are not.
+#[cfg_attr(not(target_arch = "wasm32"), test)]
+#[cfg_attr(target_arch = "wasm32", wasm_bindgen_test::wasm_bindgen_test)]
+fn an_image_written_twice_is_named() {
+    let text = "#REFERENCE 3 150.0 2.2\n\
+                5.1 10.0 20.0 0.1 0.1 0 2.0 0\n\
+                5.2 -12.0 -3.0 0.1 0.1 0 2.0 0\n\
+                6.1 10.01 20.0 0.1 0.1 0 2.0 0\n\
+                6.2 -8.0 5.0 0.1 0.1 0 2.0 0\n\
+                6.3 -8.0 5.1 0.1 0.1 0 2.0 0\n\
+                6.4 -8.02 5.1 0.1 0.1 0 2.0 0\n";
+    let (_, warnings) = parse_image_catalog(text, "w.cat", None).unwrap();
+    let messages: Vec<String> = warnings.iter().map(ToString::to_string).collect();
+    assert_eq!(
+        messages,
+        [
+            "w.cat: line 4: image '6.1' lies where image '5.1' (line 2) does, in systems 5 \
+             and 6: an image has one source, so the map is asked for two at one place; delete \
+             one row if it is the same image",
+            "w.cat: line 7: image '6.4' lies where image '6.3' (line 6) does, in system 6: it \
+             is counted twice; delete one row if it is the same image",
+        ]
+    );
+}
+
 #[cfg_attr(not(target_arch = "wasm32"), test)]
 #[cfg_attr(target_arch = "wasm32", wasm_bindgen_test::wasm_bindgen_test)]
 fn reference_modes_0_1_3_agree() {
