@@ -423,6 +423,15 @@ impl Verdict {
         if far_more > 0 && far_more as f64 <= LOST_SYSTEMS_SHARE * n as f64 {
             care.push(far_more_words());
         }
+        // One system is always fitted (its images fix the mass inside them): nothing in the
+        // data checks the map, so it cannot be called good however small its offsets.
+        if checks.iter().filter(|c| !c.held_out).count() == 1 && holdout.is_none() {
+            care.push(
+                "Only one system constrains the map: its images fix the mass inside them, and \
+                 nothing tests the rest (a second system would)."
+                    .to_string(),
+            );
+        }
         if images > 0 && on_curves as f64 > ON_CURVE_SHARE * images as f64 {
             care.push(format!(
                 "{on_curves} of {images} observed images sit on a critical curve (|μ| > \
@@ -596,6 +605,20 @@ mod tests {
         Verdict::assess(sources, VerdictInputs::default())
     }
 
+    /// A single system is fitted whatever the map: never "good" on its own.
+    #[test]
+    fn one_system_alone_is_usable_with_care() {
+        let v = assess(&[fitted("1", &[0.01, 0.02, 0.01])]);
+        assert_eq!(v.trust, Trust::UsableWithCare, "{}", v.reasons);
+        assert!(
+            v.reasons.starts_with("Only one system constrains the map"),
+            "{}",
+            v.reasons
+        );
+        let two = assess(&[fitted("1", &[0.01, 0.02]), fitted("2", &[0.02, 0.01])]);
+        assert_eq!(two.trust, Trust::Good, "{}", two.reasons);
+    }
+
     #[test]
     fn images_reproduced_to_half_an_arcsec_are_good() {
         let v = assess(&[fitted("1", &[0.3, 0.5, 0.4]), fitted("2", &[0.6, 0.2])]);
@@ -612,7 +635,7 @@ mod tests {
         let v = assess(&[fitted("1", &[1.4, 1.6]), fitted("2", &[1.5])]);
         assert_eq!(v.trust, Trust::UsableWithCare);
         assert!(v.reasons.contains("1.5″ (median)"), "{}", v.reasons);
-        let v = assess(&[fitted("1", &[0.9, 1.0])]);
+        let v = assess(&[fitted("1", &[0.9, 1.0]), fitted("2", &[1.0])]);
         assert_eq!(
             v.trust,
             Trust::Good,
@@ -823,7 +846,7 @@ mod tests {
             DVec2::new(-45.0, -20.0), // none
         ];
         assert_eq!(members_with_own_curves(&curves, &g, &members), 1);
-        let sources = [fitted("1", &[0.2, 0.3])];
+        let sources = [fitted("1", &[0.2, 0.3]), fitted("2", &[0.3, 0.2])];
         let inputs = |c_unmeasured| VerdictInputs {
             curves: Some((&curves, g)),
             main_curve_share: Some(0.99),
@@ -855,7 +878,10 @@ mod tests {
             },
             ..VerdictInputs::default()
         };
-        let v = Verdict::assess(&[fitted("1", &[0.2, 0.3])], missing(&[]));
+        let v = Verdict::assess(
+            &[fitted("1", &[0.2, 0.3]), fitted("2", &[0.3])],
+            missing(&[]),
+        );
         assert_eq!(v.trust, Trust::UsableWithCare);
         assert!(v.bcg.missing);
         assert!(
@@ -870,7 +896,7 @@ mod tests {
             id: "1009.0".to_string(),
         };
         let v = Verdict::assess(
-            &[fitted("1", &[0.2, 0.3])],
+            &[fitted("1", &[0.2, 0.3]), fitted("2", &[0.3])],
             missing(std::slice::from_ref(&row)),
         );
         assert_eq!(v.bcg.commented, std::slice::from_ref(&row));
@@ -889,7 +915,7 @@ mod tests {
             id: "2".to_string(),
         };
         let v = Verdict::assess(
-            &[fitted("1", &[0.2])],
+            &[fitted("1", &[0.2]), fitted("2", &[0.3])],
             missing(&[row.clone(), other.clone()]),
         );
         assert_eq!(v.bcg.commented, [row.clone(), other]);
@@ -911,10 +937,11 @@ mod tests {
             },
             ..VerdictInputs::default()
         };
-        let v = Verdict::assess(&[fitted("1", &[0.2])], fitted_row);
+        let v = Verdict::assess(&[fitted("1", &[0.2]), fitted("2", &[0.3])], fitted_row);
         assert_eq!(v.trust, Trust::Good, "{}", v.reasons);
         assert_eq!((v.bcg.fitted, v.bcg.commented), (vec![row], vec![]));
-        let v = Verdict::assess(&[fitted("1", &[0.2, 0.3])], VerdictInputs::default());
+        let two = [fitted("1", &[0.2, 0.3]), fitted("2", &[0.3])];
+        let v = Verdict::assess(&two, VerdictInputs::default());
         assert_eq!(v.trust, Trust::Good, "{}", v.reasons);
     }
 
