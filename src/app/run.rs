@@ -270,6 +270,10 @@ impl Session {
             return Ok(());
         };
         result.elapsed_ms = before_ms + t.ms();
+        // The refit's own timings start at the refit: the run in this worker is both.
+        if let Outcome::Reconstruction(r) = &mut result.outcome {
+            r.timings.total_ms = result.elapsed_ms;
+        }
         self.result = Some(result);
         Ok(())
     }

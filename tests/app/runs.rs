@@ -400,6 +400,13 @@ fn second_round_in_pieces_equals_one_auto_run() {
     }
     let cells = choice["chosen_cells"].as_u64().unwrap();
     assert_eq!(whole["grid_cells"].as_u64().unwrap(), cells * cells);
+    // The worker's whole run (first fit, estimates, refit) is timed, not only the refit.
+    let (t, stages) = (
+        &pieces["timings_ms"],
+        ["system_ms", "solve_ms", "products_ms"],
+    );
+    let refit: f64 = stages.iter().map(|k| t[k].as_f64().unwrap()).sum();
+    assert!(t["total_ms"].as_f64().unwrap() > refit, "{t}");
 }
 
 /// An "auto" strength in pieces, as the app's parallel workers run it: the plan, one trial
