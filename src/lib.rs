@@ -116,8 +116,8 @@ pub use fits::{
 #[cfg(not(target_arch = "wasm32"))]
 pub use lenstool_par::load_lenstool_model;
 pub use lenstool_par::{
-    parse_par, parse_par_with, LenstoolModel, LenstoolPar, ParComponent, ParError, ParGalaxies,
-    ParOptions, ParRedshiftPrior, ParWarning, Radius, GALAXY_MAX_CORE_KPC,
+    parse_par, parse_par_with, GalaxyWithoutMag, LenstoolModel, LenstoolPar, ParComponent,
+    ParError, ParGalaxies, ParOptions, ParRedshiftPrior, ParWarning, Radius, GALAXY_MAX_CORE_KPC,
 };
 pub use limits::{
     with_line_feeds, InputKind, TooLarge, MAX_ARCS_BYTES, MAX_ARC_PIXELS, MAX_CATALOG_BYTES,
@@ -162,7 +162,7 @@ pub use reconstruct::{
     SourceReport, StrengthCandidate, StrengthChoice, SystemCheck, TooMuchMemory, Trust, Verdict,
     VerdictInputs, WeakLensingFit, CALIBRATION_MIN_IMAGES, CALIBRATION_MIN_PREDICTIONS,
     CHOICE_MAP_PIXELS, DEFAULT_FOLDS, FALLBACK_MEMORY_LIMIT_BYTES, FALLBACK_SIGMA_ARCSEC,
-    MAX_ENSEMBLE_MEMBERS, SHOWN_MIN_MAGNIFICATION, WASM_MEMORY_LIMIT_BYTES,
+    MAX_ENSEMBLE_MEMBERS, PAR_GALAXY_MAX_LSTAR, SHOWN_MIN_MAGNIFICATION, WASM_MEMORY_LIMIT_BYTES,
 };
 
 // The verdict on a reconstruction and its thresholds.

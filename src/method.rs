@@ -286,7 +286,10 @@
 //! row. Given the `.par` (`wslap reconstruct --par`, or the app's setting "Galaxies and
 //! redshift priors from the .par"), its dPIE potentials with a core of at most 5 kpc and a
 //! `mag` become members, placed through the sky from the `.par`'s frame
-//! ([`crate::Dataset::add_par_galaxies`]), before commented rows are looked for. The run
+//! ([`crate::Dataset::add_par_galaxies`]), before commented rows are looked for. One without
+//! a `mag` takes the commented row where it lies, or else the magnitude whose halo mass is
+//! its dPIE's total mass `pi b0 r_cut Sigma_cr` (`(3/2) pi v_disp^2 r_cut / G` when round),
+//! up to 100 `L*` (beyond, a group's or cluster's halo with a small core). The run
 //! does not guess a position: a galaxy of ten `L*` put at the peak of a grid-only first
 //! solution helps the synthetic clusters but misses the real BCGs by 1 - 5 arcsec and makes
 //! both real catalogues worse (BENCHMARKS.md); a commented row is the catalogue's own position

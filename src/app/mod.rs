@@ -105,17 +105,18 @@ impl Session {
         let mut warnings = self.sky_warnings();
         warnings.append(&mut parsed.warnings);
         parsed.warnings = warnings;
+        let plane = self.settings.lens_plane()?;
         if self.settings.members_from_model {
             let options = self.settings.par_options().for_galaxies();
             if let Some(par) = self.data.model_par(&options)? {
                 let notes = parsed
-                    .add_par(&par)
+                    .add_par(&par, &plane, &self.settings.reconstruct)
                     .map_err(|e| AppError::File(e.to_string()))?;
                 parsed.warnings.extend(notes);
             }
         }
         // The run's warnings say so when it fits commented-out BCG rows.
-        parsed.fit_commented_bcgs(&self.settings.lens_plane()?, &self.settings.reconstruct);
+        parsed.fit_commented_bcgs(&plane, &self.settings.reconstruct);
         Ok(parsed)
     }
 
@@ -171,7 +172,11 @@ impl Session {
             return Vec::new();
         }
         let options = self.settings.par_options().for_galaxies();
-        let (Ok(Some(par)), Ok(mut trial)) = (self.data.model_par(&options), self.parsed()) else {
+        let (Ok(Some(par)), Ok(mut trial), Ok(plane)) = (
+            self.data.model_par(&options),
+            self.parsed(),
+            self.settings.lens_plane(),
+        ) else {
             return Vec::new();
         };
         let before = trial
@@ -179,7 +184,10 @@ impl Session {
             .as_ref()
             .map(|m| m.members.clone())
             .unwrap_or_default();
-        if trial.add_par_galaxies(&par).is_err() {
+        if trial
+            .add_par_galaxies(&par, &plane, &self.settings.reconstruct)
+            .is_err()
+        {
             return Vec::new();
         }
         trial

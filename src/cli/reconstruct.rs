@@ -236,7 +236,10 @@ pub fn run(args: &ReconstructArgs) -> Result<(), String> {
         for w in &par.warnings {
             eprintln!("warning: {w}");
         }
-        for note in data.add_par(&par).map_err(|e| e.to_string())? {
+        for note in data
+            .add_par(&par, &plane, &config)
+            .map_err(|e| e.to_string())?
+        {
             eprintln!("note: {note}");
         }
     }

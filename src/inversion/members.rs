@@ -301,6 +301,13 @@ impl MemberConfig {
         self.mass_to_light * self.l_star_lsun * 10f64.powf(-0.4 * (mag - mag_star))
     }
 
+    /// The apparent magnitude whose halo mass ([`Self::mass_msun`]) is `mass_msun`:
+    /// `mag* - 2.5 log10(M / (Upsilon L*))`. A galaxy a Lenstool `.par` gives a mass but no
+    /// magnitude becomes a member so.
+    pub fn mag_of_mass(&self, mass_msun: f64, mag_star: f64) -> f64 {
+        mag_star - 2.5 * (mass_msun / (self.mass_to_light * self.l_star_lsun)).log10()
+    }
+
     /// Luminosity in `L*` of a galaxy of apparent magnitude `mag`: its halo mass
     /// ([`Self::mass_msun`]) over that of an `L*` galaxy.
     pub fn luminosity_lstar(&self, mag: f64, mag_star: f64) -> f64 {

@@ -174,11 +174,31 @@ pub const GALAXY_MAX_CORE_KPC: f64 = 5.0;
 pub struct ParGalaxies {
     /// Those with a `mag`, as member rows in the file's frame.
     pub members: Vec<Member>,
-    /// Those without one: each block's name, line and centre (arcsec, the file's frame).
-    pub without_mag: Vec<(String, usize, DVec2)>,
+    /// Those without one, with what a member made of them needs instead (see
+    /// [`GalaxyWithoutMag`]).
+    pub without_mag: Vec<GalaxyWithoutMag>,
     /// Galaxies at another redshift than [`LenstoolPar::z_lens`] (read with the single-plane
     /// approximation), not the cluster's: each block's name, line and `z_lens`.
     pub other_plane: Vec<(String, usize, f64)>,
+}
+
+/// A galaxy of a `.par` with a velocity dispersion but no `mag` (a fitted `bestopt.par`
+/// lists each galaxy it modelled so; a starting `.par` gives its BCG a dispersion to fit).
+#[derive(Debug, Clone, PartialEq)]
+pub struct GalaxyWithoutMag {
+    /// The block's name, e.g. `potentiel 510`.
+    pub block: String,
+    /// The block's first line (1-based).
+    pub line: usize,
+    /// Its centre in arcsec, in the file's frame.
+    pub centre: DVec2,
+    /// The dPIE's total mass in Msun ([`Dpie::total_mass_msun`]), or `None` when the block's
+    /// radii make no dPIE (a cut radius not above the core).
+    pub mass_msun: Option<f64>,
+    /// Axis ratio `b/a` from the mass ellipticity, as for the members with a `mag`.
+    pub axis_ratio: f64,
+    /// Position angle, degrees counter-clockwise from +x.
+    pub pa_deg: f64,
 }
 
 /// One mass component of a `potentiel` block (positions in arcsec, angles in degrees
@@ -337,18 +357,20 @@ impl LenstoolPar {
     /// at most [`GALAXY_MAX_CORE_KPC`] (a BCG's is below a kpc; a group or cluster halo's tens
     /// of kpc), as member rows in the file's frame (id: the block's name, e.g. `O3`; a and b
     /// from the ellipticity `(a^2 - b^2)/(a^2 + b^2)`; line: the block's). Those without a
-    /// `mag`, which a member needs, come second, by block name, line and centre; those at
-    /// another redshift (a single-plane read, [`ParOptions::for_galaxies`]) third.
+    /// `mag`, which a member needs, come second with their dPIE's mass
+    /// ([`GalaxyWithoutMag`]; a massless one, `v_disp 0`, is left out); those at another
+    /// redshift (a single-plane read, [`ParOptions::for_galaxies`]) third.
     pub fn galaxies(&self) -> Result<ParGalaxies, ParError> {
         let plane = self.lens_plane()?;
         let (mut rows, mut without_mag, mut other_plane) = (Vec::new(), Vec::new(), Vec::new());
         for p in &self.potentials {
             let ParComponent::Dpie {
                 center_arcsec,
+                sigma_v_km_s,
                 r_core,
+                r_cut,
                 ellipticity,
                 pa_deg,
-                ..
             } = p.component
             else {
                 continue;
@@ -362,16 +384,31 @@ impl LenstoolPar {
                 continue;
             }
             let id = p.block.split_whitespace().last().unwrap_or("potentiel");
+            let e = ellipticity.clamp(0.0, 0.99);
+            let axis_ratio = ((1.0 - e) / (1.0 + e)).sqrt();
             let Some(mag) = p.mag else {
-                without_mag.push((p.block.clone(), p.line, center_arcsec));
+                // A massless potential (a node of a grid model) is no galaxy to fit.
+                if sigma_v_km_s > 0.0 {
+                    let (core, cut) = (r_core.arcsec(&plane), r_cut.arcsec(&plane));
+                    let mass_msun = Dpie::new(center_arcsec, sigma_v_km_s, core, cut, e, pa_deg)
+                        .ok()
+                        .map(|d| d.total_mass_msun(&plane));
+                    without_mag.push(GalaxyWithoutMag {
+                        block: p.block.clone(),
+                        line: p.line,
+                        centre: center_arcsec,
+                        mass_msun,
+                        axis_ratio,
+                        pa_deg,
+                    });
+                }
                 continue;
             };
-            let e = ellipticity.clamp(0.0, 0.99);
             rows.push(Member {
                 id: id.to_string(),
                 position: center_arcsec,
                 a_arcsec: 1.0,
-                b_arcsec: ((1.0 - e) / (1.0 + e)).sqrt(),
+                b_arcsec: axis_ratio,
                 theta_deg: pa_deg,
                 mag,
                 lum: 0.0,

@@ -34,7 +34,7 @@ use crate::cosmology::LensPlane;
 use crate::inversion::{
     build_constraints, missing_bcg_warning, ConstraintMode, ConstraintSource, RedshiftPrior,
 };
-use crate::lenstool_par::{LenstoolPar, ParError, ParGalaxies, GALAXY_MAX_CORE_KPC};
+use crate::lenstool_par::{LenstoolPar, ParError, ParGalaxies};
 use crate::sky::SkyReference;
 
 /// One input file: the name used in messages and its text.
@@ -74,6 +74,12 @@ pub enum DatasetError {
 /// Two galaxies closer than this (arcsec) are the same one: a `.par` galaxy the member
 /// catalogue already lists is not added again ([`Dataset::add_par_galaxies`]).
 pub const SAME_GALAXY_ARCSEC: f64 = 1.0;
+
+/// Most luminous (in `L*`, under the member law) a `.par` galaxy without a `mag` may be made
+/// a member from its mass ([`Dataset::add_par_galaxies`]): a BCG's dPIE with a long cut
+/// radius comes to tens of `L*` (`1e12 Msun` each), a group's or cluster's halo with a small
+/// core to hundreds or thousands.
+pub const PAR_GALAXY_MAX_LSTAR: f64 = 100.0;
 
 /// The catalogues read into one frame (see the module documentation).
 #[derive(Debug, Clone, Default)]
@@ -137,8 +143,14 @@ impl Dataset {
     /// What a reconstruction takes from a Lenstool `.par` of the same cluster: the galaxies it
     /// models on its own ([`Self::add_par_galaxies`]) and the redshift priors of its `image`
     /// block ([`Self::add_par_redshift_priors`]). One sentence per thing taken or not.
-    pub fn add_par(&mut self, par: &LenstoolPar) -> Result<Vec<String>, DatasetError> {
-        let mut notes = self.add_par_galaxies(par)?;
+    /// The galaxies' masses are read with the member law of `config` on `plane`.
+    pub fn add_par(
+        &mut self,
+        par: &LenstoolPar,
+        plane: &LensPlane,
+        config: &ReconstructConfig,
+    ) -> Result<Vec<String>, DatasetError> {
+        let mut notes = self.add_par_galaxies(par, plane, config)?;
         notes.extend(self.add_par_redshift_priors(par));
         Ok(notes)
     }
@@ -207,15 +219,23 @@ impl Dataset {
     /// Adds the galaxies a Lenstool `.par` models on its own ([`LenstoolPar::galaxies`]: e.g.
     /// the BCG a potfile catalogue leaves out) to the members, in the data's frame (a member
     /// catalogue is made when there is none); those it adds are recorded in
-    /// [`MemberCatalog::par_galaxies`]. A galaxy without a `mag` (a starting `.par`
-    /// gives a BCG a velocity dispersion to fit, not a magnitude) is fitted when the member
-    /// catalogue comments out a row within 1 arcsec of it, as Lenstool set-ups do with the
-    /// galaxies their `.par` models: that row, with its magnitude, becomes a member. One
-    /// sentence per galaxy says what became of it: added; already a member (one lies within
-    /// 1 arcsec); its commented row fitted; or left out for want of a `mag`.
-    pub fn add_par_galaxies(&mut self, par: &LenstoolPar) -> Result<Vec<String>, DatasetError> {
+    /// [`MemberCatalog::par_galaxies`]. A galaxy without a `mag` (a fitted `bestopt.par` lists
+    /// each galaxy it modelled so; a starting `.par` gives its BCG a velocity dispersion to
+    /// fit) takes the row the member catalogue comments out within 1 arcsec of it, as Lenstool
+    /// set-ups do with the galaxies their `.par` models; without one it becomes a member of
+    /// the magnitude whose halo mass under the member law of `config` is its dPIE's total mass
+    /// ([`crate::inversion::MemberConfig::mag_of_mass`] on `plane`), unless that mass is a group's (over
+    /// [`PAR_GALAXY_MAX_LSTAR`] L*). One sentence per galaxy says what became of it (one for
+    /// all of a kind when there are many): added; already a member (one lies within
+    /// 1 arcsec); its commented row fitted; or left out.
+    pub fn add_par_galaxies(
+        &mut self,
+        par: &LenstoolPar,
+        plane: &LensPlane,
+        config: &ReconstructConfig,
+    ) -> Result<Vec<String>, DatasetError> {
         let ParGalaxies {
-            members: rows,
+            members: mut rows,
             without_mag,
             other_plane,
         } = par.galaxies()?;
@@ -227,30 +247,62 @@ impl Dataset {
             _ => p,
         };
         let mut notes = Vec::new();
-        let mut unfitted = Vec::new();
-        for (block, line, centre) in &without_mag {
-            match self.galaxy_without_mag(name, block, *line, to_data(*centre)) {
-                Some(note) => notes.push(note),
-                None => unfitted.push((block, *line)),
+        let law = &config.members;
+        let mag_star = law.mag_star_on(plane);
+        let mut by_mass = Vec::new();
+        for g in &without_mag {
+            if let Some(note) = self.galaxy_without_mag(name, &g.block, g.line, to_data(g.centre)) {
+                notes.push(note);
+                continue;
+            }
+            let lstar = g.mass_msun.map(|m| m / law.mass_msun(mag_star, mag_star));
+            match (g.mass_msun, lstar) {
+                (Some(mass), Some(l)) if l <= PAR_GALAXY_MAX_LSTAR => {
+                    let id = g.block.split_whitespace().last().unwrap_or("potentiel");
+                    by_mass.push(Member {
+                        id: id.to_string(),
+                        position: g.centre,
+                        a_arcsec: 1.0,
+                        b_arcsec: g.axis_ratio,
+                        theta_deg: g.pa_deg,
+                        mag: law.mag_of_mass(mass, mag_star),
+                        lum: 0.0,
+                        line: g.line,
+                    });
+                }
+                (Some(mass), Some(l)) => notes.push(format!(
+                    "{name}: line {}: `{}` has no `mag` and a dPIE mass of {mass:.2e} Msun \
+                     ({l:.0} L* under the member law): a group's, not a galaxy's: not fitted",
+                    g.line, g.block
+                )),
+                _ => notes.push(format!(
+                    "{name}: line {}: `{}` has no `mag` and its radii make no dPIE (the cut \
+                     radius must exceed the core): not fitted",
+                    g.line, g.block
+                )),
             }
         }
         // A best.par lists every galaxy it fitted (hundreds): one sentence for all of them.
-        match &unfitted[..] {
+        match &by_mass[..] {
             [] => {}
-            [(block, line)] => notes.push(format!(
-                "{name}: line {line}: `{block}` is a galaxy (core at most {GALAXY_MAX_CORE_KPC} \
-                 kpc) without a `mag`, which a member needs, and no member catalogue row \
-                 (commented out or not) lies there: not fitted; give its row in the member \
-                 catalogue"
+            [g] => notes.push(format!(
+                "{name}: line {}: galaxy {} has no `mag`: fitted as a member of mag {:.2}, the \
+                 magnitude whose halo mass under the member law is its dPIE's",
+                g.line, g.id, g.mag
             )),
             many => notes.push(format!(
-                "{name}: {} galaxies (core at most {GALAXY_MAX_CORE_KPC} kpc; lines {}) have no \
-                 `mag`, which a member needs, and no member catalogue row (commented out or \
-                 not) lies at them: not fitted; give their rows in the member catalogue",
+                "{name}: {} galaxies without a `mag` (lines {}) are fitted as members of the \
+                 magnitudes whose halo masses under the member law are their dPIEs' (mag {:.2} \
+                 to {:.2})",
                 many.len(),
-                line_list(many.iter().map(|(_, line)| *line))
+                line_list(many.iter().map(|g| g.line)),
+                many.iter().map(|g| g.mag).fold(f64::INFINITY, f64::min),
+                many.iter().map(|g| g.mag).fold(f64::NEG_INFINITY, f64::max),
             )),
         }
+        // The galaxies with a `mag` have a sentence each below; those by mass had theirs.
+        let with_mag = rows.len();
+        rows.extend(by_mass);
         notes.extend(other_plane.iter().map(|(block, line, z)| {
             format!(
                 "{name}: line {line}: `{block}` is a galaxy at z = {z}, not at the cluster's \
@@ -283,7 +335,7 @@ impl Dataset {
         // Galaxies the catalogue lists already (a `best.par` writes every potfile member out
         // as a `potentiel` of its own): one sentence for all of them.
         let mut already = Vec::new();
-        for mut g in rows {
+        for (k, mut g) in rows.into_iter().enumerate() {
             g.position = to_data(g.position);
             let (x, y) = (g.position.x, g.position.y);
             let near = members
@@ -300,11 +352,13 @@ impl Dataset {
                 ));
                 continue;
             }
-            notes.push(format!(
-                "{name}: line {}: galaxy {} at ({x:.2}, {y:.2}) arcsec, mag {:.2}, fitted as a \
-                 member",
-                g.line, g.id, g.mag
-            ));
+            if k < with_mag {
+                notes.push(format!(
+                    "{name}: line {}: galaxy {} at ({x:.2}, {y:.2}) arcsec, mag {:.2}, fitted as \
+                     a member",
+                    g.line, g.id, g.mag
+                ));
+            }
             members.note_par_galaxy(g.id.clone());
             members.members.push(g);
         }
@@ -502,10 +556,30 @@ fn region_arcs(
     arcs_from_regions(file.text, file.name, reference, pixel_arcsec, &catalog_z)
 }
 
-/// Line numbers as a note lists them: "12, 15, 40".
+/// Line numbers as a note lists them: "12, 15, 40"; past [`LISTED_LINES`] the first of
+/// them and how many more, up to which line ("108, 122, ... 234 and 131 more, up to line
+/// 2078"): a `best.par` lists hundreds of galaxies.
 fn line_list(lines: impl Iterator<Item = usize>) -> String {
-    lines.map(|l| l.to_string()).collect::<Vec<_>>().join(", ")
+    let lines: Vec<usize> = lines.collect();
+    let shown = |l: &[usize]| {
+        l.iter()
+            .map(|l| l.to_string())
+            .collect::<Vec<_>>()
+            .join(", ")
+    };
+    match &lines[..] {
+        few if few.len() <= LISTED_LINES => shown(few),
+        [first @ .., last] => format!(
+            "{} and {} more, up to line {last}",
+            shown(&first[..LISTED_LINES]),
+            lines.len() - LISTED_LINES
+        ),
+        [] => unreachable!("an empty list has fewer lines than LISTED_LINES"),
+    }
 }
+
+/// Most line numbers a note lists one by one ([`line_list`]).
+const LISTED_LINES: usize = 10;
 
 #[cfg(test)]
 mod tests {

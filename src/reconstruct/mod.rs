@@ -26,7 +26,7 @@ pub use crossval::{
     cross_validate, fitted_system_ids, fold_groups, holdable_system_ids, CrossValidation, FoldRun,
     KappaSpread, PredictedSystem, DEFAULT_FOLDS,
 };
-pub use dataset::{Dataset, DatasetError, InputText, InputTexts};
+pub use dataset::{Dataset, DatasetError, InputText, InputTexts, PAR_GALAXY_MAX_LSTAR};
 pub use ensemble::{
     check_ensemble_size, run_ensemble, Calibration, Ensemble, EnsembleMaps, EnsembleMember,
     EnsemblePlan, LeftOutImage, MemberDraw, MemberRun, CALIBRATION_MIN_IMAGES,

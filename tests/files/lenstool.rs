@@ -202,7 +202,9 @@ fn the_galaxies_of_a_multi_plane_model_are_the_cluster_planes() {
         [("potentiel O3".to_string(), line, 1.05)]
     );
     let mut data = wslap::Dataset::default();
-    let notes = data.add_par_galaxies(&par).unwrap();
+    let notes = data
+        .add_par_galaxies(&par, &par.lens_plane().unwrap(), &Default::default())
+        .unwrap();
     let expected = format!(
         "group.par: line {line}: `potentiel O3` is a galaxy at z = 1.05, not at the \
          cluster's z_lens = 0.375: not fitted"
@@ -642,7 +644,9 @@ mod galaxies_of_a_par {
 
         let mut data = as1063(true);
         let before = data.members.as_ref().unwrap().members.len();
-        let notes = data.add_par_galaxies(&par).unwrap();
+        let notes = data
+            .add_par_galaxies(&par, &par.lens_plane().unwrap(), &Default::default())
+            .unwrap();
         let members = &data.members.as_ref().unwrap().members;
         assert_eq!(members.len(), before + 1);
         let added = members.last().unwrap();
@@ -669,7 +673,9 @@ mod galaxies_of_a_par {
             notes[0]
         );
         // Given twice, or with a catalogue that has it, it is not added again.
-        let notes = data.add_par_galaxies(&par).unwrap();
+        let notes = data
+            .add_par_galaxies(&par, &par.lens_plane().unwrap(), &Default::default())
+            .unwrap();
         assert_eq!(data.members.as_ref().unwrap().members.len(), before + 1);
         assert!(
             notes[0].contains("is member O3 of members.cat already: not added twice"),
@@ -678,67 +684,137 @@ mod galaxies_of_a_par {
         assert_eq!(data.members.as_ref().unwrap().par_galaxies, ["O3"]);
         // Without a member catalogue it makes one, in the images' frame.
         let mut alone = as1063(false);
-        alone.add_par_galaxies(&par).unwrap();
+        alone
+            .add_par_galaxies(&par, &par.lens_plane().unwrap(), &Default::default())
+            .unwrap();
         let made = alone.members.unwrap();
         assert_eq!((made.members.len(), made.reference), (1, Some(frame)));
         assert!((made.members[0].position - expected).length() < 1e-3);
     }
 
+    /// Newton's G in kpc (km/s)^2 / Msun (CODATA 2018 G, IAU nominal solar mass), for the
+    /// total mass of a circular dPIE, `(3/2) pi sigma^2 r_cut / G` (Eliasdottir et al. 2007:
+    /// `sigma_0^2 = (3/2) sigma^2`, and a dPIE's mass is `pi sigma_0^2 r_cut / G`).
+    const G_KPC: f64 = 4.300_917e-6;
+
+    /// The halo mass the member law gives `member`, with the default member settings on
+    /// the `.par`'s lens plane.
+    fn law_mass(member: &wslap::Member, par: &wslap::LenstoolPar) -> f64 {
+        let law = wslap::ReconstructConfig::default().members;
+        let mag_star = law.mag_star_on(&par.lens_plane().unwrap());
+        law.mass_msun(member.mag, mag_star)
+    }
+
     /// A fitted `.par` lists every galaxy it modelled (A1689's of Limousin et al.: 272), each
-    /// without a `mag`: what is not fitted is said once, with its lines, not once a galaxy.
+    /// with a velocity dispersion and radii but no `mag`: each becomes a member whose halo
+    /// has its dPIE's mass under the member law, and one note says so for all.
     #[test]
-    fn galaxies_without_a_magnitude_are_named_in_one_note() {
-        let galaxy = |n: usize, x: f64| {
+    fn galaxies_without_a_magnitude_are_fitted_by_their_mass() {
+        let galaxy = |n: usize, x: f64, sigma: f64, cut: f64| {
             format!(
                 "potentiel {n}\n    profil 81\n    x_centre {x}\n    y_centre 0.\n    \
-                 v_disp 150.\n    core_radius_kpc 0.1\n    cut_radius_kpc 50.\n    \
+                 v_disp {sigma}\n    core_radius_kpc 0.1\n    cut_radius_kpc {cut}\n    \
                  z_lens 0.35\n    end\n"
             )
         };
         let text = format!(
             "runmode\n    reference 3 292.95682 -26.575718\n    end\ncosmologie\n    H0 70.\n    \
-             omega 0.3\n    lambda 0.7\n    end\n{}{}{}",
-            galaxy(1, 10.0),
-            galaxy(2, 20.0),
-            galaxy(3, 30.0)
+             omega 0.3\n    lambda 0.7\n    end\n{}{}{}{}",
+            galaxy(1, 10.0, 150.0, 50.0),
+            galaxy(2, 20.0, 250.0, 80.0),
+            galaxy(3, 30.0, 120.0, 30.0),
+            // A node of a grid model: massless, not a galaxy.
+            galaxy(4, 40.0, 0.0, 30.0),
         );
         let par = parse_par(&text, "fitted.par").unwrap();
         assert_eq!(par.galaxies().unwrap().without_mag.len(), 3);
-        let notes = Dataset::default().add_par_galaxies(&par).unwrap();
-        assert_eq!(
-            notes,
-            [
-                "fitted.par: 3 galaxies (core at most 5 kpc; lines 9, 18, 27) have no `mag`, \
-                 which a member needs, and no member catalogue row (commented out or not) lies \
-                 at them: not fitted; give their rows in the member catalogue"
-            ]
+        let mut data = Dataset::default();
+        let notes = data
+            .add_par_galaxies(&par, &par.lens_plane().unwrap(), &Default::default())
+            .unwrap();
+        assert_eq!(notes.len(), 1, "{notes:?}");
+        assert!(
+            notes[0].starts_with(
+                "fitted.par: 3 galaxies without a `mag` (lines 9, 18, 27) are fitted as members \
+                 of the magnitudes whose halo masses under the member law are their dPIEs' (mag"
+            ),
+            "{notes:?}"
         );
+        let members = data.members.as_ref().unwrap();
+        assert_eq!(members.par_galaxies, ["1", "2", "3"]);
+        for (m, (sigma, cut)) in
+            members
+                .members
+                .iter()
+                .zip([(150.0, 50.0), (250.0, 80.0), (120.0, 30.0)])
+        {
+            let dpie = 1.5 * std::f64::consts::PI * sigma * sigma * cut / G_KPC;
+            let mass = law_mass(m, &par);
+            assert!(
+                (mass / dpie - 1.0).abs() < 1e-3,
+                "{} {mass:e} {dpie:e}",
+                m.id
+            );
+        }
+        // A cluster halo with a small core is not made a galaxy of a thousand L*.
+        let text = text
+            .replace("v_disp 250\n", "v_disp 1200\n")
+            .replace("cut_radius_kpc 80\n", "cut_radius_kpc 1500\n");
+        let par = parse_par(&text, "fitted.par").unwrap();
+        let mut data = Dataset::default();
+        let notes = data
+            .add_par_galaxies(&par, &par.lens_plane().unwrap(), &Default::default())
+            .unwrap();
+        assert!(
+            notes.iter().any(|n| n.starts_with(
+                "fitted.par: line 18: `potentiel 2` has no \
+                 `mag` and a dPIE mass of"
+            ) && n.ends_with("a group's, not a galaxy's: not fitted")),
+            "{notes:?}"
+        );
+        assert_eq!(data.members.unwrap().par_galaxies, ["1", "3"]);
     }
 
     #[test]
-    fn a_galaxy_without_a_magnitude_takes_its_commented_row_or_is_left_out() {
+    fn a_galaxy_without_a_magnitude_takes_its_commented_row_or_its_mass() {
         // MACS1931's .par is a starting model: its BCG (potential 3, core 0.115 kpc, at the
         // reference) has a velocity dispersion to fit and no `mag`; m1931.cat comments its row
         // out (`#1009.0 0.0 0.0 ... 17.325`).
         let par = parse_par(&read("MACS1931/lenstool_cats/m1931.par"), "m1931.par").unwrap();
         let found = par.galaxies().unwrap();
         assert!(found.members.is_empty());
+        let [bcg] = &found.without_mag[..] else {
+            panic!("{:?}", found.without_mag)
+        };
         assert_eq!(
-            found.without_mag,
-            [("potentiel 3".to_string(), 66, DVec2::ZERO)]
+            (bcg.block.as_str(), bcg.line, bcg.centre),
+            ("potentiel 3", 66, DVec2::ZERO)
         );
-        // Without a member catalogue there is no magnitude to take.
+        // Without a member catalogue its magnitude is the one its starting mass implies
+        // (v_disp 100 km/s, cut 100 kpc).
         let mut data = Dataset::default();
-        let notes = data.add_par_galaxies(&par).unwrap();
-        assert_eq!(
-            notes,
-            [
-                "m1931.par: line 66: `potentiel 3` is a galaxy (core at most 5 kpc) without a \
-                 `mag`, which a member needs, and no member catalogue row (commented out or \
-                 not) lies there: not fitted; give its row in the member catalogue"
-            ]
+        let notes = data
+            .add_par_galaxies(&par, &par.lens_plane().unwrap(), &Default::default())
+            .unwrap();
+        assert_eq!(notes.len(), 1, "{notes:?}");
+        assert!(
+            notes[0].starts_with(
+                "m1931.par: line 66: galaxy 3 has no `mag`: fitted as a member of mag "
+            ),
+            "{notes:?}"
         );
-        assert!(data.members.is_none());
+        let alone = data.members.as_ref().unwrap();
+        assert_eq!(alone.par_galaxies, ["3"]);
+        let dpie = 1.5 * std::f64::consts::PI * 100.0 * 100.0 * 100.0 / G_KPC;
+        let mass = law_mass(&alone.members[0], &par);
+        // Its ellipticity (0.273) lowers a dPIE's mass by 1 - eps^2 (eps the Kassiola-Kovner
+        // ellipticity, (1 - sqrt(1 - e^2)) / e).
+        let e: f64 = 0.273;
+        let eps = (1.0 - (1.0 - e * e).sqrt()) / e;
+        assert!(
+            (mass / (dpie * (1.0 - eps * eps)) - 1.0).abs() < 1e-3,
+            "{mass:e} {dpie:e}"
+        );
         // With it, the commented row there becomes a member, once; and the set-up's own
         // galaxy is recorded, so no BCG is looked for among the commented rows.
         let cat = read("MACS1931/lenstool_cats/m1931.cat");
@@ -754,7 +830,9 @@ mod galaxies_of_a_par {
         )
         .unwrap();
         let before = data.members.as_ref().unwrap().members.len();
-        let notes = data.add_par_galaxies(&par).unwrap();
+        let notes = data
+            .add_par_galaxies(&par, &par.lens_plane().unwrap(), &Default::default())
+            .unwrap();
         assert_eq!(
             notes,
             [
@@ -768,7 +846,9 @@ mod galaxies_of_a_par {
         assert_eq!((bcg.id.as_str(), bcg.mag, bcg.line), ("1009.0", 17.325, 10));
         assert!(!members.commented.iter().any(|m| m.id == "1009.0"));
         assert_eq!(members.par_galaxies, ["1009.0"]);
-        let notes = data.add_par_galaxies(&par).unwrap();
+        let notes = data
+            .add_par_galaxies(&par, &par.lens_plane().unwrap(), &Default::default())
+            .unwrap();
         assert!(
             notes[0].ends_with("`potentiel 3` (no `mag`) is member 1009.0 of m1931.cat already"),
             "{notes:?}"
@@ -806,7 +886,9 @@ fn a_published_set_up_s_par_gives_its_priors_and_bcg() {
     let par = parse_par_with(text, "best.par", &ParOptions::default().for_galaxies())
         .expect("the .par loads");
     let priors = par.redshift_priors.len();
-    let notes = data.add_par(&par).expect("its galaxies are added");
+    let notes = data
+        .add_par(&par, &par.lens_plane().unwrap(), &Default::default())
+        .expect("its galaxies are added");
     let in_front: Vec<&String> = notes
         .iter()
         .filter(|n| n.contains("puts it in front of the lens (z_lens = 0.39): not used"))

@@ -1133,7 +1133,8 @@ fn a_commented_out_bcg_row_is_fitted_unless_the_settings_say_not() {
     )
     .unwrap();
     let mut data = read_macs();
-    data.add_par_galaxies(&par).unwrap();
+    data.add_par_galaxies(&par, &par.lens_plane().unwrap(), &Default::default())
+        .unwrap();
     assert_eq!(data.members.as_ref().unwrap().par_galaxies, ["G1"]);
     assert!(data.fit_commented_bcgs(&plane, &config).is_empty());
     assert_eq!(data.members.as_ref().unwrap().members.len(), members + 1);
@@ -1153,7 +1154,10 @@ fn a_commented_out_bcg_row_is_fitted_unless_the_settings_say_not() {
     )
     .unwrap();
     let mut data = read_macs();
-    assert!(data.add_par_galaxies(&halo).unwrap().is_empty());
+    assert!(data
+        .add_par_galaxies(&halo, &halo.lens_plane().unwrap(), &Default::default())
+        .unwrap()
+        .is_empty());
     let m = data.members.as_ref().unwrap();
     assert_eq!(
         (m.par_source.as_deref(), m.par_galaxies.len()),

@@ -92,9 +92,13 @@ export function showVerdict(verdict, { fitRows = null, modelGalaxies = [], fitMo
       `Removes the # before ${rows.length === 1 ? 'that row' : 'those rows'} of the member catalogue you loaded (in this app only: your file is not changed) and runs the reconstruction again.`,
       () => fitRows(rows));
   } else if (last.bcg?.missing && modelGalaxies.length && fitModel) {
-    const names = modelGalaxies.map((g) => `${g.id}, mag ${g.mag.toFixed(2)}`).join('; ');
-    offer('fit-model-galaxies', `Fit the .par's galaxy (${names}) and reconstruct again`,
-      'The loaded Lenstool .par models this galaxy on its own (a core of at most 5 kpc, with its magnitude, or without one where the member catalogue comments out its row): fits it as a member (the setting "Galaxies and redshift priors from the .par", which also takes the redshift priors of its z_m_limit lines), as wslap reconstruct --par does, and runs the reconstruction again.',
+    // A fitted .par may list hundreds of galaxies: name a few.
+    const named = modelGalaxies.slice(0, 3).map((g) => `${g.id}, mag ${g.mag.toFixed(2)}`).join('; ');
+    const which = modelGalaxies.length === 1 ? `galaxy (${named})`
+      : modelGalaxies.length <= 3 ? `galaxies (${named})`
+        : `${modelGalaxies.length} galaxies (${named}; …)`;
+    offer('fit-model-galaxies', `Fit the .par's ${which} and reconstruct again`,
+      'The loaded Lenstool .par models these galaxies on their own (a core of at most 5 kpc, with a magnitude; without one, the member catalogue\'s commented row where it lies, or else the magnitude whose halo mass is its dPIE\'s): fits them as members (the setting "Galaxies and redshift priors from the .par", which also takes the redshift priors of its z_m_limit lines), as wslap reconstruct --par does, and runs the reconstruction again.',
       fitModel);
   }
 }
