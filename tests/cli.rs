@@ -765,7 +765,28 @@ fn reconstruct_folds_writes_crossval_json() {
         .collect();
     predicted.sort();
     assert_eq!(predicted, ["1", "2", "3", "4"]);
-    assert!(cv["holdout_image_offset_median_arcsec"].as_f64().unwrap() > 0.0);
+    let held = cv["holdout_image_offset_median_arcsec"].as_f64().unwrap();
+    assert!(held > 0.0);
+    // summary.json has the totals, and its verdict counts the held-out images as held out
+    // (the run itself holds none out).
+    let summary: serde_json::Value =
+        serde_json::from_str(&fs::read_to_string(out_dir.join("summary.json")).unwrap()).unwrap();
+    assert!(summary["holdout_image_offset_median_arcsec"].is_null());
+    for field in [
+        "folds",
+        "status",
+        "holdout_images",
+        "holdout_images_unmatched",
+        "holdout_image_offset_median_arcsec",
+        "holdout_image_plane_rms_arcsec",
+        "fit_image_offset_median_arcsec",
+    ] {
+        assert_eq!(summary["crossval"][field], cv[field], "{field}");
+    }
+    assert_eq!(
+        summary["verdict"]["holdout_offset_median_arcsec"].as_f64(),
+        Some(held)
+    );
     // The folds' convergence, on the pixels of kappa.fits.
     let read = |file: &str| {
         let path = out_dir.join(file);

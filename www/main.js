@@ -124,6 +124,7 @@ function readyText(loaded) {
 function showNoResult() {
   resultKind = null;
   $('summary').textContent = '';
+  verdictBase = null;
   showVerdict(null);
   locateExamples(null);
   runNotes(null);
@@ -182,9 +183,31 @@ async function render() {
   }
 }
 
+// The result's own verdict and what its box offers; the box shows the verdict that counts
+// the cross-validation's held-out images while the cross-validation is on screen.
+let verdictBase = null;
+let verdictOffers = {};
+let crossvalShown = false;
+
+/** Shows the result's verdict, or, while a cross-validation is on screen, the one that counts
+ * its held-out images (the core's; the result's own if it cannot give one). */
+async function refreshVerdict() {
+  let verdict = verdictBase;
+  if (verdictBase && crossvalShown) {
+    try {
+      verdict = (await ask('verdict', { crossval: true })) ?? verdictBase;
+    } catch {
+      verdict = verdictBase;
+    }
+  }
+  showVerdict(verdict, verdictOffers);
+}
+
 function caption(info) {
-  showVerdict(info.summary.verdict,
-    { fitRows: fitCommentedRows, modelGalaxies: info.model_galaxies ?? [], fitModel: fitModelGalaxies });
+  verdictBase = info.summary.verdict ?? null;
+  verdictOffers = { fitRows: fitCommentedRows, modelGalaxies: info.model_galaxies ?? [], fitModel: fitModelGalaxies };
+  showVerdict(verdictBase, verdictOffers);
+  if (crossvalShown && verdictBase) refreshVerdict();
   const s = info.summary.maps ?? info.summary;
   // The solver, when it is not the paper's QADP.
   const best = info.summary.settings?.solver?.method === 'accelerated_gradient'
@@ -427,7 +450,13 @@ async function poolTrials(project, plan, onProgress, cancelledText) {
 }
 
 // The last cross-validation, shown until the data or a setting changes (it was made with them).
-function clearCrossval() { showCrossval(null); }
+function clearCrossval() {
+  showCrossval(null);
+  if (crossvalShown) {
+    crossvalShown = false;
+    showVerdict(verdictBase, verdictOffers);
+  }
+}
 
 function crossValidate() {
   const n = settings?.reconstruct?.solver?.iterations ?? 1;
@@ -440,6 +469,8 @@ function crossValidate() {
       const files = await ask('crossvalFiles');
       showCrossval(cv, () => save('crossval.json',
         new Blob([JSON.stringify(cv, null, 2)], { type: 'application/json' })), files);
+      crossvalShown = true;
+      await refreshVerdict();
       $('crossval-box').scrollIntoView({ block: 'nearest' });
     });
 }

@@ -15,7 +15,7 @@ use crate::reconstruct::{
     ReconstructError, Reconstruction, RunSize, RunStatus, SecondRound, SourceReport, StageTimings,
     StrengthCandidate, StrengthChoice, DEFAULT_FOLDS,
 };
-use crate::reconstruct::{member_layers, shear_set, BcgFacts};
+use crate::reconstruct::{member_layers, shear_set, BcgFacts, Verdict};
 use crate::solver::{Control, Iterate};
 
 use super::data::{DataMarks, DataViews};
@@ -336,6 +336,14 @@ impl Session {
             }
             cross_validate(inputs, &config, folds, Some(geometry), progress).map_err(run_error)
         })
+    }
+
+    /// The verdict on the session's result once `cv`, a cross-validation of the loaded data
+    /// with the current settings ([`Self::cross_validate`]), has run: its held-out images count
+    /// as held out ([`Reconstruction::verdict_after`]; `None` for `cv`: the result's own
+    /// verdict). `None` when the result is no reconstruction.
+    pub fn verdict_after(&self, cv: Option<&CrossValidation>) -> Result<Option<Verdict>, AppError> {
+        Ok(self.result()?.reconstruction().map(|r| r.verdict_after(cv)))
     }
 
     /// The files of `cv`'s convergence maps (`wslap reconstruct --folds` writes the same):

@@ -307,23 +307,34 @@ pub fn run(args: &ReconstructArgs) -> Result<(), String> {
     }
     write_reconstruction(&result, &args.out)?;
     println!("{}", one_line(&result, &args.out));
-    if let Some(folds) = args.folds {
-        run_crossval(&inputs, &config, folds, &result, &args.out)?;
-    }
+    let cv = match args.folds {
+        Some(folds) => Some(run_crossval(&inputs, &config, folds, &result, &args.out)?),
+        None => None,
+    };
     if let Some(n) = args.ensemble {
-        write_ensemble(&inputs, &config, n, args.seed, &result, &args.out)?;
+        write_ensemble(
+            &inputs,
+            &config,
+            n,
+            args.seed,
+            &result,
+            cv.as_ref(),
+            &args.out,
+        )?;
     }
     Ok(())
 }
 
 /// `--ensemble`: `members` more reconstructions ([`run_ensemble`]), their files written to
-/// `out` and their ranges added to its summary.json, with a line on stdout.
+/// `out` and their ranges added to its summary.json (which keeps the cross-validation `cv`'s
+/// totals, with `--folds`), with a line on stdout.
 fn write_ensemble(
     inputs: &Inputs<'_>,
     config: &ReconstructConfig,
     members: usize,
     seed: u64,
     result: &Reconstruction,
+    cv: Option<&CrossValidation>,
     out: &Path,
 ) -> Result<(), String> {
     // Members run side by side, their reports interleaved: a line when each starts.
@@ -352,7 +363,7 @@ fn write_ensemble(
     }
     write("ensemble.json", json(&ensemble)?.as_bytes())?;
     // The ranges join the main run's summary.json.
-    let mut summary = serde_json::to_value(result.summary()).map_err(|e| e.to_string())?;
+    let mut summary = serde_json::to_value(result.summary_after(cv)).map_err(|e| e.to_string())?;
     ensemble.add_to_summary(&mut summary);
     write("summary.json", json(&summary)?.as_bytes())?;
     let radius = ensemble
@@ -370,14 +381,15 @@ fn write_ensemble(
 }
 
 /// `--folds`: the cross-validation of `result`'s inputs and settings over `folds` folds, written
-/// to `out` (crossval.json and the folds' convergence maps) with a line on stdout.
+/// to `out` (crossval.json and the folds' convergence maps; summary.json again, with its totals
+/// and the verdict they inform) with a line on stdout.
 fn run_crossval(
     inputs: &Inputs<'_>,
     config: &ReconstructConfig,
     folds: usize,
     result: &Reconstruction,
     out: &Path,
-) -> Result<(), String> {
+) -> Result<CrossValidation, String> {
     let total = config.solver.iterations;
     let mut progress = |fold: usize, r: &ConvergenceRecord| {
         if r.iteration == total {
@@ -396,6 +408,10 @@ fn run_crossval(
         fs::write(&path, bytes).map_err(|e| format!("{}: {e}", path.display()))
     };
     write("crossval.json", json(&cv)?.as_bytes())?;
+    write(
+        "summary.json",
+        json(&result.summary_after(Some(&cv)))?.as_bytes(),
+    )?;
     if let Some(kappa) = &cv.kappa {
         let p = &result.products;
         let files = kappa
@@ -406,7 +422,7 @@ fn run_crossval(
         }
     }
     println!("{}", crossval_line(&cv, &out.join("crossval.json")));
-    Ok(())
+    Ok(cv)
 }
 
 fn crossval_line(cv: &CrossValidation, path: &Path) -> String {

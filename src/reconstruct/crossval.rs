@@ -106,6 +106,39 @@ pub struct CrossValidation {
     pub kappa: Option<KappaSpread>,
 }
 
+/// A cross-validation's totals as `summary.json` gives them (`crossval`).
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct CrossvalTotals {
+    pub folds: usize,
+    /// [`CrossValidation::status`].
+    pub status: String,
+    pub holdout_images: usize,
+    pub holdout_images_unmatched: usize,
+    pub holdout_image_offset_median_arcsec: Option<f64>,
+    pub holdout_image_plane_rms_arcsec: Option<f64>,
+    pub fit_image_offset_median_arcsec: Option<f64>,
+}
+
+impl CrossValidation {
+    /// Whether every fold ran (not cancelled).
+    pub fn completed(&self) -> bool {
+        self.status == "Completed"
+    }
+
+    /// Its totals for `summary.json`.
+    pub fn totals(&self) -> CrossvalTotals {
+        CrossvalTotals {
+            folds: self.folds,
+            status: self.status.clone(),
+            holdout_images: self.holdout_images,
+            holdout_images_unmatched: self.holdout_images_unmatched,
+            holdout_image_offset_median_arcsec: self.holdout_image_offset_median_arcsec,
+            holdout_image_plane_rms_arcsec: self.holdout_image_plane_rms_arcsec,
+            fit_image_offset_median_arcsec: self.fit_image_offset_median_arcsec,
+        }
+    }
+}
+
 /// The folds' convergence (`D_ls/D_s = 1`) on one map: where the mass map depends on which
 /// systems are fitted. Pixels are those of the geometry given to [`cross_validate`].
 #[derive(Debug, Clone, PartialEq)]

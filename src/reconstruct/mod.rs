@@ -23,8 +23,8 @@ use thiserror::Error;
 
 pub use config::{ProductConfig, ReconstructConfig, SolverConfig, SolverMethod};
 pub use crossval::{
-    cross_validate, fitted_system_ids, fold_groups, holdable_system_ids, CrossValidation, FoldRun,
-    KappaSpread, PredictedSystem, DEFAULT_FOLDS,
+    cross_validate, fitted_system_ids, fold_groups, holdable_system_ids, CrossValidation,
+    CrossvalTotals, FoldRun, KappaSpread, PredictedSystem, DEFAULT_FOLDS,
 };
 pub use dataset::{Dataset, DatasetError, InputText, InputTexts, PAR_GALAXY_MAX_LSTAR};
 pub use ensemble::{
@@ -400,26 +400,46 @@ impl Reconstruction {
     /// The verdict on the map ([`Verdict::assess`]), with the curves at the products'
     /// source redshift.
     pub fn verdict(&self) -> Verdict {
-        self.verdict_with(self.products.summary().tangential_main_area_share)
+        self.verdict_after(None)
     }
 
-    fn verdict_with(&self, main_curve_share: Option<f64>) -> Verdict {
+    /// [`Self::verdict`] once `cv`, a cross-validation of the same inputs and settings, has
+    /// run: its held-out images count as held out (when it completed and the run holds no
+    /// system out itself).
+    pub fn verdict_after(&self, cv: Option<&CrossValidation>) -> Verdict {
+        self.verdict_with(self.products.summary().tangential_main_area_share, cv)
+    }
+
+    fn verdict_with(&self, main_curve_share: Option<f64>, cv: Option<&CrossValidation>) -> Verdict {
         let inputs = VerdictInputs {
             curves: Some((&self.products.curves, self.products.maps.geometry())),
             main_curve_share,
             members_arcsec: &self.member_positions_arcsec,
             c_unmeasured: self.system.members_unmeasured(),
             bcg: self.bcg.clone(),
+            crossval_holdout_median_arcsec: cv
+                .filter(|c| c.completed())
+                .and_then(|c| c.holdout_image_offset_median_arcsec),
         };
         Verdict::assess(&self.sources, inputs)
     }
 
     /// `summary.json` (what `wslap reconstruct` writes).
     pub fn summary(&self) -> ReconstructSummary<'_> {
+        self.summary_after(None)
+    }
+
+    /// [`Self::summary`] once `cv`, a cross-validation of the same inputs and settings, has
+    /// run (`--folds`): with its totals, and the verdict it informs
+    /// ([`Self::verdict_after`]).
+    pub fn summary_after(&self, cv: Option<&CrossValidation>) -> ReconstructSummary<'_> {
         let maps = self.products.summary();
-        let verdict = self.verdict_with(maps.tangential_main_area_share);
-        self.solved()
-            .summary(self.status.name().to_string(), maps, verdict)
+        let verdict = self.verdict_with(maps.tangential_main_area_share, cv);
+        let mut summary = self
+            .solved()
+            .summary(self.status.name().to_string(), maps, verdict);
+        summary.crossval = cv.map(CrossValidation::totals);
+        summary
     }
 }
 

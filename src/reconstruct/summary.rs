@@ -7,7 +7,10 @@ use serde::Serialize;
 use crate::inversion::kappa_gamma;
 use crate::profiles::MassComponent;
 
-use super::{FreeZSummary, ReconstructConfig, SourceReport, StageTimings, StrengthChoice, Verdict};
+use super::{
+    CrossvalTotals, FreeZSummary, ReconstructConfig, SourceReport, StageTimings, StrengthChoice,
+    Verdict,
+};
 use crate::inversion::LinearSystem;
 use crate::products::Summary;
 
@@ -127,6 +130,7 @@ impl<'a> Solved<'a> {
             image_offset_median_arcsec: self.image_offset_median_arcsec(false),
             holdout_image_offset_median_arcsec: self.image_offset_median_arcsec(true),
             verdict,
+            crossval: None,
             regulariser_weight: s.terms.penalty_weight,
             strength_choice: self.strength_choice,
             free_redshifts: self.free_z,
@@ -169,8 +173,13 @@ pub struct ReconstructSummary<'a> {
     pub holdout_image_plane_rms_arcsec: Option<f64>,
     pub image_offset_median_arcsec: Option<f64>,
     pub holdout_image_offset_median_arcsec: Option<f64>,
-    /// How far the map can be trusted, and why ([`Verdict::assess`]).
+    /// How far the map can be trusted, and why ([`Verdict::assess`]; with a cross-validation,
+    /// its held-out images count as held out).
     pub verdict: Verdict,
+    /// The totals of a cross-validation of the same data and settings (`--folds`; absent
+    /// without one): `crossval.json` has the folds.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub crossval: Option<CrossvalTotals>,
     /// The regulariser's absolute weight `lambda` in the objective (0 without one).
     pub regulariser_weight: Option<f64>,
     /// The cross-validation curve an "auto" strength was chosen from (candidate, held-out

@@ -237,6 +237,10 @@ pub struct VerdictInputs<'a> {
     pub c_unmeasured: bool,
     /// What the run found about the brightest cluster galaxies.
     pub bcg: BcgFacts,
+    /// The held-out images' median offset (arcsec) of a completed cross-validation of the
+    /// same data and settings (`wslap reconstruct --folds`): the held-out figure when the run
+    /// holds no system out itself.
+    pub crossval_holdout_median_arcsec: Option<f64>,
 }
 
 /// `summary.json`'s `verdict`.
@@ -250,8 +254,11 @@ pub struct Verdict {
     /// Median offset of the fitted systems' observed images from their nearest predicted
     /// images (arcsec).
     pub fit_offset_median_arcsec: Option<f64>,
-    /// The same for the held-out systems.
+    /// The same for the held-out systems, or for a cross-validation's held-out images
+    /// ([`VerdictInputs::crossval_holdout_median_arcsec`]).
     pub holdout_offset_median_arcsec: Option<f64>,
+    /// Whether that held-out figure is a cross-validation's.
+    pub holdout_from_crossval: bool,
     /// Systems judged.
     pub systems: usize,
     /// Systems with as many predicted images (shown ones) as observed, with fewer and with
@@ -343,7 +350,13 @@ impl Verdict {
                 sources.iter().filter(|s| s.held_out == held),
             ))
         };
-        let (fit, holdout) = (median(false), median(true));
+        let own_holdout = median(true);
+        let holdout_from_crossval =
+            own_holdout.is_none() && inputs.crossval_holdout_median_arcsec.is_some();
+        let (fit, holdout) = (
+            median(false),
+            own_holdout.or(inputs.crossval_holdout_median_arcsec),
+        );
         let n = checks.len();
         let count = |f: &dyn Fn(&SystemCheck) -> bool| checks.iter().filter(|c| f(c)).count();
         let fewer = count(&|c| c.predicted < c.observed);
@@ -522,6 +535,7 @@ impl Verdict {
             reasons: reasons.into_iter().take(2).collect::<Vec<_>>().join(" "),
             fit_offset_median_arcsec: fit,
             holdout_offset_median_arcsec: holdout,
+            holdout_from_crossval,
             systems: n,
             systems_matched: n - fewer - more,
             systems_fewer_predicted: fewer,
@@ -853,6 +867,7 @@ mod tests {
             members_arcsec: &members,
             c_unmeasured,
             bcg: BcgFacts::default(),
+            crossval_holdout_median_arcsec: None,
         };
         let v = Verdict::assess(&sources, inputs(true));
         assert_eq!(v.trust, Trust::UsableWithCare);
@@ -942,6 +957,44 @@ mod tests {
         assert_eq!((v.bcg.fitted, v.bcg.commented), (vec![row], vec![]));
         let two = [fitted("1", &[0.2, 0.3]), fitted("2", &[0.3])];
         let v = Verdict::assess(&two, VerdictInputs::default());
+        assert_eq!(v.trust, Trust::Good, "{}", v.reasons);
+    }
+
+    /// `wslap reconstruct --folds`: the cross-validation's held-out images are the map's
+    /// held-out figure when the run holds none out itself, and only then.
+    #[test]
+    fn a_cross_validation_s_held_out_images_count() {
+        let two = [fitted("1", &[0.2, 0.3]), fitted("2", &[0.3])];
+        let after = |m| VerdictInputs {
+            crossval_holdout_median_arcsec: Some(m),
+            ..VerdictInputs::default()
+        };
+        let v = Verdict::assess(&two, after(2.0));
+        assert_eq!(v.trust, Trust::UsableWithCare);
+        assert_eq!(v.holdout_offset_median_arcsec, Some(2.0));
+        assert!(v.holdout_from_crossval);
+        assert!(
+            v.reasons
+                .starts_with("Held-out images are predicted 2.0″ off"),
+            "{}",
+            v.reasons
+        );
+        let v = Verdict::assess(&two, after(0.6));
+        assert_eq!(v.trust, Trust::Good);
+        assert!(
+            v.reasons.contains("held-out ones to 0.60″"),
+            "{}",
+            v.reasons
+        );
+        // The run's own held-out system wins.
+        let held = [
+            fitted("1", &[0.2, 0.3]),
+            fitted("2", &[0.3]),
+            system("h", true, &[Some(0.5), Some(0.5)], 0),
+        ];
+        let v = Verdict::assess(&held, after(2.0));
+        assert_eq!(v.holdout_offset_median_arcsec, Some(0.5));
+        assert!(!v.holdout_from_crossval);
         assert_eq!(v.trust, Trust::Good, "{}", v.reasons);
     }
 

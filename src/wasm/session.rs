@@ -97,6 +97,8 @@ pub struct AppSession {
     /// The files of the last cross-validation's convergence maps (see
     /// [`Session::crossval_files`]).
     crossval_files: Vec<(&'static str, Vec<u8>)>,
+    /// The last cross-validation, for the verdict that counts it ([`Self::verdict`]).
+    crossval: Option<crate::reconstruct::CrossValidation>,
     /// The ensemble members handed over so far (see `super::ensemble`).
     pub(super) ensemble_runs: Vec<super::ensemble::HandedMember>,
 }
@@ -116,6 +118,7 @@ impl AppSession {
         AppSession {
             inner: Session::new(),
             crossval_files: Vec::new(),
+            crossval: None,
             ensemble_runs: Vec::new(),
         }
     }
@@ -305,7 +308,20 @@ impl AppSession {
         };
         let cv = self.inner.cross_validate(folds, &mut report).map_err(err)?;
         self.crossval_files = self.inner.crossval_files(&cv).map_err(err)?;
-        to_js(&cv)
+        let out = to_js(&cv);
+        self.crossval = Some(cv);
+        out
+    }
+
+    /// The verdict on the last result (`summary.json`'s `verdict`), counting the last
+    /// cross-validation's held-out images when `crossval` is true ([`Session::verdict_after`]);
+    /// null when the result is no reconstruction.
+    pub fn verdict(&self, crossval: bool) -> Result<JsValue, JsError> {
+        let cv = self.crossval.as_ref().filter(|_| crossval);
+        match self.inner.verdict_after(cv).map_err(err)? {
+            Some(v) => to_js(&v),
+            None => Ok(JsValue::NULL),
+        }
     }
 
     /// The last cross-validation's convergence maps as files: an array of `{name, bytes}`

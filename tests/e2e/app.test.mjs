@@ -259,8 +259,12 @@ test('Cross-validate predicts each system once and keeps the result on screen', 
     await page.click('#crossval-systems summary');
     const folds = await page.$$eval('#crossval-box tbody tr td:nth-child(2)', (tds) => tds.map((td) => td.textContent));
     assert.deepEqual(folds.sort(), ['1', '2', '3', '4']);
-    // The reconstruction on screen is the one from before.
+    // The reconstruction on screen is the one from before; its verdict now counts the
+    // held-out images of the cross-validation (the map's own had none held out).
     assert.equal(await page.textContent('#summary'), caption);
+    const offsets = async () => (await page.locator('#verdict-facts li').allTextContents())[0];
+    await page.waitForFunction(() => /held out in the cross-validation/.test(document.getElementById('verdict-facts')?.textContent));
+    assert.match(await offsets(), new RegExp(`^Image offsets \\(median\\): fitted [\\d.]+″, held out in the cross-validation ${median.toFixed(2)}″$`));
     await page.screenshot({ path: join(ARTIFACTS, 'app-crossval.png'), fullPage: true });
     const [download] = await Promise.all([page.waitForEvent('download'), page.click('#dl-crossval-json')]);
     const cv = JSON.parse(await readFile(await download.path(), 'utf8'));
@@ -295,6 +299,8 @@ test('Cross-validate predicts each system once and keeps the result on screen', 
     // Made with the settings of its time: a change takes it away.
     await setField(page, '#set-reconstruct-solver-iterations', QUICK_ITERATIONS + 100);
     await page.waitForSelector('#crossval-box', { state: 'hidden', timeout: 5000 });
+    // ... and the verdict is the result's own again.
+    assert.match(await offsets(), /^Image offsets \(median\): fitted [\d.]+″$/);
     assert.deepEqual(app.consoleErrors, []);
   } finally {
     await app.close();

@@ -15,15 +15,16 @@ export function worstSystems() {
 
 /** Text for the numbers behind the verdict, one per line. */
 function facts(v) {
+  const held = v.holdout_from_crossval ? 'held out in the cross-validation' : 'held out';
   const out = [`Image offsets (median): fitted ${arcsec(v.fit_offset_median_arcsec)}${
-    v.holdout_offset_median_arcsec == null ? '' : `, held out ${arcsec(v.holdout_offset_median_arcsec)}`}`];
+    v.holdout_offset_median_arcsec == null ? '' : `, ${held} ${arcsec(v.holdout_offset_median_arcsec)}`}`];
   const parts = [`${v.systems_matched} as many as observed`];
   if (v.systems_fewer_predicted) parts.push(`${v.systems_fewer_predicted} fewer`);
   if (v.systems_more_predicted) {
     const far = v.systems_far_more_predicted ? ` (${v.systems_far_more_predicted} more than twice as many)` : '';
     parts.push(`${v.systems_more_predicted} more${far}`);
   }
-  out.push(`Predicted images (|μ| ≥ 0.1) of ${v.systems} systems: ${parts.join(', ')}${
+  out.push(`Predicted images (|μ| ≥ 0.1) of ${v.systems} system${v.systems === 1 ? '' : 's'}: ${parts.join(', ')}${
     v.systems_with_lost_images ? `; ${v.systems_with_lost_images} with an image not reproduced` : ''}`);
   const z = v.z_source == null ? '' : ` at z_s = ${v.z_source}`;
   const c = v.members_with_own_curves && v.c_unmeasured ? ' (their mass is assumed: C is hardly measured)' : '';
