@@ -57,6 +57,31 @@ pub(crate) fn and_list(items: impl Iterator<Item = String>) -> String {
     }
 }
 
+/// Line numbers as a note lists them: "12, 15, 40"; past [`LISTED_LINES`] the first of
+/// them and how many more, up to which line ("108, 122, ... 234 and 131 more, up to line
+/// 2078"): a `best.par` lists hundreds of galaxies.
+pub(crate) fn line_list(lines: impl Iterator<Item = usize>) -> String {
+    let lines: Vec<usize> = lines.collect();
+    let shown = |l: &[usize]| {
+        l.iter()
+            .map(|l| l.to_string())
+            .collect::<Vec<_>>()
+            .join(", ")
+    };
+    match &lines[..] {
+        few if few.len() <= LISTED_LINES => shown(few),
+        [first @ .., last] => format!(
+            "{} and {} more, up to line {last}",
+            shown(&first[..LISTED_LINES]),
+            lines.len() - LISTED_LINES
+        ),
+        [] => unreachable!("an empty list has fewer lines than LISTED_LINES"),
+    }
+}
+
+/// Most line numbers a note lists one by one ([`line_list`]).
+const LISTED_LINES: usize = 10;
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -100,6 +125,19 @@ mod tests {
         assert_eq!(
             e(0.0),
             "solver.iterations = 0 is not allowed (at most 10^6)"
+        );
+    }
+
+    #[test]
+    fn a_long_list_of_lines_is_cut_after_ten() {
+        assert_eq!(line_list([12, 15, 40].into_iter()), "12, 15, 40");
+        assert_eq!(
+            line_list((1..=10).map(|k| 20 * k)),
+            "20, 40, 60, 80, 100, 120, 140, 160, 180, 200"
+        );
+        assert_eq!(
+            line_list((1..=267).map(|k| 20 * k + 105)),
+            "125, 145, 165, 185, 205, 225, 245, 265, 285, 305 and 257 more, up to line 5445"
         );
     }
 }

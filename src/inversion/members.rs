@@ -36,7 +36,7 @@ use thiserror::Error;
 use super::cells::CellGrid;
 use crate::catalog::{CatalogRow, CommentedBcgs, Member, MemberCatalog};
 use crate::cosmology::LensPlane;
-use crate::error::and_list;
+use crate::error::{and_list, line_list};
 use crate::profiles::{tnfw_total_mass_unit, Lens, MassComponent, Nfw, ProfileError, TruncatedNfw};
 
 /// What can be wrong with member settings or a member galaxy.
@@ -491,15 +491,12 @@ fn outside_warning(
              not used",
             catalog.source_name, m.line, m.id, m.position.x, m.position.y
         )),
-        many => {
-            let lines: Vec<String> = many.iter().map(|m| m.line.to_string()).collect();
-            Some(format!(
-                "{}: {} members lie outside the field {field} and are not used: lines {}",
-                catalog.source_name,
-                many.len(),
-                lines.join(", ")
-            ))
-        }
+        many => Some(format!(
+            "{}: {} members lie outside the field {field} and are not used: lines {}",
+            catalog.source_name,
+            many.len(),
+            line_list(many.iter().map(|m| m.line))
+        )),
     }
 }
 

@@ -31,6 +31,7 @@ use crate::catalog::{
     ArcletCatalog, CatalogError, CatalogRow, CommentedBcgs, ImageCatalog, Member, MemberCatalog,
 };
 use crate::cosmology::LensPlane;
+use crate::error::line_list;
 use crate::inversion::{
     build_constraints, missing_bcg_warning, ConstraintMode, ConstraintSource, RedshiftPrior,
 };
@@ -555,31 +556,6 @@ fn region_arcs(
     };
     arcs_from_regions(file.text, file.name, reference, pixel_arcsec, &catalog_z)
 }
-
-/// Line numbers as a note lists them: "12, 15, 40"; past [`LISTED_LINES`] the first of
-/// them and how many more, up to which line ("108, 122, ... 234 and 131 more, up to line
-/// 2078"): a `best.par` lists hundreds of galaxies.
-fn line_list(lines: impl Iterator<Item = usize>) -> String {
-    let lines: Vec<usize> = lines.collect();
-    let shown = |l: &[usize]| {
-        l.iter()
-            .map(|l| l.to_string())
-            .collect::<Vec<_>>()
-            .join(", ")
-    };
-    match &lines[..] {
-        few if few.len() <= LISTED_LINES => shown(few),
-        [first @ .., last] => format!(
-            "{} and {} more, up to line {last}",
-            shown(&first[..LISTED_LINES]),
-            lines.len() - LISTED_LINES
-        ),
-        [] => unreachable!("an empty list has fewer lines than LISTED_LINES"),
-    }
-}
-
-/// Most line numbers a note lists one by one ([`line_list`]).
-const LISTED_LINES: usize = 10;
 
 #[cfg(test)]
 mod tests {
