@@ -446,12 +446,12 @@ fn crossval_line(cv: &CrossValidation, path: &Path) -> String {
     format!(
         "wrote {} ({} folds: held-out images median {}, rms {}, {} of {} without a predicted image; fitted images median {}{spread}{always})",
         path.display(),
-        cv.folds,
-        arcsec(cv.holdout_image_offset_median_arcsec),
-        arcsec(cv.holdout_image_plane_rms_arcsec),
-        cv.holdout_images_unmatched,
-        cv.holdout_images,
-        arcsec(cv.fit_image_offset_median_arcsec),
+        cv.totals.folds,
+        arcsec(cv.totals.holdout_image_offset_median_arcsec),
+        arcsec(cv.totals.holdout_image_plane_rms_arcsec),
+        cv.totals.holdout_images_unmatched,
+        cv.totals.holdout_images,
+        arcsec(cv.totals.fit_image_offset_median_arcsec),
     )
 }
 

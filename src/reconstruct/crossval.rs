@@ -78,10 +78,10 @@ pub struct PredictedSystem {
 /// The result of [`cross_validate`] (`crossval.json`).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct CrossValidation {
-    pub folds: usize,
-    /// "Completed", or "Cancelled" when a fold was cancelled (the folds that finished are
-    /// kept).
-    pub status: String,
+    /// How many folds, whether they all ran, and what they predicted (`crossval.json` has
+    /// these at its top level; `summary.json` has them as `crossval`).
+    #[serde(flatten)]
+    pub totals: CrossvalTotals,
     pub runs: Vec<FoldRun>,
     /// The systems every fold fits and none holds out: those at an estimated redshift
     /// (`constraints.z_estimates`).
@@ -89,6 +89,19 @@ pub struct CrossValidation {
     pub always_fitted: Vec<String>,
     /// Every predicted system once, in catalogue order within each fold.
     pub systems: Vec<PredictedSystem>,
+    /// The folds' convergence maps, when asked for (not part of `crossval.json`: the CLI writes
+    /// them as FITS).
+    #[serde(skip)]
+    pub kappa: Option<KappaSpread>,
+}
+
+/// A cross-validation's totals ([`CrossValidation::totals`]).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct CrossvalTotals {
+    pub folds: usize,
+    /// "Completed", or "Cancelled" when a fold was cancelled (the folds that finished are
+    /// kept).
+    pub status: String,
     /// Observed images of the predicted systems, and how many of them had no predicted image
     /// at all (their source lies outside every caustic of the fold's lens at that redshift).
     pub holdout_images: usize,
@@ -100,42 +113,12 @@ pub struct CrossValidation {
     /// The same for the fitted systems' images, pooled over the folds' fits (arcsec): the
     /// in-sample figure to compare with.
     pub fit_image_offset_median_arcsec: Option<f64>,
-    /// The folds' convergence maps, when asked for (not part of `crossval.json`: the CLI writes
-    /// them as FITS).
-    #[serde(skip)]
-    pub kappa: Option<KappaSpread>,
-}
-
-/// A cross-validation's totals as `summary.json` gives them (`crossval`).
-#[derive(Debug, Clone, PartialEq, Serialize)]
-pub struct CrossvalTotals {
-    pub folds: usize,
-    /// [`CrossValidation::status`].
-    pub status: String,
-    pub holdout_images: usize,
-    pub holdout_images_unmatched: usize,
-    pub holdout_image_offset_median_arcsec: Option<f64>,
-    pub holdout_image_plane_rms_arcsec: Option<f64>,
-    pub fit_image_offset_median_arcsec: Option<f64>,
 }
 
 impl CrossValidation {
     /// Whether every fold ran (not cancelled).
     pub fn completed(&self) -> bool {
-        self.status == "Completed"
-    }
-
-    /// Its totals for `summary.json`.
-    pub fn totals(&self) -> CrossvalTotals {
-        CrossvalTotals {
-            folds: self.folds,
-            status: self.status.clone(),
-            holdout_images: self.holdout_images,
-            holdout_images_unmatched: self.holdout_images_unmatched,
-            holdout_image_offset_median_arcsec: self.holdout_image_offset_median_arcsec,
-            holdout_image_plane_rms_arcsec: self.holdout_image_plane_rms_arcsec,
-            fit_image_offset_median_arcsec: self.fit_image_offset_median_arcsec,
-        }
+        self.totals.status == "Completed"
     }
 }
 
@@ -393,15 +376,17 @@ pub fn cross_validate(
     let offsets = image_offsets_arcsec(systems.iter().map(|s| &s.report));
     let holdout_images = systems.iter().map(|s| s.report.observed.len()).sum();
     Ok(CrossValidation {
-        folds,
-        status: status.to_string(),
+        totals: CrossvalTotals {
+            folds,
+            status: status.to_string(),
+            holdout_images,
+            holdout_images_unmatched: holdout_images - offsets.len(),
+            holdout_image_plane_rms_arcsec: rms_arcsec(&offsets),
+            holdout_image_offset_median_arcsec: median_arcsec(offsets),
+            fit_image_offset_median_arcsec: median_arcsec(fitted),
+        },
         runs,
         always_fitted,
-        holdout_images,
-        holdout_images_unmatched: holdout_images - offsets.len(),
-        holdout_image_plane_rms_arcsec: rms_arcsec(&offsets),
-        holdout_image_offset_median_arcsec: median_arcsec(offsets),
-        fit_image_offset_median_arcsec: median_arcsec(fitted),
         systems,
         kappa: spread.and_then(SpreadSum::finish),
     })

@@ -419,7 +419,7 @@ impl Reconstruction {
             bcg: self.bcg.clone(),
             crossval_holdout_median_arcsec: cv
                 .filter(|c| c.completed())
-                .and_then(|c| c.holdout_image_offset_median_arcsec),
+                .and_then(|c| c.totals.holdout_image_offset_median_arcsec),
         };
         Verdict::assess(&self.sources, inputs)
     }
@@ -438,7 +438,7 @@ impl Reconstruction {
         let mut summary = self
             .solved()
             .summary(self.status.name().to_string(), maps, verdict);
-        summary.crossval = cv.map(CrossValidation::totals);
+        summary.crossval = cv.map(|c| c.totals.clone());
         summary
     }
 }
@@ -768,10 +768,10 @@ pub fn strength_trial(
         regulariser: candidate.regulariser,
         strength: candidate.strength,
         cells: candidate.cells,
-        holdout_median_arcsec: cv.holdout_image_offset_median_arcsec,
-        holdout_rms_arcsec: cv.holdout_image_plane_rms_arcsec,
-        holdout_unmatched: cv.holdout_images_unmatched,
-        fit_median_arcsec: cv.fit_image_offset_median_arcsec,
+        holdout_median_arcsec: cv.totals.holdout_image_offset_median_arcsec,
+        holdout_rms_arcsec: cv.totals.holdout_image_plane_rms_arcsec,
+        holdout_unmatched: cv.totals.holdout_images_unmatched,
+        fit_median_arcsec: cv.totals.fit_image_offset_median_arcsec,
         holdout_by_system: cv
             .systems
             .iter()

@@ -158,7 +158,7 @@ fn each_fold_is_a_hold_out_run_and_every_system_is_predicted_once() {
         Control::Continue
     })
     .unwrap();
-    assert_eq!(cv.status, "Completed");
+    assert_eq!(cv.totals.status, "Completed");
     assert_eq!(cv.runs.len(), 2);
     let mut predicted: Vec<&str> = cv.systems.iter().map(|s| s.report.id.as_str()).collect();
     predicted.sort();
@@ -198,16 +198,16 @@ fn each_fold_is_a_hold_out_run_and_every_system_is_predicted_once() {
         .iter()
         .flat_map(|s| s.report.observed.iter().filter_map(|o| o.offset_arcsec))
         .collect();
-    assert_eq!(cv.holdout_images, 8);
-    assert_eq!(cv.holdout_images_unmatched, 8 - offsets.len());
+    assert_eq!(cv.totals.holdout_images, 8);
+    assert_eq!(cv.totals.holdout_images_unmatched, 8 - offsets.len());
     offsets.sort_by(f64::total_cmp);
     let n = offsets.len();
     let median = 0.5 * (offsets[(n - 1) / 2] + offsets[n / 2]);
     let rms = (offsets.iter().map(|o| o * o).sum::<f64>() / n as f64).sqrt();
-    assert_eq!(cv.holdout_image_offset_median_arcsec, Some(median));
-    assert!((cv.holdout_image_plane_rms_arcsec.unwrap() - rms).abs() < 1e-12);
+    assert_eq!(cv.totals.holdout_image_offset_median_arcsec, Some(median));
+    assert!((cv.totals.holdout_image_plane_rms_arcsec.unwrap() - rms).abs() < 1e-12);
     // A lens fitted to two systems reproduces them more closely than it predicts the others.
-    assert!(cv.fit_image_offset_median_arcsec.unwrap() < median);
+    assert!(cv.totals.fit_image_offset_median_arcsec.unwrap() < median);
 }
 
 /// Two folds of the teaching example on `threads` threads, cancelled at the second fold's
@@ -234,7 +234,7 @@ fn cancelled_in_fold_two(threads: usize, seen: &mut Vec<usize>) -> wslap::CrossV
 fn cancel_keeps_the_folds_before_it() {
     let mut seen = Vec::new();
     let cv = cancelled_in_fold_two(1, &mut seen);
-    assert_eq!(cv.status, "Cancelled");
+    assert_eq!(cv.totals.status, "Cancelled");
     assert_eq!(cv.runs.len(), 1);
     assert!(cv.systems.iter().all(|s| s.fold == 1));
     assert_eq!(cv.systems.len(), 2);
@@ -261,14 +261,14 @@ fn folds_side_by_side_agree_with_one_after_another_and_cancel_together() {
     };
     let (one, seen_one) = run(1);
     let (two, seen_two) = run(2);
-    assert_eq!(two.status, "Completed");
+    assert_eq!(two.totals.status, "Completed");
     assert_eq!(
         serde_json::to_value(&one.systems).unwrap(),
         serde_json::to_value(&two.systems).unwrap()
     );
     assert_eq!(
-        one.holdout_image_offset_median_arcsec,
-        two.holdout_image_offset_median_arcsec
+        one.totals.holdout_image_offset_median_arcsec,
+        two.totals.holdout_image_offset_median_arcsec
     );
     assert_eq!(
         one.runs.iter().map(|r| r.c.clone()).collect::<Vec<_>>(),
@@ -284,7 +284,7 @@ fn folds_side_by_side_agree_with_one_after_another_and_cancel_together() {
     }
 
     let cv = cancelled_in_fold_two(2, &mut Vec::new());
-    assert_eq!(cv.status, "Cancelled");
+    assert_eq!(cv.totals.status, "Cancelled");
     assert!(cv
         .runs
         .iter()

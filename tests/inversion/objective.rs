@@ -251,11 +251,11 @@ fn auto_strength_takes_the_best_predicting_candidate() {
         let cv = cross_validate(&inputs, &fixed, 3, None, &mut |_, _| Control::Continue).unwrap();
         assert_eq!(
             row.holdout_median_arcsec,
-            cv.holdout_image_offset_median_arcsec
+            cv.totals.holdout_image_offset_median_arcsec
         );
-        assert_eq!(row.holdout_unmatched, cv.holdout_images_unmatched);
-        let m = cv.holdout_image_offset_median_arcsec.unwrap();
-        let u = cv.holdout_images_unmatched;
+        assert_eq!(row.holdout_unmatched, cv.totals.holdout_images_unmatched);
+        let m = cv.totals.holdout_image_offset_median_arcsec.unwrap();
+        let u = cv.totals.holdout_images_unmatched;
         if u < best.0 || (u == best.0 && m < best.1) {
             best = (u, m, (row.regulariser, strength, cells));
         }
