@@ -188,6 +188,8 @@ pub struct ParGalaxies {
 pub struct GalaxyWithoutMag {
     /// The block's name, e.g. `potentiel 510`.
     pub block: String,
+    /// Its last word, the id of a member made of it (`510`).
+    pub id: String,
     /// The block's first line (1-based).
     pub line: usize,
     /// Its centre in arcsec, in the file's frame.
@@ -395,6 +397,7 @@ impl LenstoolPar {
                         .map(|d| d.total_mass_msun(&plane));
                     without_mag.push(GalaxyWithoutMag {
                         block: p.block.clone(),
+                        id: id.to_string(),
                         line: p.line,
                         centre: center_arcsec,
                         mass_msun,

@@ -256,32 +256,34 @@ impl Dataset {
                 notes.push(note);
                 continue;
             }
-            let lstar = g.mass_msun.map(|m| m / law.mass_msun(mag_star, mag_star));
-            match (g.mass_msun, lstar) {
-                (Some(mass), Some(l)) if l <= PAR_GALAXY_MAX_LSTAR => {
-                    let id = g.block.split_whitespace().last().unwrap_or("potentiel");
-                    by_mass.push(Member {
-                        id: id.to_string(),
-                        position: g.centre,
-                        a_arcsec: 1.0,
-                        b_arcsec: g.axis_ratio,
-                        theta_deg: g.pa_deg,
-                        mag: law.mag_of_mass(mass, mag_star),
-                        lum: 0.0,
-                        line: g.line,
-                    });
-                }
-                (Some(mass), Some(l)) => notes.push(format!(
-                    "{name}: line {}: `{}` has no `mag` and a dPIE mass of {mass:.2e} Msun \
-                     ({l:.0} L* under the member law): a group's, not a galaxy's: not fitted",
-                    g.line, g.block
-                )),
-                _ => notes.push(format!(
+            let Some(mass) = g.mass_msun else {
+                notes.push(format!(
                     "{name}: line {}: `{}` has no `mag` and its radii make no dPIE (the cut \
                      radius must exceed the core): not fitted",
                     g.line, g.block
-                )),
+                ));
+                continue;
+            };
+            let mag = law.mag_of_mass(mass, mag_star);
+            let lstar = law.luminosity_lstar(mag, mag_star);
+            if lstar > PAR_GALAXY_MAX_LSTAR {
+                notes.push(format!(
+                    "{name}: line {}: `{}` has no `mag` and a dPIE mass of {mass:.2e} Msun \
+                     ({lstar:.0} L* under the member law): a group's, not a galaxy's: not fitted",
+                    g.line, g.block
+                ));
+                continue;
             }
+            by_mass.push(Member {
+                id: g.id.clone(),
+                position: g.centre,
+                a_arcsec: 1.0,
+                b_arcsec: g.axis_ratio,
+                theta_deg: g.pa_deg,
+                mag,
+                lum: 0.0,
+                line: g.line,
+            });
         }
         // A best.par lists every galaxy it fitted (hundreds): one sentence for all of them.
         match &by_mass[..] {

@@ -6,6 +6,13 @@ use glam::DVec2;
 use wslap::{parse_image_catalog, ParComponent, Radius, RedshiftPrior};
 use wslap::{parse_par, parse_par_with, Dpie, LensPlane, MassComponent, ParOptions};
 
+/// `data.add_par_galaxies(par)` with the default member law on the `.par`'s lens plane: its
+/// notes.
+fn add_galaxies(data: &mut wslap::Dataset, par: &wslap::LenstoolPar) -> Vec<String> {
+    data.add_par_galaxies(par, &par.lens_plane().unwrap(), &Default::default())
+        .unwrap()
+}
+
 const SINGULAR_CORE: &str = include_str!("../data/lenstool/singular_core.par");
 const MEMBERS: &str = include_str!("../data/lenstool/members.cat");
 const STRAY_END: &str = include_str!("../data/lenstool/stray_end.par");
@@ -202,9 +209,7 @@ fn the_galaxies_of_a_multi_plane_model_are_the_cluster_planes() {
         [("potentiel O3".to_string(), line, 1.05)]
     );
     let mut data = wslap::Dataset::default();
-    let notes = data
-        .add_par_galaxies(&par, &par.lens_plane().unwrap(), &Default::default())
-        .unwrap();
+    let notes = add_galaxies(&mut data, &par);
     let expected = format!(
         "group.par: line {line}: `potentiel O3` is a galaxy at z = 1.05, not at the \
          cluster's z_lens = 0.375: not fitted"
@@ -598,6 +603,7 @@ fn hff_maps_with_blank_and_zero_borders_are_used_without_them() {
 /// The real published files (../shared/data, read natively).
 #[cfg(not(target_arch = "wasm32"))]
 mod galaxies_of_a_par {
+    use super::add_galaxies;
     use glam::DVec2;
     use wslap::{parse_par, Dataset, InputText, InputTexts};
 
@@ -644,9 +650,7 @@ mod galaxies_of_a_par {
 
         let mut data = as1063(true);
         let before = data.members.as_ref().unwrap().members.len();
-        let notes = data
-            .add_par_galaxies(&par, &par.lens_plane().unwrap(), &Default::default())
-            .unwrap();
+        let notes = add_galaxies(&mut data, &par);
         let members = &data.members.as_ref().unwrap().members;
         assert_eq!(members.len(), before + 1);
         let added = members.last().unwrap();
@@ -673,9 +677,7 @@ mod galaxies_of_a_par {
             notes[0]
         );
         // Given twice, or with a catalogue that has it, it is not added again.
-        let notes = data
-            .add_par_galaxies(&par, &par.lens_plane().unwrap(), &Default::default())
-            .unwrap();
+        let notes = add_galaxies(&mut data, &par);
         assert_eq!(data.members.as_ref().unwrap().members.len(), before + 1);
         assert!(
             notes[0].contains("is member O3 of members.cat already: not added twice"),
@@ -684,9 +686,7 @@ mod galaxies_of_a_par {
         assert_eq!(data.members.as_ref().unwrap().par_galaxies, ["O3"]);
         // Without a member catalogue it makes one, in the images' frame.
         let mut alone = as1063(false);
-        alone
-            .add_par_galaxies(&par, &par.lens_plane().unwrap(), &Default::default())
-            .unwrap();
+        add_galaxies(&mut alone, &par);
         let made = alone.members.unwrap();
         assert_eq!((made.members.len(), made.reference), (1, Some(frame)));
         assert!((made.members[0].position - expected).length() < 1e-3);
@@ -729,9 +729,7 @@ mod galaxies_of_a_par {
         let par = parse_par(&text, "fitted.par").unwrap();
         assert_eq!(par.galaxies().unwrap().without_mag.len(), 3);
         let mut data = Dataset::default();
-        let notes = data
-            .add_par_galaxies(&par, &par.lens_plane().unwrap(), &Default::default())
-            .unwrap();
+        let notes = add_galaxies(&mut data, &par);
         assert_eq!(notes.len(), 1, "{notes:?}");
         assert!(
             notes[0].starts_with(
@@ -762,9 +760,7 @@ mod galaxies_of_a_par {
             .replace("cut_radius_kpc 80\n", "cut_radius_kpc 1500\n");
         let par = parse_par(&text, "fitted.par").unwrap();
         let mut data = Dataset::default();
-        let notes = data
-            .add_par_galaxies(&par, &par.lens_plane().unwrap(), &Default::default())
-            .unwrap();
+        let notes = add_galaxies(&mut data, &par);
         assert!(
             notes.iter().any(|n| n.starts_with(
                 "fitted.par: line 18: `potentiel 2` has no \
@@ -793,9 +789,7 @@ mod galaxies_of_a_par {
         // Without a member catalogue its magnitude is the one its starting mass implies
         // (v_disp 100 km/s, cut 100 kpc).
         let mut data = Dataset::default();
-        let notes = data
-            .add_par_galaxies(&par, &par.lens_plane().unwrap(), &Default::default())
-            .unwrap();
+        let notes = add_galaxies(&mut data, &par);
         assert_eq!(notes.len(), 1, "{notes:?}");
         assert!(
             notes[0].starts_with(
@@ -830,9 +824,7 @@ mod galaxies_of_a_par {
         )
         .unwrap();
         let before = data.members.as_ref().unwrap().members.len();
-        let notes = data
-            .add_par_galaxies(&par, &par.lens_plane().unwrap(), &Default::default())
-            .unwrap();
+        let notes = add_galaxies(&mut data, &par);
         assert_eq!(
             notes,
             [
@@ -846,9 +838,7 @@ mod galaxies_of_a_par {
         assert_eq!((bcg.id.as_str(), bcg.mag, bcg.line), ("1009.0", 17.325, 10));
         assert!(!members.commented.iter().any(|m| m.id == "1009.0"));
         assert_eq!(members.par_galaxies, ["1009.0"]);
-        let notes = data
-            .add_par_galaxies(&par, &par.lens_plane().unwrap(), &Default::default())
-            .unwrap();
+        let notes = add_galaxies(&mut data, &par);
         assert!(
             notes[0].ends_with("`potentiel 3` (no `mag`) is member 1009.0 of m1931.cat already"),
             "{notes:?}"
