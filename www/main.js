@@ -195,7 +195,7 @@ async function refreshVerdict() {
   let verdict = verdictBase;
   if (verdictBase && crossvalShown) {
     try {
-      verdict = (await ask('verdict', { crossval: true })) ?? verdictBase;
+      verdict = (await ask('verdict')) ?? verdictBase;
     } catch {
       verdict = verdictBase;
     }

@@ -103,7 +103,7 @@ const handlers = {
   ensembleFiles: () => session.ensemble_files(),
   crossValidate: (m, progress) => session.cross_validate(progress),
   crossvalFiles: () => session.crossval_files(),
-  verdict: (m) => session.verdict(m.crossval),
+  verdict: () => session.verdict(),
   resultInfo: () => session.result_info(),
   // The iterates the last reconstruction kept (`{iterates: null}` when none), for the slider.
   iterates: () => ({ iterates: session.iterates() }),

@@ -313,11 +313,12 @@ impl AppSession {
         out
     }
 
-    /// The verdict on the last result (`summary.json`'s `verdict`), counting the last
-    /// cross-validation's held-out images when `crossval` is true ([`Session::verdict_after`]);
-    /// null when the result is no reconstruction.
-    pub fn verdict(&self, crossval: bool) -> Result<JsValue, JsError> {
-        let cv = self.crossval.as_ref().filter(|_| crossval);
+    /// The verdict on the last result (`summary.json`'s `verdict`) counting the last
+    /// cross-validation's held-out images ([`Session::verdict_after`]; the result's own
+    /// verdict when none ran); null when the result is no reconstruction. The page asks for
+    /// it only while that cross-validation is on screen.
+    pub fn verdict(&self) -> Result<JsValue, JsError> {
+        let cv = self.crossval.as_ref();
         match self.inner.verdict_after(cv).map_err(err)? {
             Some(v) => to_js(&v),
             None => Ok(JsValue::NULL),
