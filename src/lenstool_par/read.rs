@@ -165,6 +165,13 @@ fn is_lenstool_block(word: &str) -> bool {
     EXACT.contains(&word) || PREFIXES.iter().any(|p| word.starts_with(p))
 }
 
+/// Whether `line` is one of the fit's statistics at the head of a Lenstool output `.par`: a
+/// name and a number separated by a colon, e.g. `Chi2pos: 664.746`.
+fn is_fit_statistic(line: &str) -> bool {
+    line.rsplit_once(':')
+        .is_some_and(|(name, value)| !name.trim().is_empty() && value.trim().parse::<f64>().is_ok())
+}
+
 /// Splits the text into blocks as Lenstool does (see [`parse_par_with`]).
 fn read_blocks(
     text: &str,
@@ -193,6 +200,10 @@ fn read_blocks(
                     repeated: Vec::new(),
                 });
             }
+            // The fit's statistics Lenstool writes above the blocks of its `best.par` and
+            // `bestopt.par` (`Chi2tot: 665.099`, `log(Evidence) : -430.734`): not blocks, and
+            // no cause for a warning on every published model.
+            None if blocks.is_empty() && is_fit_statistic(body) => {}
             None => {
                 if !skipping {
                     warnings.push(ParWarning {
@@ -284,7 +295,9 @@ const SHEAR_KEYS: [&str; 8] = [
     "angle_pos",
     "kappa",
 ];
-const POTFILE_KEYS: [&str; 15] = [
+/// Lenstool reads the scatter keywords by their first letters (`vdscat...`,
+/// `rcutscat...`); both spellings seen in published files are taken.
+const POTFILE_KEYS: [&str; 17] = [
     "filein",
     "zlens",
     "z_lens",
@@ -300,6 +313,8 @@ const POTFILE_KEYS: [&str; 15] = [
     "vdslope",
     "vdscatter",
     "rcutscatter",
+    "vdscat",
+    "rcutscat",
 ];
 
 /// Every keyword Lenstool reads in a `potentiel` block (`r_potentiel.c`; `mag...` and
@@ -730,7 +745,7 @@ impl Ctx<'_> {
                 }
             }
         }
-        for key in ["vdscatter", "rcutscatter"] {
+        for key in ["vdscatter", "rcutscatter", "vdscat", "rcutscat"] {
             if let (Some(m), Some(e)) = (self.opt(b, key, 0)?, b.entries.get(key)) {
                 if m != 0.0 {
                     return Err(self.bad(b, key, e, "random scatter (mode != 0) is not supported"));

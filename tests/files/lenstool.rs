@@ -156,21 +156,27 @@ fn a_stray_end_before_fini_is_skipped_as_by_lenstool() {
     let again = parse_par(&text, "x.par").unwrap();
     let (a, b) = (&again.potentials, &par.potentials);
     assert!(a.len() == 2 && a.iter().zip(b).all(|(a, b)| a.component == b.component));
-    // A fitted model's header lines (A1689's best model of Limousin et al.) are skipped with
-    // one warning, and the blocks after them read as without.
+    // A fitted model's statistics above its blocks (A1689's best model of Limousin et al.,
+    // every published bestopt.par) are skipped without a word, and the blocks after them read
+    // as without.
     let text = format!("Chi2formey: 0.000\nChi2l: 0.000\nlog(Evidence) : -291.035\n{STRAY_END}");
     let headed = parse_par(&text, "headed.par").unwrap();
     let (h, b) = (&headed.potentials, &par.potentials);
     assert!(h.len() == 2 && h.iter().zip(b).all(|(h, b)| h.component == b.component));
     assert_eq!(headed.reference, par.reference);
-    let [w] = &headed.warnings[..] else {
-        panic!("{:?}", headed.warnings)
+    assert!(headed.warnings.is_empty(), "{:?}", headed.warnings);
+    // Any other word there is still skipped with a warning, statistics after it or not.
+    let text = format!("Chi2tot: 1.0\nnotes by hand\nChi2l: 0.000\n{STRAY_END}");
+    let stray = parse_par(&text, "stray.par").unwrap();
+    assert_eq!(stray.potentials.len(), 2);
+    let [w] = &stray.warnings[..] else {
+        panic!("{:?}", stray.warnings)
     };
-    assert_eq!(w.line, 1);
+    assert_eq!(w.line, 2);
     assert_eq!(
         w.message,
-        "`Chi2formey:` is not a Lenstool block: skipped, with the lines after it, up to the \
-         next block or `end` (Lenstool skips it too)"
+        "`notes` is not a Lenstool block: skipped, with the lines after it, up to the next \
+         block or `end` (Lenstool skips it too)"
     );
     // Without its `end`, the block that is still open is named.
     let e = refused(&STRAY_END.replace("\tend\n\tend\nfini\n", ""), "cut.par");

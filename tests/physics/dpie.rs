@@ -585,6 +585,18 @@ fn par_reader_names_what_is_wrong() {
     assert!(e.contains("no `end`"), "{e}");
     let e = err(PAR.replace("vdscatter 0", "vdscatter 1"));
     assert!(e.contains("vdscatter") && e.contains("scatter"), "{e}");
+    // Lenstool reads the keyword by its first letters: A1835's published model of Richard et
+    // al. writes `vdscat` and `rcutscat` (refused before as unknown keywords).
+    let short = PAR.replace("vdscatter 0", "vdscat 0");
+    let short = short.replace(
+        "\tvdscat 0 0.000000 0.000000\n",
+        "\tvdscat 0 0 0\n\trcutscat 0 0 0\n",
+    );
+    assert!(short.contains("rcutscat"), "{short}");
+    let read = parse_par(&short, "short.par").expect("reads");
+    assert_eq!(read.potfiles, parse_par(PAR, "x.par").unwrap().potfiles);
+    let e = err(short.replace("vdscat 0", "vdscat 1"));
+    assert!(e.contains("vdscat") && e.contains("scatter"), "{e}");
     assert!(matches!(
         parse_par("runmode\nend\n", "x.par"),
         Err(ParError::Model { .. })
