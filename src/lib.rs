@@ -101,10 +101,10 @@ pub use radial::{radial_profile, rect_disc_area, RadialBins, RadialError, Radial
 // The inputs: catalogues, arcs, regions, Lenstool models, FITS.
 pub use arcs::{arcs_from_regions, parse_arcs, ArcCatalog, ArcSystem, ArcsError};
 pub use catalog::{
-    arclet_ellipticity, parse_arclet_catalog, parse_image_catalog, parse_member_catalog, Arclet,
-    ArcletCatalog, CatalogError, CatalogRow, CommentedBcgs, Image, ImageCatalog, ImageSystem,
-    Member, MemberCatalog, DEGREE_LOOKALIKE, FIELD_ERROR_DEG, FIELD_WARN_DEG, MAG_NO_MEASUREMENT,
-    Z_AGREEMENT_TOL,
+    arclet_ellipticity, parse_arclet_catalog, parse_image_catalog, parse_member_catalog,
+    parse_potfile_catalog, Arclet, ArcletCatalog, CatalogError, CatalogRow, CommentedBcgs, Image,
+    ImageCatalog, ImageSystem, Member, MemberCatalog, DEGREE_LOOKALIKE, FIELD_ERROR_DEG,
+    FIELD_WARN_DEG, MAG_NO_MEASUREMENT, Z_AGREEMENT_TOL,
 };
 pub use ds9::{
     polyline_is_open, read_regions, write_marks, write_regions, Ds9Error, Ds9Frame, Mark, Region,

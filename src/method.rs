@@ -420,6 +420,10 @@
 //! #REFERENCE 2 ...         pixel offsets: refused (the catalogue carries no WCS)
 //! ```
 //!
+//! One exception, as Lenstool reads it: the potfile a `.par` names (`filein`) without a header,
+//! whose positions cannot be degrees (an RA below 0, say), is in arcsec offsets from the
+//! `.par`'s own `reference`, and is read so, with a warning (published models write them so).
+//!
 //! Every catalogue of a run is brought into one frame: the one the caller asks for, else the
 //! header's reference, else (absolute degrees without a reference) the mean position of the
 //! rows. Relative positions given about another reference are re-projected through RA, Dec.

@@ -9,7 +9,7 @@ use std::collections::HashMap;
 
 use glam::DVec2;
 
-use super::frame;
+use super::frame::{self, Coords};
 use super::rows::{
     read_table, warn_extra_columns, warn_repeated_id, Fields, Row, Shape, Table, ALL_COLUMNS,
 };
@@ -153,11 +153,61 @@ pub fn parse_member_catalog(
     source_name: &str,
     reference: Option<SkyReference>,
 ) -> Result<(MemberCatalog, Vec<CatalogWarning>), CatalogError> {
+    parse_members(text, source_name, reference, false)
+}
+
+/// [`parse_member_catalog`] of the catalogue a `.par`'s `potfile` block names (`filein`), in
+/// the frame of the `.par`'s `reference`. Published Lenstool models write such catalogues
+/// without a `#REFERENCE` header in arcsec relative to that reference (A1835's of Richard et
+/// al., LoCuSS: `199 -70.47 -22.85 ...`), and Lenstool reads them so: a catalogue without a
+/// header whose positions cannot be (RA, Dec) in degrees is read that way here too, with a
+/// warning that says so. Any other catalogue reads as [`parse_member_catalog`] reads it.
+pub fn parse_potfile_catalog(
+    text: &str,
+    source_name: &str,
+    reference: Option<SkyReference>,
+) -> Result<(MemberCatalog, Vec<CatalogWarning>), CatalogError> {
+    parse_members(text, source_name, reference, true)
+}
+
+/// The first data row of `table`, read as a headerless catalogue is (degrees), whose position
+/// is numbers that cannot be (RA, Dec): its line and the two values as written.
+fn row_not_in_degrees<'a>(table: &Table<'a>) -> Option<(usize, &'a str, &'a str)> {
+    let degrees = Coords::AbsoluteDeg { header: None };
+    table.rows.iter().find_map(|row| {
+        let (x, y) = (row.fields.get(1)?, row.fields.get(2)?);
+        let raw = DVec2::new(x.parse().ok()?, y.parse().ok()?);
+        degrees.check(raw).is_err().then_some((row.line, *x, *y))
+    })
+}
+
+fn parse_members(
+    text: &str,
+    source_name: &str,
+    reference: Option<SkyReference>,
+    headerless_relative: bool,
+) -> Result<(MemberCatalog, Vec<CatalogWarning>), CatalogError> {
     let requested = frame::check_requested(reference, source_name)?;
-    let table = read_table(text, source_name)?;
+    let mut table = read_table(text, source_name)?;
+    let mut warnings = Vec::new();
+    if let (true, false, Some(r)) = (headerless_relative, table.has_header, requested) {
+        if let Some((line, x, y)) = row_not_in_degrees(&table) {
+            table.coords = Coords::RelativeArcsec { reference: r };
+            warnings.push(CatalogWarning {
+                source_name: source_name.into(),
+                line,
+                message: format!(
+                    "no #REFERENCE header, and positions that are not degrees ({x} {y}): read \
+                     as arcsec relative to the .par's reference (RA {}, Dec {} deg), as \
+                     Lenstool reads them; write '#REFERENCE 3 ra0 dec0' at the top to say so",
+                    crate::error::number(r.ra_deg),
+                    crate::error::number(r.dec_deg)
+                ),
+            });
+        }
+    }
     let [c0, c1] = table.coords.column_names();
     let names = ["id", c0, c1, "a", "b", "theta", "mag", "lum"];
-    let mut warnings = Vec::new();
     let mut extra_lines = Vec::new();
     let mut seen: HashMap<&str, usize> = HashMap::new();
     let mut rows_by_id: HashMap<&str, &Row<'_>> = HashMap::new();

@@ -24,8 +24,8 @@ pub use arclets::{arclet_ellipticity, parse_arclet_catalog, Arclet, ArcletCatalo
 pub use error::{CatalogError, CatalogWarning};
 pub(crate) use frame::{mean_position, reframe, sexagesimal};
 pub use lenstool::{
-    parse_image_catalog, parse_member_catalog, redshifts_agree, system_of_image,
-    MAG_NO_MEASUREMENT, Z_AGREEMENT_TOL,
+    parse_image_catalog, parse_member_catalog, parse_potfile_catalog, redshifts_agree,
+    system_of_image, MAG_NO_MEASUREMENT, Z_AGREEMENT_TOL,
 };
 pub use units::{DEGREE_LOOKALIKE, FIELD_ERROR_DEG, FIELD_WARN_DEG};
 

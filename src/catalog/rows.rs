@@ -22,6 +22,8 @@ pub(super) struct Row<'a> {
 /// The rows of a catalogue and how to read their positions.
 pub(super) struct Table<'a> {
     pub(super) coords: Coords,
+    /// Whether the text has a `#REFERENCE` header (`coords` is then the header's).
+    pub(super) has_header: bool,
     pub(super) rows: Vec<Row<'a>>,
     /// `#` lines that read as rows (an id, then numbers in the required columns): rows the
     /// author commented out, e.g. a member catalogue's BCG that the `.par` models on its own.
@@ -92,6 +94,7 @@ pub(super) fn read_table<'a>(text: &'a str, source_name: &str) -> Result<Table<'
     let coords = header.map_or(Coords::AbsoluteDeg { header: None }, |(_, c)| c);
     Ok(Table {
         coords,
+        has_header: header.is_some(),
         rows,
         commented,
     })

@@ -444,7 +444,7 @@ impl LenstoolPar {
         let mut warnings = Vec::new();
         for (name, text) in member_texts {
             let (catalog, w) =
-                crate::catalog::parse_member_catalog(text.as_ref(), name.as_ref(), self.reference)
+                crate::catalog::parse_potfile_catalog(text.as_ref(), name.as_ref(), self.reference)
                     .map_err(|e| ParError::Catalog(Box::new(e)))?;
             warnings.extend(w);
             catalogs.push(catalog);

@@ -260,6 +260,49 @@ fn relative_catalogue_reprojects_and_back() {
     }
 }
 
+/// A `.par`'s potfile without a `#REFERENCE` header, in arcsec relative to the `.par`'s
+/// reference (A1835's published model of Richard et al. writes `199 -70.4727720 -22.8484800
+/// ...`), reads as Lenstool reads it: in that frame, with one warning naming the first row that
+/// cannot be degrees. The same text as a member catalogue of its own stays refused, and a
+/// headerless catalogue in degrees reads as degrees either way.
+#[cfg_attr(not(target_arch = "wasm32"), test)]
+#[cfg_attr(target_arch = "wasm32", wasm_bindgen_test::wasm_bindgen_test)]
+fn a_par_s_headerless_potfile_in_arcsec_reads_in_the_par_s_frame() {
+    let r = as1063_reference();
+    let text = "1 12.5 30.0 0.5 0.4 10.0 19.0 1.0\n2 -70.47 -22.85 0.6 0.4 -63.1 20.0 1.0\n";
+    let (cat, warnings) = wslap::parse_potfile_catalog(text, "pot.cat", Some(r)).unwrap();
+    assert_eq!(cat.reference, Some(r));
+    let got: Vec<DVec2> = cat.members.iter().map(|m| m.position).collect();
+    assert_eq!(got, [DVec2::new(12.5, 30.0), DVec2::new(-70.47, -22.85)]);
+    let [w] = &warnings[..] else {
+        panic!("{warnings:?}")
+    };
+    assert_eq!(w.line, 2);
+    assert_contains(
+        &w.message,
+        &[
+            "no #REFERENCE header",
+            "-70.47 -22.85",
+            "relative to the .par's reference",
+        ],
+    );
+    let refused = parse_member_catalog(text, "pot.cat", Some(r)).unwrap_err();
+    assert_contains(&refused.to_string(), &["line 2", "not a right ascension"]);
+    // Without a reference to read them against, refused as before.
+    let e = wslap::parse_potfile_catalog(text, "pot.cat", None).unwrap_err();
+    assert_contains(&e.to_string(), &["line 2", "not a right ascension"]);
+    // In degrees: both read the same, without a warning.
+    let deg = "1 342.18 -44.53 0.5 0.4 10.0 19.0 1.0\n2 342.19 -44.52 0.5 0.4 10.0 19.5 1.0\n";
+    let (a, wa) = wslap::parse_potfile_catalog(deg, "deg.cat", Some(r)).unwrap();
+    let (b, wb) = parse_member_catalog(deg, "deg.cat", Some(r)).unwrap();
+    assert!(wa.is_empty() && wb.is_empty(), "{wa:?} {wb:?}");
+    assert_eq!(a.members, b.members);
+    // A header is obeyed whatever the values.
+    let headed = format!("#REFERENCE 0\n{text}");
+    let e = wslap::parse_potfile_catalog(&headed, "pot.cat", Some(r)).unwrap_err();
+    assert_contains(&e.to_string(), &["line 3", "not a right ascension"]);
+}
+
 #[cfg_attr(not(target_arch = "wasm32"), test)]
 #[cfg_attr(target_arch = "wasm32", wasm_bindgen_test::wasm_bindgen_test)]
 fn commented_rows_are_kept_aside_in_the_frame() {
