@@ -181,6 +181,10 @@ impl Summary {
     pub fn einstein_radius_text(&self) -> String {
         let r = self.einstein_radius_arcsec;
         match self.einstein_radius_map_arcsec {
+            // A map that holds every curve and none that encloses anything.
+            Some(_) if r == 0.0 => {
+                "none (no tangential critical curve at this source redshift)".into()
+            }
             Some(side) if side > self.map_size_arcsec => format!(
                 "{r:.2} arcsec (measured on a {side:.0} arcsec map: the tangential critical curve leaves the {:.0} arcsec map)",
                 self.map_size_arcsec

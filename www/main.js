@@ -238,8 +238,12 @@ function caption(info) {
   const note = info.model_note ? ` ${info.model_note}.` : '';
   const stale = [...rejected.values()].map(({ file, kept }) => ` Made with ${kept}: ${file} had errors and was not loaded.`).join('')
     + ($('sky-warning').hidden ? '' : ' Made with files of different parts of the sky (see the warning above).');
-  $('summary').textContent = `${status}Einstein radius ${bound}${s.einstein_radius_arcsec.toFixed(1)}″ at ` +
-    `z_s = ${s.z_source}; ${factors}${offsets}${held}${shear}${s.tangential_curves} tangential and ${s.radial_curves} radial critical curves.${ensembleCaption(sum)}${note}${stale}`;
+  // No tangential curve at all: a radius of 0″ would read as a measurement.
+  const radius = s.einstein_radius_arcsec === 0 && s.einstein_radius_map_arcsec !== null
+    ? `No tangential critical curve (no Einstein radius) at z_s = ${s.z_source}; `
+    : `Einstein radius ${bound}${s.einstein_radius_arcsec.toFixed(1)}″ at z_s = ${s.z_source}; `;
+  $('summary').textContent = `${status}${radius}` +
+    `${factors}${offsets}${held}${shear}${s.tangential_curves} tangential and ${s.radial_curves} radial critical curves.${ensembleCaption(sum)}${note}${stale}`;
 }
 
 /** Under the views: the systems a run left out of the fit and its warnings (collapsed: a

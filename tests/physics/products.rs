@@ -634,6 +634,15 @@ fn an_einstein_curve_larger_than_the_map_is_measured_on_a_wider_one() {
     assert_eq!(tiny.einstein_radius_map_arcsec, None);
     let text = tiny.summary().einstein_radius_text();
     assert!(text.starts_with("at least"), "{text}");
+    // No tangential curve at all (SGAS J1152's catalogue at z_s = 2): not "0.00 arcsec".
+    let faint = Sis::from_theta_e(DVec2::ZERO, 1e-3).expect("faint SIS");
+    let none = products_of(&wslap::Lens::new(vec![Box::new(faint)]), 3.0 * r_true).summary();
+    assert_eq!(none.tangential_curves, 0);
+    let text = none.einstein_radius_text();
+    assert!(
+        text.starts_with("none (no tangential critical curve"),
+        "{text}"
+    );
     // A small lens cut by the border of a map that holds the main curve: its few pixels do
     // not make the main curve "leave" the map.
     let size = 3.0 * r_true;
