@@ -715,8 +715,8 @@ fn reconstruct_from_arc_pixels() {
 }
 
 /// `--folds K` also writes crossval.json: K hold-out runs, every fitted system predicted once
-/// (library: tests/inversion/crossval.rs). A number of folds that cannot work is refused before the first
-/// run, naming the count of systems.
+/// (library: tests/inversion/crossval.rs). More folds than systems give one per system, said; a
+/// number of folds that cannot work is refused before the first run, naming the count of systems.
 #[test]
 fn reconstruct_folds_writes_crossval_json() {
     let dir = temp_dir("folds");
@@ -809,11 +809,28 @@ fn reconstruct_folds_writes_crossval_json() {
     assert!(spread.data.iter().any(|&v| v > 0.0), "the two folds differ");
     let png = fs::read(out_dir.join("crossval-kappa-spread.png")).unwrap();
     assert!(png.starts_with(b"\x89PNG"));
+    // More folds than systems: one per system, said (SGAS J1152's 2 systems with `--folds 5`
+    // were refused).
+    let out9 = dir.join("out9");
+    let mut all = vec!["reconstruct"];
+    all.extend(args);
+    all.extend(["--folds", "9", "--out", out9.to_str().unwrap()]);
+    let out = wslap(&all);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "{stderr}");
+    assert!(
+        stderr.contains("note: --folds 9: 4 systems can be held out"),
+        "{stderr}"
+    );
+    let cv: serde_json::Value =
+        serde_json::from_str(&fs::read_to_string(out9.join("crossval.json")).unwrap()).unwrap();
+    assert_eq!(cv["folds"], 4);
+    // Fewer than two folds cannot work: refused before the first run.
     let mut all = args.to_vec();
-    all.extend(["--folds", "5"]);
+    all.extend(["--folds", "1"]);
     let err = refused(&dir, "reconstruct", &all);
     assert!(
-        err.contains("folds = 5") && err.contains("4 fitted"),
+        err.contains("folds = 1") && err.contains("4 fitted"),
         "{err}"
     );
 }

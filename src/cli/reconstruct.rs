@@ -6,10 +6,11 @@ use std::path::{Path, PathBuf};
 use clap::Args;
 use serde::Serialize;
 use wslap::{
-    check_ensemble_size, check_memory, cross_validate, export_system, fold_groups, image_regions,
-    parse_par_with, reconstruct, run_ensemble, ColorScale, Control, ConvergenceRecord, Cosmology,
-    CrossValidation, Dataset, InputKind, InputText, InputTexts, Inputs, LensPlane, ParOptions,
-    ReconstructConfig, ReconstructError, Reconstruction, SolverMethod,
+    check_ensemble_size, check_memory, cross_validate, export_system, fold_groups,
+    holdable_system_ids, image_regions, parse_par_with, reconstruct, run_ensemble, ColorScale,
+    Control, ConvergenceRecord, Cosmology, CrossValidation, Dataset, InputKind, InputText,
+    InputTexts, Inputs, LensPlane, ParOptions, ReconstructConfig, ReconstructError, Reconstruction,
+    SolverMethod,
 };
 
 use super::input::read_text;
@@ -103,7 +104,8 @@ pub struct ReconstructArgs {
     /// median and rms offsets against the fitted ones'). How well the settings predict images
     /// the model was not given. Also the mean and standard deviation of the folds' convergence
     /// on the maps of kappa.fits (crossval-kappa-mean.fits, crossval-kappa-spread.fits and a
-    /// PNG): where the mass map depends on which systems are fitted.
+    /// PNG): where the mass map depends on which systems are fitted. With fewer systems that
+    /// can be held out than K, one fold per system.
     #[arg(long, value_name = "K", num_args = 0..=1, default_missing_value = "5")]
     folds: Option<usize>,
     /// Also run an ensemble of N more reconstructions (2 to 200) that differ in the systems
@@ -252,10 +254,10 @@ pub fn run(args: &ReconstructArgs) -> Result<(), String> {
     let inputs = data
         .inputs(plane, &args.holdout, &mut config)
         .map_err(|e| e.to_string())?;
-    if let Some(folds) = args.folds {
-        // A number of folds that cannot work is refused before the first run.
-        fold_groups(&inputs, &config, folds).map_err(|e| e.to_string())?;
-    }
+    let folds = match args.folds {
+        Some(asked) => Some(usable_folds(&inputs, &config, asked)?),
+        None => None,
+    };
     if let Some(n) = args.ensemble {
         check_ensemble_size(n).map_err(|e| format!("--ensemble: {e}"))?;
     }
@@ -307,7 +309,7 @@ pub fn run(args: &ReconstructArgs) -> Result<(), String> {
     }
     write_reconstruction(&result, &args.out)?;
     println!("{}", one_line(&result, &args.out));
-    let cv = match args.folds {
+    let cv = match folds {
         Some(folds) => Some(run_crossval(&inputs, &config, folds, &result, &args.out)?),
         None => None,
     };
@@ -378,6 +380,31 @@ fn write_ensemble(
         ensemble.members.len()
     );
     Ok(())
+}
+
+/// The folds `--folds asked` runs: `asked`, or one per system a fold can hold out when there
+/// are fewer (as the app's Cross-validate takes them), said on stderr; a number that cannot
+/// work even so (below 2 folds or 2 such systems) is refused before the first run.
+fn usable_folds(
+    inputs: &Inputs<'_>,
+    config: &ReconstructConfig,
+    asked: usize,
+) -> Result<usize, String> {
+    let holdable = holdable_system_ids(inputs, config)
+        .map_err(|e| e.to_string())?
+        .len();
+    let folds = match asked > holdable && holdable >= 2 {
+        true => {
+            eprintln!(
+                "note: --folds {asked}: {holdable} systems can be held out (those fitted at a \
+                 redshift of their own), so {holdable} folds, one system each"
+            );
+            holdable
+        }
+        false => asked,
+    };
+    fold_groups(inputs, config, folds).map_err(|e| e.to_string())?;
+    Ok(folds)
 }
 
 /// `--folds`: the cross-validation of `result`'s inputs and settings over `folds` folds, written

@@ -101,7 +101,7 @@ pub enum ReconstructError {
     NoConstraints(String),
     #[error("cancelled")]
     Cancelled,
-    #[error("folds = {folds}: cross-validation holds out each of at least 2 groups of the fitted systems, at most one group per system ({systems} fitted here)")]
+    #[error("folds = {folds}: cross-validation holds out each of at least 2 groups of the fitted systems, at most one group per system ({systems} fitted here at a redshift of their own; a system without one is not held out)")]
     Folds { folds: usize, systems: usize },
 }
 
