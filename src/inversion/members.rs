@@ -668,6 +668,26 @@ pub fn missing_bcg_warning(
     let mut distances: Vec<f64> = images.iter().map(|p| p.distance(centre)).collect();
     distances.sort_by(f64::total_cmp);
     let radius = crate::stats::quantile(&distances, 0.5).max(1.0);
+    // Members nowhere near the images (SGAS J1152's catalogue rows all lie 3.5' from its
+    // arcs): a missing BCG is the wrong thing to suggest; the catalogue's frame or cluster is
+    // what to check.
+    let reach = distances.last().copied().unwrap_or(0.0).max(radius);
+    let nearest = members
+        .iter()
+        .map(|(m, _)| (m, m.position.distance(centre)))
+        .min_by(|a, b| a.1.total_cmp(&b.1));
+    if let Some((m, d)) = nearest.filter(|(_, d)| *d > 2.0 * reach) {
+        return Some(MissingBcg {
+            warning: format!(
+                "{catalog_name}: no member lies near the multiple images: the nearest, {} (line \
+                 {}), is {d:.0} arcsec from their centre, and the farthest image {reach:.0} \
+                 arcsec. Is the member catalogue of this cluster, and in the images' frame (its \
+                 #REFERENCE header)?",
+                m.id, m.line
+            ),
+            commented: None,
+        });
+    }
     let brightest = members
         .iter()
         .filter(|(m, _)| m.position.distance(centre) <= radius)
@@ -838,6 +858,25 @@ mod tests {
             .expect("a warning")
             .warning;
         assert!(w.contains("there is none there"), "{w}");
+    }
+
+    #[test]
+    fn members_nowhere_near_the_images_ask_for_the_frame_not_a_bcg() {
+        // Every row far beyond the images (ring of 20 arcsec about (10, -5)), as when the
+        // catalogue is of another field or frame: no BCG is asked for.
+        let halos = [halo("a", 210.0, -5.0, 8.0), halo("b", 10.0, 240.0, 1.0)];
+        let missing = missing_bcg_warning("m.cat", None, &lum(&halos), &ring(), &[]).unwrap();
+        assert_eq!(
+            missing.warning,
+            "m.cat: no member lies near the multiple images: the nearest, a (line 1), is 200 \
+             arcsec from their centre, and the farthest image 20 arcsec. Is the member \
+             catalogue of this cluster, and in the images' frame (its #REFERENCE header)?"
+        );
+        assert!(missing.commented.is_none());
+        // One member among the images is enough for the usual search.
+        let halos = [halos[0].clone(), halo("7", 12.0, -3.0, 1.0)];
+        let w = missing_bcg_warning("m.cat", None, &lum(&halos), &ring(), &[]).unwrap();
+        assert!(w.warning.contains("member 7 at mag 20.00"), "{}", w.warning);
     }
 
     fn commented(id: &str, line: usize, x: f64, y: f64, mag: f64) -> Member {
