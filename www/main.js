@@ -240,7 +240,7 @@ function caption(info) {
     + ($('sky-warning').hidden ? '' : ' Made with files of different parts of the sky (see the warning above).');
   // No tangential curve at all: a radius of 0″ would read as a measurement.
   const radius = s.einstein_radius_arcsec === 0 && s.einstein_radius_map_arcsec !== null
-    ? `No tangential critical curve (no Einstein radius) at z_s = ${s.z_source}; `
+    ? `Einstein radius: none (no tangential critical curve at z_s = ${s.z_source}); `
     : `Einstein radius ${bound}${s.einstein_radius_arcsec.toFixed(1)}″ at z_s = ${s.z_source}; `;
   $('summary').textContent = `${status}${radius}` +
     `${factors}${offsets}${held}${shear}${s.tangential_curves} tangential and ${s.radial_curves} radial critical curves.${ensembleCaption(sum)}${note}${stale}`;
