@@ -686,6 +686,7 @@ pub fn missing_bcg_warning(
                 m.id, m.line
             ),
             commented: None,
+            members_far: true,
         });
     }
     let brightest = members
@@ -787,7 +788,11 @@ pub fn missing_bcg_warning(
              the app: \"Fit commented-out BCG rows\")"
         ),
     });
-    Some(MissingBcg { warning, commented })
+    Some(MissingBcg {
+        warning,
+        commented,
+        members_far: false,
+    })
 }
 
 /// What [`missing_bcg_warning`] found: its warning and the commented-out rows that could be
@@ -796,6 +801,9 @@ pub fn missing_bcg_warning(
 pub struct MissingBcg {
     pub warning: String,
     pub commented: Option<CommentedBcgs>,
+    /// No member lies near the images at all (the catalogue is of another field, or in
+    /// another frame): the warning asks about that, not about a BCG.
+    pub members_far: bool,
 }
 
 #[cfg(test)]
@@ -872,11 +880,12 @@ mod tests {
              arcsec from their centre, and the farthest image 20 arcsec. Is the member \
              catalogue of this cluster, and in the images' frame (its #REFERENCE header)?"
         );
-        assert!(missing.commented.is_none());
+        assert!(missing.commented.is_none() && missing.members_far);
         // One member among the images is enough for the usual search.
         let halos = [halos[0].clone(), halo("7", 12.0, -3.0, 1.0)];
         let w = missing_bcg_warning("m.cat", None, &lum(&halos), &ring(), &[]).unwrap();
         assert!(w.warning.contains("member 7 at mag 20.00"), "{}", w.warning);
+        assert!(!w.members_far);
     }
 
     fn commented(id: &str, line: usize, x: f64, y: f64, mag: f64) -> Member {

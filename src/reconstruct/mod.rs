@@ -1308,8 +1308,10 @@ pub(crate) fn member_layers(
     // Commented rows fitted as BCGs, then a missing BCG: they matter more than the members
     // left out one by one.
     let mut warnings: Vec<String> = catalog.fitted_bcgs.iter().map(|b| b.note.clone()).collect();
+    let members_far = bcg.as_ref().is_some_and(|b| b.members_far);
     let facts = BcgFacts {
-        missing: bcg.is_some(),
+        missing: bcg.is_some() && !members_far,
+        members_far,
         commented: bcg
             .and_then(|b| {
                 warnings.push(b.warning);

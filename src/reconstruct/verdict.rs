@@ -216,6 +216,10 @@ pub struct BcgFacts {
     /// No member near the images is bright enough to be a brightest cluster galaxy
     /// (`missing_bcg_warning` in the inversion): the catalogue has most likely left it out.
     pub missing: bool,
+    /// No member lies near the images at all: the catalogue is most likely of another field
+    /// or in another frame (`missing` is then false: no BCG is asked for).
+    #[serde(default)]
+    pub members_far: bool,
     /// The member catalogue's commented-out rows that could be the missing BCGs (one per
     /// core), in the file's order: the warnings name them and the app offers to fit them.
     pub commented: Vec<CatalogRow>,
@@ -455,6 +459,13 @@ impl Verdict {
                  {ON_CURVE_MAGNIFICATION:.0}): the map bends its curves through the images \
                  instead of between them, an over-focused fit."
             ));
+        }
+        if inputs.bcg.members_far {
+            care.push(
+                "No member lies near the images: the member catalogue may be of another field \
+                 or in another frame (see the warnings), so the map there is the grid's alone."
+                    .to_string(),
+            );
         }
         if inputs.bcg.missing {
             let rows = &inputs.bcg.commented;
@@ -893,7 +904,7 @@ mod tests {
             bcg: BcgFacts {
                 missing: true,
                 commented: commented.to_vec(),
-                fitted: Vec::new(),
+                ..BcgFacts::default()
             },
             ..VerdictInputs::default()
         };
@@ -952,7 +963,7 @@ mod tests {
             bcg: BcgFacts {
                 fitted: vec![row.clone()],
                 commented: vec![row.clone()],
-                missing: false,
+                ..BcgFacts::default()
             },
             ..VerdictInputs::default()
         };
@@ -962,6 +973,23 @@ mod tests {
         let two = [fitted("1", &[0.2, 0.3]), fitted("2", &[0.3])];
         let v = Verdict::assess(&two, VerdictInputs::default());
         assert_eq!(v.trust, Trust::Good, "{}", v.reasons);
+        // No member near the images at all (SGAS J1152's catalogue lies 3.5' away): the
+        // catalogue is questioned, no BCG asked for.
+        let far = VerdictInputs {
+            bcg: BcgFacts {
+                members_far: true,
+                ..BcgFacts::default()
+            },
+            ..VerdictInputs::default()
+        };
+        let v = Verdict::assess(&two, far);
+        assert_eq!(v.trust, Trust::UsableWithCare);
+        assert!(v.bcg.members_far && !v.bcg.missing);
+        assert_eq!(
+            v.reasons,
+            "No member lies near the images: the member catalogue may be of another field or in \
+             another frame (see the warnings), so the map there is the grid's alone."
+        );
     }
 
     /// `wslap reconstruct --folds`: the cross-validation's held-out images are the map's
