@@ -26,7 +26,9 @@ For each cluster it runs, with target/release/wslap:
     systems without a catalogue redshift are estimated within them, OUT/NAME/with-priors;
   - `wslap maps --lenstool` the published model `--z-source 2 --out OUT/NAME/published`
     (A370's group at z = 1.05 in the single-plane approximation);
-and compares: the Einstein radius at z_s = 2 (summary.json, the same definition for both),
+and compares: the Einstein radius at z_s = 2 (summary.json, the same definition for both:
+every tangential loop that reaches the lens, member galaxies' too) and the main curve's alone
+(`sqrt(area / pi)` of the largest tangential curve in critical-curves.json),
 the held-out images' median offset (crossval.json), the fitted images' median, the tangential
 curves, and the deflection difference from the published model (D_ls/D_s = 1, both maps
 sampled at the same sky positions through their WCS, the mean difference removed): at the
@@ -126,6 +128,21 @@ def deflection_difference(published, ours):
                 at_estimated=stats(difference(estimated), mean))
 
 
+def main_curve_radius(folder):
+    """sqrt(A / pi) of the largest tangential critical curve of `folder`'s critical-curves.json
+    (a curve cut by the map's border closed by its chord), arcsec; None without one. The
+    Einstein radius of summary.json counts every tangential loop that reaches the lens (member
+    galaxies' and a neighbouring group's too); this is the main curve's alone, the figure
+    published models are usually quoted by."""
+    curves = json.loads((folder / "critical-curves.json").read_text())["tangential"]
+    if not curves:
+        return None
+    def area(points):
+        x, y = np.asarray(points, dtype=float).T
+        return 0.5 * abs(np.dot(x, np.roll(y, -1)) - np.dot(y, np.roll(x, -1)))
+    return float(np.sqrt(max(area(c) for c in curves) / np.pi))
+
+
 def scores(folder, published):
     s = json.loads((folder / "summary.json").read_text())
     cv = json.loads((folder / "crossval.json").read_text())
@@ -133,6 +150,7 @@ def scores(folder, published):
     v = s["verdict"]
     return dict(
         theta_e=s["einstein_radius_arcsec"],
+        theta_e_main=main_curve_radius(folder),
         held_out=cv["holdout_image_offset_median_arcsec"],
         held_out_rms=cv["holdout_image_plane_rms_arcsec"],
         fitted=s["image_offset_median_arcsec"],
@@ -165,6 +183,7 @@ def main():
         pub = json.loads((out / "published" / "summary.json").read_text())
         row = dict(name=name, model=model, start=start, z_lens=z,
                    theta_e_published=pub["einstein_radius_arcsec"],
+                   theta_e_main_published=main_curve_radius(out / "published"),
                    published_tangential=pub["tangential_curves"])
         kinds = [("ours", []), ("with-par", ["--par", par])]
         if start:
@@ -179,10 +198,11 @@ def main():
         rows.append(row)
     (a.out / "published.json").write_text(json.dumps(rows, indent=1))
     lines = [
-        "| cluster | run | θE(z=2) ours / published (\") | ΔθE | held-out median / rms (\") "
+        "| cluster | run | θE(z=2) ours / published (\") | ΔθE | main curve's ours / published (\") "
+        "| held-out median / rms (\") "
         "| fitted median (\") | Δα at images / within 40\" / at estimated-z images (median, \") "
         "| tangential curves ours / published | main share | C | s |",
-        "|---|---|---|---:|---|---:|---|---|---:|---:|---:|",
+        "|---|---|---|---:|---|---|---:|---|---|---:|---:|---:|",
     ]
     for r in rows:
         for kind in ("ours", "with-par", "with-priors"):
@@ -195,6 +215,7 @@ def main():
                 f"| {r['name']} | {run_name} "
                 f"| {k['theta_e']:.2f} / {r['theta_e_published']:.2f} "
                 f"| {100 * (k['theta_e'] / r['theta_e_published'] - 1):+.1f}% "
+                f"| {k['theta_e_main'] or 0:.2f} / {r['theta_e_main_published'] or 0:.2f} "
                 f"| {k['held_out']:.2f} / {k['held_out_rms']:.2f} | {k['fitted']:.2f} "
                 f"| {k['deflection']['at_images'][0]:.2f} / {k['deflection']['region'][0]:.2f} / "
                 f"{'—' if (est := k['deflection']['at_estimated']) is None else f'{est[0]:.2f}'} "

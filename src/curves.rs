@@ -29,6 +29,12 @@ pub struct CriticalCurves {
     pub z_source: f64,
     /// `sqrt(area inside the tangential curves / pi)`, 0 when there is none.
     pub einstein_radius_arcsec: f64,
+    /// `sqrt(area enclosed by the main tangential curve / pi)`: the largest closed loop of the
+    /// lens alone, without the loops of member galaxies or a neighbouring group beside it (which
+    /// `einstein_radius_arcsec` counts), the figure published models are usually quoted by; 0
+    /// when there is none.
+    #[serde(default)]
+    pub main_curve_radius_arcsec: f64,
     pub tangential: Vec<Polyline>,
     /// True when the region inside the tangential curves (`lambda_t < 0`) covers more than
     /// [`TANGENTIAL_BORDER_SHARE`] of the map's border pixels, or when the curves open at the
@@ -163,6 +169,10 @@ pub fn critical_curves_about(
         .map(|c| signed_area_arcsec2(&c.points))
         .sum::<f64>();
     let einstein_radius_arcsec = (area.max(0.0) / std::f64::consts::PI).sqrt();
+    let main_area = lens_loops(&tangential, about)
+        .map(|c| -signed_area_arcsec2(&c.points))
+        .fold(0.0, f64::max);
+    let main_curve_radius_arcsec = (main_area / std::f64::consts::PI).sqrt();
     // The lens's region lambda_t < 0 reaches the border along more than a few pixels (also when
     // no curve crosses the map because the whole map lies inside the critical curve), or its
     // open curves bound a region that matters next to the closed ones.
@@ -205,6 +215,7 @@ pub fn critical_curves_about(
     CriticalCurves {
         z_source,
         einstein_radius_arcsec,
+        main_curve_radius_arcsec,
         tangential_leaves_map,
         tangential: points(tangential),
         radial: points(radial),

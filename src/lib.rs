@@ -87,7 +87,9 @@ pub use model::{ComponentSpec, ModelError, ModelFile};
 pub use potential::{
     arrival_time_days, potential_at, potential_difference, potential_map, time_delay_distance_mpc,
 };
-pub use products::{ProductOptions, Products, ProductsError, EINSTEIN_MAP_WIDENING};
+pub use products::{
+    ProductOptions, Products, ProductsError, EINSTEIN_MAP_WIDENING, MAIN_CURVE_NOTE_SHARE,
+};
 pub use profiles::{
     add_pixelwise, cell_unit_deflection, dpie_b0_arcsec, gaussian_unit_deflection,
     gaussian_unit_hessian, kk_epsilon, nfw_deflection, nfw_hessian, nfw_mass_cylinder_msun,

@@ -139,6 +139,10 @@ pub struct Summary {
     pub map_size_arcsec: f64,
     pub map_pixels: usize,
     pub einstein_radius_arcsec: f64,
+    /// The main tangential curve's alone ([`CriticalCurves::main_curve_radius_arcsec`]),
+    /// measured on the same map; 0 in files written before it was kept.
+    #[serde(default)]
+    pub einstein_radius_main_curve_arcsec: f64,
     /// See [`Products::einstein_radius_map_arcsec`]: `null` when the radius is a lower bound.
     #[serde(default)]
     pub einstein_radius_map_arcsec: Option<f64>,
@@ -177,8 +181,22 @@ const EINSTEIN_MAP_MAX_PIXELS: usize = 256;
 
 impl Summary {
     /// The Einstein radius for a reader, saying on which map it was measured when that is not
-    /// the products' own, and that it is a lower bound when the curve left every map.
+    /// the products' own, that it is a lower bound when the curve left every map, and the main
+    /// curve's alone when the other loops (members', a neighbouring group's) add more than
+    /// [`MAIN_CURVE_NOTE_SHARE`] to it.
     pub fn einstein_radius_text(&self) -> String {
+        let (r, main) = (
+            self.einstein_radius_arcsec,
+            self.einstein_radius_main_curve_arcsec,
+        );
+        let text = self.einstein_radius_words();
+        match main > 0.0 && main < (1.0 - MAIN_CURVE_NOTE_SHARE) * r {
+            true => format!("{text}; the main curve alone {main:.2} arcsec"),
+            false => text,
+        }
+    }
+
+    fn einstein_radius_words(&self) -> String {
         let r = self.einstein_radius_arcsec;
         match self.einstein_radius_map_arcsec {
             // A map that holds every curve and none that encloses anything.
@@ -196,6 +214,10 @@ impl Summary {
         }
     }
 }
+
+/// How much smaller than the Einstein radius the main curve's must be for the text to give it
+/// too (the run's one-line summary, `einstein_radius_text` of the products' summary): 2%.
+pub const MAIN_CURVE_NOTE_SHARE: f64 = 0.02;
 
 /// Radii of the enclosed masses reported in the summary, arcsec.
 const SUMMARY_RADII_ARCSEC: [f64; 3] = [10.0, 20.0, 50.0];
@@ -313,9 +335,9 @@ impl Products {
         let mut curves = critical_curves(&maps, f, z_source, lens);
         let einstein_radius_map_arcsec = match lens {
             Some(lens) if curves.tangential_leaves_map => {
-                let (radius, map) =
-                    einstein_radius_on_wider_maps(lens, maps.geometry(), f, z_source);
-                curves.einstein_radius_arcsec = radius;
+                let (wide, map) = einstein_radius_on_wider_maps(lens, maps.geometry(), f, z_source);
+                curves.einstein_radius_arcsec = wide.einstein_radius_arcsec;
+                curves.main_curve_radius_arcsec = wide.main_curve_radius_arcsec;
                 map
             }
             _ => own_map_side(&curves, maps.geometry()),
@@ -375,6 +397,7 @@ impl Products {
             map_size_arcsec: g.size_arcsec,
             map_pixels: g.pixels,
             einstein_radius_arcsec: self.curves.einstein_radius_arcsec,
+            einstein_radius_main_curve_arcsec: self.curves.main_curve_radius_arcsec,
             einstein_radius_map_arcsec: self.einstein_radius_map_arcsec,
             tangential_curves: self.curves.tangential.len(),
             tangential_main_area_share: main_area_share(&self.curves.tangential),
@@ -521,18 +544,18 @@ pub(crate) fn own_map_side(curves: &CriticalCurves, geometry: MapGeometry) -> Op
     (!curves.tangential_leaves_map).then_some(geometry.size_arcsec)
 }
 
-/// The Einstein radius of `lens` measured on the maps of [`EINSTEIN_MAP_WIDENING`] around
-/// `geometry`, and the side of the first map that holds the whole tangential curve (`None` when
-/// none does: the radius is then the widest map's closed loops only). The lens is the one of
-/// `geometry` (within half its side of its centre): what the wider maps add beyond is another
-/// structure's.
+/// The Einstein radius of `lens` (and its main curve's, [`CriticalCurves`]) measured on the
+/// maps of [`EINSTEIN_MAP_WIDENING`] around `geometry`, and the side of the first map that
+/// holds the whole tangential curve (`None` when none does: the radius is then the widest
+/// map's closed loops only). The lens is the one of `geometry` (within half its side of its
+/// centre): what the wider maps add beyond is another structure's.
 fn einstein_radius_on_wider_maps(
     lens: &dyn MassComponent,
     geometry: MapGeometry,
     f: f64,
     z_source: f64,
-) -> (f64, Option<f64>) {
-    let mut radius = 0.0;
+) -> (CriticalCurves, Option<f64>) {
+    let mut last = CriticalCurves::default();
     for widen in EINSTEIN_MAP_WIDENING {
         let wide = MapGeometry {
             pixels: geometry.pixels.min(EINSTEIN_MAP_MAX_PIXELS),
@@ -544,13 +567,12 @@ fn einstein_radius_on_wider_maps(
             center: geometry.center,
             radius_arcsec: 0.5 * geometry.size_arcsec,
         };
-        let curves = critical_curves_about(&maps, f, z_source, None, about);
-        radius = curves.einstein_radius_arcsec;
-        if !curves.tangential_leaves_map {
-            return (radius, Some(wide.size_arcsec));
+        last = critical_curves_about(&maps, f, z_source, None, about);
+        if !last.tangential_leaves_map {
+            return (last, Some(wide.size_arcsec));
         }
     }
-    (radius, None)
+    (last, None)
 }
 
 /// The radius (arcsec) of the largest disc about `center` holding no pixel without data (NaN)

@@ -82,6 +82,7 @@ fn caustics_as_curves(c: &CriticalCurves) -> CriticalCurves {
     CriticalCurves {
         z_source: c.z_source,
         einstein_radius_arcsec: c.einstein_radius_arcsec,
+        main_curve_radius_arcsec: c.main_curve_radius_arcsec,
         tangential_leaves_map: c.tangential_leaves_map,
         tangential: c.caustics.tangential.clone(),
         radial: c.caustics.radial.clone(),

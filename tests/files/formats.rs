@@ -82,6 +82,7 @@ fn small_curves() -> CriticalCurves {
     CriticalCurves {
         z_source: 2.0,
         einstein_radius_arcsec: 2.0,
+        main_curve_radius_arcsec: 2.0,
         tangential_leaves_map: true,
         tangential: vec![circle(c, 2.0, 24), open],
         radial: vec![circle(c, 0.6, 12)],

@@ -752,4 +752,35 @@ fn a_second_structure_beyond_half_the_map_is_not_the_lens() {
         r_lens,
         1e-9,
     );
+    // The main curve's radius is that loop's alone wherever the group's counts too.
+    assert_abs(
+        "main curve with the group counted",
+        all.main_curve_radius_arcsec,
+        r_lens,
+        1e-9,
+    );
+    assert_abs(
+        "main curve, measured on the wider map",
+        narrow.curves.main_curve_radius_arcsec,
+        r_lens,
+        1e-9,
+    );
+    // A heavier group within the lens's half of the map (MACS J1149's to its north in the
+    // CATS model): the text gives the main curve's radius beside the one that counts both.
+    let lens = group(DVec2::splat(1.8 * r_true), 0.3 * THETA_E_ARCSEC);
+    let s = products(&lens, 6.0 * r_true).summary();
+    assert_eq!(s.tangential_curves, 2);
+    let main = s.einstein_radius_main_curve_arcsec;
+    assert!(main < 0.95 * s.einstein_radius_arcsec, "{s:?}");
+    assert_rel("the main curve is the lens's", main, r_true, 0.1);
+    let text = s.einstein_radius_text();
+    assert!(
+        text.ends_with(&format!("; the main curve alone {main:.2} arcsec")),
+        "{text}"
+    );
+    // A lone lens: nothing more to say.
+    let text = products(&sis(), 3.0 * r_true)
+        .summary()
+        .einstein_radius_text();
+    assert!(!text.contains("main curve"), "{text}");
 }

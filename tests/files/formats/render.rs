@@ -22,6 +22,7 @@ fn figure_curves() -> CriticalCurves {
     CriticalCurves {
         z_source: 3.0,
         einstein_radius_arcsec: 12.0,
+        main_curve_radius_arcsec: 12.0,
         tangential_leaves_map: false,
         tangential: vec![circle(DVec2::ZERO, 12.0, 90)],
         radial: vec![circle(DVec2::ZERO, 3.0, 40)],
