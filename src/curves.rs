@@ -165,13 +165,13 @@ pub fn critical_curves_about(
         (Vec::new(), Vec::new())
     };
     // Tangential loops run clockwise around their lambda_t < 0 interior (negative area).
-    let area: f64 = -lens_loops(&tangential, about)
-        .map(|c| signed_area_arcsec2(&c.points))
-        .sum::<f64>();
-    let einstein_radius_arcsec = (area.max(0.0) / std::f64::consts::PI).sqrt();
-    let main_area = lens_loops(&tangential, about)
+    // (A hole runs the other way: its area counts against the sum, and is no main curve.)
+    let loop_areas: Vec<f64> = lens_loops(&tangential, about)
         .map(|c| -signed_area_arcsec2(&c.points))
-        .fold(0.0, f64::max);
+        .collect();
+    let area: f64 = loop_areas.iter().sum();
+    let einstein_radius_arcsec = (area.max(0.0) / std::f64::consts::PI).sqrt();
+    let main_area = loop_areas.iter().copied().fold(0.0, f64::max);
     let main_curve_radius_arcsec = (main_area / std::f64::consts::PI).sqrt();
     // The lens's region lambda_t < 0 reaches the border along more than a few pixels (also when
     // no curve crosses the map because the whole map lies inside the critical curve), or its
