@@ -79,9 +79,11 @@ test('catalogues and DS9 regions dropped on the drop zone load in their roles', 
   try {
     const { page } = app;
     await waitStatus(page, /^Ready/);
+    // Named against their roles: the rows say which is which (an image catalogue's 7th column
+    // is a redshift, a member catalogue's a magnitude), not the names.
     const files = [
-      ['cats_gold_mul_gold.cat', await readFile(join(AS1063, 'cats_gold_mul_gold.cat'), 'utf8')],
-      ['cats_gold_ref_potential_w_clumpNE.cat',
+      ['gold_ref.cat', await readFile(join(AS1063, 'cats_gold_mul_gold.cat'), 'utf8')],
+      ['as1063.cat',
         await readFile(join(AS1063, 'cats_gold_ref_potential_w_clumpNE.cat'), 'utf8')],
       // Arcs drawn in DS9 around two of its systems (redshifts from the catalogue).
       ['arcs.reg', '# Region file format: DS9 version 4.1\nfk5\n'
@@ -96,8 +98,8 @@ test('catalogues and DS9 regions dropped on the drop zone load in their roles', 
     await page.dispatchEvent('#drop-zone', 'dragover', { dataTransfer });
     assert.equal(await page.$eval('#drop-zone', (el) => el.classList.contains('over')), true);
     await page.dispatchEvent('#drop-zone', 'drop', { dataTransfer });
-    await page.waitForFunction(() => /19 systems, 50 images/.test(document.getElementById('status-images').textContent));
-    await page.waitForFunction(() => /cats_gold_ref_potential_w_clumpNE\.cat: \d+ members/
+    await page.waitForFunction(() => /gold_ref\.cat: 19 systems, 50 images/.test(document.getElementById('status-images').textContent));
+    await page.waitForFunction(() => /as1063\.cat: \d+ members/
       .test(document.getElementById('status-members').textContent));
     assert.equal(await page.$eval('#drop-zone', (el) => el.classList.contains('over')), false);
     assert.equal(await page.isDisabled('#reconstruct'), false);

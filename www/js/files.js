@@ -25,8 +25,22 @@ export async function guessRole(file) {
     return 'arcs';
   }
   if (/arclet|shear|weak|(^|[-_.])wl([-_.]|$)/.test(name)) return 'shear';
-  if (/member|pot|gal|ref/.test(name)) return 'members';
-  return 'images';
+  return catalogueRole(head) ?? (/member|pot|gal/.test(name) ? 'members' : 'images');
+}
+
+/** A Lenstool catalogue's role from its rows: the 7th column is a redshift in an image
+ * catalogue (0 - 12) and a magnitude in a member catalogue (about 14 - 30, or 99 for none), so
+ * the median over the first rows tells them apart whatever the file is called (SGAS J1152's
+ * `source_ids_ref0.cat` was taken for members by its name). `null` without three such rows. */
+function catalogueRole(head) {
+  const sevenths = head.split(/\r?\n/)
+    .map((line) => line.trim())
+    .filter((line) => line && !line.startsWith('#'))
+    .map((line) => Number(line.split(/\s+/)[6]))
+    .filter(Number.isFinite)
+    .sort((a, b) => a - b);
+  if (sevenths.length < 3) return null;
+  return sevenths[Math.floor(sevenths.length / 2)] >= 12 ? 'members' : 'images';
 }
 
 /** Builds the rows; `onFile(role, file)` is called for every chosen file. */
