@@ -645,7 +645,8 @@ async function leaveExample(ex, role) {
 
 /** The status line of a loaded file: its LoadReport's summary and warnings. */
 function reportText(report) {
-  const warn = report.warnings.length ? ` (${report.warnings.length} warnings: ${report.warnings.join('; ')})` : '';
+  const n = report.warnings.length;
+  const warn = n ? ` (${n} warning${n === 1 ? '' : 's'}: ${report.warnings.join('; ')})` : '';
   return `${report.name}: ${report.summary}${warn}`;
 }
 

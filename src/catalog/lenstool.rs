@@ -488,8 +488,12 @@ fn system_redshift(
             first.0,
             format!(
                 "system '{id}': line {} gives z = {} and line {} gives z = {} (within the \
-                 tolerance); using their mean z = {z}",
-                first.0, first.1, second.0, second.1
+                 tolerance); using their mean z = {}",
+                first.0,
+                first.1,
+                second.0,
+                second.1,
+                crate::error::number((z * 1e6).round() / 1e6)
             ),
         );
     }

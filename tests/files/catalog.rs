@@ -180,6 +180,14 @@ mod real_files {
             &warnings[0].to_string(),
             &[rel, "system '32'", "line 13", "1.1783"],
         );
+        // The mean as a person writes it (was "1.1782333333333332").
+        assert!(
+            warnings[0]
+                .to_string()
+                .ends_with("using their mean z = 1.178233"),
+            "{}",
+            warnings[0]
+        );
         let ids: Vec<&str> = cat.systems.iter().map(|s| s.id.as_str()).collect();
         assert_eq!(
             ids,
