@@ -98,6 +98,8 @@ test('New project starts over and can be undone', async () => {
     await page.waitForFunction(() => document.getElementById('project-name').textContent === 'New project');
     await waitStatus(page, /^Load an image catalogue or arcs/);
     assert.ok(await page.isDisabled('#reconstruct'));
+    // No figure of the data that went (the hidden image stayed on screen before).
+    await page.waitForSelector('#view-image', { state: 'hidden' });
     for (const role of ['images', 'model']) assert.equal(await page.textContent(`#status-${role}`), '');
     // Saved as such: a reload opens the empty project.
     await page.reload();
