@@ -423,6 +423,9 @@
 //! One exception, as Lenstool reads it: the potfile a `.par` names (`filein`) without a header,
 //! whose positions cannot be degrees (an RA below 0, say), is in arcsec offsets from the
 //! `.par`'s own `reference`, and is read so, with a warning (published models write them so).
+//! The member catalogue given with a `.par` that has a potfile is taken for that potfile: by
+//! `wslap maps --lenstool`, by `wslap reconstruct --par`, and in the app once the `.par` is
+//! loaded as the model file (loaded before it, such a catalogue is refused with that hint).
 //!
 //! Every catalogue of a run is brought into one frame: the one the caller asks for, else the
 //! header's reference, else (absolute degrees without a reference) the mean position of the

@@ -81,7 +81,8 @@ async function persist() {
 async function refreshLoaded() {
   const loaded = await ask('loaded');
   $('reconstruct').disabled = !(loaded.images || loaded.arcs);
-  $('forward').disabled = !loaded.model;
+  // A .par with a potfile runs once its member catalogue is loaded (the status line says so).
+  $('forward').disabled = !loaded.model || Boolean(loaded.missing_potfile);
   $('lookup').disabled = !(loaded.deflection_x && loaded.deflection_y);
   $('crossval').disabled = $('reconstruct').disabled;
   // Overlays with nothing to draw are greyed out (their choice is kept for when there is).
@@ -114,6 +115,10 @@ function skyNote() {
 /** What the loaded files allow, as the status line says it when nothing else is to be said. */
 function readyText(loaded) {
   if (loaded.images || loaded.arcs) return 'Ready: press Reconstruct.';
+  if (loaded.model && loaded.missing_potfile) {
+    const file = loaded.missing_potfile.split('/').pop();
+    return `Load ${file}, the member catalogue ${loaded.model}'s potfile names, as the member catalogue: then press Forward model.`;
+  }
   if (loaded.model) return 'Ready: press Forward model.';
   if (loaded.deflection_x && loaded.deflection_y) return 'Ready: press Deflection look-up.';
   if (loaded.deflection_x || loaded.deflection_y) return `Load the deflection ${loaded.deflection_x ? 'y' : 'x'} map too for the look-up.`;
@@ -691,7 +696,9 @@ async function onFile(role, file) {
     // The file before it (if any) stays loaded: said next to the file, at the top of the
     // results and in the next run's caption, so that nobody takes a run on it for one on theirs.
     const kept = role === 'project' ? null : (await ask('loaded').catch(() => ({})))[role];
-    const still = kept ? ` Still using ${kept} loaded before.` : '';
+    // While an example is open its file is the one kept: the user never loaded it.
+    const still = !kept ? '' : example ? ` The example (${example.name}) stays open as it was.`
+      : ` Still using ${kept} loaded before.`;
     // A sentence of its own before the next one ("... (at most 10^6). Still using ...").
     const message = /[.!?]$/.test(err.message) ? err.message : `${err.message}.`;
     setFileStatus(role, `${message}${still ? `\n${still.trim()}` : ''}`, true);

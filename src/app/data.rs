@@ -6,7 +6,8 @@ use serde::{Deserialize, Serialize};
 
 use crate::arcs::{is_region_file, ArcCatalog};
 use crate::catalog::{
-    parse_arclet_catalog, parse_image_catalog, parse_member_catalog, ImageCatalog,
+    parse_arclet_catalog, parse_image_catalog, parse_member_catalog, parse_potfile_catalog,
+    CatalogError, ImageCatalog,
 };
 use crate::cosmology::LensPlane;
 use crate::fits::read_image;
@@ -131,6 +132,24 @@ impl LoadedData {
             _ => Ok(None),
         }
     }
+
+    /// The member catalogue the loaded `.par` needs and that is not loaded: its `potfile`'s
+    /// `filein` as written (e.g. `../model/a1835/galsorted.cat`); `None` when nothing is
+    /// missing (no `.par`, no potfile, or a member catalogue loaded).
+    pub fn missing_potfile(&self, par_options: &ParOptions) -> Option<String> {
+        if self.members.is_some() {
+            return None;
+        }
+        let par = self.model_par(par_options).ok().flatten()?;
+        par.potfiles.first().map(|p| p.filein.clone())
+    }
+
+    /// The frame of a member catalogue without a header in arcsec: the loaded `.par`'s
+    /// reference when it has a potfile ([`LenstoolPar::potfile_reference`]).
+    fn potfile_reference(&self, par_options: &ParOptions) -> Option<SkyReference> {
+        let par = self.model_par(par_options).ok().flatten()?;
+        par.potfile_reference()
+    }
 }
 
 /// Whether a model file's text is a Lenstool parameter file rather than a JSON model file: a
@@ -140,6 +159,25 @@ fn is_lenstool_par(name: &str, text: &str) -> bool {
     let json_name = name.to_ascii_lowercase().ends_with(".json");
     let json_start = text.trim_start().starts_with(['{', '[', '"']);
     !(json_name || json_start)
+}
+
+/// The message of a member catalogue refused as `error`, with a hint when the catalogue would
+/// read as a `.par`'s potfile (headerless arcsec from the `.par`'s reference): then the `.par`
+/// must be loaded first.
+fn potfile_hint(error: CatalogError, text: &str, name: &str) -> String {
+    let anywhere = SkyReference {
+        ra_deg: 0.0,
+        dec_deg: 0.0,
+    };
+    let message = error.to_string();
+    match parse_potfile_catalog(text, name, Some(anywhere)) {
+        Ok((_, w)) if !w.is_empty() => format!(
+            "{message}. If it is the potfile of a Lenstool .par (arcsec from the .par's \
+             reference, as Lenstool reads it), load that .par as the model file first, then \
+             this catalogue again"
+        ),
+        _ => message,
+    }
 }
 
 /// Arc pixel side assumed when it cannot be measured (milliarcsec).
@@ -351,7 +389,11 @@ impl LoadedData {
                 )
             }
             DataRole::Members => {
-                let (c, w) = parse_member_catalog(text, name, None).map_err(|e| file(&e))?;
+                let read = match self.potfile_reference(par_options) {
+                    Some(r) => parse_potfile_catalog(text, name, Some(r)),
+                    None => parse_member_catalog(text, name, None),
+                };
+                let (c, w) = read.map_err(|e| AppError::File(potfile_hint(e, text, name)))?;
                 let n = c.members.len();
                 (
                     format!("{n} members"),
@@ -580,8 +622,13 @@ impl LoadedData {
     }
 
     /// The loaded files read into one frame (see [`Dataset::read`]); DS9 region arcs are
-    /// sampled at `arc_pixel_arcsec`.
-    pub fn parse(&self, arc_pixel_arcsec: f64) -> Result<Dataset, AppError> {
+    /// sampled at `arc_pixel_arcsec`. A member catalogue that is the potfile of the loaded
+    /// `.par` (read with `par_options`) may be in the `.par`'s frame.
+    pub fn parse(
+        &self,
+        arc_pixel_arcsec: f64,
+        par_options: &ParOptions,
+    ) -> Result<Dataset, AppError> {
         fn text(f: &Option<NamedText>) -> Option<InputText<'_>> {
             f.as_ref().map(|f| InputText {
                 name: &f.name,
@@ -593,6 +640,7 @@ impl LoadedData {
             members: text(&self.members),
             arcs: text(&self.arcs),
             shear: text(&self.shear),
+            potfile_reference: self.potfile_reference(par_options),
         };
         Dataset::read(&files, arc_pixel_arcsec).map_err(|e| AppError::File(e.to_string()))
     }

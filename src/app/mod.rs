@@ -99,9 +99,10 @@ impl Session {
     /// commented-out BCG rows are fitted when `reconstruct.members.fit_commented_bcg` is
     /// ([`Dataset::fit_commented_bcgs`]).
     pub fn parsed(&self) -> Result<Dataset, AppError> {
-        let mut parsed = self
-            .data
-            .parse(self.settings.reconstruct.constraints.pixel_arcsec)?;
+        let mut parsed = self.data.parse(
+            self.settings.reconstruct.constraints.pixel_arcsec,
+            &self.settings.par_options(),
+        )?;
         let mut warnings = self.sky_warnings();
         warnings.append(&mut parsed.warnings);
         parsed.warnings = warnings;

@@ -9,8 +9,8 @@ use wslap::{
     check_ensemble_size, check_memory, cross_validate, export_system, fold_groups,
     holdable_system_ids, image_regions, parse_par_with, reconstruct, run_ensemble, ColorScale,
     Control, ConvergenceRecord, Cosmology, CrossValidation, Dataset, InputKind, InputText,
-    InputTexts, Inputs, LensPlane, ParOptions, ReconstructConfig, ReconstructError, Reconstruction,
-    SolverMethod,
+    InputTexts, Inputs, LensPlane, LenstoolPar, ParOptions, ReconstructConfig, ReconstructError,
+    Reconstruction, SolverMethod,
 };
 
 use super::input::read_text;
@@ -222,24 +222,29 @@ pub fn run(args: &ReconstructArgs) -> Result<(), String> {
     fn text(f: &Option<(String, String)>) -> Option<InputText<'_>> {
         f.as_ref().map(|(name, text)| InputText { name, text })
     }
+    let par = match &args.par {
+        Some(path) => {
+            let text = read_text(path, InputKind::Model)?;
+            let options = ParOptions::default().for_galaxies();
+            Some(parse_par_with(&text, &name(path), &options).map_err(|e| e.to_string())?)
+        }
+        None => None,
+    };
     let files = InputTexts {
         images: text(&images),
         members: text(&members),
         arcs: text(&arcs),
         shear: text(&shear),
+        potfile_reference: par.as_ref().and_then(LenstoolPar::potfile_reference),
     };
     let mut data =
         Dataset::read(&files, config.constraints.pixel_arcsec).map_err(|e| e.to_string())?;
-    if let Some(path) = &args.par {
-        let par_name = name(path);
-        let text = read_text(path, InputKind::Model)?;
-        let par = parse_par_with(&text, &par_name, &ParOptions::default().for_galaxies())
-            .map_err(|e| e.to_string())?;
+    if let Some(par) = &par {
         for w in &par.warnings {
             eprintln!("warning: {w}");
         }
         for note in data
-            .add_par(&par, &plane, &config)
+            .add_par(par, &plane, &config)
             .map_err(|e| e.to_string())?
         {
             eprintln!("note: {note}");

@@ -347,6 +347,13 @@ pub struct LenstoolModel {
 }
 
 impl LenstoolPar {
+    /// The frame a member catalogue given with this `.par` is read in when it has no header:
+    /// [`Self::reference`] when the `.par` has a `potfile` block (the catalogue is its potfile,
+    /// whose positions Lenstool reads as arcsec from the reference), else `None`.
+    pub fn potfile_reference(&self) -> Option<SkyReference> {
+        self.reference.filter(|_| !self.potfiles.is_empty())
+    }
+
     /// The lens plane at [`Self::z_lens`] in the file's cosmology.
     pub fn lens_plane(&self) -> Result<LensPlane, ParError> {
         LensPlane::new(self.cosmology, self.z_lens).map_err(|source| ParError::Cosmology {

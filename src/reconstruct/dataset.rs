@@ -3,7 +3,9 @@
 //! one rule for which constraints are fitted.
 //!
 //! - **Frame.** The image catalogue's `#REFERENCE` sets the frame; the member catalogue is read
-//!   in it (or sets it when there is no image catalogue); DS9 region arcs are read in that frame,
+//!   in it (or sets it when there is no image catalogue); a member catalogue that is the
+//!   potfile of a `.par` given with it may be headerless arcsec from the `.par`'s reference;
+//!   DS9 region arcs are read in that frame,
 //!   or, with no catalogue at all, in a frame centred on the regions' mean position (a warning
 //!   says so).
 //! - **Weak lensing.** An arclet catalogue is read in the frame of the others (or sets it when
@@ -27,8 +29,9 @@ use crate::arcs::{
     arcs_from_regions, is_region_file, parse_arcs, ArcCatalog, ArcsError, RegionArcs,
 };
 use crate::catalog::{
-    parse_arclet_catalog, parse_image_catalog, parse_member_catalog, reframe, system_of_image,
-    ArcletCatalog, CatalogError, CatalogRow, CommentedBcgs, ImageCatalog, Member, MemberCatalog,
+    parse_arclet_catalog, parse_image_catalog, parse_member_catalog, parse_potfile_catalog,
+    reframe, system_of_image, ArcletCatalog, CatalogError, CatalogRow, CommentedBcgs, ImageCatalog,
+    Member, MemberCatalog,
 };
 use crate::cosmology::LensPlane;
 use crate::error::line_list;
@@ -56,6 +59,11 @@ pub struct InputTexts<'a> {
     pub arcs: Option<InputText<'a>>,
     /// Lenstool arclet catalogue (weak lensing).
     pub shear: Option<InputText<'a>>,
+    /// The `reference` of a Lenstool `.par` given with the files whose `potfile` the member
+    /// catalogue is ([`LenstoolPar::potfile_reference`]): a member catalogue without a header,
+    /// in arcsec, is then read in that frame, as Lenstool reads it
+    /// ([`crate::catalog::parse_potfile_catalog`]).
+    pub potfile_reference: Option<SkyReference>,
 }
 
 /// What went wrong reading the files (each message names the file and, where there is one,
@@ -112,7 +120,15 @@ impl Dataset {
         }
         if let Some(f) = files.members {
             let frame = out.images.as_ref().and_then(|c| c.reference);
-            let (m, w) = parse_member_catalog(f.text, f.name, frame)?;
+            let (m, w) = match (files.potfile_reference, frame, &out.images) {
+                // A potfile is read in the `.par`'s frame, then moved into the images'.
+                (Some(par), Some(to), _) => {
+                    let (m, w) = parse_potfile_catalog(f.text, f.name, Some(par))?;
+                    (m.reframed(to)?, w)
+                }
+                (Some(par), None, None) => parse_potfile_catalog(f.text, f.name, Some(par))?,
+                _ => parse_member_catalog(f.text, f.name, frame)?,
+            };
             out.warnings.extend(w.iter().map(ToString::to_string));
             out.members = Some(m);
         }
@@ -585,6 +601,7 @@ mod tests {
             }),
             members: None,
             shear: None,
+            potfile_reference: None,
             arcs: arcs.then_some(InputText {
                 name: "arcs.reg",
                 text: REGIONS,

@@ -496,7 +496,8 @@ impl AppSession {
 
     /// Which files are loaded: `{images, members, arcs, model, deflection_x, deflection_y}`
     /// (names or null), and `sky_warnings`: one sentence per file whose sky positions lie
-    /// apart from the others' (files of different clusters).
+    /// apart from the others' (files of different clusters), and `missing_potfile`: the
+    /// member catalogue a loaded `.par` names and that is not loaded (or null).
     pub fn loaded(&self) -> Result<JsValue, JsError> {
         let d = &self.inner.data;
         let name = |t: &Option<crate::app::NamedText>| t.as_ref().map(|x| x.name.clone());
@@ -506,6 +507,7 @@ impl AppSession {
             "model": name(&d.model), "shear": name(&d.shear),
             "deflection_x": fits(0), "deflection_y": fits(1),
             "sky_warnings": self.inner.sky_warnings(),
+            "missing_potfile": d.missing_potfile(&self.inner.settings.par_options()),
         }))
     }
 }

@@ -414,6 +414,79 @@ fn a_lenstool_par_is_a_model_file_with_the_member_catalogue_as_its_potfile() {
     assert!(why.contains("needs the member catalogue"), "{why}");
 }
 
+/// A `.par`'s potfile without a header in arcsec from the `.par`'s reference (A1835's published
+/// model of Richard et al.: `199 -70.4727720 -22.8484800 ...`): loaded before the `.par` it is
+/// refused with a hint to load the `.par` first; after it, it loads with a warning, the forward
+/// model runs, and a reconstruction reads the members in the image catalogue's frame (here
+/// 10 arcsec north of the `.par`'s reference: every member 10 arcsec lower).
+#[cfg_attr(not(target_arch = "wasm32"), test)]
+#[cfg_attr(target_arch = "wasm32", wasm_bindgen_test::wasm_bindgen_test)]
+fn a_par_s_headerless_arcsec_potfile_loads_after_the_par() {
+    let par = "runmode\n\treference 3 210.258650 2.878470\n\tend\n\
+        potentiel O1\n\tprofil 81\n\tx_centre 0.0\n\ty_centre 0.0\n\tellipticite 0.2\n\
+        \tangle_pos 10.0\n\tcore_radius_kpc 50.0\n\tcut_radius_kpc 1500.0\n\tv_disp 1100.0\n\
+        \tz_lens 0.253\n\tend\n\
+        potfile\n\tfilein 1 gal.cat\n\tzlens 0.253\n\ttype 81\n\tcorekpc 0.15\n\tmag0 17.0\n\
+        \tsigma 0 150.0\n\tcutkpc 0 40.0\n\tslope 0 4.0\n\tvdslope 0 4.0\n\tend\n\
+        cosmologie\n\tH0 70.0\n\tomegaM 0.3\n\tomegaX 0.7\n\tend\nfini\n";
+    let members = "199 -70.4727720 -22.8484800 0.557 0.371 -63.100 17.39 0.10\n\
+        106 -35.9541832 101.6661600 0.500 0.500 50.000 18.41 0.10\n\
+        232 23.2212647 -52.7292000 0.563 0.280 -48.300 18.42 0.10\n";
+    let mut s = Session::new();
+    let refused = s
+        .load_text(DataRole::Members, "gal.cat", members)
+        .unwrap_err()
+        .to_string();
+    for part in [
+        "line 1",
+        "not a right ascension",
+        "potfile of a Lenstool .par",
+        "load that .par as the model file first",
+    ] {
+        assert!(refused.contains(part), "{part:?} not in {refused}");
+    }
+    assert!(s.data.members.is_none());
+
+    s.load_text(DataRole::Model, "bestopt.par", par).unwrap();
+    // Until its member catalogue is loaded, the page names the one it lacks.
+    let options = s.settings.par_options();
+    assert_eq!(s.data.missing_potfile(&options).as_deref(), Some("gal.cat"));
+    let report = s.load_text(DataRole::Members, "gal.cat", members).unwrap();
+    assert_eq!(s.data.missing_potfile(&options), None);
+    assert_eq!(report.summary, "3 members");
+    let [w] = &report.warnings[..] else {
+        panic!("{:?}", report.warnings)
+    };
+    assert!(w.contains("no #REFERENCE header"), "{w}");
+    s.run(RunKind::Forward, &mut |_| Control::Continue).unwrap();
+    let theta_e = s.result().unwrap().products().curves.einstein_radius_arcsec;
+    assert!(theta_e > 5.0, "{theta_e}");
+
+    let images = "#REFERENCE 3 210.258650 2.881247778\n\
+        1.1 10.0 5.0 0.5 0.5 0 2.0 25\n1.2 -12.0 -8.0 0.5 0.5 0 2.0 25\n";
+    s.load_text(DataRole::Images, "images.cat", images).unwrap();
+    let data = s.parsed().unwrap();
+    let got: Vec<DVec2> = data
+        .members
+        .unwrap()
+        .members
+        .iter()
+        .map(|m| m.position)
+        .collect();
+    let want = [
+        (-70.4727720, -22.8484800),
+        (-35.9541832, 101.6661600),
+        (23.2212647, -52.7292000),
+    ];
+    for (g, (x, y)) in got.iter().zip(want) {
+        // 10 arcsec north, on the tangent planes of two references 10 arcsec apart.
+        assert!(
+            (g.x - x).abs() < 0.01 && (g.y - (y - 10.0)).abs() < 0.01,
+            "{g} vs {x} {y}"
+        );
+    }
+}
+
 /// A Lenstool model with a group at another redshift (tests/data/lenstool/multiplane.par with
 /// one potfile, after A370's CATS bestopt.par): refused, naming the setting; with the
 /// single-plane setting it loads, its report names the block moved, and it evaluates. The

@@ -344,6 +344,24 @@ test("a loaded .par's redshift priors bound the estimates once the setting takes
   }
 });
 
+test('a .par alone asks for the member catalogue its potfile names before Forward model', async () => {
+  const app = await openApp();
+  try {
+    const { page } = app;
+    await waitStatus(page, /^Ready/);
+    await page.setInputFiles('#file-model', join(AS1063, 'cats_gold_bestopt.par'));
+    await page.waitForFunction(() => /Lenstool model/.test(document.getElementById('status-model').textContent));
+    await waitStatus(page, /^Load ref_potential_w_clumpNE\.cat, the member catalogue cats_gold_bestopt\.par's potfile names, as the member catalogue: then press Forward model\.$/);
+    assert.equal(await page.isDisabled('#forward'), true);
+    await page.setInputFiles('#file-members', join(AS1063, 'cats_gold_ref_potential_w_clumpNE.cat'));
+    await page.waitForFunction(() => /members/.test(document.getElementById('status-members').textContent));
+    await waitStatus(page, /^Ready: press Forward model\.$/);
+    assert.equal(await page.isDisabled('#forward'), false);
+  } finally {
+    await app.close();
+  }
+});
+
 test('the BCG a loaded .par models on its own is offered, and fitted on a click', async () => {
   const app = await openApp();
   try {

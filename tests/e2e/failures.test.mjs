@@ -27,9 +27,10 @@ test('a rejected file keeps the one before, and says so at the top and in the ca
     await page.waitForSelector('#error:not([hidden])');
     const error = await page.textContent('#error');
     assert.match(error, /^bad\.cat was not loaded: .*line 2/s);
-    assert.match(error, /Still using images\.cat loaded before\.$/);
+    // The example's images.cat is kept, but the user never loaded it: the example is named.
+    assert.match(error, /The example \(Teaching example: one halo, four sources\) stays open as it was\.$/);
     assert.match(await page.textContent('#status'), /^bad\.cat was not loaded/);
-    assert.match(await page.textContent('#status-images'), /Still using images\.cat loaded before\./);
+    assert.match(await page.textContent('#status-images'), /The example \(Teaching example: one halo, four sources\) stays open as it was\./);
     assert.equal(await page.textContent('#project-name'), 'Teaching example: one halo, four sources');
     await runToMap(page, '#reconstruct');
     assert.match(await page.textContent('#summary'), /Made with images\.cat: bad\.cat had errors and was not loaded\./);
@@ -46,6 +47,7 @@ test('a rejected file keeps the one before, and says so at the top and in the ca
     assert.doesNotMatch(await page.textContent('#summary'), /Made with|had errors/);
     await page.setInputFiles('#file-images', { name: 'bad.cat', mimeType: 'text/plain', buffer: Buffer.from('#REFERENCE 0\n1 x 2 0.5 0.5 0 2.0 25\n') });
     await waitStatus(page, /^bad\.cat was not loaded/);
+    assert.match(await page.textContent('#error'), /Still using images\.cat loaded before\.$/);
     await page.setInputFiles('#file-images', good);
     await waitStatus(page, /^Loaded images\.cat: .*; the map shown was made before it\.$/);
     assert.ok(await page.isHidden('#error'));
