@@ -702,7 +702,9 @@ async function onFile(role, file) {
     // A sentence of its own before the next one ("... (at most 10^6). Still using ...").
     const message = /[.!?]$/.test(err.message) ? err.message : `${err.message}.`;
     setFileStatus(role, `${message}${still ? `\n${still.trim()}` : ''}`, true);
-    showError(`${file.name} was not loaded: ${message}${still}`);
+    // The box names the file once ("x.cat was not loaded: line 2: ..."), not twice.
+    const why = message.startsWith(`${file.name}: `) ? message.slice(file.name.length + 2) : message;
+    showError(`${file.name} was not loaded: ${why}${still}`);
     setStatus(`${file.name} was not loaded (see the message below).`);
     if (kept) rejected.set(role, { file: file.name, kept });
     return;

@@ -194,7 +194,7 @@ mod tests {
             ),
             (
                 "1 0 0 1 0.5\n",
-                "line 2: 5 column(s) found, at least 7 needed",
+                "line 2: '1 0 0 1 0.5': 5 column(s) found, at least 7 needed",
             ),
         ];
         for (row, expected) in cases {

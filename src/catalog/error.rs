@@ -8,6 +8,10 @@ use std::fmt;
 use serde::{Deserialize, Serialize};
 use thiserror::Error;
 
+/// Said of a Lenstool parameter file given where a catalogue is wanted.
+const PAR_HINT: &str = "; this is a Lenstool parameter file (.par), not a catalogue: load it as \
+                        the model file in the app, or give it with --par";
+
 /// A catalogue that cannot be used as written.
 #[derive(Debug, Error, Clone, PartialEq)]
 pub enum CatalogError {
@@ -27,16 +31,22 @@ pub enum CatalogError {
 
     /// A row with fewer columns than the format needs.
     #[error(
-        "{source_name}: line {line}: {found} column(s) found, at least {needed} needed \
-         ({expected})"
+        "{source_name}: line {line}: '{row}': {found} column(s) found, at least {needed} needed \
+         ({expected}){hint}",
+        hint = if *lenstool_par { PAR_HINT } else { "" }
     )]
     MissingColumns {
         source_name: String,
         line: usize,
+        /// The row as written (its fields joined by one space, shortened past 60 characters).
+        row: String,
         found: usize,
         needed: usize,
         /// The column layout, e.g. `"id x y a b theta z [mag]"`.
         expected: &'static str,
+        /// The row is a Lenstool `.par` block or keyword (`runmode`, `potentiel`, ...): the
+        /// file is a parameter file given as a catalogue.
+        lenstool_par: bool,
     },
 
     /// One field that is not a usable value: not a number, NaN/inf, out of range, a bad id.

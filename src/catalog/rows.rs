@@ -109,6 +109,14 @@ fn commented_row(line: &str) -> Option<Vec<&str>> {
         .then_some(fields)
 }
 
+/// Characters of a short row a message quotes.
+const ROW_SHOWN_CHARS: usize = 60;
+
+/// First words of a Lenstool `.par`'s lines (block names in French and English, and the
+/// keywords of its first block): a row starting so is a parameter file read as a catalogue.
+const PAR_WORDS: &str = "runmode reference potentiel potential potfile limit image grille grid \
+                         source champ field cosmologie cosmology fini finish";
+
 /// Position (as written) and ellipse of one row.
 pub(super) struct Shape {
     pub(super) raw: DVec2,
@@ -144,12 +152,20 @@ impl Fields<'_, '_> {
     ) -> Result<(), CatalogError> {
         let found = self.row.fields.len();
         if found < REQUIRED_COLUMNS {
+            let row = self.row.fields.join(" ");
+            let row = match row.char_indices().nth(ROW_SHOWN_CHARS) {
+                Some((at, _)) => format!("{}...", &row[..at]),
+                None => row,
+            };
+            let first = self.row.fields.first().map(|f| f.to_ascii_lowercase());
             return Err(CatalogError::MissingColumns {
                 source_name: self.source_name.into(),
                 line: self.row.line,
+                row,
                 found,
                 needed: REQUIRED_COLUMNS,
                 expected: layout,
+                lenstool_par: first.is_some_and(|f| PAR_WORDS.split(' ').any(|w| w == f)),
             });
         }
         if found > ALL_COLUMNS {

@@ -545,7 +545,26 @@ fn missing_columns() {
     let err = image_err("1.1 342.1 -44.5 0.1 0.1 0 1.2\n1.2 342.2 -44.5 0.1 0.1\n");
     assert_eq!(
         err,
-        "bad.cat: line 2: 5 column(s) found, at least 7 needed (id x y a b theta z [mag])"
+        "bad.cat: line 2: '1.2 342.2 -44.5 0.1 0.1': 5 column(s) found, at least 7 needed \
+         (id x y a b theta z [mag])"
+    );
+    // A Lenstool .par given as a catalogue is named as one, with where it goes instead.
+    let err = image_err("# made by Lenstool\nrunmode\n\treference 3 292.95 -26.57\n");
+    assert_eq!(
+        err,
+        "bad.cat: line 2: 'runmode': 1 column(s) found, at least 7 needed \
+         (id x y a b theta z [mag]); this is a Lenstool parameter file (.par), not a \
+         catalogue: load it as the model file in the app, or give it with --par"
+    );
+    // A long row is quoted shortened.
+    let long = format!("1.1 {}\n", "x".repeat(80));
+    let err = image_err(&long);
+    assert!(
+        err.starts_with(&format!(
+            "bad.cat: line 1: '1.1 {}...': 2 column(s)",
+            "x".repeat(56)
+        )),
+        "{err}"
     );
 }
 
