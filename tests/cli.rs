@@ -636,6 +636,12 @@ fn reconstruct_takes_the_redshift_priors_of_a_par() {
     let [lo, hi] = [0, 1].map(|i| two["z_interval"][i].as_f64().unwrap());
     assert!(lo >= 2.0 && hi <= 2.3 && lo <= z && z <= hi, "{two}");
     assert!(z > 2.2, "the end nearer the truth, 2.5: {two}");
+    // An interval that reaches the top of its range is said to be open above.
+    assert_eq!(
+        stderr.contains("2.30, open above: 2.30 is the top of the range searched)"),
+        hi >= 2.3 - 1e-3,
+        "{two}: {stderr}"
+    );
     let four = system(&sources, "4");
     assert_eq!(four["z"], 2.2);
     assert!(four["z_estimate"].is_null(), "{four}");

@@ -541,7 +541,12 @@ async function afterOpen(report) {
   clearCrossval();
   await showSessionSettings();
   const loaded = await refreshLoaded();
-  for (const { role } of ROLES) setFileStatus(role, loaded[role] ? `${loaded[role]}: loaded` : '');
+  // Each file's line as when it was loaded by hand: its counts and warnings.
+  const reports = new Map((report?.files ?? []).map((r) => [r.role, r]));
+  for (const { role } of ROLES) {
+    const r = reports.get(role);
+    setFileStatus(role, r && r.name === loaded[role] ? reportText(r) : loaded[role] ? `${loaded[role]}: loaded` : '');
+  }
   rejected.clear();
   showNoResult();
   if (report?.result === 'restored' || report?.result === 'recomputed') await showResult(await ask('resultInfo'));

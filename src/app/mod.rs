@@ -36,7 +36,7 @@ pub use iterates::{
 pub use overlap::{separation_arcsec, SkyFootprint, FIELD_MARGIN_ARCSEC};
 pub use plots::{profile_relative_differences, ModelCurves};
 pub use project::{Project, ProjectResult, StoredFits, PROJECT_FORMAT, PROJECT_VERSION};
-pub use run::{Outcome, RunKind, SessionResult};
+pub use run::{Outcome, RunKind, SessionResult, StoredRun};
 pub use settings::{AppSettings, APP_MAP_PIXELS};
 pub use views::{
     system_rgb, CounterImages, HoverReadout, ViewOptions, ViewPng, COUNTER_IMAGE_RGB,

@@ -33,11 +33,11 @@ use serde::{Deserialize, Serialize};
 use crate::limits::json_error_message;
 use crate::reconstruct::{ConvergenceRecord, SourceReport};
 
-use super::data::{NamedText, MAX_STORED_FITS_BYTES};
+use super::data::{LoadReport, NamedText, MAX_STORED_FITS_BYTES};
 use super::ensemble::StoredEnsemble;
 use super::iterates::StoredIterates;
 use super::outputs::pretty;
-use super::run::RunKind;
+use super::run::{RunKind, StoredRun};
 use super::{AppError, AppSettings, Session};
 use base64::Engine as _;
 
@@ -167,6 +167,9 @@ pub struct ReopenReport {
     /// "solve_needed" (a reconstruction without a usable X: solve again) or "none".
     pub result: String,
     pub message: String,
+    /// What loading each of the project's files found, as when it was loaded by hand.
+    #[serde(default)]
+    pub files: Vec<LoadReport>,
 }
 
 impl Session {
@@ -282,6 +285,7 @@ impl Session {
             ..Session::default()
         };
         use super::DataRole as R;
+        let mut files = Vec::new();
         for (role, file) in [
             (R::Images, &p.data.images),
             (R::Members, &p.data.members),
@@ -290,8 +294,10 @@ impl Session {
             (R::Shear, &p.data.shear),
         ] {
             if let Some(f) = file {
-                next.load_text(role, &f.name, &f.text)
+                let report = next
+                    .load_text(role, &f.name, &f.text)
                     .map_err(|e| AppError::File(format!("{source_name}: {e}")))?;
+                files.push(report);
             }
         }
         for (axis, file) in [&p.data.deflection_x, &p.data.deflection_y]
@@ -300,8 +306,10 @@ impl Session {
         {
             if let Some(f) = file {
                 let bytes = stored_bytes(f, source_name)?;
-                next.load_fits(axis, &f.name, &bytes)
+                let report = next
+                    .load_fits(axis, &f.name, &bytes)
                     .map_err(|e| AppError::File(format!("{source_name}: {e}")))?;
+                files.push(report);
             }
         }
         let (result, message) = match p.result {
@@ -322,20 +330,27 @@ impl Session {
                         .summary
                         .get("strength_choice")
                         .and_then(|c| serde_json::from_value(c.clone()).ok());
-                    match next.restore_reconstruction(
+                    // The run's warnings, as its summary.json lists them.
+                    let warnings = r
+                        .summary
+                        .get("warnings")
+                        .and_then(|w| serde_json::from_value(w.clone()).ok());
+                    match next.restore_reconstruction(StoredRun {
                         x,
-                        r.iterations,
-                        r.convergence,
-                        r.sources,
+                        iterations: r.iterations,
+                        convergence: r.convergence,
+                        sources: r.sources,
                         iterates,
                         choice,
-                    ) {
+                        warnings,
+                    }) {
                         Ok(()) => {
                             let ensemble = next.restore_ensemble(r.ensemble);
                             (
                                 "restored",
                                 format!(
-                                    "maps rebuilt from the stored solution X{dropped}{ensemble}"
+                                    "the last reconstruction is back, its maps rebuilt from the \
+                                     stored cell masses (not solved again){dropped}{ensemble}"
                                 ),
                             )
                         }
@@ -360,6 +375,7 @@ impl Session {
             name: p.name,
             result: result.to_string(),
             message,
+            files,
         })
     }
 }

@@ -155,6 +155,25 @@ fn reconstruction_result(mut r: Reconstruction, parsed: &Dataset) -> SessionResu
     }
 }
 
+/// What a project keeps of a reconstruction besides its data and settings
+/// ([`Session::restore_reconstruction`] rebuilds the rest).
+#[derive(Debug, Clone, Default)]
+pub struct StoredRun {
+    /// The solution vector `X`.
+    pub x: Vec<f64>,
+    pub iterations: usize,
+    pub convergence: Vec<ConvergenceRecord>,
+    pub sources: Vec<SourceReport>,
+    /// The kept iterates, for the iteration slider (none: no slider).
+    pub iterates: Vec<Iterate>,
+    /// An "auto" strength's choice (the project's `summary.json`): it sets the grid and
+    /// regulariser the run used, and the result keeps it.
+    pub choice: Option<StrengthChoice>,
+    /// The run's warnings (its `summary.json`), among them what its redshift estimates said,
+    /// which rebuilding from `x` cannot say again; `None`: the data's, found again.
+    pub warnings: Option<Vec<String>>,
+}
+
 impl Session {
     /// Runs `kind`; `progress` sees every QADP report (reconstruction only) and may cancel.
     /// The previous result is replaced only on success.
@@ -372,19 +391,18 @@ impl Session {
 
     /// Rebuilds a reconstruction from a stored solution `x` without iterating: the same
     /// constraints, grid, layers and linear system as the run that found `x` (no grid
-    /// refinements), the lens of `x` and its products. Sources, convergence and the kept
-    /// `iterates` (for the iteration slider; none: no slider) come from the project. An
-    /// "auto" strength's `choice` (the project's `summary.json`) sets the grid and regulariser
-    /// the run used, and the result keeps it.
-    pub fn restore_reconstruction(
-        &mut self,
-        x: Vec<f64>,
-        iterations: usize,
-        convergence: Vec<ConvergenceRecord>,
-        sources: Vec<SourceReport>,
-        iterates: Vec<Iterate>,
-        choice: Option<StrengthChoice>,
-    ) -> Result<(), AppError> {
+    /// refinements), the lens of `x` and its products; the rest of the result is `stored`'s
+    /// (see [`StoredRun`]).
+    pub fn restore_reconstruction(&mut self, stored: StoredRun) -> Result<(), AppError> {
+        let StoredRun {
+            x,
+            iterations,
+            convergence,
+            sources,
+            iterates,
+            choice,
+            warnings: run_warnings,
+        } = stored;
         let t = crate::products::Clock::start();
         let run = |e: &dyn std::fmt::Display| AppError::Run(e.to_string());
         let parsed = self.parsed()?;
@@ -438,6 +456,9 @@ impl Session {
         .map_err(|e| run(&e))?;
         warnings.extend(system.measurability_warnings());
         let lens = system.reconstructed_lens(&x).map_err(|e| run(&e))?;
+        if let Some(w) = run_warnings {
+            warnings = w;
+        }
         let opts = product_options(&config, &grid);
         let products =
             Products::from_lens(&lens, plane, parsed.reference(), &opts).map_err(|e| run(&e))?;

@@ -296,9 +296,17 @@ pub(super) fn fit_at_estimates(
     let mut notes: Vec<String> = estimates
         .iter()
         .map(|(id, e)| {
+            // An interval that ends at the top of the range searched is not bounded by the
+            // images there: the top is the setting's, and the note says so.
+            let top = search_range(config, id)[1];
+            let open = if e.interval[1] >= top - AT_RANGE_TOP {
+                format!(", open above: {top:.2} is the top of the range searched")
+            } else {
+                String::new()
+            };
             format!(
-                "system {id}: redshift estimated z = {:.2} (68%: {:.2} - {:.2}){} on the lens \
-                 of the systems with a known one{}{}, and fitted at it",
+                "system {id}: redshift estimated z = {:.2} (68%: {:.2} - {:.2}{open}){} on the \
+                 lens of the systems with a known one{}{}, and fitted at it",
                 e.z,
                 e.interval[0],
                 e.interval[1],
@@ -502,6 +510,9 @@ pub(super) fn draw(
         })
         .collect()
 }
+
+/// How close to the top of the range searched an interval's end is taken to reach it.
+const AT_RANGE_TOP: f64 = 1e-3;
 
 /// The range searched when `constraints.free_z_prior` is off (then only systems with a prior
 /// of their own are estimated, within it): every redshift a setting allows (the low end is

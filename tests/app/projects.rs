@@ -5,7 +5,7 @@ use crate::fixtures::{forward_session, solved};
 use serde_json::json;
 use wslap::Control;
 use wslap::RunStatus;
-use wslap::{app::RunKind, app::Session, app::MAX_STORED_FITS_BYTES};
+use wslap::{app::DataRole, app::RunKind, app::Session, app::MAX_STORED_FITS_BYTES};
 
 #[cfg_attr(not(target_arch = "wasm32"), test)]
 #[cfg_attr(target_arch = "wasm32", wasm_bindgen_test::wasm_bindgen_test)]
@@ -15,6 +15,37 @@ fn a_project_reopens_with_the_maps_rebuilt_from_x() {
     let mut t = Session::new();
     let report = t.open_project(&text, "p.json").unwrap();
     assert_eq!(report.result, "restored", "{}", report.message);
+    // Each file reports as it did when it was loaded: its counts and warnings.
+    let images = s.data.images.as_ref().unwrap();
+    let by_hand = Session::new()
+        .load_text(DataRole::Images, &images.name, &images.text)
+        .unwrap();
+    assert_eq!(report.files, [by_hand]);
+    assert!(
+        report.files[0].summary.contains("systems"),
+        "{:?}",
+        report.files
+    );
+    // The run's warnings come back as its summary.json lists them, also those that
+    // rebuilding from X cannot find again (what a run's redshift estimates said).
+    let mut project: serde_json::Value = serde_json::from_str(&text).unwrap();
+    let said = "system 3: redshift estimated z = 2.18 (68%: 1.39 - 3.23) ..., and fitted at it";
+    project["result"]["summary"]["warnings"]
+        .as_array_mut()
+        .unwrap()
+        .push(json!(said));
+    let mut u = Session::new();
+    u.open_project(&project.to_string(), "p.json").unwrap();
+    let back = &u.result().unwrap().reconstruction().unwrap().warnings;
+    let mut expected = s
+        .result()
+        .unwrap()
+        .reconstruction()
+        .unwrap()
+        .warnings
+        .clone();
+    expected.push(said.to_string());
+    assert_eq!(*back, expected);
     let (a, b) = (s.result().unwrap(), t.result().unwrap());
     // serde_json's float parsing may differ from the written value in the last bit.
     const KAPPA_RTOL: f64 = 1e-9;

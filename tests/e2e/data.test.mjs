@@ -134,8 +134,13 @@ test('systems without a redshift have it estimated, or take the one the settings
     // By default each is left out of a first fit, its redshift estimated on that lens, and
     // then fitted: the systems table gives the estimate and its 68% interval.
     const free = await run();
-    const found = free.warnings.filter((t) => /^system \S+: redshift estimated z = [\d.]+ \(68%: [\d.]+ - [\d.]+\)/.test(t));
+    const found = free.warnings.filter((t) => /^system \S+: redshift estimated z = [\d.]+ \(68%: [\d.]+ - [\d.]+(, open above: [\d.]+ is the top of the range searched)?\)/.test(t));
     assert.ok(found.length >= 1, free.warnings.join(' | '));
+    // An interval that reaches the top of the range searched (8 by default) says so.
+    for (const t of found) {
+      const top = t.match(/\(68%: [\d.]+ - ([\d.]+)/)[1] === '8.00';
+      assert.equal(/, open above: 8\.00 is the top of the range searched\)/.test(t), top, t);
+    }
     assert.equal(free.estimated.length, found.length, free.estimated.join(' | '));
     // ... and, ± ″, how far that interval moves its images (added to their position error).
     for (const cell of free.estimated) assert.match(cell, /^[\d.]+ est\.[\d.]+–[\d.]+± [\d.]+″$/);
@@ -206,7 +211,9 @@ test('the second round of the choice shows the first map, and Cancel there keeps
     await page.reload();
     await waitStatus(page, /^Restored your project from this browser/, 120_000);
     const description = await page.textContent('#project-description');
-    assert.match(description, /maps rebuilt from the stored solution/, description);
+    assert.match(description, /the last reconstruction is back, its maps rebuilt from the stored cell masses \(not solved again\)/, description);
+    // Each file's line keeps its counts, as when it was loaded.
+    assert.match(await page.textContent('#status-images'), /^immul_ongoing\.cat: \d+ systems, \d+ images/);
     await page.waitForFunction(() => !document.getElementById('strength-box').hidden, null, { timeout: 60_000 });
     const after = await imageStats(page, '#view-image');
     assert.ok(after.reddish > 20, `only ${after.reddish} red curve pixels after the reload`);

@@ -288,7 +288,7 @@ test('look-up mode reads deflection FITS, shows μ where clicked and survives a 
     // The session, deflection maps included, comes back after a reload.
     await page.reload();
     await waitStatus(page, /^Restored/);
-    await page.waitForFunction(() => /x-arcsec-deflect\.fits: loaded/.test(document.getElementById('status-deflection_x').textContent));
+    await page.waitForFunction(() => /^x-arcsec-deflect\.fits: \d+ x \d+ pixels, [\d.]+ arcsec wide/.test(document.getElementById('status-deflection_x').textContent));
     await waitView(page, 'kappa');
     assert.equal(await page.isDisabled('#lookup'), false);
     assert.equal(await page.textContent('#summary'), caption);
