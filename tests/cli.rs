@@ -639,7 +639,7 @@ fn reconstruct_takes_the_redshift_priors_of_a_par() {
     // An interval that reaches the top of its range is said to be open above.
     assert_eq!(
         stderr.contains("2.30, open above: 2.30 is the top of the range searched)"),
-        hi >= 2.3 - 1e-3,
+        hi >= 2.3 - 0.005,
         "{two}: {stderr}"
     );
     let four = system(&sources, "4");

@@ -511,8 +511,9 @@ pub(super) fn draw(
         .collect()
 }
 
-/// How close to the top of the range searched an interval's end is taken to reach it.
-const AT_RANGE_TOP: f64 = 1e-3;
+/// How close to the top of the range searched an interval's end is taken to reach it: half
+/// the last digit the note prints, so that an end printed as the top is said to be it.
+const AT_RANGE_TOP: f64 = 0.005;
 
 /// The range searched when `constraints.free_z_prior` is off (then only systems with a prior
 /// of their own are estimated, within it): every redshift a setting allows (the low end is
