@@ -122,7 +122,7 @@ function readyText(loaded) {
   if (loaded.model) return 'Ready: press Forward model.';
   if (loaded.deflection_x && loaded.deflection_y) return 'Ready: press Deflection look-up.';
   if (loaded.deflection_x || loaded.deflection_y) return `Load the deflection ${loaded.deflection_x ? 'y' : 'x'} map too for the look-up.`;
-  return 'Load an image catalogue or arcs to reconstruct (Your data), or open an example.';
+  return 'Load an image catalogue or arcs to reconstruct (under Files), or open an example.';
 }
 
 /** No result on screen: caption, notes, downloads and the clicked point go with it. */
@@ -702,7 +702,7 @@ async function onFile(role, file) {
     // results and in the next run's caption, so that nobody takes a run on it for one on theirs.
     const kept = role === 'project' ? null : (await ask('loaded').catch(() => ({})))[role];
     // While an example is open its file is the one kept: the user never loaded it.
-    const still = !kept ? '' : example ? ` The example (${example.name}) stays open as it was.`
+    const still = !kept ? '' : example ? ` The example "${example.name}" stays open as it was.`
       : ` Still using ${kept} loaded before.`;
     // A sentence of its own before the next one ("... (at most 10^6). Still using ...").
     const message = /[.!?]$/.test(err.message) ? err.message : `${err.message}.`;
@@ -736,7 +736,7 @@ async function newProject() {
     clearError();
     await ask('reset');
     await ask('setName', { name: NEW_PROJECT });
-    describe(NEW_PROJECT, 'Nothing loaded yet: add your catalogues under "Your data", or pick an example.');
+    describe(NEW_PROJECT, 'Nothing loaded yet: add your catalogues under "Files", or pick an example.');
     const loaded = await afterOpen(null);
     await persist();
     setStatus(`${readyText(loaded)} `);

@@ -28,9 +28,9 @@ test('a rejected file keeps the one before, and says so at the top and in the ca
     const error = await page.textContent('#error');
     assert.match(error, /^bad\.cat was not loaded: line 2/);
     // The example's images.cat is kept, but the user never loaded it: the example is named.
-    assert.match(error, /The example \(Teaching example: one halo, four sources\) stays open as it was\.$/);
+    assert.match(error, /The example "Teaching example: one halo, four sources" stays open as it was\.$/);
     assert.match(await page.textContent('#status'), /^bad\.cat was not loaded/);
-    assert.match(await page.textContent('#status-images'), /The example \(Teaching example: one halo, four sources\) stays open as it was\./);
+    assert.match(await page.textContent('#status-images'), /The example "Teaching example: one halo, four sources" stays open as it was\./);
     assert.equal(await page.textContent('#project-name'), 'Teaching example: one halo, four sources');
     await runToMap(page, '#reconstruct');
     assert.match(await page.textContent('#summary'), /Made with images\.cat: bad\.cat had errors and was not loaded\./);

@@ -69,11 +69,11 @@ function locateHelp(h) {
   if (!h) {
     // No data's sky reference yet: the forms, with no cluster's position as an example.
     return `RA Dec in degrees or sexagesimal (hh:mm:ss.ss ±dd:mm:ss.s), or x y in arcsec from the
-      reference (12.5 -3.2 arcsec): ${what}`;
+      reference (for example 12.5 -3.2): ${what}`;
   }
-  if (!h.radec_sexagesimal) return `x y in arcsec from the frame's origin (12.5 -3.2; these data give no sky reference): ${what}`;
+  if (!h.radec_sexagesimal) return `x y in arcsec from the frame's origin (for example 12.5 -3.2; these data give no sky reference): ${what}`;
   return `RA Dec in degrees (${fmt(h.radec_deg[0], 4)} ${fmt(h.radec_deg[1], 4)}) or sexagesimal
-    (${h.radec_sexagesimal}), or x y in arcsec from the reference (12.5 -3.2 arcsec): ${what}`;
+    (${h.radec_sexagesimal}), or x y in arcsec from that reference (for example 12.5 -3.2): ${what}`;
 }
 
 /** Gives the position box examples at the loaded data's sky reference: `h` is the read-out at

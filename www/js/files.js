@@ -1,4 +1,4 @@
-// The "Your data" panel: one row per file role with a labelled file picker and a status line
+// The "Files" panel: one row per file role with a labelled file picker and a status line
 // (the parse error with its line, or what was loaded), and a drop zone that guesses roles.
 
 export const ROLES = [

@@ -292,9 +292,9 @@ export function showCrossval(cv, onDownload, files = []) {
     ${fmt(cv.fit_image_offset_median_arcsec)}″: the first says how well these settings find images the model
     was not given.${spread}${always}${unmatched}${cancelled}</p>
     <details id="crossval-systems"><summary>Per system (${cv.systems.length})</summary>
-    <div class="table-scroll"><table><caption>Per held-out system: the fold that left it out, its redshift, each
-    observed image's offset from the nearest predicted image (arcsec) with the fold's magnification there, and their rms</caption>
-    <thead><tr><th scope="col">system</th><th scope="col">fold</th><th scope="col">z</th>
+    <p class="table-caption" id="crossval-caption">Per held-out system: the fold that left it out, its redshift, each
+    observed image's offset from the nearest predicted image (arcsec) with the fold's magnification there, and their rms</p>
+    <div class="table-scroll"><table aria-describedby="crossval-caption"><thead><tr><th scope="col">system</th><th scope="col">fold</th><th scope="col">z</th>
     <th scope="col">offsets [″] (μ)</th><th scope="col">rms [″]</th></tr></thead><tbody>${rows}</tbody></table></div></details>`;
   const type = (name) => (name.endsWith('.png') ? 'image/png' : 'application/fits');
   const png = files.find((f) => f.name.endsWith('.png'));
