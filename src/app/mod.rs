@@ -34,7 +34,7 @@ pub use iterates::{
     IterateList, IterateStep, StoredIterates, APP_KEPT_ITERATES, MAX_STORED_ITERATE_VALUES,
 };
 pub use overlap::{separation_arcsec, SkyFootprint, FIELD_MARGIN_ARCSEC};
-pub use plots::{profile_relative_differences, ModelCurves};
+pub use plots::{profile_relative_differences, ModelCurves, MODEL_PLANE_TOLERANCE};
 pub use project::{Project, ProjectResult, StoredFits, PROJECT_FORMAT, PROJECT_VERSION};
 pub use run::{Outcome, RunKind, SessionResult, StoredRun};
 pub use settings::{AppSettings, APP_MAP_PIXELS};

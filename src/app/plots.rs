@@ -6,6 +6,7 @@ use std::hash::{DefaultHasher, Hash, Hasher};
 
 use glam::DVec2;
 
+use crate::cosmology::LensPlane;
 use crate::curves::{critical_curves, Polyline};
 use crate::map::LensMaps;
 use crate::map::MapGeometry;
@@ -85,6 +86,9 @@ pub(crate) struct ModelMaps {
     /// The reconstruction's origin in the model's frame (the maps are centred on the
     /// reconstruction's map centre, in the model's frame).
     origin: DVec2,
+    /// The model's own lens plane (its `z_lens` may differ a little from the
+    /// reconstruction's: see [`MODEL_PLANE_TOLERANCE`]).
+    plane: LensPlane,
     /// The model's critical curves at the last distance ratio asked for, in the
     /// reconstruction's frame.
     curves: RefCell<Option<(f64, ModelCurves)>>,
@@ -204,14 +208,16 @@ impl Session {
     /// The radial profile of the loaded model file (the true lens of the built-in examples) in
     /// the bins of a reconstruction's profile, about the same sky position, with the file's
     /// name; `None` for other results, without a model file, or when the model's lens plane
-    /// (`z_lens`, cosmology) is not the reconstruction's: its kappa and masses would not
-    /// compare. When both frames have a sky reference the model's map is centred on the
+    /// is not the reconstruction's (another cosmology, or a `z_lens` farther than
+    /// [`MODEL_PLANE_TOLERANCE`]): its kappa and masses would not compare. Its masses are
+    /// those of its own plane. When both frames have a sky reference the model's map is centred on the
     /// reconstruction's origin (the small rotation between the two tangent planes is ignored).
     /// The model's map has at most `MODEL_MAPS_MAX_PIXELS` per side.
     pub fn model_profile(&self, result: &SessionResult) -> Result<Option<NamedProfile>, AppError> {
         self.with_model_maps(result, |m| {
             let bins = RadialBins::Edges(result.products().profile.r_edges_arcsec.clone());
-            let profile = radial_profile(&m.maps.kappa, m.origin, &bins, &result.products().plane)
+            // Masses on the model's own plane: the same whatever small z_lens difference.
+            let profile = radial_profile(&m.maps.kappa, m.origin, &bins, &m.plane)
                 .map_err(|e| AppError::Run(format!("{}: {e}", m.name)))?;
             Ok((m.name.clone(), profile))
         })
@@ -223,10 +229,14 @@ impl Session {
     /// per side), once per source redshift.
     pub fn model_curves(&self, result: &SessionResult) -> Result<Option<ModelCurves>, AppError> {
         self.with_model_maps(result, |m| {
-            let f = result.products().distance_ratio;
+            // The model's own D_ls / D_s at the result's source redshift.
+            let z_s = result.products().curves.z_source;
+            let f = m
+                .plane
+                .distance_ratio(z_s)
+                .unwrap_or(result.products().distance_ratio);
             let mut cached = m.curves.borrow_mut();
             if !matches!(&*cached, Some((g, _)) if *g == f) {
-                let z_s = result.products().curves.z_source;
                 let curves = critical_curves(&m.maps, f, z_s, None);
                 let shift = |lines: Vec<Polyline>| -> Vec<Polyline> {
                     let moved = lines
@@ -274,6 +284,30 @@ impl Session {
         Some(format!("{} is not compared: {why}", file.name))
     }
 
+    /// What the caption says of the loaded model file over `result` (a reconstruction): why it
+    /// is not compared ([`Self::model_not_compared`]), or, when it is compared although its
+    /// `z_lens` differs a little from the reconstruction's, that it is compared at its own.
+    pub fn model_note(&self, result: &SessionResult) -> Option<String> {
+        if let Some(why) = self.model_not_compared(result) {
+            return Some(why);
+        }
+        let (RunKind::Reconstruct, Some(file)) = (result.kind, &self.data.model) else {
+            return None;
+        };
+        let model = self.data.model_lens(&self.settings.par_options()).ok()??;
+        let (theirs, ours) = (model.plane, result.products().plane);
+        (theirs.z_lens != ours.z_lens).then(|| {
+            format!(
+                "{} is compared at its own z_lens = {} (the reconstruction's is {}: their \
+                 distances to the lens differ by {:.1}%)",
+                file.name,
+                theirs.z_lens,
+                ours.z_lens,
+                100.0 * plane_mismatch(&theirs, &ours)
+            )
+        })
+    }
+
     /// How many times this session computed the loaded model's maps (they are kept for the next
     /// result over the same field: a second reconstruction does not compute them again).
     pub fn model_maps_computed(&self) -> usize {
@@ -316,6 +350,7 @@ impl Session {
                 name: file.name.clone(),
                 maps: LensMaps::from_lens(&model.lens, geometry),
                 origin,
+                plane: model.plane,
                 curves: RefCell::new(None),
             };
             *self.model_maps.maps.borrow_mut() = Some((key, maps));
@@ -423,12 +458,25 @@ fn objective_decrease(x: &[f64], levels: &[usize], objectives: &[f64]) -> Vec<(f
         .collect()
 }
 
+/// How far apart two lens planes' distances `D_l` are (relative). A model's kappa
+/// (`D_ls/D_s = 1`) is relative to `c^2 / (4 pi G D_l)` of its own plane, and its arcsec to its
+/// own `D_l`: compared on another plane it is off by about this much.
+fn plane_mismatch(a: &LensPlane, b: &LensPlane) -> f64 {
+    (a.d_l_mpc / b.d_l_mpc - 1.0).abs()
+}
+
+/// The largest relative difference of `D_l` at which a loaded model is compared with a reconstruction
+/// (1%): a published model's `z_lens` written to fewer or more digits (AS1063: 0.3475 for 0.348,
+/// 0.1% apart; MACS1931: 0.35 for 0.352, 0.4%) is compared, with a note; another cluster's is
+/// not.
+pub const MODEL_PLANE_TOLERANCE: f64 = 0.01;
+
 /// The reconstruction's origin in the model's frame and the geometry of the model's maps over
-/// the reconstruction's map (see [`Session::model_profile`]); when the model's lens plane is not
-/// the reconstruction's (its kappa would not compare), why, in words.
+/// the reconstruction's map (see [`Session::model_profile`]); when the model's lens plane is
+/// not close enough to the reconstruction's (its kappa would not compare), why, in words.
 fn model_frame(result: &SessionResult, model: &ModelLens) -> Result<(DVec2, MapGeometry), String> {
     let (theirs, ours) = (model.plane, result.products().plane);
-    if theirs.z_lens != ours.z_lens {
+    if plane_mismatch(&theirs, &ours) > MODEL_PLANE_TOLERANCE {
         return Err(format!(
             "its z_lens = {} is not the reconstruction's {} (set z_lens to compare)",
             theirs.z_lens, ours.z_lens

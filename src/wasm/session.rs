@@ -345,7 +345,7 @@ impl AppSession {
             "status": rec.map(|x| x.status.name()),
             "iterations": rec.map(|x| x.iterations),
             "summary": summary,
-            "model_note": self.inner.model_not_compared(r),
+            "model_note": self.inner.model_note(r),
             // What the verdict may offer to fit: `[{id, line, mag}]` of the loaded .par.
             "model_galaxies": self.inner.model_galaxies().iter()
                 .map(|g| serde_json::json!({"id": g.id, "line": g.line, "mag": g.mag}))

@@ -396,16 +396,33 @@ fn a_lenstool_par_is_a_model_file_with_the_member_catalogue_as_its_potfile() {
     assert!(!curves.tangential.is_empty());
     assert!(s.model_profile(s.result().unwrap()).unwrap().is_some());
     assert_eq!(s.model_not_compared(s.result().unwrap()), None);
-    // At another z_lens its kappa would not compare: no curves, and the result says why.
+    assert_eq!(s.model_note(s.result().unwrap()), None);
+    let profile = s.model_profile(s.result().unwrap()).unwrap().unwrap();
+    // The z_lens of the CATS catalogues' papers (0.348) is 0.1% away in D_l: the model is
+    // compared on its own plane (the same curves and masses), and the caption says so.
     s.set_field("z_lens", json!(0.348)).unwrap();
+    s.run(RunKind::Reconstruct, &mut |_| Control::Continue)
+        .unwrap();
+    let r = s.result().unwrap();
+    assert_eq!(s.model_curves(r).unwrap(), Some(curves));
+    assert_eq!(s.model_profile(r).unwrap(), Some(profile));
+    let note = s.model_note(r).unwrap();
+    let prefix = "cats_gold_bestopt.par is compared at its own z_lens = 0.3475 (the \
+                  reconstruction's is 0.348: their distances to the lens differ by ";
+    assert!(note.starts_with(prefix) && note.ends_with("%)"), "{note}");
+    let percent: f64 = note[prefix.len()..note.len() - 2].parse().unwrap();
+    assert!((0.05..=0.15).contains(&percent), "{note}");
+    // At another cluster's z_lens its kappa would not compare: no curves, and the result
+    // says why.
+    s.set_field("z_lens", json!(0.4)).unwrap();
     s.run(RunKind::Reconstruct, &mut |_| Control::Continue)
         .unwrap();
     assert!(s.model_curves(s.result().unwrap()).unwrap().is_none());
     assert_eq!(
-        s.model_not_compared(s.result().unwrap()).as_deref(),
+        s.model_note(s.result().unwrap()).as_deref(),
         Some(
             "cats_gold_bestopt.par is not compared: its z_lens = 0.3475 is not the \
-             reconstruction's 0.348 (set z_lens to compare)"
+             reconstruction's 0.4 (set z_lens to compare)"
         )
     );
     // Without its member catalogue it cannot be built: that is the reason given.
