@@ -185,15 +185,21 @@ impl Summary {
     /// curve's alone when the other loops (members', a neighbouring group's) add more than
     /// [`MAIN_CURVE_NOTE_SHARE`] to it.
     pub fn einstein_radius_text(&self) -> String {
+        let text = self.einstein_radius_words();
+        match self.main_curve_apart_arcsec() {
+            Some(main) => format!("{text}; the main curve alone {main:.2} arcsec"),
+            None => text,
+        }
+    }
+
+    /// The main curve's Einstein radius (arcsec) when a reader should be given it beside the
+    /// Einstein radius: it is more than [`MAIN_CURVE_NOTE_SHARE`] smaller; else `None`.
+    pub fn main_curve_apart_arcsec(&self) -> Option<f64> {
         let (r, main) = (
             self.einstein_radius_arcsec,
             self.einstein_radius_main_curve_arcsec,
         );
-        let text = self.einstein_radius_words();
-        match main > 0.0 && main < (1.0 - MAIN_CURVE_NOTE_SHARE) * r {
-            true => format!("{text}; the main curve alone {main:.2} arcsec"),
-            false => text,
-        }
+        (main > 0.0 && main < (1.0 - MAIN_CURVE_NOTE_SHARE) * r).then_some(main)
     }
 
     fn einstein_radius_words(&self) -> String {

@@ -244,14 +244,11 @@ function caption(info) {
   const stale = [...rejected.values()].map(({ file, kept }) => ` Made with ${kept}: ${file} had errors and was not loaded.`).join('')
     + ($('sky-warning').hidden ? '' : ' Made with files of different parts of the sky (see the warning above).');
   // The main curve's alone, when the other loops (members', a neighbouring group's) add to it.
-  const mainCurve = (m) => {
-    const main = m.einstein_radius_main_curve_arcsec ?? 0;
-    return main > 0 && main < 0.98 * m.einstein_radius_arcsec ? ` (the main curve alone ${main.toFixed(1)}″)` : '';
-  };
+  const mainCurve = info.main_curve_arcsec == null ? '' : ` (the main curve alone ${info.main_curve_arcsec.toFixed(1)}″)`;
   // No tangential curve at all: a radius of 0″ would read as a measurement.
   const radius = s.einstein_radius_arcsec === 0 && s.einstein_radius_map_arcsec !== null
     ? `Einstein radius: none (no tangential critical curve at z_s = ${s.z_source}); `
-    : `Einstein radius ${bound}${s.einstein_radius_arcsec.toFixed(1)}″ at z_s = ${s.z_source}${mainCurve(s)}; `;
+    : `Einstein radius ${bound}${s.einstein_radius_arcsec.toFixed(1)}″ at z_s = ${s.z_source}${mainCurve}; `;
   $('summary').textContent = `${status}${radius}` +
     `${factors}${offsets}${held}${shear}${s.tangential_curves} tangential and ${s.radial_curves} radial critical curves.${ensembleCaption(sum)}${note}${stale}`;
 }

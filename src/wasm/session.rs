@@ -332,8 +332,11 @@ impl AppSession {
         files_js(self.crossval_files.iter().map(|(n, b)| (*n, b.as_slice())))
     }
 
-    /// `{kind, elapsed_ms, status, iterations, summary, model_note}` of the last result
-    /// (`model_note`: why the loaded model file is not compared with a reconstruction, or null).
+    /// `{kind, elapsed_ms, status, iterations, summary, model_note, main_curve_arcsec,
+    /// model_galaxies}` of the last result (`model_note`: what the caption says of the loaded
+    /// model file, [`crate::app::Session::model_note`], or null; `main_curve_arcsec`: the main
+    /// curve's Einstein radius when the caption gives it,
+    /// `Summary::main_curve_apart_arcsec` of the products, or null).
     pub fn result_info(&self) -> Result<JsValue, JsError> {
         let r = self.inner.result().map_err(err)?;
         let summary: serde_json::Value =
@@ -346,6 +349,7 @@ impl AppSession {
             "iterations": rec.map(|x| x.iterations),
             "summary": summary,
             "model_note": self.inner.model_note(r),
+            "main_curve_arcsec": r.products().summary().main_curve_apart_arcsec(),
             // What the verdict may offer to fit: `[{id, line, mag}]` of the loaded .par.
             "model_galaxies": self.inner.model_galaxies().iter()
                 .map(|g| serde_json::json!({"id": g.id, "line": g.line, "mag": g.mag}))

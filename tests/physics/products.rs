@@ -778,9 +778,11 @@ fn a_second_structure_beyond_half_the_map_is_not_the_lens() {
         text.ends_with(&format!("; the main curve alone {main:.2} arcsec")),
         "{text}"
     );
+    // The app's caption gives it from the same rule.
+    assert_eq!(s.main_curve_apart_arcsec(), Some(main));
     // A lone lens: nothing more to say.
-    let text = products(&sis(), 3.0 * r_true)
-        .summary()
-        .einstein_radius_text();
+    let alone = products(&sis(), 3.0 * r_true).summary();
+    let text = alone.einstein_radius_text();
     assert!(!text.contains("main curve"), "{text}");
+    assert_eq!(alone.main_curve_apart_arcsec(), None);
 }
