@@ -114,7 +114,8 @@ function skyNote() {
 
 /** What the loaded files allow, as the status line says it when nothing else is to be said. */
 function readyText(loaded) {
-  if (loaded.images || loaded.arcs) return 'Ready: press Reconstruct.';
+  // A model file at another z_lens than the settings' would not be compared: said before the run.
+  if (loaded.images || loaded.arcs) return `Ready: press Reconstruct.${loaded.model_z_lens_note ? ` But ${loaded.model_z_lens_note}.` : ''}`;
   if (loaded.model && loaded.missing_potfile) {
     const file = loaded.missing_potfile.split('/').pop();
     return `Load ${file}, the member catalogue ${loaded.model}'s potfile names, as the member catalogue: then press Forward model.`;
@@ -810,6 +811,8 @@ async function applySetting(path, value) {
       setFileStatus('model', err.message);
     }
   }
+  // The status line's "Ready" follows z_lens: its note on a model at another z_lens goes or comes.
+  if (path === 'z_lens' && /^Ready/.test($('status').textContent)) setStatus(readyText(await refreshLoaded()) + skyNote());
   await persist();
   return settings;
 }

@@ -133,6 +133,17 @@ impl LoadedData {
         }
     }
 
+    /// The loaded model file's lens redshift (a `.par`'s or a JSON model's); `None` without
+    /// one or when it does not read.
+    pub fn model_z_lens(&self, par_options: &ParOptions) -> Option<f64> {
+        let file = self.model.as_ref()?;
+        if is_lenstool_par(&file.name, &file.text) {
+            return Some(self.model_par(par_options).ok()??.z_lens);
+        }
+        let model = ModelFile::from_json_str(&file.text, &file.name).ok()?;
+        Some(model.z_lens)
+    }
+
     /// The member catalogue the loaded `.par` needs and that is not loaded: its `potfile`'s
     /// `filein` as written (e.g. `../model/a1835/galsorted.cat`); `None` when nothing is
     /// missing (no `.par`, no potfile, or a member catalogue loaded).

@@ -308,6 +308,28 @@ impl Session {
         })
     }
 
+    /// Before a reconstruction: when images or arcs and a model file are loaded and the
+    /// model's `z_lens` is farther from the settings' than [`MODEL_PLANE_TOLERANCE`] allows
+    /// (a reconstruction would not be compared with it), a sentence that says so and what to
+    /// set; else `None`.
+    pub fn model_z_lens_note(&self) -> Option<String> {
+        let d = &self.data;
+        if d.images.is_none() && d.arcs.is_none() {
+            return None;
+        }
+        let name = &d.model.as_ref()?.name;
+        let z = d.model_z_lens(&self.settings.par_options())?;
+        let ours = self.settings.lens_plane().ok()?;
+        let theirs = LensPlane::new(ours.cosmology, z).ok()?;
+        (plane_mismatch(&theirs, &ours) > MODEL_PLANE_TOLERANCE).then(|| {
+            format!(
+                "{name} is at z_lens = {z} and the settings at {}: set z_lens to {z} if the \
+                 images are of its cluster (else the model is not compared)",
+                ours.z_lens
+            )
+        })
+    }
+
     /// How many times this session computed the loaded model's maps (they are kept for the next
     /// result over the same field: a second reconstruction does not compute them again).
     pub fn model_maps_computed(&self) -> usize {

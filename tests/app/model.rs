@@ -482,6 +482,17 @@ fn a_par_s_headerless_arcsec_potfile_loads_after_the_par() {
     let images = "#REFERENCE 3 210.258650 2.881247778\n\
         1.1 10.0 5.0 0.5 0.5 0 2.0 25\n1.2 -12.0 -8.0 0.5 0.5 0 2.0 25\n";
     s.load_text(DataRole::Images, "images.cat", images).unwrap();
+    // Before a reconstruction, a z_lens that would not compare with the .par's is said.
+    s.set_field("z_lens", json!(0.35)).unwrap();
+    assert_eq!(
+        s.model_z_lens_note().as_deref(),
+        Some(
+            "bestopt.par is at z_lens = 0.253 and the settings at 0.35: set z_lens to 0.253 if \
+             the images are of its cluster (else the model is not compared)"
+        )
+    );
+    s.set_field("z_lens", json!(0.253)).unwrap();
+    assert_eq!(s.model_z_lens_note(), None);
     let data = s.parsed().unwrap();
     let got: Vec<DVec2> = data
         .members

@@ -364,6 +364,14 @@ test('a .par alone asks for the member catalogue its potfile names before Forwar
     await page.waitForFunction(() => /members/.test(document.getElementById('status-members').textContent));
     await waitStatus(page, /^Ready: press Forward model\.$/);
     assert.equal(await page.isDisabled('#forward'), false);
+    // With images, a z_lens the model would not be compared at is said before the run, and
+    // the sentence goes once z_lens is the cluster's.
+    await setField(page, '#set-z_lens', 0.4);
+    await page.setInputFiles('#file-images', join(AS1063, 'cats_gold_mul_gold.cat'));
+    await page.waitForFunction(() => /19 systems/.test(document.getElementById('status-images').textContent));
+    await waitStatus(page, /^Ready: press Reconstruct\. But cats_gold_bestopt\.par is at z_lens = 0\.3475 and the settings at 0\.4: set z_lens to 0\.3475 if the images are of its cluster \(else the model is not compared\)\.$/);
+    await setField(page, '#set-z_lens', 0.348);
+    await waitStatus(page, /^Ready: press Reconstruct\.$/);
   } finally {
     await app.close();
   }
