@@ -180,6 +180,9 @@ async function render() {
     const options = name === 'kappa' ? { ...viewOptions(), ...iterateOption() } : viewOptions();
     const { png } = await ask('view', { name, options });
     showPng(name, png);
+    // The data before any result: the figure's title says what it is; an earlier view's
+    // message ("no catalogue is loaded") must not stay beside it.
+    if (name === 'data') $('summary').textContent = '';
     syncIterates();
     // The read-out under a still cursor follows the new map (z_s, a new result).
     if (name === 'kappa') await refreshReadout();

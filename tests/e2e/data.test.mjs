@@ -359,6 +359,7 @@ test('a .par alone asks for the member catalogue its potfile names before Forwar
     await page.setInputFiles('#file-model', join(AS1063, 'cats_gold_bestopt.par'));
     await page.waitForFunction(() => /Lenstool model/.test(document.getElementById('status-model').textContent));
     await waitStatus(page, /^Load ref_potential_w_clumpNE\.cat, the member catalogue cats_gold_bestopt\.par's potfile names, as the member catalogue: then press Forward model\.$/);
+    assert.equal(await page.textContent('#summary'), 'no catalogue is loaded');
     assert.equal(await page.isDisabled('#forward'), true);
     await page.setInputFiles('#file-members', join(AS1063, 'cats_gold_ref_potential_w_clumpNE.cat'));
     await page.waitForFunction(() => /members/.test(document.getElementById('status-members').textContent));
@@ -370,6 +371,8 @@ test('a .par alone asks for the member catalogue its potfile names before Forwar
     await page.setInputFiles('#file-images', join(AS1063, 'cats_gold_mul_gold.cat'));
     await page.waitForFunction(() => /19 systems/.test(document.getElementById('status-images').textContent));
     await waitStatus(page, /^Ready: press Reconstruct\. But cats_gold_bestopt\.par is at z_lens = 0\.3475 and the settings at 0\.4: set z_lens to 0\.3475 if the images are of its cluster \(else the model is not compared\)\.$/);
+    // The data view replaces the "no catalogue is loaded" the .par alone had beside the map.
+    await page.waitForFunction(() => document.getElementById('summary').textContent === '');
     await setField(page, '#set-z_lens', 0.348);
     await waitStatus(page, /^Ready: press Reconstruct\.$/);
   } finally {
