@@ -273,39 +273,45 @@ impl Session {
     /// built (a Lenstool model without its member catalogue) or its lens plane is not the
     /// reconstruction's; `None` when it is compared, or when there is nothing to compare.
     pub fn model_not_compared(&self, result: &SessionResult) -> Option<String> {
-        let (RunKind::Reconstruct, Some(file)) = (result.kind, &self.data.model) else {
-            return None;
-        };
-        let why = match self.data.model_lens(&self.settings.par_options()) {
-            Err(e) => e.to_string(),
-            Ok(None) => return None,
-            Ok(Some(model)) => model_frame(result, &model).err()?,
-        };
-        Some(format!("{} is not compared: {why}", file.name))
+        self.model_comparison(result)?.err()
     }
 
     /// What the caption says of the loaded model file over `result` (a reconstruction): why it
     /// is not compared ([`Self::model_not_compared`]), or, when it is compared although its
     /// `z_lens` differs a little from the reconstruction's, that it is compared at its own.
     pub fn model_note(&self, result: &SessionResult) -> Option<String> {
-        if let Some(why) = self.model_not_compared(result) {
-            return Some(why);
-        }
-        let (RunKind::Reconstruct, Some(file)) = (result.kind, &self.data.model) else {
-            return None;
+        let theirs = match self.model_comparison(result)? {
+            Err(why) => return Some(why),
+            Ok(plane) => plane,
         };
-        let model = self.data.model_lens(&self.settings.par_options()).ok()??;
-        let (theirs, ours) = (model.plane, result.products().plane);
+        let (name, ours) = (&self.data.model.as_ref()?.name, result.products().plane);
         (theirs.z_lens != ours.z_lens).then(|| {
             format!(
-                "{} is compared at its own z_lens = {} (the reconstruction's is {}: their \
+                "{name} is compared at its own z_lens = {} (the reconstruction's is {}: their \
                  distances to the lens differ by {:.1}%)",
-                file.name,
                 theirs.z_lens,
                 ours.z_lens,
                 100.0 * plane_mismatch(&theirs, &ours)
             )
         })
+    }
+
+    /// Whether the loaded model file is compared with `result`: its lens plane when it is, why
+    /// not (with the file's name) when it is not; `None` when there is nothing to compare (not
+    /// a reconstruction, or no model file).
+    fn model_comparison(&self, result: &SessionResult) -> Option<Result<LensPlane, String>> {
+        let (RunKind::Reconstruct, Some(file)) = (result.kind, &self.data.model) else {
+            return None;
+        };
+        let why = match self.data.model_lens(&self.settings.par_options()) {
+            Err(e) => e.to_string(),
+            Ok(None) => return None,
+            Ok(Some(model)) => match model_frame(result, &model) {
+                Ok(_) => return Some(Ok(model.plane)),
+                Err(why) => why,
+            },
+        };
+        Some(Err(format!("{} is not compared: {why}", file.name)))
     }
 
     /// Before a reconstruction: when images or arcs and a model file are loaded and the
