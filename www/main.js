@@ -53,6 +53,11 @@ const NEW_PROJECT = 'New project';
 // {file, kept}. Said in the caption of the runs made meanwhile; a file of that role that loads,
 // an example or a new project clears it.
 const rejected = new Map();
+// A member catalogue refused only because it reads as a Lenstool potfile (arcsec from a .par's
+// reference) and no .par was loaded: read again once a .par that names a potfile loads. An
+// example, a project or a member catalogue that loads forgets it.
+let waitingMembers = null;
+const WANTS_PAR = 'load that .par as the model file first';
 
 const client = new LensClient({ onCrash: (m) => showError(m), onRestart: restoreSession });
 const ask = (type, payload = {}, onProgress) => client.request(type, payload, onProgress);
@@ -549,6 +554,7 @@ async function afterOpen(report) {
     setFileStatus(role, r && r.name === loaded[role] ? reportText(r) : loaded[role] ? `${loaded[role]}: loaded` : '');
   }
   rejected.clear();
+  waitingMembers = null;
   showNoResult();
   if (report?.result === 'restored' || report?.result === 'recomputed') await showResult(await ask('resultInfo'));
   await render();
@@ -713,9 +719,24 @@ async function onFile(role, file) {
     showError(`${file.name} was not loaded: ${why}${still}`);
     setStatus(`${file.name} was not loaded (see the message below).`);
     if (kept) rejected.set(role, { file: file.name, kept });
+    if (role === 'members' && err.message.includes(WANTS_PAR)) waitingMembers = file;
     return;
   }
   rejected.delete(role);
+  if (role === 'members') waitingMembers = null;
+  if (role === 'model' && waitingMembers) await membersForPar(file.name);
+}
+
+/** The member catalogue refused for want of its .par, read again now that `par` is loaded
+ * when the .par names a potfile; the status line says so when it loads. */
+async function membersForPar(par) {
+  if (!(await ask('loaded')).missing_potfile) return;
+  const members = waitingMembers;
+  waitingMembers = null;
+  await onFile('members', members);
+  if ((await ask('loaded')).members !== members.name) return;
+  setStatus(`${members.name}, refused before ${par} was loaded, is read now as its potfile's ` +
+    `member catalogue. ${$('status').textContent}`);
 }
 
 // Files and examples are opened one at a time, in the order they came (a drop of several

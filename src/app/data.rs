@@ -184,8 +184,8 @@ fn potfile_hint(error: CatalogError, text: &str, name: &str) -> String {
     match parse_potfile_catalog(text, name, Some(anywhere)) {
         Ok((_, w)) if !w.is_empty() => format!(
             "{message}. If it is the potfile of a Lenstool .par (arcsec from the .par's \
-             reference, as Lenstool reads it), load that .par as the model file first, then \
-             this catalogue again"
+             reference, as Lenstool reads it), load that .par as the model file first: the \
+             app then reads this catalogue again"
         ),
         _ => message,
     }
@@ -447,8 +447,9 @@ impl LoadedData {
                 };
                 (
                     format!(
-                        "Lenstool model: {} potentials{members}, at z_lens = {}",
+                        "Lenstool model: {} potential{}{members}, at z_lens = {}",
                         par.potentials.len(),
+                        if par.potentials.len() == 1 { "" } else { "s" },
                         par.z_lens
                     ),
                     par.warnings.iter().map(|w| w.to_string()).collect(),

@@ -380,6 +380,44 @@ test('a .par alone asks for the member catalogue its potfile names before Forwar
   }
 });
 
+test('a headerless potfile refused before its .par is read again when the .par loads', async () => {
+  // A1835's published model (Richard et al.) writes its potfile in arcsec from the .par's
+  // reference, without a header: alone it cannot be placed on the sky.
+  const dir = await mkdtemp(join(tmpdir(), 'wslap-potfile-'));
+  const par = join(dir, 'bestopt.par');
+  const members = join(dir, 'gal.cat');
+  await writeFile(par, [
+    'runmode', '\treference 3 210.258650 2.878470', '\tend',
+    'potentiel O1', '\tprofil 81', '\tx_centre 0.0', '\ty_centre 0.0', '\tellipticite 0.2',
+    '\tangle_pos 10.0', '\tcore_radius_kpc 50.0', '\tcut_radius_kpc 1500.0', '\tv_disp 1100.0',
+    '\tz_lens 0.253', '\tend',
+    'potfile', '\tfilein 1 gal.cat', '\tzlens 0.253', '\ttype 81', '\tcorekpc 0.15', '\tmag0 17.0',
+    '\tsigma 0 150.0', '\tcutkpc 0 40.0', '\tslope 0 4.0', '\tvdslope 0 4.0', '\tend',
+    'cosmologie', '\tH0 70.0', '\tomegaM 0.3', '\tomegaX 0.7', '\tend', 'fini', ''].join('\n'));
+  await writeFile(members, [
+    '199 -70.4727720 -22.8484800 0.557 0.371 -63.100 17.39 0.10',
+    '106 -35.9541832 101.6661600 0.500 0.500 50.000 18.41 0.10',
+    '232 23.2212647 -52.7292000 0.563 0.280 -48.300 18.42 0.10', ''].join('\n'));
+  const app = await openApp();
+  try {
+    const { page } = app;
+    await waitStatus(page, /^Ready/);
+    await page.setInputFiles('#file-members', members);
+    await waitStatus(page, /^gal\.cat was not loaded/);
+    assert.match(await page.textContent('#error'), /load that \.par as the model file first: the app then reads this catalogue again/);
+    await page.setInputFiles('#file-model', par);
+    await waitStatus(page, /^gal\.cat, refused before bestopt\.par was loaded, is read now as its potfile's member catalogue\. Ready: press Forward model\.$/);
+    assert.match(await page.textContent('#status-members'), /^gal\.cat: 3 members/);
+    assert.match(await page.textContent('#status-model'), /^bestopt\.par: Lenstool model: 1 potential, and its potfile's members/);
+    assert.equal(await page.isHidden('#error'), true);
+    assert.equal(await page.isDisabled('#forward'), false);
+    await runToMap(page, '#forward', 60_000);
+    assert.deepEqual(app.consoleErrors, []);
+  } finally {
+    await app.close();
+  }
+});
+
 test('the BCG a loaded .par models on its own is offered, and fitted on a click', async () => {
   const app = await openApp();
   try {
