@@ -642,6 +642,7 @@ fn reconstruct_takes_the_redshift_priors_of_a_par() {
         hi >= 2.3 - 0.005,
         "{two}: {stderr}"
     );
+    assert_eq!(two["z_open_above"], hi >= 2.3 - 0.005, "{two}");
     let four = system(&sources, "4");
     assert_eq!(four["z"], 2.2);
     assert!(four["z_estimate"].is_null(), "{four}");

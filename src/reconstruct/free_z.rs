@@ -280,11 +280,17 @@ pub(super) fn fit_at_estimates(
         .map(|(id, e)| (id.clone(), e.position_error_arcsec))
         .collect();
     let mut r = reconstruct_limited(inputs, &second, progress)?;
+    // An interval that ends at the top of the range searched is not bounded by the images
+    // there: the top is the setting's (or the system's own prior's), and the note says so.
+    let open_above = |id: &str, e: &RedshiftEstimate| {
+        e.interval[1] >= search_range(config, id)[1] - AT_RANGE_TOP
+    };
     for s in r.sources.iter_mut() {
         if let Some((_, e)) = estimates.iter().find(|(id, _)| *id == s.id) {
             s.z_estimate = Some(e.z);
             s.z_interval = Some(e.interval);
             s.z_position_error_arcsec = Some(e.position_error_arcsec);
+            s.z_open_above = open_above(&s.id, e);
         }
     }
     let estimated = |id: &str| estimates.iter().any(|(e, _)| e == id);
@@ -293,39 +299,76 @@ pub(super) fn fit_at_estimates(
             .iter()
             .filter(|s| !s.held_out && !estimated(&s.id)),
     ));
-    let mut notes: Vec<String> = estimates
-        .iter()
-        .map(|(id, e)| {
-            // An interval that ends at the top of the range searched is not bounded by the
-            // images there: the top is the setting's, and the note says so.
-            let top = search_range(config, id)[1];
-            let open = if e.interval[1] >= top - AT_RANGE_TOP {
-                format!(", open above: {top:.2} is the top of the range searched")
-            } else {
-                String::new()
+    let own_prior = |id: &str| match config.constraints.z_priors.get(id) {
+        Some(p) => format!(" under its own prior ({})", p.describe()),
+        None => String::new(),
+    };
+    // How the estimates were made: said once.
+    let how = format!(
+        "on the lens of the systems with a known one{}",
+        match free.maps {
+            0 | 1 => String::new(),
+            n => format!(" (the interval over the maps of {n} regularisers)"),
+        },
+    );
+    let again = match free.passes {
+        0 => String::new(),
+        1 => " and again on the map of every system".to_string(),
+        n => format!(" and again, {n} times, on the map of every system"),
+    };
+    let mut notes: Vec<String> = match &estimates[..] {
+        [] => Vec::new(),
+        [(id, e)] => {
+            let open = match open_above(id, e) {
+                true => format!(
+                    ", open above: {:.2} is the top of the range searched",
+                    search_range(config, id)[1]
+                ),
+                false => String::new(),
             };
-            format!(
-                "system {id}: redshift estimated z = {:.2} (68%: {:.2} - {:.2}{open}){} on the \
-                 lens of the systems with a known one{}{}, and fitted at it",
+            vec![format!(
+                "system {id}: redshift estimated z = {:.2} (68%: {:.2} - {:.2}{open}){} {how}{again}, \
+                 and fitted at it",
                 e.z,
                 e.interval[0],
                 e.interval[1],
-                match config.constraints.z_priors.get(id) {
-                    Some(p) => format!(" under its own prior ({})", p.describe()),
-                    None => String::new(),
-                },
-                match free.maps {
-                    0 | 1 => String::new(),
-                    n => format!(" (the interval over the maps of {n} regularisers)"),
-                },
-                match free.passes {
-                    0 => String::new(),
-                    1 => " and again on the map of every system".to_string(),
-                    n => format!(" and again, {n} times, on the map of every system"),
-                }
-            )
-        })
-        .collect();
+                own_prior(id),
+            )]
+        }
+        // One line for them all (27 lines for one catalogue said less than this one); the
+        // systems table and sources.json have each again.
+        many => {
+            let each: Vec<String> = many
+                .iter()
+                .map(|(id, e)| {
+                    format!(
+                        "system {id} at z = {:.2} ({:.2} - {:.2}{}){}",
+                        e.z,
+                        e.interval[0],
+                        e.interval[1],
+                        if open_above(id, e) {
+                            ", open above"
+                        } else {
+                            ""
+                        },
+                        own_prior(id),
+                    )
+                })
+                .collect();
+            let open = match many.iter().any(|(id, e)| open_above(id, e)) {
+                true => "; \"open above\": the interval ends at the top of the range searched, \
+                         where the images no longer bound it"
+                    .to_string(),
+                false => String::new(),
+            };
+            vec![format!(
+                "redshifts estimated for {} systems {how}{again}, and fitted at them (68% \
+                 intervals): {}{open}",
+                many.len(),
+                each.join(", "),
+            )]
+        }
+    };
     notes.extend(not_estimated_note(&free.not_estimated));
     r.warnings.extend(notes);
     r.free_z = Some(free);

@@ -146,6 +146,10 @@ pub struct SourceReport {
     /// error in quadrature, so a redshift the images hardly fix weighs little in the map.
     #[serde(default)]
     pub z_position_error_arcsec: Option<f64>,
+    /// True when `z_interval` reaches the top of the range searched (the setting's, or the
+    /// system's own prior's): the images do not bound the redshift from above there.
+    #[serde(default)]
+    pub z_open_above: bool,
     /// The system's own redshift prior (`constraints.z_priors`, e.g. a `.par`'s `z_m_limit`
     /// line), if it has one: `z_estimate` was found under it, or, fixed, `z` is its value.
     #[serde(default)]
@@ -526,6 +530,7 @@ fn finish(
         z_estimate: None,
         z_interval: None,
         z_position_error_arcsec: None,
+        z_open_above: false,
         z_prior: None,
         held_out,
         beta_arcsec: beta,

@@ -615,6 +615,7 @@ mod tests {
             z_estimate: None,
             z_interval: None,
             z_position_error_arcsec: None,
+            z_open_above: false,
             z_prior: None,
             held_out,
             beta_arcsec: DVec2::ZERO,

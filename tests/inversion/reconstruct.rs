@@ -585,6 +585,33 @@ fn blanked_redshifts_of_a_synthetic_cluster_are_found_again() {
     );
     assert_eq!(known.sigma_arcsec, wslap::FALLBACK_SIGMA_ARCSEC);
     assert_estimates_settled(&catalog, &inputs, &config, &r);
+    // The eight estimates are said on one line, each with its interval, as sources.json has
+    // them; "open above" where the interval reaches the top of the range searched (8).
+    let said: Vec<&String> = r
+        .warnings
+        .iter()
+        .filter(|w| w.contains("redshift") && w.contains("estimated") && !w.contains("named"))
+        .collect();
+    let [line] = &said[..] else {
+        panic!("{said:?}")
+    };
+    assert!(
+        line.starts_with(
+            "redshifts estimated for 8 systems on the lens of the systems with a known one"
+        ),
+        "{line}"
+    );
+    for id in &free {
+        let s = r.sources.iter().find(|s| &s.id == id).unwrap();
+        let [lo, hi] = s.z_interval.unwrap();
+        assert_eq!(s.z_open_above, hi >= 8.0 - 0.005, "system {id}: {hi}");
+        let open = if s.z_open_above { ", open above" } else { "" };
+        let each = format!(
+            "system {id} at z = {:.2} ({lo:.2} - {hi:.2}{open})",
+            s.z_estimate.unwrap()
+        );
+        assert!(line.contains(&each), "{each} not in {line}");
+    }
 }
 
 /// The estimates of `r` were made again on the map of every system until they settled: each

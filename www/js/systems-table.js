@@ -37,7 +37,10 @@ const zCell = (s) => {
   // quadrature, so an uncertain redshift weighs little in the map.
   const e = s.z_position_error_arcsec;
   const fitted = e == null ? '' : `; fitted with ${fmt(e, 2)}″ added to its images' position error (how far they move across the interval)`;
-  return `<td class="z-estimated" title="estimated on the lens of the systems with a redshift${under}, 68% interval (the run's warnings say over the maps of which regularisers)${fitted}">${fmt(s.z_estimate, 2)} est.<br><small>${fmt(s.z_interval[0], 2)}–${fmt(s.z_interval[1], 2)}</small>${prior ? `<br><small>prior ${prior.replace(/^uniform /, '').replace(/^normal /, '')}</small>` : ''}${e == null ? '' : `<br><small>± ${fmt(e, 2)}″</small>`}</td>`;
+  // An interval that ends at the top of the range searched: the images do not bound it there.
+  const open = s.z_open_above ? ' (open above)' : '';
+  const openTitle = s.z_open_above ? ', open above: it ends at the top of the range searched, where the images no longer bound it' : '';
+  return `<td class="z-estimated" title="estimated on the lens of the systems with a redshift${under}, 68% interval${openTitle} (the run's warnings say over the maps of which regularisers)${fitted}">${fmt(s.z_estimate, 2)} est.<br><small>${fmt(s.z_interval[0], 2)}–${fmt(s.z_interval[1], 2)}${open}</small>${prior ? `<br><small>prior ${prior.replace(/^uniform /, '').replace(/^normal /, '')}</small>` : ''}${e == null ? '' : `<br><small>± ${fmt(e, 2)}″</small>`}</td>`;
 };
 
 /** Ids in natural order: "2" before "10", "2.1" before "2.10". */
@@ -116,7 +119,7 @@ function draw() {
   worstOrder = new Map(list.map((w, k) => [w.id, k]));
   const body = order(rows).map((s) => row(s, worst)).join('');
   box.innerHTML = rows.length === 0 ? '<p class="hint">No systems: not a reconstruction.</p>'
-    : `<p class="table-caption" id="systems-caption">Per system: redshift (est.: estimated by the fit, with its 68% interval and, ± ″, how far that interval moves its images, which the fit adds to their position error; *: the default redshift assumed), solved source position β, source-plane scatter, images observed / predicted (those the map shows, |μ| ≥ 0.1; the demagnified ones in brackets), offsets of the observed images from the nearest predicted one (arcsec) and the model's magnification μ at each observed image: a large offset where |μ| is high usually means the image lies near a critical curve with its source just outside the model's caustic, so its pair has merged. Check: the verdict's worst systems (ringed on the map), worst first when sorted by it. Click a column's header to sort by it.</p>
+    : `<p class="table-caption" id="systems-caption">Per system: redshift (est.: estimated by the fit, with its 68% interval (open above: it reaches the top of the range searched, where the images no longer bound it) and, ± ″, how far that interval moves its images, which the fit adds to their position error; *: the default redshift assumed), solved source position β, source-plane scatter, images observed / predicted (those the map shows, |μ| ≥ 0.1; the demagnified ones in brackets), offsets of the observed images from the nearest predicted one (arcsec) and the model's magnification μ at each observed image: a large offset where |μ| is high usually means the image lies near a critical curve with its source just outside the model's caustic, so its pair has merged. Check: the verdict's worst systems (ringed on the map), worst first when sorted by it. Click a column's header to sort by it.</p>
     <div class="table-scroll"><table id="systems-table" aria-describedby="systems-caption"><thead><tr>${COLUMNS.map(header).join('')}</tr></thead><tbody>${body}</tbody></table></div>`;
   for (const b of box.querySelectorAll('button.sort')) {
     b.addEventListener('click', () => {
