@@ -1040,6 +1040,7 @@ fn reconstruct_limited(
         )));
     }
     let mut warnings = constraints.warnings.clone();
+    warnings.extend(just_behind_lens(&constraints, config, &inputs.plane));
     let (shear, shear_warning) = shear_set(inputs.shear, config, &inputs.plane);
     warnings.extend(shear_warning);
     let mut grid = grid_of(&constraints, &shear, config)?;
@@ -1571,6 +1572,40 @@ fn check_source_redshifts(
         }
     }
     Ok(())
+}
+
+/// `D_ls/D_s` below which a system's given redshift is said to be just behind the lens.
+/// A distant source has 0.5 - 0.9 behind a cluster at z_l = 0.2 - 0.5; at a tenth of that
+/// the lens deflects the light a tenth as much, and multiple images are rare.
+const JUST_BEHIND_RATIO: f64 = 0.1;
+
+/// One warning per fitted system whose given redshift lies just behind the lens
+/// (`D_ls/D_s` < [`JUST_BEHIND_RATIO`]): allowed, but more often a typing slip (the lens's
+/// own redshift, a member's) than a real multiple image. Assumed and estimated redshifts
+/// are not the catalogue's and are not said.
+fn just_behind_lens(
+    constraints: &ConstraintSet,
+    config: &ReconstructConfig,
+    plane: &LensPlane,
+) -> Vec<String> {
+    let estimated = |id: &str| config.constraints.z_estimates.iter().any(|(e, _)| e == id);
+    constraints
+        .systems
+        .iter()
+        .filter(|s| !s.z_assumed && !estimated(&s.id))
+        .filter_map(|s| {
+            let ratio = plane.distance_ratio(s.z).ok()?;
+            let at_2 = plane.distance_ratio(2.0).ok()?;
+            (ratio < JUST_BEHIND_RATIO).then(|| {
+                format!(
+                    "system {}: z_s = {} lies just behind the lens (z_lens = {}): D_ls/D_s = \
+                     {ratio:.3} against {at_2:.2} for a source at z = 2, so the lens bends its \
+                     light little and multiple images of it are rare; check that redshift",
+                    s.id, s.z, plane.z_lens
+                )
+            })
+        })
+        .collect()
 }
 
 fn describe_excluded(constraints: &ConstraintSet) -> String {

@@ -614,6 +614,36 @@ fn blanked_redshifts_of_a_synthetic_cluster_are_found_again() {
     }
 }
 
+/// A system whose given redshift lies just behind the lens (here 0.34 behind `c_smooth`'s
+/// z_l = 0.32, typed for its true 1 - 5.5) is fitted, and the run says it is suspicious with
+/// D_ls/D_s as astropy gives it; the systems farther behind are not named.
+#[cfg(not(target_arch = "wasm32"))]
+#[test]
+fn a_redshift_just_behind_the_lens_is_said() {
+    let mut catalog = c_smooth();
+    let id = catalog.systems[3].id.clone();
+    catalog.systems[3].z = Some(0.34);
+    let mut config = ReconstructConfig::default();
+    config.objective.strength = wslap::Strength::Value(0.01);
+    config.products.pixels = 64;
+    let r = reconstruct(&c_smooth_inputs(&catalog), &config, &mut quiet).unwrap();
+    let said: Vec<&String> = r
+        .warnings
+        .iter()
+        .filter(|w| w.contains("just behind the lens"))
+        .collect();
+    let [line] = &said[..] else {
+        panic!("{:?}", r.warnings)
+    };
+    // astropy 8: FlatLambdaCDM(H0=70, Om0=0.3).angular_diameter_distance(0.32, z) /
+    // angular_diameter_distance(z) for z = 0.34 and 2.
+    let expected = format!(
+        "system {id}: z_s = 0.34 lies just behind the lens (z_lens = 0.32): D_ls/D_s = 0.054 \
+         against 0.76 for a source at z = 2"
+    );
+    assert!(line.starts_with(&expected), "{line}");
+}
+
 /// The estimates of `r` were made again on the map of every system until they settled: each
 /// is where that map itself puts its system, within 0.01 (1 + z), unless every pass allowed
 /// was used.
