@@ -161,6 +161,44 @@ impl LoadedData {
         let par = self.model_par(par_options).ok().flatten()?;
         par.potfile_reference()
     }
+
+    /// What replacing the model file by `text` (named `name`) does to a loaded member
+    /// catalogue that reads only in the loaded `.par`'s frame (headerless arcsec, as its
+    /// potfile): with no reference a reconstruction refuses it, with another `.par`'s its
+    /// members move. `None` when the members do not depend on the model file.
+    fn members_frame_note(
+        &self,
+        name: &str,
+        text: &str,
+        par_options: &ParOptions,
+    ) -> Option<String> {
+        let members = self.members.as_ref()?;
+        let before = self.potfile_reference(par_options)?;
+        if parse_member_catalog(&members.text, &members.name, None).is_ok() {
+            return None;
+        }
+        let next = LoadedData {
+            model: Some(NamedText {
+                name: name.to_string(),
+                text: text.to_string(),
+            }),
+            ..Default::default()
+        };
+        let after = next.potfile_reference(par_options);
+        let (m, old) = (&members.name, &self.model.as_ref()?.name);
+        match after {
+            Some(r) if r == before => None,
+            Some(_) => Some(format!(
+                "{m} was read as {old}'s potfile, in arcsec from its reference; it is read now \
+                 from {name}'s, which is another: its members move with it"
+            )),
+            None => Some(format!(
+                "{m} was read as {old}'s potfile, in arcsec from its reference, and {name} \
+                 gives none: a reconstruction now refuses {m}. Load {old} again, or a member catalogue \
+                 with a '#REFERENCE 3 ra0 dec0' header"
+            )),
+        }
+    }
 }
 
 /// Whether a model file's text is a Lenstool parameter file rather than a JSON model file: a
@@ -391,7 +429,7 @@ impl LoadedData {
     ) -> Result<LoadReport, AppError> {
         let text = &*crate::limits::with_line_feeds(text);
         let file = |e: &dyn std::fmt::Display| AppError::File(e.to_string());
-        let (summary, warnings) = match role {
+        let (summary, mut warnings) = match role {
             DataRole::Images => {
                 let (c, w) = parse_image_catalog(text, name, None).map_err(|e| file(&e))?;
                 (
@@ -464,6 +502,9 @@ impl LoadedData {
                 )
             }
         };
+        if role == DataRole::Model {
+            warnings.extend(self.members_frame_note(name, text, par_options));
+        }
         *self.slot(role) = Some(NamedText {
             name: name.to_string(),
             text: text.to_string(),

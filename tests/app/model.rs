@@ -513,6 +513,29 @@ fn a_par_s_headerless_arcsec_potfile_loads_after_the_par() {
             "{g} vs {x} {y}"
         );
     }
+    // Another .par moves the members with its reference; a JSON model leaves them none (a
+    // reconstruction refuses them): each is said when the model file loads. The same .par again
+    // says nothing.
+    let moved = par.replace("210.258650 2.878470", "210.258650 2.880000");
+    let said = |report: wslap::app::LoadReport| report.warnings.join(" | ");
+    let report = s.load_text(DataRole::Model, "other.par", &moved).unwrap();
+    assert!(said(report).contains(
+        "gal.cat was read as bestopt.par's potfile, in arcsec from its reference; it is \
+             read now from other.par's, which is another: its members move with it"
+    ),);
+    s.load_text(DataRole::Model, "bestopt.par", par).unwrap();
+    let report = s.load_text(DataRole::Model, "bestopt.par", par).unwrap();
+    assert!(!said(report.clone()).contains("gal.cat"), "{report:?}");
+    let report = s
+        .load_text(DataRole::Model, "model.json", TEACHING_MODEL_JSON)
+        .unwrap();
+    assert!(
+        said(report.clone()).contains(
+            "gal.cat was read as bestopt.par's potfile, in arcsec from its reference, and \
+             model.json gives none: a reconstruction now refuses gal.cat. Load bestopt.par again"
+        ),
+        "{report:?}"
+    );
 }
 
 /// A Lenstool model with a group at another redshift (tests/data/lenstool/multiplane.par with
