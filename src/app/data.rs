@@ -162,14 +162,15 @@ impl LoadedData {
         par.potfile_reference()
     }
 
-    /// What replacing the model file by `text` (named `name`) does to a loaded member
-    /// catalogue that reads only in the loaded `.par`'s frame (headerless arcsec, as its
-    /// potfile): with no reference a reconstruction refuses it, with another `.par`'s its
-    /// members move. `None` when the members do not depend on the model file.
+    /// What replacing the model file by `name`, whose potfile frame is `after` (none for a
+    /// JSON model or a `.par` without a potfile), does to a loaded member catalogue that reads
+    /// only in the loaded `.par`'s frame (headerless arcsec, as its potfile): with no frame a
+    /// reconstruction refuses it, with another `.par`'s its members move. `None` when the
+    /// members do not depend on the model file.
     fn members_frame_note(
         &self,
         name: &str,
-        text: &str,
+        after: Option<SkyReference>,
         par_options: &ParOptions,
     ) -> Option<String> {
         let members = self.members.as_ref()?;
@@ -177,14 +178,6 @@ impl LoadedData {
         if parse_member_catalog(&members.text, &members.name, None).is_ok() {
             return None;
         }
-        let next = LoadedData {
-            model: Some(NamedText {
-                name: name.to_string(),
-                text: text.to_string(),
-            }),
-            ..Default::default()
-        };
-        let after = next.potfile_reference(par_options);
         let (m, old) = (&members.name, &self.model.as_ref()?.name);
         match after {
             Some(r) if r == before => None,
@@ -429,7 +422,7 @@ impl LoadedData {
     ) -> Result<LoadReport, AppError> {
         let text = &*crate::limits::with_line_feeds(text);
         let file = |e: &dyn std::fmt::Display| AppError::File(e.to_string());
-        let (summary, mut warnings) = match role {
+        let (summary, warnings) = match role {
             DataRole::Images => {
                 let (c, w) = parse_image_catalog(text, name, None).map_err(|e| file(&e))?;
                 (
@@ -483,6 +476,13 @@ impl LoadedData {
                         )))
                     }
                 };
+                let mut warnings: Vec<String> =
+                    par.warnings.iter().map(|w| w.to_string()).collect();
+                warnings.extend(self.members_frame_note(
+                    name,
+                    par.potfile_reference(),
+                    par_options,
+                ));
                 (
                     format!(
                         "Lenstool model: {} potential{}{members}, at z_lens = {}",
@@ -490,7 +490,7 @@ impl LoadedData {
                         if par.potentials.len() == 1 { "" } else { "s" },
                         par.z_lens
                     ),
-                    par.warnings.iter().map(|w| w.to_string()).collect(),
+                    warnings,
                 )
             }
             DataRole::Model => {
@@ -498,13 +498,12 @@ impl LoadedData {
                 let n = m.components.len();
                 (
                     format!("{n} components at z_lens = {}", m.z_lens),
-                    Vec::new(),
+                    self.members_frame_note(name, None, par_options)
+                        .into_iter()
+                        .collect(),
                 )
             }
         };
-        if role == DataRole::Model {
-            warnings.extend(self.members_frame_note(name, text, par_options));
-        }
         *self.slot(role) = Some(NamedText {
             name: name.to_string(),
             text: text.to_string(),

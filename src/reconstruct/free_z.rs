@@ -282,15 +282,17 @@ pub(super) fn fit_at_estimates(
     let mut r = reconstruct_limited(inputs, &second, progress)?;
     // An interval that ends at the top of the range searched is not bounded by the images
     // there: the top is the setting's (or the system's own prior's), and the note says so.
-    let open_above = |id: &str, e: &RedshiftEstimate| {
-        e.interval[1] >= search_range(config, id)[1] - AT_RANGE_TOP
-    };
+    let open_above: Vec<bool> = estimates
+        .iter()
+        .map(|(id, e)| e.interval[1] >= search_range(config, id)[1] - AT_RANGE_TOP)
+        .collect();
     for s in r.sources.iter_mut() {
-        if let Some((_, e)) = estimates.iter().find(|(id, _)| *id == s.id) {
+        if let Some(k) = estimates.iter().position(|(id, _)| *id == s.id) {
+            let e = &estimates[k].1;
             s.z_estimate = Some(e.z);
             s.z_interval = Some(e.interval);
             s.z_position_error_arcsec = Some(e.position_error_arcsec);
-            s.z_open_above = open_above(&s.id, e);
+            s.z_open_above = open_above[k];
         }
     }
     let estimated = |id: &str| estimates.iter().any(|(e, _)| e == id);
@@ -319,7 +321,7 @@ pub(super) fn fit_at_estimates(
     let mut notes: Vec<String> = match &estimates[..] {
         [] => Vec::new(),
         [(id, e)] => {
-            let open = match open_above(id, e) {
+            let open = match open_above[0] {
                 true => format!(
                     ", open above: {:.2} is the top of the range searched",
                     search_range(config, id)[1]
@@ -340,22 +342,19 @@ pub(super) fn fit_at_estimates(
         many => {
             let each: Vec<String> = many
                 .iter()
-                .map(|(id, e)| {
+                .zip(&open_above)
+                .map(|((id, e), &open)| {
                     format!(
                         "system {id} at z = {:.2} ({:.2} - {:.2}{}){}",
                         e.z,
                         e.interval[0],
                         e.interval[1],
-                        if open_above(id, e) {
-                            ", open above"
-                        } else {
-                            ""
-                        },
+                        if open { ", open above" } else { "" },
                         own_prior(id),
                     )
                 })
                 .collect();
-            let open = match many.iter().any(|(id, e)| open_above(id, e)) {
+            let open = match open_above.contains(&true) {
                 true => "; \"open above\": the interval ends at the top of the range searched, \
                          where the images no longer bound it"
                     .to_string(),
