@@ -282,9 +282,13 @@ pub(super) fn fit_at_estimates(
     let mut r = reconstruct_limited(inputs, &second, progress)?;
     // An interval that ends at the top of the range searched is not bounded by the images
     // there: the top is the setting's (or the system's own prior's), and the note says so.
-    let open_above: Vec<bool> = estimates
+    // Per estimate, that top when its interval reaches it.
+    let open_above: Vec<Option<f64>> = estimates
         .iter()
-        .map(|(id, e)| e.interval[1] >= search_range(config, id)[1] - AT_RANGE_TOP)
+        .map(|(id, e)| {
+            let top = search_range(config, id)[1];
+            (e.interval[1] >= top - AT_RANGE_TOP).then_some(top)
+        })
         .collect();
     for s in r.sources.iter_mut() {
         if let Some(k) = estimates.iter().position(|(id, _)| *id == s.id) {
@@ -292,7 +296,7 @@ pub(super) fn fit_at_estimates(
             s.z_estimate = Some(e.z);
             s.z_interval = Some(e.interval);
             s.z_position_error_arcsec = Some(e.position_error_arcsec);
-            s.z_open_above = open_above[k];
+            s.z_open_above = open_above[k].is_some();
         }
     }
     let estimated = |id: &str| estimates.iter().any(|(e, _)| e == id);
@@ -322,11 +326,8 @@ pub(super) fn fit_at_estimates(
         [] => Vec::new(),
         [(id, e)] => {
             let open = match open_above[0] {
-                true => format!(
-                    ", open above: {:.2} is the top of the range searched",
-                    search_range(config, id)[1]
-                ),
-                false => String::new(),
+                Some(top) => format!(", open above: {top:.2} is the top of the range searched"),
+                None => String::new(),
             };
             vec![format!(
                 "system {id}: redshift estimated z = {:.2} (68%: {:.2} - {:.2}{open}){} {how}{again}, \
@@ -349,12 +350,12 @@ pub(super) fn fit_at_estimates(
                         e.z,
                         e.interval[0],
                         e.interval[1],
-                        if open { ", open above" } else { "" },
+                        if open.is_some() { ", open above" } else { "" },
                         own_prior(id),
                     )
                 })
                 .collect();
-            let open = match open_above.contains(&true) {
+            let open = match open_above.iter().any(Option::is_some) {
                 true => "; \"open above\": the interval ends at the top of the range searched, \
                          where the images no longer bound it"
                     .to_string(),

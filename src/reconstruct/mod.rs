@@ -1589,13 +1589,15 @@ fn just_behind_lens(
     plane: &LensPlane,
 ) -> Vec<String> {
     let estimated = |id: &str| config.constraints.z_estimates.iter().any(|(e, _)| e == id);
+    let Ok(at_2) = plane.distance_ratio(2.0) else {
+        return Vec::new();
+    };
     constraints
         .systems
         .iter()
         .filter(|s| !s.z_assumed && !estimated(&s.id))
         .filter_map(|s| {
             let ratio = plane.distance_ratio(s.z).ok()?;
-            let at_2 = plane.distance_ratio(2.0).ok()?;
             (ratio < JUST_BEHIND_RATIO).then(|| {
                 format!(
                     "system {}: z_s = {} lies just behind the lens (z_lens = {}): D_ls/D_s = \
