@@ -82,7 +82,9 @@ export class LensClient {
       job.resolve(msg.result);
     } else if (msg.type === 'error') {
       this.pending.delete(msg.id);
-      job.reject(new Error(msg.message));
+      const err = new Error(msg.message);
+      if (msg.code) err.code = msg.code;
+      job.reject(err);
     }
   }
 

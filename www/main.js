@@ -57,7 +57,6 @@ const rejected = new Map();
 // reference) and no .par was loaded: read again once a .par that names a potfile loads. An
 // example, a project or a member catalogue that loads forgets it.
 let waitingMembers = null;
-const WANTS_PAR = 'load that .par as the model file first';
 
 const client = new LensClient({ onCrash: (m) => showError(m), onRestart: restoreSession });
 const ask = (type, payload = {}, onProgress) => client.request(type, payload, onProgress);
@@ -719,7 +718,7 @@ async function onFile(role, file) {
     showError(`${file.name} was not loaded: ${why}${still}`);
     setStatus(`${file.name} was not loaded (see the message below).`);
     if (kept) rejected.set(role, { file: file.name, kept });
-    if (role === 'members' && err.message.includes(WANTS_PAR)) waitingMembers = file;
+    if (role === 'members' && err.code === 'wants-par') waitingMembers = file;
     return;
   }
   rejected.delete(role);

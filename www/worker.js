@@ -163,7 +163,8 @@ async function start() {
         postMessage({ id: msg.id, type: 'error', message, crashed: true });
         return;
       }
-      postMessage({ id: msg.id, type: 'error', message: String(err?.message ?? err) });
+      // `code` names the error's kind where the core gives one (e.g. 'wants-par').
+      postMessage({ id: msg.id, type: 'error', message: String(err?.message ?? err), code: err?.code });
     }
   };
   postMessage({ type: 'ready', version: core.version(), simd });

@@ -203,22 +203,22 @@ fn is_lenstool_par(name: &str, text: &str) -> bool {
     !(json_name || json_start)
 }
 
-/// The message of a member catalogue refused as `error`, with a hint when the catalogue would
-/// read as a `.par`'s potfile (headerless arcsec from the `.par`'s reference): then the `.par`
-/// must be loaded first.
-fn potfile_hint(error: CatalogError, text: &str, name: &str) -> String {
+/// A member catalogue refused as `error`: [`AppError::WantsPar`], with a hint, when the
+/// catalogue would read as a `.par`'s potfile (headerless arcsec from the `.par`'s reference):
+/// then the `.par` must be loaded first. Otherwise the catalogue's own error.
+fn potfile_hint(error: CatalogError, text: &str, name: &str) -> AppError {
     let anywhere = SkyReference {
         ra_deg: 0.0,
         dec_deg: 0.0,
     };
     let message = error.to_string();
     match parse_potfile_catalog(text, name, Some(anywhere)) {
-        Ok((_, w)) if !w.is_empty() => format!(
+        Ok((_, w)) if !w.is_empty() => AppError::WantsPar(format!(
             "{message}. If it is the potfile of a Lenstool .par (arcsec from the .par's \
              reference, as Lenstool reads it), load that .par as the model file first: the \
              app then reads this catalogue again"
-        ),
-        _ => message,
+        )),
+        _ => AppError::File(message),
     }
 }
 
@@ -435,7 +435,7 @@ impl LoadedData {
                     Some(r) => parse_potfile_catalog(text, name, Some(r)),
                     None => parse_member_catalog(text, name, None),
                 };
-                let (c, w) = read.map_err(|e| AppError::File(potfile_hint(e, text, name)))?;
+                let (c, w) = read.map_err(|e| potfile_hint(e, text, name))?;
                 let n = c.members.len();
                 (
                     format!("{n} members"),

@@ -59,6 +59,22 @@ pub enum AppError {
     /// The computation failed (the core's message).
     #[error("{0}")]
     Run(String),
+    /// A member catalogue that reads only as a Lenstool `.par`'s potfile (headerless arcsec
+    /// from the `.par`'s reference), loaded before that `.par`: the app keeps the file and reads
+    /// it again when a `.par` with a potfile loads (the message says so).
+    #[error("{0}")]
+    WantsPar(String),
+}
+
+impl AppError {
+    /// A short, stable name of the error's kind for the page's code (`"wants-par"` for
+    /// [`AppError::WantsPar`], `None` for the rest), so that it does not match message text.
+    pub fn code(&self) -> Option<&'static str> {
+        match self {
+            AppError::WantsPar(_) => Some("wants-par"),
+            _ => None,
+        }
+    }
 }
 
 /// Loaded data, settings and the last result of one app session.

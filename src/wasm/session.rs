@@ -3,7 +3,7 @@
 
 use wasm_bindgen::prelude::*;
 
-use crate::app::{DataRole, RunKind, Session, ViewOptions};
+use crate::app::{AppError, DataRole, RunKind, Session, ViewOptions};
 use crate::reconstruct::ConvergenceRecord;
 use crate::solver::Control;
 
@@ -63,6 +63,17 @@ pub(super) fn reporter<'a, const N: usize>(
 
 pub(super) fn err(e: impl std::fmt::Display) -> JsError {
     JsError::new(&e.to_string())
+}
+
+/// An `Error` with the core's message and, when the error has one, its [`AppError::code`] as
+/// the property `code` (the worker passes it on; the page tells kinds apart by it).
+fn coded(e: AppError) -> JsValue {
+    let error = js_sys::Error::new(&e.to_string());
+    if let Some(code) = e.code() {
+        // Setting a property on a fresh Error cannot fail.
+        let _ = js_sys::Reflect::set(&error, &"code".into(), &code.into());
+    }
+    error.into()
 }
 
 fn view_options(options: JsValue) -> Result<ViewOptions, JsError> {
@@ -138,10 +149,12 @@ impl AppSession {
 
     /// Loads a text file as `role` (images, members, arcs, shear, model); returns its
     /// `LoadReport`.
-    /// On an error (naming the file, line and reason) nothing loaded changes.
-    pub fn load_text(&mut self, role: &str, name: &str, text: &str) -> Result<JsValue, JsError> {
-        let role = DataRole::parse(role).map_err(err)?;
-        to_js(&self.inner.load_text(role, name, text).map_err(err)?)
+    /// On an error (naming the file, line and reason) nothing loaded changes; a member
+    /// catalogue that wants its `.par` first is refused with `code` `"wants-par"`.
+    pub fn load_text(&mut self, role: &str, name: &str, text: &str) -> Result<JsValue, JsValue> {
+        let role = DataRole::parse(role).map_err(coded)?;
+        let report = self.inner.load_text(role, name, text).map_err(coded)?;
+        Ok(to_js(&report)?)
     }
 
     /// Checks the loaded file of `role` again with the current settings: its `LoadReport`, or

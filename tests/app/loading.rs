@@ -58,6 +58,11 @@ fn a_bad_file_names_its_line_and_keeps_what_was_loaded() {
         .unwrap_err();
     assert!(err.to_string().contains("line 3"), "{err}");
     assert!(s.data.arcs.is_none());
+    // A member catalogue bad in itself has no code: only one a .par would read has.
+    let err = s
+        .load_text(DataRole::Members, "gal.cat", "1 x 2.0 0.1 0.1 0 19.5\n")
+        .unwrap_err();
+    assert_eq!(err.code(), None, "{err}");
 }
 
 #[cfg_attr(not(target_arch = "wasm32"), test)]

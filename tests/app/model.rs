@@ -450,10 +450,12 @@ fn a_par_s_headerless_arcsec_potfile_loads_after_the_par() {
         106 -35.9541832 101.6661600 0.500 0.500 50.000 18.41 0.10\n\
         232 23.2212647 -52.7292000 0.563 0.280 -48.300 18.42 0.10\n";
     let mut s = Session::new();
-    let refused = s
+    let error = s
         .load_text(DataRole::Members, "gal.cat", members)
-        .unwrap_err()
-        .to_string();
+        .unwrap_err();
+    // The page tells this refusal from the rest by its code, not by its words.
+    assert_eq!(error.code(), Some("wants-par"));
+    let refused = error.to_string();
     for part in [
         "line 1",
         "not a right ascension",
