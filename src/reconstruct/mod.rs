@@ -1040,7 +1040,12 @@ fn reconstruct_limited(
         )));
     }
     let mut warnings = constraints.warnings.clone();
-    warnings.extend(just_behind_lens(&constraints, config, &inputs.plane));
+    warnings.extend(just_behind_lens(
+        &constraints,
+        config,
+        &inputs.plane,
+        inputs.catalog,
+    ));
     let (shear, shear_warning) = shear_set(inputs.shear, config, &inputs.plane);
     warnings.extend(shear_warning);
     let mut grid = grid_of(&constraints, &shear, config)?;
@@ -1582,11 +1587,13 @@ const JUST_BEHIND_RATIO: f64 = 0.1;
 /// One warning per fitted system whose given redshift lies just behind the lens
 /// (`D_ls/D_s` < [`JUST_BEHIND_RATIO`]): allowed, but more often a typing slip (the lens's
 /// own redshift, a member's) than a real multiple image. Assumed and estimated redshifts
-/// are not the catalogue's and are not said.
+/// are not the catalogue's and are not said. With an image catalogue the warning names the
+/// lines that give the redshift, where the user would mend it.
 fn just_behind_lens(
     constraints: &ConstraintSet,
     config: &ReconstructConfig,
     plane: &LensPlane,
+    catalog: Option<&ImageCatalog>,
 ) -> Vec<String> {
     let estimated = |id: &str| config.constraints.z_estimates.iter().any(|(e, _)| e == id);
     let Ok(at_2) = plane.distance_ratio(2.0) else {
@@ -1600,14 +1607,28 @@ fn just_behind_lens(
             let ratio = plane.distance_ratio(s.z).ok()?;
             (ratio < JUST_BEHIND_RATIO).then(|| {
                 format!(
-                    "system {}: z_s = {} lies just behind the lens (z_lens = {}): D_ls/D_s = \
+                    "system {}{}: z_s = {} lies just behind the lens (z_lens = {}): D_ls/D_s = \
                      {ratio:.3} against {at_2:.2} for a source at z = 2, so the lens bends its \
                      light little and multiple images of it are rare; check that redshift",
-                    s.id, s.z, plane.z_lens
+                    s.id,
+                    catalog.map_or(String::new(), |c| catalogue_lines(c, &s.id)),
+                    s.z,
+                    plane.z_lens
                 )
             })
         })
         .collect()
+}
+
+/// " (images.cat, lines 12, 13, 14)": where system `id`'s images are in `catalog`, or
+/// nothing when it holds no such system.
+fn catalogue_lines(catalog: &ImageCatalog, id: &str) -> String {
+    let Some(system) = catalog.systems.iter().find(|s| s.id == id) else {
+        return String::new();
+    };
+    let lines: Vec<String> = system.images.iter().map(|i| i.line.to_string()).collect();
+    let noun = if lines.len() == 1 { "line" } else { "lines" };
+    format!(" ({}, {noun} {})", catalog.source_name, lines.join(", "))
 }
 
 fn describe_excluded(constraints: &ConstraintSet) -> String {

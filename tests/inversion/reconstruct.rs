@@ -637,9 +637,22 @@ fn a_redshift_just_behind_the_lens_is_said() {
     };
     // astropy 8: FlatLambdaCDM(H0=70, Om0=0.3).angular_diameter_distance(0.32, z) /
     // angular_diameter_distance(z) for z = 0.34 and 2.
+    // The lines that give the redshift, counted in the file's text (ids `<system>.<image>`).
+    let text = include_str!("../data/fidelity/c_smooth/images.cat");
+    let lines: Vec<String> = text
+        .lines()
+        .enumerate()
+        .filter(|(_, l)| {
+            let first = l.split_whitespace().next().unwrap_or("");
+            first.split('.').next() == Some(id.as_str()) && first.contains('.')
+        })
+        .map(|(i, _)| (i + 1).to_string())
+        .collect();
+    assert!(lines.len() >= 2, "{lines:?}");
     let expected = format!(
-        "system {id}: z_s = 0.34 lies just behind the lens (z_lens = 0.32): D_ls/D_s = 0.054 \
-         against 0.76 for a source at z = 2"
+        "system {id} (c_smooth/images.cat, lines {}): z_s = 0.34 lies just behind the lens \
+         (z_lens = 0.32): D_ls/D_s = 0.054 against 0.76 for a source at z = 2",
+        lines.join(", ")
     );
     assert!(line.starts_with(&expected), "{line}");
 }
