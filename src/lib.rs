@@ -103,10 +103,11 @@ pub use radial::{radial_profile, rect_disc_area, RadialBins, RadialError, Radial
 // The inputs: catalogues, arcs, regions, Lenstool models, FITS.
 pub use arcs::{arcs_from_regions, parse_arcs, ArcCatalog, ArcSystem, ArcsError};
 pub use catalog::{
-    arclet_ellipticity, parse_arclet_catalog, parse_image_catalog, parse_member_catalog,
-    parse_potfile_catalog, Arclet, ArcletCatalog, CatalogError, CatalogRow, CommentedBcgs, Image,
-    ImageCatalog, ImageSystem, Member, MemberCatalog, DEGREE_LOOKALIKE, FIELD_ERROR_DEG,
-    FIELD_WARN_DEG, MAG_NO_MEASUREMENT, Z_AGREEMENT_TOL,
+    arclet_ellipticity, parse_arclet_catalog, parse_arclet_catalog_with, parse_image_catalog,
+    parse_member_catalog, parse_potfile_catalog, Arclet, ArcletCatalog, ArcletUnknownZ,
+    CatalogError, CatalogRow, CommentedBcgs, Image, ImageCatalog, ImageSystem, Member,
+    MemberCatalog, DEGREE_LOOKALIKE, FIELD_ERROR_DEG, FIELD_WARN_DEG, MAG_NO_MEASUREMENT,
+    Z_AGREEMENT_TOL,
 };
 pub use ds9::{
     polyline_is_open, read_regions, write_marks, write_regions, Ds9Error, Ds9Frame, Mark, Region,
@@ -119,7 +120,8 @@ pub use fits::{
 pub use lenstool_par::load_lenstool_model;
 pub use lenstool_par::{
     parse_par, parse_par_with, GalaxyWithoutMag, LenstoolModel, LenstoolPar, ParComponent,
-    ParError, ParGalaxies, ParOptions, ParRedshiftPrior, ParWarning, Radius, GALAXY_MAX_CORE_KPC,
+    ParError, ParGalaxies, ParOptions, ParRedshiftPrior, ParSourceZ, ParWarning, Radius,
+    UnknownSourceZ, GALAXY_MAX_CORE_KPC, LENSTOOL_DEFAULT_Z_SOURCE,
 };
 pub use limits::{
     with_line_feeds, InputKind, TooLarge, MAX_ARCS_BYTES, MAX_ARC_PIXELS, MAX_CATALOG_BYTES,

@@ -53,10 +53,11 @@ const NEW_PROJECT = 'New project';
 // {file, kept}. Said in the caption of the runs made meanwhile; a file of that role that loads,
 // an example or a new project clears it.
 const rejected = new Map();
-// A member catalogue refused only because it reads as a Lenstool potfile (arcsec from a .par's
-// reference) and no .par was loaded: read again once a .par that names a potfile loads. An
-// example, a project or a member catalogue that loads forgets it.
-let waitingMembers = null;
+// Files refused only for want of a Lenstool .par (the core's code 'wants-par'), by role: a
+// member catalogue that reads as a .par's potfile (arcsec from its reference), arclets without
+// a redshift (the .par's z_source gives them one). Read again once a .par loads (for members,
+// one that names a potfile). An example, a project or a file of the role that loads forgets it.
+const waitingForPar = new Map();
 
 const client = new LensClient({ onCrash: (m) => showError(m), onRestart: restoreSession });
 const ask = (type, payload = {}, onProgress) => client.request(type, payload, onProgress);
@@ -553,7 +554,7 @@ async function afterOpen(report) {
     setFileStatus(role, r && r.name === loaded[role] ? reportText(r) : loaded[role] ? `${loaded[role]}: loaded` : '');
   }
   rejected.clear();
-  waitingMembers = null;
+  waitingForPar.clear();
   showNoResult();
   if (report?.result === 'restored' || report?.result === 'recomputed') await showResult(await ask('resultInfo'));
   await render();
@@ -718,24 +719,35 @@ async function onFile(role, file) {
     showError(`${file.name} was not loaded: ${why}${still}`);
     setStatus(`${file.name} was not loaded (see the message below).`);
     if (kept) rejected.set(role, { file: file.name, kept });
-    if (role === 'members' && err.code === 'wants-par') waitingMembers = file;
+    if (err.code === 'wants-par') waitingForPar.set(role, file);
     return;
   }
   rejected.delete(role);
-  if (role === 'members') waitingMembers = null;
-  if (role === 'model' && waitingMembers) await membersForPar(file.name);
+  waitingForPar.delete(role);
+  if (role === 'model' && waitingForPar.size) await readAgainForPar(file.name);
 }
 
-/** The member catalogue refused for want of its .par, read again now that `par` is loaded
- * when the .par names a potfile; the status line says so when it loads. */
-async function membersForPar(par) {
-  if (!(await ask('loaded')).missing_potfile) return;
-  const members = waitingMembers;
-  waitingMembers = null;
-  await onFile('members', members);
-  if ((await ask('loaded')).members !== members.name) return;
-  setStatus(`${members.name}, refused before ${par} was loaded, is read now as its potfile's ` +
-    `member catalogue. ${$('status').textContent}`);
+/** What a file refused for want of a .par is read as once `par` is loaded. */
+const READ_WITH_PAR = {
+  members: (par) => `as the member catalogue of ${par}'s potfile`,
+  shear: (par) => `with the redshift ${par} gives arclets without one`,
+};
+
+/** The files refused for want of a .par, read again now that the model file `par` is one (a
+ * member catalogue only when the .par names a potfile); the status line says which load. */
+async function readAgainForPar(par) {
+  const loaded = await ask('loaded');
+  if (!loaded.model_is_par) return;
+  const read = [];
+  for (const [role, file] of [...waitingForPar]) {
+    if (role === 'members' && !loaded.missing_potfile) continue;
+    waitingForPar.delete(role);
+    await onFile(role, file);
+    if ((await ask('loaded'))[role] === file.name) read.push(`${file.name} ${READ_WITH_PAR[role](par)}`);
+  }
+  if (read.length) {
+    setStatus(`Refused before ${par} was loaded, now read: ${read.join('; ')}. ${$('status').textContent}`);
+  }
 }
 
 // Files and examples are opened one at a time, in the order they came (a drop of several

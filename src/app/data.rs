@@ -6,16 +6,18 @@ use serde::{Deserialize, Serialize};
 
 use crate::arcs::{is_region_file, ArcCatalog};
 use crate::catalog::{
-    parse_arclet_catalog, parse_image_catalog, parse_member_catalog, parse_potfile_catalog,
-    CatalogError, ImageCatalog,
+    parse_arclet_catalog_with, parse_image_catalog, parse_member_catalog, parse_potfile_catalog,
+    ArcletUnknownZ, CatalogError, ImageCatalog,
 };
 use crate::cosmology::LensPlane;
 use crate::fits::read_image;
-use crate::lenstool_par::{parse_par_with, LenstoolPar, ParOptions};
+use crate::lenstool_par::{
+    parse_par_with, LenstoolPar, ParOptions, UnknownSourceZ, LENSTOOL_DEFAULT_Z_SOURCE,
+};
 use crate::map::Map;
 use crate::model::ModelFile;
 use crate::profiles::Lens;
-use crate::reconstruct::{Dataset, InputText, InputTexts};
+use crate::reconstruct::{arclet_unknown_z, Dataset, InputText, InputTexts};
 use crate::sky::SkyReference;
 
 use super::AppError;
@@ -155,11 +157,23 @@ impl LoadedData {
         par.potfiles.first().map(|p| p.filein.clone())
     }
 
+    /// Whether the model file is a Lenstool `.par` that reads.
+    pub fn model_is_par(&self, par_options: &ParOptions) -> bool {
+        matches!(self.model_par(par_options), Ok(Some(_)))
+    }
+
     /// The frame of a member catalogue without a header in arcsec: the loaded `.par`'s
     /// reference when it has a potfile ([`LenstoolPar::potfile_reference`]).
     fn potfile_reference(&self, par_options: &ParOptions) -> Option<SkyReference> {
         let par = self.model_par(par_options).ok().flatten()?;
         par.potfile_reference()
+    }
+
+    /// What the loaded `.par` says of sources without a redshift
+    /// ([`LenstoolPar::unknown_source_z`]); `None` without a `.par`.
+    fn unknown_source_z(&self, par_options: &ParOptions) -> Option<Result<UnknownSourceZ, String>> {
+        let par = self.model_par(par_options).ok().flatten()?;
+        Some(par.unknown_source_z())
     }
 
     /// What replacing the model file by `name`, whose potfile frame is `after` (none for a
@@ -219,6 +233,26 @@ fn potfile_hint(error: CatalogError, text: &str, name: &str) -> AppError {
              app then reads this catalogue again"
         )),
         _ => AppError::File(message),
+    }
+}
+
+/// An arclet catalogue refused as `error`: [`AppError::WantsPar`] when no `.par` is loaded
+/// and the catalogue would read with one (rows without a redshift, which Lenstool gives its
+/// `.par`'s z_source), so that the app reads it again when a `.par` loads. Otherwise the
+/// catalogue's own error.
+fn arclets_hint(error: CatalogError, no_par: bool, text: &str, name: &str) -> AppError {
+    let take = ArcletUnknownZ::Take {
+        z: LENSTOOL_DEFAULT_Z_SOURCE,
+        origin: "",
+    };
+    let message = error.to_string();
+    if no_par && parse_arclet_catalog_with(text, name, None, take).is_ok() {
+        AppError::WantsPar(format!(
+            "{message}. The app reads this catalogue again when a .par is loaded as the model \
+             file"
+        ))
+    } else {
+        AppError::File(message)
     }
 }
 
@@ -443,7 +477,10 @@ impl LoadedData {
                 )
             }
             DataRole::Shear => {
-                let (c, w) = parse_arclet_catalog(text, name, None).map_err(|e| file(&e))?;
+                let answer = self.unknown_source_z(par_options);
+                let rule = arclet_unknown_z(answer.as_ref());
+                let (c, w) = parse_arclet_catalog_with(text, name, None, rule)
+                    .map_err(|e| arclets_hint(e, answer.is_none(), text, name))?;
                 let n = c.arclets.len();
                 (
                     format!("{n} arclets (weak lensing)"),
@@ -687,12 +724,14 @@ impl LoadedData {
                 text: &f.text,
             })
         }
+        let unknown_source_z = self.unknown_source_z(par_options);
         let files = InputTexts {
             images: text(&self.images),
             members: text(&self.members),
             arcs: text(&self.arcs),
             shear: text(&self.shear),
             potfile_reference: self.potfile_reference(par_options),
+            unknown_source_z: unknown_source_z.as_ref(),
         };
         Dataset::read(&files, arc_pixel_arcsec).map_err(|e| AppError::File(e.to_string()))
     }

@@ -75,22 +75,48 @@ pub fn arclet_ellipticity(a: f64, b: f64, theta_deg: f64) -> DVec2 {
     modulus * DVec2::new(two_theta.cos(), two_theta.sin())
 }
 
-/// Why an arclet row with `z = 0` is refused, and what to do.
-const UNKNOWN_Z: &str = "is 0 (unknown): an arclet needs its redshift (> 0). Lenstool takes \
-                         unknown ones from the .par's `source` block; write a redshift in this \
-                         column (a photometric one, or the background's median)";
+/// Why an arclet row with `z = 0` is refused when no `.par` is given, and what to do.
+const UNKNOWN_Z: &str = "is 0 (unknown): an arclet needs its redshift (> 0). Lenstool gives \
+                         unknown ones the z_source of the .par's `source` block: give that \
+                         .par with the catalogue (--par, or the app's model file), or write a \
+                         redshift in this column (a photometric one, or the background's median)";
+
+/// What an arclet row with `z = 0` (unknown) gets: Lenstool gives it the redshift of its
+/// `.par`'s `source` block (`crate::LenstoolPar::unknown_source_z`).
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub enum ArcletUnknownZ<'a> {
+    /// Refused: no `.par` says (the message says what to do).
+    #[default]
+    Refuse,
+    /// Refused for this reason of the `.par`'s (a distribution of redshifts, a bad `z_source`).
+    RefuseBecause(&'a str),
+    /// Put at `z`; `origin` says where it comes from, in the reader's warning.
+    Take { z: f64, origin: &'a str },
+}
 
 /// Parses a Lenstool arclet catalogue: rows `id x y a b theta z`.
 ///
 /// Same `#REFERENCE` rules and frame as [`super::parse_image_catalog`]: positions end in the
 /// arcsec frame (+x West, +y North) of `reference` when given, else of the header's. `a`, `b`
 /// arcsec (>= 0, not both 0), `theta` degrees, `z` the galaxy's redshift (> 0: a weak-lensing
-/// row needs its distance ratio). Ids are free text; a repeated id is a warning, and so are
-/// extra columns (ignored).
+/// row needs its distance ratio; a row with 0, unknown, is refused here, and takes a `.par`'s
+/// redshift with [`parse_arclet_catalog_with`]). Ids are free text; a repeated id is a
+/// warning, and so are extra columns (ignored).
 pub fn parse_arclet_catalog(
     text: &str,
     source_name: &str,
     reference: Option<SkyReference>,
+) -> Result<(ArcletCatalog, Vec<CatalogWarning>), CatalogError> {
+    parse_arclet_catalog_with(text, source_name, reference, ArcletUnknownZ::Refuse)
+}
+
+/// [`parse_arclet_catalog`], with rows of `z = 0` given what `unknown_z` says (one warning
+/// names how many took it, and from where).
+pub fn parse_arclet_catalog_with(
+    text: &str,
+    source_name: &str,
+    reference: Option<SkyReference>,
+    unknown_z: ArcletUnknownZ<'_>,
 ) -> Result<(ArcletCatalog, Vec<CatalogWarning>), CatalogError> {
     let requested = frame::check_requested(reference, source_name)?;
     let table = read_table(text, source_name)?;
@@ -101,6 +127,8 @@ pub fn parse_arclet_catalog(
     let mut seen: HashMap<&str, usize> = HashMap::new();
     let mut arclets = Vec::with_capacity(table.rows.len());
     let mut positions = Vec::with_capacity(table.rows.len());
+    // The first row without a redshift, and how many there are.
+    let mut unknown: Option<(usize, usize)> = None;
     for row in &table.rows {
         let f = Fields {
             row,
@@ -121,8 +149,23 @@ pub fn parse_arclet_catalog(
         if shape.a + shape.b <= 0.0 {
             return Err(f.bad(4, "is 0 as is a: an arclet needs a shape (a + b > 0)"));
         }
-        let Some(z) = f.redshift(6)? else {
-            return Err(f.bad(6, UNKNOWN_Z));
+        let z = match (f.redshift(6)?, unknown_z) {
+            (Some(z), _) => z,
+            (None, ArcletUnknownZ::Take { z, .. }) => {
+                let first = unknown.get_or_insert((row.line, 0));
+                first.1 += 1;
+                z
+            }
+            (None, ArcletUnknownZ::RefuseBecause(why)) => {
+                return Err(f.bad(
+                    6,
+                    format!(
+                        "is 0 (unknown): {why}; write each arclet's redshift in this column \
+                         (a photometric one, or the background's median)"
+                    ),
+                ))
+            }
+            (None, ArcletUnknownZ::Refuse) => return Err(f.bad(6, UNKNOWN_Z)),
         };
         positions.push(RowPosition::of(row, shape.raw));
         arclets.push(Arclet {
@@ -137,6 +180,16 @@ pub fn parse_arclet_catalog(
         });
     }
     warn_extra_columns(&extra_lines, source_name, &mut warnings);
+    if let (Some((line, n)), ArcletUnknownZ::Take { z, origin }) = (unknown, unknown_z) {
+        let rows = if n == 1 { "arclet" } else { "arclets" };
+        warnings.push(CatalogWarning {
+            source_name: source_name.into(),
+            line,
+            message: format!(
+                "{n} {rows} without a redshift (z = 0) put at z = {z}, as Lenstool does: {origin}"
+            ),
+        });
+    }
     check_field(table.coords, &positions, source_name, &mut warnings)?;
     let raw: Vec<DVec2> = arclets.iter().map(|g| g.position).collect();
     let (frame_ref, positions) = table.coords.into_frame(&raw, requested);
@@ -185,7 +238,8 @@ mod tests {
             (
                 "1 0 0 1 0.5 10 0\n",
                 "line 2, column 7 (z): '0' is 0 (unknown): an arclet needs its redshift (> 0). \
-                 Lenstool takes unknown ones from the .par's `source` block",
+                 Lenstool gives unknown ones the z_source of the .par's `source` block: give \
+                 that .par with the catalogue",
             ),
             ("1 0 0 0 0 10 1\n", "line 2, column 5 (b): '0' is 0 as is a"),
             (

@@ -20,7 +20,10 @@ mod lenstool;
 mod rows;
 mod units;
 
-pub use arclets::{arclet_ellipticity, parse_arclet_catalog, Arclet, ArcletCatalog};
+pub use arclets::{
+    arclet_ellipticity, parse_arclet_catalog, parse_arclet_catalog_with, Arclet, ArcletCatalog,
+    ArcletUnknownZ,
+};
 pub use error::{CatalogError, CatalogWarning};
 pub(crate) use frame::{mean_position, reframe, sexagesimal};
 pub use lenstool::{

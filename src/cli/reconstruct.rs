@@ -230,12 +230,14 @@ pub fn run(args: &ReconstructArgs) -> Result<(), String> {
         }
         None => None,
     };
+    let unknown_source_z = par.as_ref().map(LenstoolPar::unknown_source_z);
     let files = InputTexts {
         images: text(&images),
         members: text(&members),
         arcs: text(&arcs),
         shear: text(&shear),
         potfile_reference: par.as_ref().and_then(LenstoolPar::potfile_reference),
+        unknown_source_z: unknown_source_z.as_ref(),
     };
     let mut data =
         Dataset::read(&files, config.constraints.pixel_arcsec).map_err(|e| e.to_string())?;

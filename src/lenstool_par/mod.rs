@@ -320,9 +320,35 @@ pub struct LenstoolPar {
     /// The redshift priors of multiple-image systems, from the `image` block's `z_m_limit`
     /// lines, in the file's order.
     pub redshift_priors: Vec<ParRedshiftPrior>,
+    /// The `source` block's redshift keywords, as written (read only when a catalogue row has
+    /// no redshift: [`Self::unknown_source_z`]).
+    pub source_z: ParSourceZ,
     /// What was skipped or approximated while reading (unknown blocks and keywords, blocks
     /// moved by the single-plane approximation).
     pub warnings: Vec<ParWarning>,
+}
+
+/// Lenstool's redshift for a source without one when the `.par` gives no `z_source`
+/// (its manual, `source` section).
+pub const LENSTOOL_DEFAULT_Z_SOURCE: f64 = 0.8;
+
+/// The redshift keywords of a `.par`'s `source` block, as written: `z_source z` (the redshift
+/// Lenstool gives sources without one, default [`LENSTOOL_DEFAULT_Z_SOURCE`]) and `dist_z kind
+/// ...` (how it draws simulated sources' redshifts: 0 all at `z_source`, 1 uniform between two
+/// redshifts, 2 the Smail et al. law of the `smail` keyword). Each is its values and line.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct ParSourceZ {
+    pub z_source: Option<(Vec<String>, usize)>,
+    pub dist_z: Option<(Vec<String>, usize)>,
+}
+
+/// The redshift a `.par` gives catalogue rows without one ([`LenstoolPar::unknown_source_z`]).
+#[derive(Debug, Clone, PartialEq)]
+pub struct UnknownSourceZ {
+    pub z: f64,
+    /// Where it comes from, for the reader's warning: "z_source 1.5 of x.par's `source`
+    /// block (line 12)" or "Lenstool's default 0.8: x.par gives no z_source".
+    pub origin: String,
 }
 
 /// One `z_m_limit` line: the prior a Lenstool model put on a system's redshift.
@@ -347,6 +373,48 @@ pub struct LenstoolModel {
 }
 
 impl LenstoolPar {
+    /// The redshift this `.par` gives sources without one, as Lenstool does: its `source`
+    /// block's `z_source`, else Lenstool's default 0.8. Refused, with the reason, when the
+    /// block draws redshifts from a distribution (`dist_z` 1 or 2: a catalogue row without a
+    /// redshift then stands for many, which one redshift does not stand for) or when
+    /// `z_source` is not a redshift.
+    pub fn unknown_source_z(&self) -> Result<UnknownSourceZ, String> {
+        let file = &self.source_name;
+        if let Some((values, line)) = &self.source_z.dist_z {
+            let kind = values.first().map(String::as_str).unwrap_or("");
+            if kind.parse::<f64>() != Ok(0.0) {
+                let law = match kind {
+                    "1" => "uniform between two redshifts",
+                    "2" => "the Smail et al. law of its `smail` line",
+                    _ => "a law this tool does not know",
+                };
+                return Err(format!(
+                    "{file} (line {line}: dist_z {}) draws the redshifts of sources without \
+                     one from a distribution ({law}), which this tool does not model",
+                    values.join(" ")
+                ));
+            }
+        }
+        let Some((values, line)) = &self.source_z.z_source else {
+            return Ok(UnknownSourceZ {
+                z: LENSTOOL_DEFAULT_Z_SOURCE,
+                origin: format!(
+                    "Lenstool's default {LENSTOOL_DEFAULT_Z_SOURCE}: {file} gives no z_source"
+                ),
+            });
+        };
+        let written = values.first().map(String::as_str).unwrap_or("");
+        match written.parse::<f64>() {
+            Ok(z) if z.is_finite() && z > 0.0 => Ok(UnknownSourceZ {
+                z,
+                origin: format!("z_source {written} of {file}'s `source` block (line {line})"),
+            }),
+            _ => Err(format!(
+                "{file} (line {line}): z_source '{written}' is not a redshift (a number above 0)"
+            )),
+        }
+    }
+
     /// The frame a member catalogue given with this `.par` is read in when it has no header:
     /// [`Self::reference`] when the `.par` has a `potfile` block (the catalogue is its potfile,
     /// whose positions Lenstool reads as arcsec from the reference), else `None`.

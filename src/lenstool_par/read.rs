@@ -8,7 +8,7 @@ use glam::DVec2;
 
 use super::{
     LenstoolPar, ParComponent, ParError, ParOptions, ParPotential, ParPotfile, ParRedshiftPrior,
-    ParWarning, Radius, Z_MATCH_TOL,
+    ParSourceZ, ParWarning, Radius, Z_MATCH_TOL,
 };
 use crate::cosmology::{Cosmology, LensPlane};
 use crate::inversion::RedshiftPrior;
@@ -67,6 +67,7 @@ pub fn parse_par_with(
     let mut potentials = Vec::new();
     let mut potfiles = Vec::new();
     let mut redshift_priors = Vec::new();
+    let mut source_z = ParSourceZ::default();
     // (z, block, index in potentials or potfiles, is a potfile)
     let mut z_values: Vec<(f64, &Block, usize, bool)> = Vec::new();
     for b in &blocks {
@@ -83,6 +84,13 @@ pub fn parse_par_with(
             potfiles.push(p);
         } else if name.starts_with("image") {
             redshift_priors.extend(b.repeated.iter().flat_map(|e| cx.redshift_priors(e)));
+        } else if name == "source" {
+            // As written: read only for catalogue rows without a redshift.
+            let raw = |key: &str| b.entries.get(key).map(|e| (e.values.clone(), e.line));
+            source_z = ParSourceZ {
+                z_source: raw("z_source"),
+                dist_z: raw("dist_z"),
+            };
         }
     }
     let cosmology = cosmology.ok_or_else(|| cx.model("no `cosmologie` block"))?;
@@ -137,6 +145,7 @@ pub fn parse_par_with(
         potentials,
         potfiles,
         redshift_priors,
+        source_z,
         warnings: cx.warnings.into_inner(),
     })
 }

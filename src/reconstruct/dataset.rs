@@ -29,16 +29,16 @@ use crate::arcs::{
     arcs_from_regions, is_region_file, parse_arcs, ArcCatalog, ArcsError, RegionArcs,
 };
 use crate::catalog::{
-    parse_arclet_catalog, parse_image_catalog, parse_member_catalog, parse_potfile_catalog,
-    reframe, system_of_image, ArcletCatalog, CatalogError, CatalogRow, CommentedBcgs, ImageCatalog,
-    Member, MemberCatalog,
+    parse_arclet_catalog_with, parse_image_catalog, parse_member_catalog, parse_potfile_catalog,
+    reframe, system_of_image, ArcletCatalog, ArcletUnknownZ, CatalogError, CatalogRow,
+    CommentedBcgs, ImageCatalog, Member, MemberCatalog,
 };
 use crate::cosmology::LensPlane;
 use crate::error::line_list;
 use crate::inversion::{
     build_constraints, missing_bcg_warning, ConstraintMode, ConstraintSource, RedshiftPrior,
 };
-use crate::lenstool_par::{LenstoolPar, ParError, ParGalaxies};
+use crate::lenstool_par::{LenstoolPar, ParError, ParGalaxies, UnknownSourceZ};
 use crate::sky::SkyReference;
 
 /// One input file: the name used in messages and its text.
@@ -64,6 +64,25 @@ pub struct InputTexts<'a> {
     /// in arcsec, is then read in that frame, as Lenstool reads it
     /// ([`crate::catalog::parse_potfile_catalog`]).
     pub potfile_reference: Option<SkyReference>,
+    /// What a Lenstool `.par` given with the files says of sources without a redshift
+    /// ([`LenstoolPar::unknown_source_z`]): arclet rows with `z = 0` take it, as Lenstool
+    /// gives it them. `None` (no `.par`): such rows are refused, with what to do.
+    pub unknown_source_z: Option<&'a Result<UnknownSourceZ, String>>,
+}
+
+/// The arclet reader's rule for rows without a redshift, from a `.par`'s answer
+/// ([`InputTexts::unknown_source_z`]).
+pub(crate) fn arclet_unknown_z(
+    answer: Option<&Result<UnknownSourceZ, String>>,
+) -> ArcletUnknownZ<'_> {
+    match answer {
+        None => ArcletUnknownZ::Refuse,
+        Some(Ok(u)) => ArcletUnknownZ::Take {
+            z: u.z,
+            origin: &u.origin,
+        },
+        Some(Err(why)) => ArcletUnknownZ::RefuseBecause(why),
+    }
 }
 
 /// What went wrong reading the files (each message names the file and, where there is one,
@@ -134,7 +153,8 @@ impl Dataset {
         }
         if let Some(f) = files.shear {
             let frame = out.reference();
-            let (a, w) = parse_arclet_catalog(f.text, f.name, frame)?;
+            let unknown_z = arclet_unknown_z(files.unknown_source_z);
+            let (a, w) = parse_arclet_catalog_with(f.text, f.name, frame, unknown_z)?;
             out.warnings.extend(w.iter().map(ToString::to_string));
             out.shear = Some(a);
         }
@@ -602,6 +622,7 @@ mod tests {
             members: None,
             shear: None,
             potfile_reference: None,
+            unknown_source_z: None,
             arcs: arcs.then_some(InputText {
                 name: "arcs.reg",
                 text: REGIONS,

@@ -26,6 +26,7 @@ pub use crossval::{
     cross_validate, fitted_system_ids, fold_groups, holdable_system_ids, CrossValidation,
     CrossvalTotals, FoldRun, KappaSpread, PredictedSystem, DEFAULT_FOLDS,
 };
+pub(crate) use dataset::arclet_unknown_z;
 pub use dataset::{Dataset, DatasetError, InputText, InputTexts, PAR_GALAXY_MAX_LSTAR};
 pub use ensemble::{
     check_ensemble_size, run_ensemble, Calibration, Ensemble, EnsembleMaps, EnsembleMember,

@@ -514,7 +514,8 @@ impl AppSession {
     /// Which files are loaded: `{images, members, arcs, model, deflection_x, deflection_y}`
     /// (names or null), and `sky_warnings`: one sentence per file whose sky positions lie
     /// apart from the others' (files of different clusters), and `missing_potfile`: the
-    /// member catalogue a loaded `.par` names and that is not loaded (or null), and
+    /// member catalogue a loaded `.par` names and that is not loaded (or null),
+    /// `model_is_par`: whether the model file is a Lenstool `.par` that reads, and
     /// `model_z_lens_note`: [`crate::app::Session::model_z_lens_note`] (or null).
     pub fn loaded(&self) -> Result<JsValue, JsError> {
         let d = &self.inner.data;
@@ -526,6 +527,7 @@ impl AppSession {
             "deflection_x": fits(0), "deflection_y": fits(1),
             "sky_warnings": self.inner.sky_warnings(),
             "missing_potfile": d.missing_potfile(&self.inner.settings.par_options()),
+            "model_is_par": d.model_is_par(&self.inner.settings.par_options()),
             "model_z_lens_note": self.inner.model_z_lens_note(),
         }))
     }

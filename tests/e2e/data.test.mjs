@@ -385,12 +385,17 @@ test('a .par alone asks for the member catalogue its potfile names before Forwar
   }
 });
 
-test('a headerless potfile refused before its .par is read again when the .par loads', async () => {
+test('files refused before their .par are read again when the .par loads', async () => {
   // A1835's published model (Richard et al.) writes its potfile in arcsec from the .par's
-  // reference, without a header: alone it cannot be placed on the sky.
+  // reference, without a header: alone it cannot be placed on the sky. Arclets without a
+  // redshift (z = 0) take the `source` block's z_source, as Lenstool gives them.
   const dir = await mkdtemp(join(tmpdir(), 'wslap-potfile-'));
   const par = join(dir, 'bestopt.par');
   const members = join(dir, 'gal.cat');
+  const arclets = join(dir, 'arclets.cat');
+  await writeFile(arclets, [
+    '#REFERENCE 3 210.258650 2.878470',
+    '1 30.0 40.0 0.6 0.4 10.0 0', '2 -50.0 20.0 0.5 0.3 80.0 0', '3 10.0 -60.0 0.7 0.5 -30.0 1.4', ''].join('\n'));
   await writeFile(par, [
     'runmode', '\treference 3 210.258650 2.878470', '\tend',
     'potentiel O1', '\tprofil 81', '\tx_centre 0.0', '\ty_centre 0.0', '\tellipticite 0.2',
@@ -398,6 +403,7 @@ test('a headerless potfile refused before its .par is read again when the .par l
     '\tz_lens 0.253', '\tend',
     'potfile', '\tfilein 1 gal.cat', '\tzlens 0.253', '\ttype 81', '\tcorekpc 0.15', '\tmag0 17.0',
     '\tsigma 0 150.0', '\tcutkpc 0 40.0', '\tslope 0 4.0', '\tvdslope 0 4.0', '\tend',
+    'source', '\tz_source 1.2', '\tend',
     'cosmologie', '\tH0 70.0', '\tomegaM 0.3', '\tomegaX 0.7', '\tend', 'fini', ''].join('\n'));
   await writeFile(members, [
     '199 -70.4727720 -22.8484800 0.557 0.371 -63.100 17.39 0.10',
@@ -407,12 +413,17 @@ test('a headerless potfile refused before its .par is read again when the .par l
   try {
     const { page } = app;
     await waitStatus(page, /^Ready/);
+    await page.setInputFiles('#file-shear', arclets);
+    await waitStatus(page, /^arclets\.cat was not loaded/);
+    assert.match(await page.textContent('#error'), /line 2, column 7 \(z\): '0' is 0 \(unknown\).*z_source of the \.par's `source` block.*The app reads this catalogue again when a \.par is loaded as the model file\.$/);
     await page.setInputFiles('#file-members', members);
     await waitStatus(page, /^gal\.cat was not loaded/);
     assert.match(await page.textContent('#error'), /load that \.par as the model file first: the app then reads this catalogue again/);
     await page.setInputFiles('#file-model', par);
-    await waitStatus(page, /^gal\.cat, refused before bestopt\.par was loaded, is read now as its potfile's member catalogue\. Ready: press Forward model\.$/);
+    await waitStatus(page, /^Refused before bestopt\.par was loaded, now read: arclets\.cat with the redshift bestopt\.par gives arclets without one; gal\.cat as the member catalogue of bestopt\.par's potfile\. Ready: press Forward model\.$/);
     assert.match(await page.textContent('#status-members'), /^gal\.cat: 3 members/);
+    assert.match(await page.textContent('#status-shear'), /^arclets\.cat: 3 arclets \(weak lensing\)/);
+    assert.match(await page.textContent('#status-shear'), /2 arclets without a redshift \(z = 0\) put at z = 1\.2, as Lenstool does: z_source 1\.2 of bestopt\.par's `source` block \(line 27\)/);
     assert.match(await page.textContent('#status-model'), /^bestopt\.par: Lenstool model: 1 potential, and its potfile's members/);
     assert.equal(await page.isHidden('#error'), true);
     assert.equal(await page.isDisabled('#forward'), false);

@@ -917,3 +917,90 @@ fn a_published_set_up_s_par_gives_its_priors_and_bcg() {
     assert_eq!(m.par_galaxies, ["4"]);
     assert!(m.members.iter().any(|g| g.id == "4" && g.line == 5));
 }
+
+/// Arclets without a redshift (z = 0) take the z_source of the `.par`'s `source` block, as
+/// Lenstool gives it to "sources without redshift" (its manual's `source` section: default
+/// 0.8); a `.par` that draws the redshifts from a distribution (`dist_z` 1 or 2) is named in
+/// the refusal, and so is a z_source that is not a redshift.
+#[cfg_attr(not(target_arch = "wasm32"), test)]
+#[cfg_attr(target_arch = "wasm32", wasm_bindgen_test::wasm_bindgen_test)]
+fn arclets_without_a_redshift_take_the_par_s_z_source() {
+    let base = "runmode\n\treference 3 342.1832 -44.5309\n\tend\n\
+        potentiel O1\n\tprofil 81\n\tx_centre 0.0\n\ty_centre 0.0\n\tellipticite 0.2\n\
+        \tangle_pos 10.0\n\tcore_radius_kpc 50.0\n\tcut_radius_kpc 1500.0\n\tv_disp 1100.0\n\
+        \tz_lens 0.32\n\tend\n\
+        cosmologie\n\tH0 70.0\n\tomegaM 0.3\n\tomegaX 0.7\n\tend\n";
+    // The `source` block opens on line 20: its first keyword is on line 21.
+    let par = |source: &str| parse_par(&format!("{base}{source}fini\n"), "x.par").unwrap();
+    let arclets = "#REFERENCE 3 342.1832 -44.5309\n\
+        1 60 10 0.5 0.3 20 1.5\n2 70 -5 0.5 0.3 20 0\n3 -40 25 0.6 0.4 70 0\n";
+    let read = |answer: &Result<wslap::UnknownSourceZ, String>| {
+        let files = wslap::InputTexts {
+            shear: Some(wslap::InputText {
+                name: "arclets.cat",
+                text: arclets,
+            }),
+            unknown_source_z: Some(answer),
+            ..Default::default()
+        };
+        wslap::Dataset::read(&files, 0.2)
+    };
+
+    let given = par("source\n\tgrid 0\n\tz_source 1.8\n\tdist_z 0\n\tend\n").unknown_source_z();
+    let data = read(&given).unwrap();
+    let z: Vec<f64> = data.shear.unwrap().arclets.iter().map(|a| a.z).collect();
+    assert_eq!(z, [1.5, 1.8, 1.8]);
+    let said = "arclets.cat: line 3: 2 arclets without a redshift (z = 0) put at z = 1.8, as \
+                Lenstool does: z_source 1.8 of x.par's `source` block (line 22)";
+    assert!(
+        data.warnings.iter().any(|w| w == said),
+        "{:?}",
+        data.warnings
+    );
+
+    // No z_source (or no `source` block): Lenstool's default.
+    for source in ["", "source\n\tgrid 0\n\tend\n"] {
+        let default = par(source).unknown_source_z();
+        let data = read(&default).unwrap();
+        assert_eq!(data.shear.unwrap().arclets[2].z, 0.8);
+        let said = "put at z = 0.8, as Lenstool does: Lenstool's default 0.8: x.par gives no \
+                    z_source";
+        assert!(
+            data.warnings.iter().any(|w| w.ends_with(said)),
+            "{:?}",
+            data.warnings
+        );
+    }
+
+    // A distribution: the first row without a redshift is refused, naming the .par's line.
+    let smail = par("source\n\tdist_z 2 0.44 2.94\n\tsmail 2. 1.3 1.8\n\tend\n").unknown_source_z();
+    let err = read(&smail).unwrap_err().to_string();
+    assert!(
+        err.starts_with(
+            "arclets.cat: line 3, column 7 (z): '0' is 0 (unknown): x.par (line 21: dist_z 2 \
+             0.44 2.94) draws the redshifts of sources without one from a distribution (the \
+             Smail et al. law of its `smail` line), which this tool does not model; write each \
+             arclet's redshift"
+        ),
+        "{err}"
+    );
+    let uniform = par("source\n\tdist_z 1 1.0 3.0\n\tend\n").unknown_source_z();
+    assert!(uniform
+        .unwrap_err()
+        .contains("uniform between two redshifts"));
+    let bad = par("source\n\tz_source -1\n\tend\n").unknown_source_z();
+    assert_eq!(
+        bad.unwrap_err(),
+        "x.par (line 21): z_source '-1' is not a redshift (a number above 0)"
+    );
+    // Without a .par the row is refused with what to do.
+    let files = wslap::InputTexts {
+        shear: Some(wslap::InputText {
+            name: "arclets.cat",
+            text: arclets,
+        }),
+        ..Default::default()
+    };
+    let err = wslap::Dataset::read(&files, 0.2).unwrap_err().to_string();
+    assert!(err.contains("give that .par with the catalogue"), "{err}");
+}
