@@ -289,7 +289,11 @@
 //! ([`crate::Dataset::add_par_galaxies`]), before commented rows are looked for. One without
 //! a `mag` takes the commented row where it lies, or else the magnitude whose halo mass is
 //! its dPIE's total mass `pi b0 r_cut Sigma_cr` (`(3/2) pi v_disp^2 r_cut / G` when round),
-//! up to 100 `L*` (beyond, a group's or cluster's halo with a small core). The run
+//! up to 100 `L*` (beyond, a group's or cluster's halo with a small core, left to the grid
+//! even when a member lies at its centre: MACS J1149's northern group on member 1824). A
+//! galaxy the member catalogue lists already is not added again (a `best.par` writes every
+//! potfile member out); a `potentiel` the `.par` writes twice is two galaxies, as Lenstool
+//! reads it, and a note says so. The run
 //! does not guess a position: a galaxy of ten `L*` put at the peak of a grid-only first
 //! solution helps the synthetic clusters but misses the real BCGs by 1 - 5 arcsec and makes
 //! both real catalogues worse (BENCHMARKS.md); a commented row is the catalogue's own position

@@ -262,9 +262,11 @@ impl Dataset {
     /// set-ups do with the galaxies their `.par` models; without one it becomes a member of
     /// the magnitude whose halo mass under the member law of `config` is its dPIE's total mass
     /// ([`crate::inversion::MemberConfig::mag_of_mass`] on `plane`), unless that mass is a group's (over
-    /// [`PAR_GALAXY_MAX_LSTAR`] L*). One sentence per galaxy says what became of it (one for
-    /// all of a kind when there are many): added; already a member (one lies within
-    /// 1 arcsec); its commented row fitted; or left out.
+    /// [`PAR_GALAXY_MAX_LSTAR`] L*, left to the grid even when a member lies at its centre).
+    /// One sentence per galaxy says what became of it (one for all of a kind when there are
+    /// many): added; already a member (a catalogue member lies within 1 arcsec); its commented
+    /// row fitted; or left out. A galaxy the `.par` writes twice is fitted twice, as Lenstool
+    /// reads it, with a sentence.
     pub fn add_par_galaxies(
         &mut self,
         par: &LenstoolPar,
@@ -288,6 +290,26 @@ impl Dataset {
         let mag_star = law.mag_star_on(plane);
         let mut by_mass = Vec::new();
         for g in &without_mag {
+            // A halo of a group's mass centred on a galaxy (MACS J1149's northern group `O4`
+            // on member 1824) is not that galaxy: it is left to the grid, whatever lies there.
+            let group = g.mass_msun.and_then(|mass| {
+                let lstar = law.luminosity_lstar(law.mag_of_mass(mass, mag_star), mag_star);
+                (lstar > PAR_GALAXY_MAX_LSTAR).then_some((mass, lstar))
+            });
+            if let Some((mass, lstar)) = group {
+                let on = self
+                    .member_near(to_data(g.centre))
+                    .map_or(String::new(), |id| {
+                        format!(" (centred on member {id}, which is fitted as a member)")
+                    });
+                notes.push(format!(
+                    "{name}: line {}: `{}` has no `mag` and a dPIE mass of {mass:.2e} Msun \
+                     ({lstar:.0} L* under the member law): a group's halo, not a galaxy's: not \
+                     fitted as a member{on}; the grid models its mass",
+                    g.line, g.block
+                ));
+                continue;
+            }
             if let Some(note) = self.galaxy_without_mag(name, &g.block, g.line, to_data(g.centre)) {
                 notes.push(note);
                 continue;
@@ -301,15 +323,6 @@ impl Dataset {
                 continue;
             };
             let mag = law.mag_of_mass(mass, mag_star);
-            let lstar = law.luminosity_lstar(mag, mag_star);
-            if lstar > PAR_GALAXY_MAX_LSTAR {
-                notes.push(format!(
-                    "{name}: line {}: `{}` has no `mag` and a dPIE mass of {mass:.2e} Msun \
-                     ({lstar:.0} L* under the member law): a group's, not a galaxy's: not fitted",
-                    g.line, g.block
-                ));
-                continue;
-            }
             by_mass.push(Member {
                 id: g.id.clone(),
                 position: g.centre,
@@ -372,15 +385,21 @@ impl Dataset {
         });
         members.par_source = Some(name.clone());
         // Galaxies the catalogue lists already (a `best.par` writes every potfile member out
-        // as a `potentiel` of its own): one sentence for all of them.
+        // as a `potentiel` of its own): one sentence for all of them. Only the catalogue's:
+        // a `potentiel` the `.par` repeats is two galaxies to Lenstool, and here.
+        let catalogued = members.members.len();
         let mut already = Vec::new();
+        let mut repeated = Vec::new();
         for (k, mut g) in rows.into_iter().enumerate() {
             g.position = to_data(g.position);
             let (x, y) = (g.position.x, g.position.y);
-            let near = members
-                .members
-                .iter()
-                .find(|m| m.position.distance(g.position) <= SAME_GALAXY_ARCSEC);
+            let same = |m: &&Member| m.position.distance(g.position) <= SAME_GALAXY_ARCSEC;
+            if let Some(first) = members.members[catalogued..].iter().find(same) {
+                if first.id == g.id && first.mag == g.mag {
+                    repeated.push((g.line, first.line));
+                }
+            }
+            let near = members.members[..catalogued].iter().find(same);
             if let Some(m) = near {
                 already.push((
                     g.line,
@@ -401,6 +420,24 @@ impl Dataset {
             members.note_par_galaxy(g.id.clone());
             members.members.push(g);
         }
+        if !repeated.is_empty() {
+            let pairs: Vec<String> = repeated
+                .iter()
+                .map(|(line, first)| format!("{line} repeats line {first}"))
+                .collect();
+            let (what, mass) = match repeated.len() {
+                1 => ("1 galaxy is".to_string(), "its mass; delete one"),
+                n => (
+                    format!("{n} galaxies are"),
+                    "each one's mass; delete one of each",
+                ),
+            };
+            notes.push(format!(
+                "{name}: {what} written twice (line {}): both are fitted (as Lenstool reads \
+                 them), which doubles {mass} if that is not meant",
+                pairs.join(", line ")
+            ));
+        }
         match &already[..] {
             [] => {}
             [(_, one)] => notes.push(format!(
@@ -415,6 +452,16 @@ impl Dataset {
             )),
         }
         Ok(notes)
+    }
+
+    /// The id of the member within [`SAME_GALAXY_ARCSEC`] of `at` (arcsec, the data's frame).
+    fn member_near(&self, at: DVec2) -> Option<String> {
+        let members = self.members.as_ref()?;
+        let m = members
+            .members
+            .iter()
+            .find(|m| m.position.distance(at) <= SAME_GALAXY_ARCSEC)?;
+        Some(m.id.clone())
     }
 
     /// What becomes of the `.par`'s galaxy `block` (at `line`) without a `mag`, centred at `at`

@@ -771,10 +771,56 @@ mod galaxies_of_a_par {
             notes.iter().any(|n| n.starts_with(
                 "fitted.par: line 18: `potentiel 2` has no \
                  `mag` and a dPIE mass of"
-            ) && n.ends_with("a group's, not a galaxy's: not fitted")),
+            ) && n.ends_with(
+                "a group's halo, not a galaxy's: not fitted as a member; the grid models its mass"
+            )),
             "{notes:?}"
         );
         assert_eq!(data.members.unwrap().par_galaxies, ["1", "3"]);
+        // A block written twice is two galaxies to Lenstool, and here, with a note; a
+        // neighbour within 1 arcsec is a galaxy of its own.
+        let twice = format!(
+            "{text}{}{}",
+            galaxy(1, 10.0, 150.0, 50.0),
+            galaxy(5, 10.5, 140.0, 40.0)
+        );
+        let par = parse_par(&twice, "fitted.par").unwrap();
+        let mut data = Dataset::default();
+        let notes = add_galaxies(&mut data, &par);
+        assert!(
+            notes.contains(
+                &"fitted.par: 1 galaxy is written twice (line 45 repeats line 9): both are \
+                  fitted (as Lenstool reads them), which doubles its mass; delete one if that \
+                  is not meant"
+                    .to_string()
+            ),
+            "{notes:?}"
+        );
+        // (Galaxy 2 is the group's halo above.)
+        let members = data.members.unwrap();
+        assert_eq!(members.par_galaxies, ["1", "3", "5"]);
+        let ids: Vec<&str> = members.members.iter().map(|m| m.id.as_str()).collect();
+        assert_eq!(ids, ["1", "3", "1", "5"]);
+        // The same halo centred on a catalogue member (MACS J1149's northern group `O4` on
+        // member 1824) is not that member: the member stays as it is, the halo is said.
+        let mut data = Dataset::default();
+        let (catalog, _) = wslap::parse_member_catalog(
+            "#REFERENCE 3 292.95682 -26.575718\n7 0.0 0.0 1 1 0 18.5\n",
+            "gal.cat",
+            None,
+        )
+        .unwrap();
+        data.members = Some(catalog);
+        let centred = text.replace("x_centre 20\n", "x_centre 0\n");
+        let par = parse_par(&centred, "fitted.par").unwrap();
+        let notes = add_galaxies(&mut data, &par);
+        assert!(
+            notes.iter().any(|n| n.ends_with(
+                "not fitted as a member (centred on member 7, which is fitted as a member); \
+                 the grid models its mass"
+            )),
+            "{notes:?}"
+        );
     }
 
     #[test]
