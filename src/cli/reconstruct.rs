@@ -243,7 +243,18 @@ pub fn run(args: &ReconstructArgs) -> Result<(), String> {
         Dataset::read(&files, config.constraints.pixel_arcsec).map_err(|e| e.to_string())?;
     if let Some(par) = &par {
         for w in &par.warnings {
-            eprintln!("warning: {w}");
+            if let Some(block) = &w.moved_block {
+                // Read for its galaxies, a multi-plane .par is moved to one plane only to be
+                // read: nothing of a block at another redshift is used.
+                eprintln!(
+                    "note: {}:{}: block `{block}` lies at another redshift than z_lens = {}: \
+                     not used (a reconstruction takes from a .par its galaxies at z_lens and \
+                     its redshift priors; members come from --members)",
+                    w.file, w.line, par.z_lens
+                );
+            } else {
+                eprintln!("warning: {w}");
+            }
         }
         for note in data
             .add_par(par, &plane, &config)

@@ -140,6 +140,11 @@ pub struct ParWarning {
     /// 1-based line.
     pub line: usize,
     pub message: String,
+    /// The header of the block (e.g. `potfile1`) when the warning says that a block at another
+    /// redshift was moved to the cluster's plane by the single-plane approximation
+    /// ([`ParOptions::single_plane`]): a reader that takes only the galaxies at the cluster's
+    /// redshift uses nothing of that block.
+    pub moved_block: Option<String>,
 }
 
 impl std::fmt::Display for ParWarning {

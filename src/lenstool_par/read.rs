@@ -127,7 +127,8 @@ pub fn parse_par_with(
             to_arcsec(r_core);
             to_arcsec(r_cut);
         }
-        cx.warn(
+        cx.warn_moved(
+            &b.header,
             b.line,
             format!(
                 "single-plane approximation: block `{}` at z = {z} is moved to z_lens = {z_lens} \
@@ -218,6 +219,7 @@ fn read_blocks(
                     warnings.push(ParWarning {
                         file: file.into(),
                         line,
+                        moved_block: None,
                         message: format!(
                             "`{first}` is not a Lenstool block: skipped, with the lines after \
                              it, up to the next block or `end` (Lenstool skips it too)"
@@ -465,7 +467,15 @@ impl Ctx<'_> {
             file: self.file.into(),
             line,
             message,
+            moved_block: None,
         });
+    }
+    /// [`Self::warn`] for the block `header` the single-plane approximation moved.
+    fn warn_moved(&self, header: &str, line: usize, message: String) {
+        self.warn(line, message);
+        if let Some(w) = self.warnings.borrow_mut().last_mut() {
+            w.moved_block = Some(header.to_string());
+        }
     }
     fn model(&self, reason: &str) -> ParError {
         ParError::Model {

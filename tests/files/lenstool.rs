@@ -198,6 +198,15 @@ fn the_galaxies_of_a_multi_plane_model_are_the_cluster_planes() {
     let ids: Vec<&str> = found.members.iter().map(|m| m.id.as_str()).collect();
     assert_eq!(ids, ["O2"]);
     assert!(found.other_plane.is_empty() && found.without_mag.is_empty());
+    // The background potfile moved to one plane to be read is marked, so that a
+    // reconstruction can say that it does not use it; the other warnings are not.
+    let moved: Vec<(usize, Option<&str>)> = par
+        .warnings
+        .iter()
+        .map(|w| (w.line, w.moved_block.as_deref()))
+        .filter(|(_, b)| b.is_some())
+        .collect();
+    assert_eq!(moved, [(42, Some("potfile1"))]);
     // A galaxy of the background group modelled on its own (core 0.2 kpc, a `mag`).
     let background = "potentiel O3\n\tprofil       81\n\tx_centre     30.0\n\ty_centre     \
                       -20.0\n\tellipticite     0.1\n\tangle_pos       10.0\n\t\
