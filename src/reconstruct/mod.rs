@@ -1202,6 +1202,7 @@ fn reconstruct_limited(
     let t = crate::products::Clock::start();
     warnings.splice(0..0, system.measurability_warnings());
     timings.system_ms += t.ms();
+    warnings.extend(system.prior_pull_warnings(&x));
     let lens = system.reconstructed_lens(&x)?;
     let t = crate::products::Clock::start();
     let opts = product_options(config, &system.grid);

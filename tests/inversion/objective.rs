@@ -210,7 +210,24 @@ fn an_unmeasured_member_factor_is_held_near_one() {
     let held = reconstruct(&inputs, &config, &mut quiet).unwrap();
     let c = held.layer_factors()[0];
     assert!((c - 1.0).abs() < 0.2, "C = {c}");
-    assert!(held.warnings[0].contains("held near 1 by the prior C = 1 +- 0.1"));
+    assert!(held.warnings[0].contains("it is given the prior C = 1 +- 0.1"));
+    // Within the prior's reach nothing more is said; a factor ending 5 sigma below it is.
+    assert!(
+        !held.warnings.iter().any(|w| w.contains("C ends at")),
+        "{:?}",
+        held.warnings
+    );
+    let mut x = held.x.clone();
+    x[held.system.layer_columns().start] = 0.5;
+    let name = &held.system.layers[0].name;
+    assert_eq!(
+        held.system.prior_pull_warnings(&x),
+        [format!(
+            "member layer \"{name}\": C ends at 0.50, 5.0 sigma below its prior C = 1 +- 0.1: \
+             the images and the regulariser make the members lighter than the luminosity law as \
+             set (members.mass_to_light), and the map keeps the fitted C"
+        )]
+    );
     config.members.c_prior_sigma_unmeasured = None;
     let free = reconstruct(&inputs, &config, &mut quiet).unwrap();
     let c_free = free.layer_factors()[0];
