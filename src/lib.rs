@@ -137,7 +137,7 @@ pub use inversion::{
     HaloProfile, Layer, LayerSplit, LinearSystem, MapPlan, MemberConfig, MemberHalo, MemberModel,
     MembersError, NpyError, ObjectiveConfig, ObjectiveTerms, RedshiftPrior, Regulariser, RowBlock,
     ScaledLens, Strength, SystemConfig, SystemError, Weighting, LAYER_SHARE_WARN,
-    MAX_SINGLE_LAYERS,
+    MAX_SINGLE_LAYERS, PRIOR_PULL_SIGMA,
 };
 pub use inversion::{
     kappa_gamma, with_ring, ShearConfig, ShearPoint, ShearSet, MIN_ONE_MINUS_KAPPA,

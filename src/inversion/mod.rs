@@ -37,5 +37,5 @@ pub use regularise::{
 pub use shear::{kappa_gamma, with_ring, ShearConfig, ShearPoint, ShearSet, MIN_ONE_MINUS_KAPPA};
 pub use system::{
     ColumnInfo, LinearSystem, ObjectiveTerms, RowBlock, ScaledLens, SystemConfig, SystemError,
-    LAYER_SHARE_WARN,
+    LAYER_SHARE_WARN, PRIOR_PULL_SIGMA,
 };
