@@ -59,9 +59,10 @@ pub enum AppError {
     /// The computation failed (the core's message).
     #[error("{0}")]
     Run(String),
-    /// A member catalogue that reads only as a Lenstool `.par`'s potfile (headerless arcsec
-    /// from the `.par`'s reference), loaded before that `.par`: the app keeps the file and reads
-    /// it again when a `.par` with a potfile loads (the message says so).
+    /// A file that reads only with a Lenstool `.par`, loaded before one: a member catalogue
+    /// that is a `.par`'s potfile (headerless arcsec from its reference), or arclets without a
+    /// redshift (the `.par`'s z_source gives them one). The page keeps the file and reads it
+    /// again when a `.par` loads (the message says so).
     #[error("{0}")]
     WantsPar(String),
 }

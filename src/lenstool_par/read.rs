@@ -127,8 +127,7 @@ pub fn parse_par_with(
             to_arcsec(r_core);
             to_arcsec(r_cut);
         }
-        cx.warn_moved(
-            &b.header,
+        cx.warn_about(
             b.line,
             format!(
                 "single-plane approximation: block `{}` at z = {z} is moved to z_lens = {z_lens} \
@@ -136,6 +135,7 @@ pub fn parse_par_with(
                  scales with D_ls/D_s of z_lens, and lensing between the planes is ignored)",
                 b.header
             ),
+            Some(b.header.clone()),
         );
     }
     Ok(LenstoolPar {
@@ -463,19 +463,17 @@ impl Ctx<'_> {
     }
 
     fn warn(&self, line: usize, message: String) {
+        self.warn_about(line, message, None);
+    }
+    /// A warning on `line`; `moved_block` is the header of the block it says the single-plane
+    /// approximation moved, if it says so.
+    fn warn_about(&self, line: usize, message: String, moved_block: Option<String>) {
         self.warnings.borrow_mut().push(ParWarning {
             file: self.file.into(),
             line,
             message,
-            moved_block: None,
+            moved_block,
         });
-    }
-    /// [`Self::warn`] for the block `header` the single-plane approximation moved.
-    fn warn_moved(&self, header: &str, line: usize, message: String) {
-        self.warn(line, message);
-        if let Some(w) = self.warnings.borrow_mut().last_mut() {
-            w.moved_block = Some(header.to_string());
-        }
     }
     fn model(&self, reason: &str) -> ParError {
         ParError::Model {

@@ -292,11 +292,12 @@ impl Dataset {
         for g in &without_mag {
             // A halo of a group's mass centred on a galaxy (MACS J1149's northern group `O4`
             // on member 1824) is not that galaxy: it is left to the grid, whatever lies there.
-            let group = g.mass_msun.and_then(|mass| {
-                let lstar = law.luminosity_lstar(law.mag_of_mass(mass, mag_star), mag_star);
-                (lstar > PAR_GALAXY_MAX_LSTAR).then_some((mass, lstar))
+            // Its mass, the magnitude of that halo mass under the member law, and its L*.
+            let by_law = g.mass_msun.map(|mass| {
+                let mag = law.mag_of_mass(mass, mag_star);
+                (mass, mag, law.luminosity_lstar(mag, mag_star))
             });
-            if let Some((mass, lstar)) = group {
+            if let Some((mass, _, lstar)) = by_law.filter(|b| b.2 > PAR_GALAXY_MAX_LSTAR) {
                 let on = self
                     .member_near(to_data(g.centre))
                     .map_or(String::new(), |id| {
@@ -314,7 +315,7 @@ impl Dataset {
                 notes.push(note);
                 continue;
             }
-            let Some(mass) = g.mass_msun else {
+            let Some((_, mag, _)) = by_law else {
                 notes.push(format!(
                     "{name}: line {}: `{}` has no `mag` and its radii make no dPIE (the cut \
                      radius must exceed the core): not fitted",
@@ -322,7 +323,6 @@ impl Dataset {
                 ));
                 continue;
             };
-            let mag = law.mag_of_mass(mass, mag_star);
             by_mass.push(Member {
                 id: g.id.clone(),
                 position: g.centre,
@@ -394,11 +394,6 @@ impl Dataset {
             g.position = to_data(g.position);
             let (x, y) = (g.position.x, g.position.y);
             let same = |m: &&Member| m.position.distance(g.position) <= SAME_GALAXY_ARCSEC;
-            if let Some(first) = members.members[catalogued..].iter().find(same) {
-                if first.id == g.id && first.mag == g.mag {
-                    repeated.push((g.line, first.line));
-                }
-            }
             let near = members.members[..catalogued].iter().find(same);
             if let Some(m) = near {
                 already.push((
@@ -409,6 +404,12 @@ impl Dataset {
                     ),
                 ));
                 continue;
+            }
+            // Added already from the `.par` itself, as written: a repeat.
+            if let Some(first) = members.members[catalogued..].iter().find(same) {
+                if first.id == g.id && first.mag == g.mag {
+                    repeated.push((g.line, first.line));
+                }
             }
             if k < with_mag {
                 notes.push(format!(
@@ -475,8 +476,9 @@ impl Dataset {
         at: DVec2,
     ) -> Option<String> {
         let near = |m: &&Member| m.position.distance(at) <= SAME_GALAXY_ARCSEC;
+        let on_member = self.member_near(at);
         if let Some(members) = self.members.as_mut() {
-            if let Some(id) = members.members.iter().find(near).map(|m| m.id.clone()) {
+            if let Some(id) = on_member {
                 let note = format!(
                     "{name}: line {line}: `{block}` (no `mag`) is member {id} of {} already",
                     members.source_name

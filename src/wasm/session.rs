@@ -149,8 +149,8 @@ impl AppSession {
 
     /// Loads a text file as `role` (images, members, arcs, shear, model); returns its
     /// `LoadReport`.
-    /// On an error (naming the file, line and reason) nothing loaded changes; a member
-    /// catalogue that wants its `.par` first is refused with `code` `"wants-par"`.
+    /// On an error (naming the file, line and reason) nothing loaded changes; a file that
+    /// wants a `.par` first is refused with `code` `"wants-par"`.
     pub fn load_text(&mut self, role: &str, name: &str, text: &str) -> Result<JsValue, JsValue> {
         let role = DataRole::parse(role).map_err(coded)?;
         let report = self.inner.load_text(role, name, text).map_err(coded)?;

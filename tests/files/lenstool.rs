@@ -1059,3 +1059,50 @@ fn arclets_without_a_redshift_take_the_par_s_z_source() {
     let err = wslap::Dataset::read(&files, 0.2).unwrap_err().to_string();
     assert!(err.contains("give that .par with the catalogue"), "{err}");
 }
+
+/// A galaxy a `.par` writes twice (with its `mag`) is fitted twice, as Lenstool sums every
+/// potential, and said; when the member catalogue lists it, neither copy is added and no
+/// repeat is said.
+#[cfg_attr(not(target_arch = "wasm32"), test)]
+#[cfg_attr(target_arch = "wasm32", wasm_bindgen_test::wasm_bindgen_test)]
+fn a_galaxy_written_twice_is_fitted_twice_unless_catalogued() {
+    let galaxy = "potentiel 569\n\tprofil 81\n\tx_centre -73.383\n\ty_centre -30.375\n\t\
+                  ellipticite 0.237\n\tangle_pos -47.2\n\tcore_radius_kpc 0.169\n\t\
+                  cut_radius_kpc 64.372\n\tv_disp 152.621\n\tmag 20.38\n\tz_lens 0.544\n\tend\n";
+    let text = format!(
+        "runmode\n\treference 3 177.398750 22.398530\n\tend\n\
+         cosmologie\n\tH0 70.0\n\tomegaM 0.3\n\tomegaX 0.7\n\tend\n{galaxy}{galaxy}fini\n"
+    );
+    let par = parse_par(&text, "best.par").unwrap();
+    let mut data = wslap::Dataset::default();
+    let notes = add_galaxies(&mut data, &par);
+    assert!(
+        notes.iter().any(|n| n.starts_with(
+            "best.par: 1 galaxy is written twice (line 21 repeats line 9): both are fitted"
+        )),
+        "{notes:?}"
+    );
+    assert_eq!(data.members.unwrap().members.len(), 2);
+    let (catalog, _) = wslap::parse_member_catalog(
+        "#REFERENCE 3 177.398750 22.398530\n569 -73.383 -30.375 1 0.8 -47.2 20.38\n",
+        "gal.cat",
+        None,
+    )
+    .unwrap();
+    let mut data = wslap::Dataset {
+        members: Some(catalog),
+        ..Default::default()
+    };
+    let notes = add_galaxies(&mut data, &par);
+    assert!(
+        !notes.iter().any(|n| n.contains("written twice")),
+        "{notes:?}"
+    );
+    assert!(
+        notes
+            .iter()
+            .any(|n| n.ends_with(") are members of gal.cat already: not added twice")),
+        "{notes:?}"
+    );
+    assert_eq!(data.members.unwrap().members.len(), 1);
+}
