@@ -1628,9 +1628,13 @@ fn catalogue_lines(catalog: &ImageCatalog, id: &str) -> String {
     let Some(system) = catalog.systems.iter().find(|s| s.id == id) else {
         return String::new();
     };
-    let lines: Vec<String> = system.images.iter().map(|i| i.line.to_string()).collect();
-    let noun = if lines.len() == 1 { "line" } else { "lines" };
-    format!(" ({}, {noun} {})", catalog.source_name, lines.join(", "))
+    let noun = if system.images.len() == 1 {
+        "line"
+    } else {
+        "lines"
+    };
+    let lines = crate::error::line_list(system.images.iter().map(|i| i.line));
+    format!(" ({}, {noun} {lines})", catalog.source_name)
 }
 
 fn describe_excluded(constraints: &ConstraintSet) -> String {
