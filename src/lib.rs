@@ -120,7 +120,7 @@ pub use fits::{
 pub use lenstool_par::load_lenstool_model;
 pub use lenstool_par::{
     parse_par, parse_par_with, GalaxyWithoutMag, LenstoolModel, LenstoolPar, ParComponent,
-    ParError, ParGalaxies, ParOptions, ParRedshiftPrior, ParSourceZ, ParWarning, Radius,
+    ParError, ParGalaxies, ParHalo, ParOptions, ParRedshiftPrior, ParSourceZ, ParWarning, Radius,
     UnknownSourceZ, GALAXY_MAX_CORE_KPC, LENSTOOL_DEFAULT_Z_SOURCE,
 };
 pub use limits::{

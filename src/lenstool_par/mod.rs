@@ -174,6 +174,19 @@ impl Radius {
 /// the CATS model of AS1063 gives its BCG (O3) 0.5 kpc and its north-east group (O4) 49 kpc.
 pub const GALAXY_MAX_CORE_KPC: f64 = 5.0;
 
+/// A `potentiel` on the lens plane with a core too wide for a galaxy (over
+/// [`GALAXY_MAX_CORE_KPC`]; [`ParGalaxies::halos`]): a cluster's or a group's halo, or a
+/// galaxy a set-up gives a wide core, whose mass the grid models.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ParHalo {
+    /// The block's name, e.g. `potentiel O1`.
+    pub block: String,
+    /// The block's first line (1-based).
+    pub line: usize,
+    /// Its core radius in kpc.
+    pub core_kpc: f64,
+}
+
 /// The galaxies of a `.par` ([`LenstoolPar::galaxies`]).
 #[derive(Debug, Clone, PartialEq)]
 pub struct ParGalaxies {
@@ -185,6 +198,9 @@ pub struct ParGalaxies {
     /// Galaxies at another redshift than [`LenstoolPar::z_lens`] (read with the single-plane
     /// approximation), not the cluster's: each block's name, line and `z_lens`.
     pub other_plane: Vec<(String, usize, f64)>,
+    /// The dPIEs on the lens plane with a core too wide for a galaxy (over
+    /// [`GALAXY_MAX_CORE_KPC`]).
+    pub halos: Vec<ParHalo>,
 }
 
 /// A galaxy of a `.par` with a velocity dispersion but no `mag` (a fitted `bestopt.par`
@@ -439,12 +455,14 @@ impl LenstoolPar {
     /// at most [`GALAXY_MAX_CORE_KPC`] (a BCG's is below a kpc; a group or cluster halo's tens
     /// of kpc), as member rows in the file's frame (id: the block's name, e.g. `O3`; a and b
     /// from the ellipticity `(a^2 - b^2)/(a^2 + b^2)`; line: the block's). Those without a
-    /// `mag`, which a member needs, come second with their dPIE's mass
-    /// ([`GalaxyWithoutMag`]; a massless one, `v_disp 0`, is left out); those at another
-    /// redshift (a single-plane read, [`ParOptions::for_galaxies`]) third.
+    /// `mag`, which a member needs, come second with their dPIE's mass ([`GalaxyWithoutMag`];
+    /// a massless one, `v_disp 0`, is left out); those at another redshift (a single-plane
+    /// read, [`ParOptions::for_galaxies`]) third; the wider ones on the lens plane last
+    /// ([`ParGalaxies::halos`]).
     pub fn galaxies(&self) -> Result<ParGalaxies, ParError> {
         let plane = self.lens_plane()?;
         let (mut rows, mut without_mag, mut other_plane) = (Vec::new(), Vec::new(), Vec::new());
+        let mut halos = Vec::new();
         for p in &self.potentials {
             let ParComponent::Dpie {
                 center_arcsec,
@@ -458,10 +476,18 @@ impl LenstoolPar {
                 continue;
             };
             let core_kpc = r_core.arcsec(&plane) * plane.mpc_per_arcsec * 1.0e3;
+            let same_plane = (p.z_lens - self.z_lens).abs() <= Z_MATCH_TOL;
             if core_kpc > GALAXY_MAX_CORE_KPC {
+                if same_plane {
+                    halos.push(ParHalo {
+                        block: p.block.clone(),
+                        line: p.line,
+                        core_kpc,
+                    });
+                }
                 continue;
             }
-            if (p.z_lens - self.z_lens).abs() > Z_MATCH_TOL {
+            if !same_plane {
                 other_plane.push((p.block.clone(), p.line, p.z_lens));
                 continue;
             }
@@ -502,6 +528,7 @@ impl LenstoolPar {
             members: rows,
             without_mag,
             other_plane,
+            halos,
         })
     }
 

@@ -34,11 +34,13 @@ use crate::catalog::{
     CommentedBcgs, ImageCatalog, Member, MemberCatalog,
 };
 use crate::cosmology::LensPlane;
-use crate::error::line_list;
+use crate::error::{and_list, line_list};
 use crate::inversion::{
     build_constraints, missing_bcg_warning, ConstraintMode, ConstraintSource, RedshiftPrior,
 };
-use crate::lenstool_par::{LenstoolPar, ParError, ParGalaxies, UnknownSourceZ};
+use crate::lenstool_par::{
+    LenstoolPar, ParError, ParGalaxies, ParHalo, UnknownSourceZ, GALAXY_MAX_CORE_KPC,
+};
 use crate::sky::SkyReference;
 
 /// One input file: the name used in messages and its text.
@@ -277,6 +279,7 @@ impl Dataset {
             members: mut rows,
             without_mag,
             other_plane,
+            halos,
         } = par.galaxies()?;
         let name = &par.source_name;
         let frame = self.reference();
@@ -362,10 +365,32 @@ impl Dataset {
                 par.z_lens
             )
         }));
+        // The blocks with a core too wide for a galaxy (the cluster's halos, groups', a galaxy
+        // given a wide core): said last, so that no block of the .par goes unmentioned.
+        let wide = |h: &ParHalo| {
+            format!(
+                "`{}` (line {}, core {:.0} kpc)",
+                h.block, h.line, h.core_kpc
+            )
+        };
+        let halo_note = match &halos[..] {
+            [] => None,
+            [h] => Some(format!(
+                "{name}: {} has a core wider than a galaxy's (over {GALAXY_MAX_CORE_KPC} kpc): \
+                 not fitted as a member; the grid models its mass",
+                wide(h)
+            )),
+            many => Some(format!(
+                "{name}: {} have cores wider than a galaxy's (over {GALAXY_MAX_CORE_KPC} kpc): \
+                 not fitted as members; the grid models their mass",
+                and_list(many.iter().map(wide))
+            )),
+        };
         if let Some(members) = self.members.as_mut() {
             members.par_source = Some(name.clone());
         }
         if rows.is_empty() {
+            notes.extend(halo_note);
             return Ok(notes);
         }
         if par.reference.is_none() && frame.is_some() {
@@ -452,6 +477,7 @@ impl Dataset {
                 members.source_name
             )),
         }
+        notes.extend(halo_note);
         Ok(notes)
     }
 

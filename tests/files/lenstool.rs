@@ -684,7 +684,17 @@ mod galaxies_of_a_par {
             "{}",
             added.position
         );
-        assert_eq!(notes.len(), 1);
+        // Then one sentence for the cluster's halo (O1, 99 kpc) and the north-east group's
+        // (O4, 49 kpc), which the grid models.
+        assert_eq!(notes.len(), 2, "{notes:?}");
+        assert!(
+            notes[1].ends_with(
+                "`potentiel O1` (line 27, core 99 kpc) and `potentiel O4` (line 70, core 49 \
+                 kpc) have cores wider than a galaxy's (over 5 kpc): not fitted as members; the \
+                 grid models their mass"
+            ),
+            "{notes:?}"
+        );
         assert!(
             notes[0].starts_with("best.par: line 55: galaxy O3 at (")
                 && notes[0].ends_with(" arcsec, mag 17.04, fitted as a member"),
@@ -832,6 +842,82 @@ mod galaxies_of_a_par {
         );
     }
 
+    /// Every dPIE of the lens plane with a core too wide for a galaxy is named in a note,
+    /// with its line and core: the cluster's halos, a group's with a `mag`, and a galaxy a
+    /// set-up fits one by one with a wide core (COOL J1153's three, 7 - 19 kpc, no `mag`;
+    /// they were left to the grid without a word). One alone has a sentence of its own.
+    #[test]
+    fn halos_too_wide_for_a_galaxy_are_said() {
+        let block = |name: &str, x: f64, sigma: f64, core: f64, mag: &str| {
+            format!(
+                "potentiel {name}\n    profil 81\n    x_centre {x}\n    y_centre 0.\n    \
+                 v_disp {sigma}\n    core_radius_kpc {core}\n    cut_radius_kpc 100\n{mag}    \
+                 z_lens 0.35\n    end\n"
+            )
+        };
+        let head = "runmode\n    reference 3 292.95682 -26.575718\n    end\ncosmologie\n    \
+                    H0 70.\n    omega 0.3\n    lambda 0.7\n    end\n";
+        let text = format!(
+            "{head}{}{}{}{}",
+            block("G1", 10.0, 200.0, 12.0, ""),
+            block("O1", 0.0, 1000.0, 80.0, ""),
+            block("O2", 40.0, 300.0, 30.0, "    mag 19.0\n"),
+            // A galaxy with a galaxy's core: fitted, not named here.
+            block("G3", 20.0, 150.0, 0.2, "    mag 20.0\n"),
+        );
+        let par = parse_par(&text, "wide.par").unwrap();
+        let found = par.galaxies().unwrap();
+        let ids: Vec<&str> = found.members.iter().map(|m| m.id.as_str()).collect();
+        assert_eq!(ids, ["G3"]);
+        assert!(found.without_mag.is_empty());
+        let halos: Vec<(&str, usize)> = found
+            .halos
+            .iter()
+            .map(|h| (h.block.as_str(), h.line))
+            .collect();
+        assert_eq!(
+            halos,
+            [
+                ("potentiel G1", 9),
+                ("potentiel O1", 18),
+                ("potentiel O2", 27)
+            ]
+        );
+        assert!((found.halos[0].core_kpc - 12.0).abs() < 1e-9);
+        let mut data = Dataset::default();
+        let notes = add_galaxies(&mut data, &par);
+        assert!(
+            notes.contains(
+                &"wide.par: `potentiel G1` (line 9, core 12 kpc), `potentiel O1` (line 18, core \
+                  80 kpc) and `potentiel O2` (line 27, core 30 kpc) have cores wider than a \
+                  galaxy's (over 5 kpc): not fitted as members; the grid models their mass"
+                    .to_string()
+            ),
+            "{notes:?}"
+        );
+        assert_eq!(data.members.unwrap().par_galaxies, ["G3"]);
+        let one = format!("{head}{}", block("O1", 0.0, 1000.0, 80.0, ""));
+        let par = parse_par(&one, "one.par").unwrap();
+        let mut data = Dataset::default();
+        assert_eq!(
+            add_galaxies(&mut data, &par),
+            [
+                "one.par: `potentiel O1` (line 9, core 80 kpc) has a core wider than a galaxy's \
+              (over 5 kpc): not fitted as a member; the grid models its mass"
+            ]
+        );
+        // A halo of another plane is not the cluster's: not named here.
+        let other = format!(
+            "{head}{}{}",
+            block("G3", 20.0, 150.0, 0.2, "    mag 20.0\n"),
+            block("O1", 0.0, 1000.0, 80.0, "").replace("z_lens 0.35\n", "z_lens 1.2\n")
+        );
+        let options = wslap::ParOptions::default().for_galaxies();
+        let par = wslap::parse_par_with(&other, "other.par", &options).unwrap();
+        assert_eq!(par.z_lens, 0.35);
+        assert!(par.galaxies().unwrap().halos.is_empty());
+    }
+
     #[test]
     fn a_galaxy_without_a_magnitude_takes_its_commented_row_or_its_mass() {
         // MACS1931's .par is a starting model: its BCG (potential 3, core 0.115 kpc, at the
@@ -851,7 +937,13 @@ mod galaxies_of_a_par {
         // (v_disp 100 km/s, cut 100 kpc).
         let mut data = Dataset::default();
         let notes = add_galaxies(&mut data, &par);
-        assert_eq!(notes.len(), 1, "{notes:?}");
+        assert_eq!(notes.len(), 2, "{notes:?}");
+        assert_eq!(
+            notes[1],
+            "m1931.par: `potentiel 1` (line 28, core 50 kpc) and `potentiel 2` (line 47, core \
+             50 kpc) have cores wider than a galaxy's (over 5 kpc): not fitted as members; the \
+             grid models their mass"
+        );
         assert!(
             notes[0].starts_with(
                 "m1931.par: line 66: galaxy 3 has no `mag`: fitted as a member of mag "
@@ -887,12 +979,13 @@ mod galaxies_of_a_par {
         let before = data.members.as_ref().unwrap().members.len();
         let notes = add_galaxies(&mut data, &par);
         assert_eq!(
-            notes,
+            notes[..1],
             [
                 "m1931.par: line 66: `potentiel 3` has no `mag`; the row m1931.cat comments out \
-                 there (line 10, galaxy 1009.0, mag 17.32) is fitted as a member"
+              there (line 10, galaxy 1009.0, mag 17.32) is fitted as a member"
             ]
         );
+        assert_eq!(notes.len(), 2, "{notes:?}");
         let members = data.members.as_ref().unwrap();
         assert_eq!(members.members.len(), before + 1);
         let bcg = members.members.last().unwrap();

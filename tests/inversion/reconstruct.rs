@@ -1224,10 +1224,14 @@ fn a_commented_out_bcg_row_is_fitted_unless_the_settings_say_not() {
     )
     .unwrap();
     let mut data = read_macs();
-    assert!(data
-        .add_par_galaxies(&halo, &halo.lens_plane().unwrap(), &Default::default())
-        .unwrap()
-        .is_empty());
+    assert_eq!(
+        data.add_par_galaxies(&halo, &halo.lens_plane().unwrap(), &Default::default())
+            .unwrap(),
+        [
+            "halo.par: `potentiel 1` (line 4, core 50 kpc) has a core wider than a galaxy's (over \
+          5 kpc): not fitted as a member; the grid models its mass"
+        ]
+    );
     let m = data.members.as_ref().unwrap();
     assert_eq!(
         (m.par_source.as_deref(), m.par_galaxies.len()),
