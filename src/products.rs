@@ -157,6 +157,11 @@ pub struct Summary {
     /// Projected mass inside 10, 20 and 50 arcsec of (0, 0), Msun (`null` where the circle
     /// leaves the map).
     pub mass_within_arcsec: Vec<(f64, Option<f64>)>,
+    /// The sky position of the frame's origin (0, 0), about which `mass_within_arcsec` is
+    /// measured: a catalogue's `#REFERENCE`, or for absolute RA/Dec without one the images'
+    /// mean position (`null` for a frame without a sky position).
+    #[serde(default)]
+    pub frame_reference: Option<SkyReference>,
     pub timings_ms: Timings,
 }
 
@@ -413,6 +418,7 @@ impl Products {
                 .iter()
                 .map(|&r| (r, profile_mass_at(r)))
                 .collect(),
+            frame_reference: self.reference,
             timings_ms: self.timings,
         }
     }

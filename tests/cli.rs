@@ -837,7 +837,7 @@ fn reconstruct_folds_writes_crossval_json() {
     all.extend(["--folds", "1"]);
     let err = refused(&dir, "reconstruct", &all);
     assert!(
-        err.contains("folds = 1") && err.contains("4 fitted"),
+        err.contains("folds = 1: ") && err.contains("use folds from 2 to 4"),
         "{err}"
     );
 }

@@ -102,8 +102,30 @@ pub enum ReconstructError {
     NoConstraints(String),
     #[error("cancelled")]
     Cancelled,
-    #[error("folds = {folds}: cross-validation holds out each of at least 2 groups of the fitted systems, at most one group per system ({systems} fitted here at a redshift of their own; a system without one is not held out)")]
+    #[error("{}", folds_message(*folds, *systems))]
     Folds { folds: usize, systems: usize },
+}
+
+/// Why `folds` groups cannot be held out in turn from `systems` systems that can be (those
+/// fitted at a redshift of their own), and what to do.
+fn folds_message(folds: usize, systems: usize) -> String {
+    let which = "systems with a redshift of their own; a system whose redshift is estimated is \
+                 never held out";
+    match (folds, systems) {
+        (_, 0 | 1) => format!(
+            "folds = {folds}: holding systems out needs at least 2 that can be, and there {} \
+             ({which}): run without folds",
+            if systems == 1 { "is 1" } else { "are none" }
+        ),
+        (0 | 1, _) => format!(
+            "folds = {folds}: cross-validation holds out at least 2 groups of systems in turn: \
+             use folds from 2 to {systems} ({which})"
+        ),
+        _ => format!(
+            "folds = {folds}: more groups than the {systems} systems that can be held out: \
+             use folds from 2 to {systems} ({which})"
+        ),
+    }
 }
 
 /// Where the member-galaxy layers come from.

@@ -141,10 +141,23 @@ fn fold_groups_deal_the_fitted_systems_out_in_turn() {
         );
         let text = err.to_string();
         assert!(
-            text.contains(&format!("folds = {folds}")) && text.contains("4 fitted"),
+            text.starts_with(&format!("folds = {folds}: "))
+                && text.contains("use folds from 2 to 4 (systems with a redshift of their own"),
             "{text}"
         );
     }
+    // With one system there is nothing to hold out in turn, whatever the folds: said so.
+    let one = wslap::ImageCatalog {
+        systems: cat.systems[..1].to_vec(),
+        ..cat.clone()
+    };
+    let err = fold_groups(&inputs(&one, &none), &config(), 5).unwrap_err();
+    assert_eq!(
+        err.to_string(),
+        "folds = 5: holding systems out needs at least 2 that can be, and there is 1 (systems \
+         with a redshift of their own; a system whose redshift is estimated is never held out): \
+         run without folds"
+    );
 }
 
 /// Each fold is exactly `reconstruct` with that group held out: the same predicted images and

@@ -627,6 +627,13 @@ fn a_redshift_just_behind_the_lens_is_said() {
     config.objective.strength = wslap::Strength::Value(0.01);
     config.products.pixels = 64;
     let r = reconstruct(&c_smooth_inputs(&catalog), &config, &mut quiet).unwrap();
+    // summary.json says where the frame's origin lies on the sky: the file's `#REFERENCE 3
+    // 342.183200 -44.530900`.
+    let json = serde_json::to_value(r.products.summary()).unwrap();
+    assert_eq!(
+        json["frame_reference"],
+        serde_json::json!({"ra": 342.1832, "dec": -44.5309})
+    );
     let said: Vec<&String> = r
         .warnings
         .iter()
