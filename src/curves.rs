@@ -27,7 +27,9 @@ pub type Polyline = Vec<DVec2>;
 #[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
 pub struct CriticalCurves {
     pub z_source: f64,
-    /// `sqrt(area inside the tangential curves / pi)`, 0 when there is none.
+    /// `sqrt(area inside the tangential curves / pi)`, 0 when there is none. A hole inside a
+    /// loop (a subcritical island within the critical region) counts against the area, so
+    /// `main_curve_radius_arcsec` can exceed it.
     pub einstein_radius_arcsec: f64,
     /// `sqrt(area enclosed by the main tangential curve / pi)`: the largest closed loop of the
     /// lens alone, without the loops of member galaxies or a neighbouring group beside it (which
