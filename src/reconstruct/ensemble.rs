@@ -571,10 +571,7 @@ impl EnsemblePlan {
         fitting.constraints.z_estimates = super::free_z::most_probable_of(&estimated);
         let ids = fitted_system_ids(inputs, &fitting)?;
         if ids.len() < 2 {
-            return Err(ReconstructError::Folds {
-                folds: 2,
-                systems: ids.len(),
-            });
+            return Err(ReconstructError::EnsembleSystems { systems: ids.len() });
         }
         let grid = &main.system.grid;
         let cell = grid.width_arcsec / grid.cells_per_side.max(1) as f64;

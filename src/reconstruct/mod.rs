@@ -104,6 +104,8 @@ pub enum ReconstructError {
     Cancelled,
     #[error("{}", folds_message(*folds, *systems))]
     Folds { folds: usize, systems: usize },
+    #[error("an ensemble redraws the fitted systems and needs at least 2 of them, and {} fitted here: run without an ensemble", if *systems == 1 { "1 is".to_string() } else { format!("{systems} are") })]
+    EnsembleSystems { systems: usize },
 }
 
 /// Why `folds` groups cannot be held out in turn from `systems` systems that can be (those

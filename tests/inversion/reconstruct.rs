@@ -827,6 +827,29 @@ fn outer_redshifts_are_estimated_over_the_regularisers_tried() {
     );
 }
 
+/// An ensemble of one fitted system cannot redraw the systems: refused in words that name the
+/// ensemble, not folds.
+#[cfg(not(target_arch = "wasm32"))]
+#[test]
+fn an_ensemble_of_one_system_is_refused_in_its_own_words() {
+    let catalog = c_smooth();
+    let mut config = ReconstructConfig::default();
+    config.objective.strength = wslap::Strength::Value(0.01);
+    config.products.pixels = 64;
+    let others: Vec<String> = catalog.systems[1..].iter().map(|s| s.id.clone()).collect();
+    let inputs = Inputs {
+        holdout: &others,
+        ..c_smooth_inputs(&catalog)
+    };
+    let main = reconstruct(&inputs, &config, &mut quiet).unwrap();
+    let err = wslap::EnsemblePlan::new(&inputs, &config, &main, 3, 1).unwrap_err();
+    assert_eq!(
+        err.to_string(),
+        "an ensemble redraws the fitted systems and needs at least 2 of them, and 1 is fitted \
+         here: run without an ensemble"
+    );
+}
+
 /// An ensemble carries an estimated redshift's interval into its members: each fits the
 /// system at a redshift drawn from the estimate, inside the range the draw allows, and the
 /// members' redshifts differ (c_smooth, two systems blanked, small maps to keep it short).
