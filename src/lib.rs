@@ -142,6 +142,11 @@ pub use inversion::{
 pub use inversion::{
     kappa_gamma, with_ring, ShearConfig, ShearPoint, ShearSet, MIN_ONE_MINUS_KAPPA,
 };
+// The tidal field of mass beyond the grid.
+pub use inversion::{
+    external_shear_layers, external_shear_of, shear_strength_angle, ExternalShearFit, LayerKind,
+    EXTERNAL_SHEAR_UNIT,
+};
 
 // Non-negative quadratic programming.
 pub use solver::{

@@ -235,6 +235,9 @@ function caption(info) {
   const c = info.summary.c_per_layer ?? [];
   const unmeasured = info.summary.c_unmeasured ? ', which these data hardly measure (see the warnings)' : '';
   const factors = c.length ? `member factor C = ${c.map((v) => v.toFixed(2)).join(', ')}${unmeasured}; ` : '';
+  // The tidal field of mass beyond the grid, fitted with the map (Lenstool's gamma, angle_pos).
+  const xs = info.summary.external_shear;
+  const external = xs ? `external shear γ = ${xs.gamma.toFixed(3)} along ${xs.angle_deg.toFixed(0)}°; ` : '';
   // Observed images against the predicted ones: the median (the typical image) and the rms
   // (which one image whose pair has merged can dominate); then the same for the held-out
   // systems: how well the model predicts images it was not given.
@@ -259,7 +262,7 @@ function caption(info) {
     ? `Einstein radius: none (no tangential critical curve at z_s = ${s.z_source}); `
     : `Einstein radius ${bound}${s.einstein_radius_arcsec.toFixed(1)}″ at z_s = ${s.z_source}${mainCurve}; `;
   $('summary').textContent = `${status}${radius}` +
-    `${factors}${offsets}${held}${shear}${s.tangential_curves} tangential and ${s.radial_curves} radial critical curves.${ensembleCaption(sum)}${note}${stale}`;
+    `${factors}${external}${offsets}${held}${shear}${s.tangential_curves} tangential and ${s.radial_curves} radial critical curves.${ensembleCaption(sum)}${note}${stale}`;
 }
 
 /** Under the views: the systems a run left out of the fit and its warnings (collapsed: a

@@ -7,6 +7,7 @@ use serde::{Deserialize, Serialize};
 use crate::curves::critical_curves;
 use crate::inversion::{build_constraints, Layer, LinearSystem, ObjectiveTerms};
 use crate::products::{own_map_side, ProductOptions, Products};
+use crate::reconstruct::{add_external_shear, member_layers, shear_set, BcgFacts, Verdict};
 use crate::reconstruct::{
     check_memory, cross_validate, fitted_system_ids, grid_of, map_geometry, product_options,
     reconstruct, reconstruct_with_choice, refit_for_second_choice, second_choice, second_round,
@@ -15,7 +16,6 @@ use crate::reconstruct::{
     ReconstructError, Reconstruction, RunSize, RunStatus, SecondRound, SourceReport, StageTimings,
     StrengthCandidate, StrengthChoice, DEFAULT_FOLDS,
 };
-use crate::reconstruct::{member_layers, shear_set, BcgFacts, Verdict};
 use crate::solver::{Control, Iterate};
 
 use super::data::{DataMarks, DataViews};
@@ -434,7 +434,7 @@ impl Session {
         warnings.extend(shear_warning);
         warnings.extend(unfitted);
         let mut bcg = BcgFacts::default();
-        let layers: Vec<Layer> = match &parsed.members {
+        let mut layers: Vec<Layer> = match &parsed.members {
             None => Vec::new(),
             Some(m) => {
                 let members = member_layers(m, &config.members, &plane, &grid, &constraints)
@@ -444,6 +444,7 @@ impl Session {
                 members.layers
             }
         };
+        add_external_shear(&mut layers, &config, &grid);
         let system = LinearSystem::build_with_shear(
             &grid,
             &layers,

@@ -533,13 +533,19 @@ fn one_line(r: &Reconstruction, out: &Path) -> String {
         .strength_choice
         .as_ref()
         .map_or(String::new(), |c| format!("; regulariser {}", c.describe()));
+    let shear = r.external_shear().map_or(String::new(), |g| {
+        format!(
+            "; external shear {:.3} along {:.0} deg",
+            g.gamma, g.angle_deg
+        )
+    });
     format!(
-        "wrote {} ({} systems, {} constraint pixels, {} iterations{}; grid mass {:.3e} Msun; Einstein radius at z_s = {}: {}; image offsets: rms {}, median {}{choice})",
+        "wrote {} ({} systems, {} constraint pixels, {} iterations{}{shear}; grid mass {:.3e} Msun; Einstein radius at z_s = {}: {}; image offsets: rms {}, median {}{choice})",
         out.display(),
         r.system.constraints.systems.len(),
         r.system.constraints.pixels.len(),
         r.iterations,
-        c_text("; ", &r.layer_factors()),
+        c_text("; ", &r.member_factors()),
         r.grid_mass_msun(),
         r.config.products.z_source,
         r.products.summary().einstein_radius_text(),

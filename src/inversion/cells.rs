@@ -71,6 +71,11 @@ pub struct GridConfig {
     /// Fraction of the cells (those of highest mass density) split in each pass (default 0.25:
     /// the cells above the 75th percentile). Allowed (0, 1].
     pub refine_fraction: f64,
+    /// The tidal field of mass beyond the grid: an external shear, two more unknowns
+    /// `gamma1`, `gamma2` with the Gaussian prior `0 +- external_shear_sigma` each (default
+    /// 0.1; see [`super::external_shear_layers`]). `null`: none, as in the paper.
+    /// Allowed (0, 1].
+    pub external_shear_sigma: Option<f64>,
 }
 
 impl Default for GridConfig {
@@ -84,6 +89,7 @@ impl Default for GridConfig {
             cell_sigma_factor: 0.75,
             refinements: 0,
             refine_fraction: 0.25,
+            external_shear_sigma: Some(0.1),
         }
     }
 }
@@ -152,6 +158,11 @@ impl GridConfig {
                 self.refinements as f64,
                 "must be in 0..=4",
             ));
+        }
+        if let Some(sigma) = self.external_shear_sigma {
+            if !(sigma > 0.0 && sigma <= 1.0) {
+                return Err(bad("external_shear_sigma", sigma, "must be in (0, 1]"));
+            }
         }
         if !(self.refine_fraction > 0.0 && self.refine_fraction <= 1.0) {
             return Err(bad(

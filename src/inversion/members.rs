@@ -365,6 +365,32 @@ pub struct Layer {
     /// Width of the Gaussian prior on this layer's factor `C_l` around 1, if any
     /// ([`MemberConfig::c_prior_sigma`]).
     pub prior_sigma: Option<f64>,
+    /// What `C_l` scales: galaxies, or one half of an external shear's component.
+    pub kind: LayerKind,
+}
+
+/// What a layer's factor `C_l` scales.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum LayerKind {
+    /// Galaxies: `C_l` rescales their masses from the luminosity law (members, or a test's
+    /// true galaxies).
+    #[default]
+    Galaxies,
+    /// One signed half of an external shear's component `gamma1` or `gamma2`
+    /// ([`super::external_shear_layers`]): no mass, no galaxy.
+    ExternalShear {
+        /// 1 or 2.
+        component: u8,
+        /// The `-gamma` half.
+        negative: bool,
+    },
+}
+
+impl LayerKind {
+    /// Whether the layer is galaxies (its factor is a member factor `C`).
+    pub fn is_galaxies(self) -> bool {
+        self == Self::Galaxies
+    }
 }
 
 impl Layer {
@@ -375,6 +401,7 @@ impl Layer {
             members: Vec::new(),
             lens: Arc::new(Lens::new(components)),
             prior_sigma: None,
+            kind: LayerKind::Galaxies,
         }
     }
 
@@ -604,6 +631,7 @@ fn split_layers(
             members: vec![halos[k].member],
             lens: Arc::new(Lens::new(slots[k].take().into_iter().collect())),
             prior_sigma,
+            kind: LayerKind::Galaxies,
         });
     }
     let mut rest: Vec<usize> = order[n_alone..].to_vec();
@@ -617,6 +645,7 @@ fn split_layers(
                 rest.iter().filter_map(|&k| slots[k].take()).collect(),
             )),
             prior_sigma,
+            kind: LayerKind::Galaxies,
         });
     }
     layers

@@ -9,6 +9,7 @@
 mod cells;
 mod cells_fft;
 mod constraints;
+mod external_shear;
 mod members;
 mod npy;
 mod regularise;
@@ -22,13 +23,17 @@ pub use constraints::{
     ConstraintPixel, ConstraintSet, ConstraintSource, ConstraintSystem, ExcludedSystem, Exclusion,
     RedshiftPrior, Weighting,
 };
+pub use external_shear::{
+    external_shear_layers, external_shear_of, shear_strength_angle, ExternalShearFit,
+    EXTERNAL_SHEAR_UNIT,
+};
 pub(crate) use members::member_halo;
 pub(crate) use members::BCG_MIN_LSTAR;
 pub(crate) use members::MAX_MAG_FROM_L_STAR;
 pub(crate) use members::MAX_MASS_TO_LIGHT;
 pub use members::{
-    build_member_layers, missing_bcg_warning, HaloProfile, Layer, LayerSplit, MemberConfig,
-    MemberHalo, MemberModel, MembersError, MAX_SINGLE_LAYERS,
+    build_member_layers, missing_bcg_warning, HaloProfile, Layer, LayerKind, LayerSplit,
+    MemberConfig, MemberHalo, MemberModel, MembersError, MAX_SINGLE_LAYERS,
 };
 pub use npy::{export_system, npy_header, write_f64s, write_npy, NpyError};
 pub use regularise::{

@@ -410,10 +410,12 @@ impl LinearSystem {
     /// True when these constraints hardly measure the member factors `C`: when there are
     /// layers and [`Self::measurability_warnings`] has something to say.
     pub fn members_unmeasured(&self) -> bool {
-        !self.layers.is_empty() && !self.measurability_warnings().is_empty()
+        self.layers.iter().any(|l| l.kind.is_galaxies())
+            && !self.measurability_warnings().is_empty()
     }
 
-    /// One sentence per member layer with a prior whose factor `C` in the solution `x` ends
+    /// One sentence per member layer (not an external shear's) with a prior whose factor `C`
+    /// in the solution `x` ends
     /// more than [`PRIOR_PULL_SIGMA`] of the prior's width from 1: "given the prior" (the
     /// warning of [`Self::measurability_warnings`], said before the solve) is then not "at 1"
     /// (the HFF catalogues end at C = 0.6 - 0.7 with the prior 1 +- 0.1).
@@ -424,6 +426,7 @@ impl LinearSystem {
         self.layers
             .iter()
             .zip(factors)
+            .filter(|(layer, _)| layer.kind.is_galaxies())
             .filter_map(|(layer, &c)| {
                 let sigma = layer.prior_sigma?;
                 let pull = (c - 1.0) / sigma;
@@ -460,7 +463,7 @@ impl LinearSystem {
             None => "the start and the iteration count set it".to_string(),
         };
         if rows < unknowns {
-            let members = match self.layers.first() {
+            let members = match self.layers.iter().find(|l| l.kind.is_galaxies()) {
                 None => String::new(),
                 Some(layer) => format!(
                     ", and the member factors C are not measured: {}",
@@ -472,9 +475,13 @@ impl LinearSystem {
             } else {
                 "the start and the iteration count choose among the maps that fit them"
             };
+            let shear = match self.layers.iter().any(|l| !l.kind.is_galaxies()) {
+                true => ", external shear",
+                false => "",
+            };
             return vec![format!(
                 "{rows} constraint rows (two per image or arc pixel) for {unknowns} unknowns \
-                 (cell masses, member factors, source positions): the data cannot fix the mass \
+                 (cell masses, member factors{shear}, source positions): the data cannot fix the mass \
                  map on their own; {chooser}{members}. Arc pixels or ellipses, or a coarser \
                  grid, give the data more say"
             )];
@@ -482,6 +489,7 @@ impl LinearSystem {
         self.layers
             .iter()
             .zip(self.layer_independence())
+            .filter(|(layer, _)| layer.kind.is_galaxies())
             .filter_map(|(layer, share)| {
                 let share = share.filter(|&s| s < LAYER_SHARE_WARN)?;
                 Some(format!(

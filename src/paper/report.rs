@@ -100,7 +100,7 @@ impl CaseReport {
             grid_mass_msun: rec.grid_mass_msun(),
             // Filled in by the scorer, which has the grid-only map.
             grid_mass_region_msun: f64::NAN,
-            c: rec.layer_factors(),
+            c: rec.member_factors(),
             c_independence: rec.system.layer_independence().to_vec(),
             deflection_error_median_arcsec: deflection.median_arcsec,
             deflection_error_p90_arcsec: deflection.p90_arcsec,

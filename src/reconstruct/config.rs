@@ -150,6 +150,7 @@ impl ReconstructConfig {
         c.solver.method = SolverMethod::Qadp;
         c.objective = ObjectiveConfig::paper();
         c.members.c_prior_sigma_unmeasured = None;
+        c.grid.external_shear_sigma = None;
         c
     }
 

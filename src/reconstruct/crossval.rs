@@ -45,7 +45,7 @@ pub struct FoldRun {
     pub held_out: Vec<String>,
     pub status: String,
     pub iterations: usize,
-    /// `C_l` per layer of this fold's lens.
+    /// `C_l` per member layer of this fold's lens (not an external shear's).
     pub c: Vec<f64>,
     /// Its grid mass in Msun.
     pub grid_mass_msun: f64,
@@ -441,7 +441,7 @@ fn run_fold(
         held_out: group.to_vec(),
         status: r.status.name().to_string(),
         iterations: r.iterations,
-        c: r.layer_factors(),
+        c: r.member_factors(),
         grid_mass_msun: r.grid_mass_msun(),
         einstein_radius_arcsec: summary.einstein_radius_arcsec,
         einstein_radius_z_source: r.products.curves.z_source,

@@ -97,7 +97,7 @@ pub struct EnsembleMember {
     #[serde(default = "unit_factor")]
     pub member_mass_factor: f64,
     pub status: String,
-    /// `C_l` per layer.
+    /// `C_l` per member layer (not an external shear's).
     pub c: Vec<f64>,
     /// Its Einstein radius at the products' z_s (arcsec).
     pub einstein_radius_arcsec: f64,
@@ -725,7 +725,7 @@ impl EnsemblePlan {
             cells: draw.cells,
             member_mass_factor: draw.member_mass_factor,
             status: r.status.name().to_string(),
-            c: r.layer_factors(),
+            c: r.member_factors(),
             einstein_radius_arcsec: summary.einstein_radius_arcsec,
             mass_within_arcsec: summary.mass_within_arcsec,
             left_out_image_offset_median_arcsec: r.image_offset_median_arcsec(true),

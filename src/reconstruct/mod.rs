@@ -182,7 +182,12 @@ impl ConvergenceRecord {
             iteration: p.iteration,
             objective: p.objective,
             grid_mass_msun: p.x[system.cell_columns()].iter().sum::<f64>() * system.mass_unit_msun,
-            c: p.x[system.layer_columns()].to_vec(),
+            c: system
+                .layer_columns()
+                .zip(&system.layers)
+                .filter(|(_, l)| l.kind.is_galaxies())
+                .map(|(j, _)| p.x[j])
+                .collect(),
             beta_arcsec: system
                 .beta_x_columns()
                 .zip(system.beta_y_columns())
@@ -393,9 +398,19 @@ impl Reconstruction {
         }
     }
 
-    /// `C_l` per layer.
+    /// `C_l` per layer (the member layers', then an external shear's four).
     pub fn layer_factors(&self) -> Vec<f64> {
         self.solved().layer_factors()
+    }
+
+    /// `C_l` of the member layers alone: the factors "C" a user reads.
+    pub fn member_factors(&self) -> Vec<f64> {
+        self.solved().member_factors()
+    }
+
+    /// The fitted external shear, when the run has one.
+    pub fn external_shear(&self) -> Option<crate::inversion::ExternalShearFit> {
+        self.solved().external_shear()
     }
 
     /// Total mass of the grid cells in Msun.
@@ -531,7 +546,8 @@ fn with_own_priors(r: &mut Reconstruction, config: &ReconstructConfig) {
 
 /// The estimated peak memory of [`reconstruct`] with `config` on `inputs`, checked against
 /// [`MemoryLimit::here`] before any work (the `memory` module says what it counts). The
-/// member layers are counted from `members.layers` and the catalogue (an upper bound); an
+/// member layers are counted from `members.layers` and the catalogue (an upper bound), with an
+/// external shear's four; an
 /// "auto" strength's candidates, which natively run side by side, count once per core.
 pub fn check_memory(
     inputs: &Inputs<'_>,
@@ -544,6 +560,10 @@ pub fn check_memory(
         LayerSource::Members(catalog) => {
             layer_count(config.members.layers, Some(catalog.members.len()))
         }
+    } + if config.grid.external_shear_sigma.is_some() {
+        4
+    } else {
+        0
     };
     let (pixels, systems) = (constraints.pixels.len(), constraints.systems.len());
     let mut estimate = RunSize::of(config, pixels, systems, layers).memory(config);
@@ -1086,6 +1106,7 @@ fn reconstruct_limited(
             members.layers
         }
     };
+    add_external_shear(&mut layers, config, &grid);
     // The system's true sizes (the layers built, the systems kept, the weak-lensing ring's
     // cells), before it is built.
     let mut size = RunSize::of(
@@ -1413,6 +1434,18 @@ fn member_positions(inputs: &Inputs<'_>) -> Vec<DVec2> {
     match inputs.layers {
         LayerSource::Members(catalog) => catalog.members.iter().map(|m| m.position).collect(),
         LayerSource::None | LayerSource::Given(_) => Vec::new(),
+    }
+}
+
+/// Appends the four layers of an external shear about the grid's centre to `layers` when
+/// `grid.external_shear_sigma` asks for one ([`crate::inversion::external_shear_layers`]).
+pub(crate) fn add_external_shear(
+    layers: &mut Vec<Layer>,
+    config: &ReconstructConfig,
+    grid: &CellGrid,
+) {
+    if let Some(sigma) = config.grid.external_shear_sigma {
+        layers.extend(crate::inversion::external_shear_layers(grid.center, sigma));
     }
 }
 

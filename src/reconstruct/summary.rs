@@ -11,7 +11,7 @@ use super::{
     CrossvalTotals, FreeZSummary, ReconstructConfig, SourceReport, StageTimings, StrengthChoice,
     Verdict,
 };
-use crate::inversion::LinearSystem;
+use crate::inversion::{external_shear_of, ExternalShearFit, LinearSystem};
 use crate::products::Summary;
 
 /// A solved system: what the summary is made of.
@@ -38,6 +38,22 @@ impl<'a> Solved<'a> {
             .get(self.system.layer_columns())
             .map(<[f64]>::to_vec)
             .unwrap_or_default()
+    }
+
+    /// `C_l` of the member layers alone (not an external shear's): the factors "C" a user reads.
+    pub fn member_factors(&self) -> Vec<f64> {
+        let layers = &self.system.layers;
+        layers
+            .iter()
+            .zip(self.layer_factors())
+            .filter(|(l, _)| l.kind.is_galaxies())
+            .map(|(_, c)| c)
+            .collect()
+    }
+
+    /// The fitted external shear, when the run has one (`grid.external_shear_sigma`).
+    pub fn external_shear(&self) -> Option<ExternalShearFit> {
+        external_shear_of(&self.system.layers, &self.layer_factors())
     }
 
     /// Total mass of the grid cells in Msun: the sum of the cell unknowns times the mass unit.
@@ -113,9 +129,21 @@ impl<'a> Solved<'a> {
                 .iter()
                 .map(|e| format!("{} ({})", e.id, e.reason))
                 .collect(),
-            layers: s.layers.iter().map(|l| l.name.as_str()).collect(),
-            c_per_layer: self.layer_factors(),
-            c_independence: s.layer_independence().to_vec(),
+            layers: s
+                .layers
+                .iter()
+                .filter(|l| l.kind.is_galaxies())
+                .map(|l| l.name.as_str())
+                .collect(),
+            c_per_layer: self.member_factors(),
+            c_independence: s
+                .layers
+                .iter()
+                .zip(s.layer_independence())
+                .filter(|(l, _)| l.kind.is_galaxies())
+                .map(|(_, share)| *share)
+                .collect(),
+            external_shear: self.external_shear(),
             c_unmeasured: s.members_unmeasured(),
             grid_mass_msun: self.grid_mass_msun(),
             grid_cells: s.grid.cells.len(),
@@ -158,6 +186,9 @@ pub struct ReconstructSummary<'a> {
     /// above [`crate::solver::INDEPENDENCE_MAX_UNKNOWNS`] unknowns). See
     /// [`LinearSystem::measurability_warnings`].
     pub c_independence: Vec<Option<f64>>,
+    /// The tidal field of mass beyond the grid, fitted with the map
+    /// ([`crate::inversion::external_shear_layers`]); `None` without one.
+    pub external_shear: Option<ExternalShearFit>,
     /// True when the data hardly measure `C` ([`LinearSystem::members_unmeasured`]; the
     /// warnings say why).
     pub c_unmeasured: bool,

@@ -42,6 +42,10 @@ test('uploading the AS1063 catalogues reconstructs them', async () => {
     // The caption gives the member factor, which the prior holds near 1 (1.04 natively).
     const c = Number(caption.match(/member factor C = ([\d.]+)/)[1]);
     assert.ok(Math.abs(c - 1) < 0.2, caption);
+    // And the external shear fitted with the map: along the published CATS model's (gamma 0.10
+    // along 50.8 degrees; 0.21 along 54 natively).
+    const [gamma, angle] = caption.match(/external shear γ = ([\d.]+) along (-?\d+)°/).slice(1).map(Number);
+    assert.ok(gamma > 0.03 && Math.abs(angle - 50.8) < 15, caption);
     // And how well the images are reproduced: the typical one well (0.21 arcsec natively), the
     // rms pulled up by a few whose pair has merged.
     const [median, rms] = caption.match(/image offsets median ([\d.]+)″, rms ([\d.]+)″/).slice(1).map(Number);

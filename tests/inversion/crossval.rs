@@ -186,7 +186,7 @@ fn each_fold_is_a_hold_out_run_and_every_system_is_predicted_once() {
             .map(|s| &s.report)
             .collect();
         assert_eq!(got, expected, "fold {}", run.fold);
-        assert_eq!(run.c, alone.layer_factors());
+        assert_eq!(run.c, alone.member_factors());
         assert_eq!(
             run.einstein_radius_arcsec,
             alone.products.summary().einstein_radius_arcsec

@@ -10,6 +10,9 @@ mod fixtures;
 mod cells;
 mod constraints;
 mod crossval;
+// Reads tests/data from disk.
+#[cfg(not(target_arch = "wasm32"))]
+mod external_shear;
 mod members;
 mod objective;
 mod reconstruct;

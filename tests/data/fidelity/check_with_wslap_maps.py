@@ -47,6 +47,10 @@ def model_from_truth(t):
     for c in t["clumps"]:
         comps.append(dict(type="nfw", x=c["x"], y=c["y"], m200=c["m200"], c200=c["c"]))
     for name, kw, role in zip(t["lens_model_list"], t["kwargs_lens"], t["component_roles"]):
+        if role == "external shear":
+            assert name == "SHEAR"
+            comps.append(dict(type="shear", gamma1=kw["gamma1"], gamma2=kw["gamma2"]))
+            continue
         if role != "member":
             continue
         assert name == "TNFW"

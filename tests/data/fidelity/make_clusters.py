@@ -16,7 +16,7 @@ Conventions (those of wslap, see tests/data/fidelity/README.md):
   one frame, and they do.
 - lens kwargs are written for D_ls/D_s = 1 (the HFF convention of wslap's maps): a source at
   z_s sees every deflection times f = D_ls/D_s(z_l, z_s); all profiles used here are linear in
-  alpha_Rs, so `scaled_kwargs(kwargs, f)` multiplies alpha_Rs by f.
+  alpha_Rs, so `scaled_kwargs(kwargs, f)` multiplies alpha_Rs (and an external shear's gamma1, gamma2) by f.
 - member galaxies follow wslap's member prior (src/inversion/members.rs): M = Upsilon L with
   Upsilon = 20, L* = 5e10 Lsun (M* = 1e12 Msun), truncated NFW (Baltz, Marshall & Oguri 2009,
   = lenstronomy 'TNFW') of TOTAL mass M with r_s = 10 kpc (M/1e12)^(1/3),
@@ -131,11 +131,14 @@ def tnfw_kwargs(plane, mass, x, y):
 
 
 def scaled_kwargs(kwargs, f):
-    """The kwargs for a source at D_ls/D_s = f (every profile here is linear in alpha_Rs)."""
+    """The kwargs for a source at D_ls/D_s = f (every profile here is linear in alpha_Rs, the
+    external shear in gamma1 and gamma2)."""
     out = []
     for kw in kwargs:
         kw = dict(kw)
-        kw["alpha_Rs"] *= f
+        for key in ("alpha_Rs", "gamma1", "gamma2"):
+            if key in kw:
+                kw[key] *= f
         out.append(kw)
     return out
 
@@ -253,6 +256,13 @@ CLUSTERS = [
          n_members=70, member_rc=22.0,
          what="(j) a distant lens (z_l = 0.55): elliptical NFW halo with a BCG, a dark clump "
               "39 arcsec SW, 70 members"),
+    # The tidal field of mass beyond the field (added with wslap's external shear, 2026-12-06):
+    # a Lenstool fit of AS1063 finds gamma 0.10, so a cluster's own field is not always alone.
+    dict(name="k_external_shear", seed=1111, z_l=0.36, ra0=44.7370, dec0=-8.5560, n_sys=25,
+         halos=[dict(m200=1.3e15, c=6.0, x=0.0, y=0.0, q=0.85, phi=10.0, bcg_l=8.0)],
+         clumps=[], n_members=70, member_rc=30.0, shear=dict(gamma=0.08, angle_deg=60.0),
+         what="(k) a rounder NFW halo (q = 0.85) with a BCG, 70 members, and an external "
+              "shear of 0.08 along 60 degrees (lenstronomy SHEAR) from mass beyond the field"),
 ]
 
 
@@ -308,6 +318,13 @@ def build_lens(plane, spec, rng):
         models.append("TNFW")
         kwargs.append(tnfw_kwargs(plane, m_true, x, y))
         roles.append("member")
+    if "shear" in spec:
+        two = np.deg2rad(2 * spec["shear"]["angle_deg"])
+        g = spec["shear"]["gamma"]
+        models.append("SHEAR")
+        kwargs.append({"gamma1": g * np.cos(two), "gamma2": g * np.sin(two), "ra_0": 0.0,
+                       "dec_0": 0.0})
+        roles.append("external shear")
     return models, kwargs, roles, members
 
 
@@ -563,7 +580,7 @@ def make_cluster(spec, out_root, log):
                        astropy=astropy.__version__, script="tests/data/fidelity/make_clusters.py",
                        seed=spec["seed"]),
         note=("Lens kwargs are for D_ls/D_s = 1 (HFF convention): for a source at z_s multiply "
-              "every alpha_Rs by D_ls/D_s. Positions are arcsec in wslap's frame of "
+              "every alpha_Rs (and an external SHEAR's gamma1, gamma2) by D_ls/D_s. Positions are arcsec in wslap's frame of "
               "'#REFERENCE 3 ra0 dec0' (+x West, +y North); lenstronomy x, y are these x, y. "
               "Observed image positions = true positions + Gaussian noise of "
               f"{ASTROMETRIC_NOISE} arcsec per coordinate. Images with |mu| < {MU_MIN} or "
@@ -580,6 +597,7 @@ def make_cluster(spec, out_root, log):
         kwargs_lens=[{k: float(v) for k, v in kw.items()} for kw in kwargs],
         component_roles=roles,
         halos=spec["halos"], clumps=spec["clumps"],
+        external_shear=spec.get("shear"),
         einstein_radius_z2_arcsec=theta_e,
         tangential_curves_z2=n_tang,
         einstein_radius_definition=(
