@@ -276,19 +276,22 @@
 //! **External shear.** Mass beyond the grid (a neighbouring group, the cluster's own mass
 //! outside the field) puts a nearly uniform tidal field on it, which no positive mass inside
 //! can make: the cells bend into a lopsided map to mimic it, and the Einstein radius grows.
-//! By default (**setting** `grid.external_shear_sigma`, 0.1; `null` for none, as in the paper
-//! and `wslap paper`) the map has an external shear of its own, Lenstool's profile 14 with
-//! sky-frame components `gamma1`, `gamma2` at `D_ls/D_s = 1` about the field's centre, each
-//! with the Gaussian prior `0 +- 0.1`: `alpha = (gamma1 dx + gamma2 dy, gamma2 dx - gamma1 dy)`,
+//! With the **setting** `grid.external_shear_sigma` (say 0.1; default `null`, none, as in the
+//! paper and `wslap paper`) the map has an external shear of its own, Lenstool's profile 14
+//! with sky-frame components `gamma1`, `gamma2` at `D_ls/D_s = 1` about the field's centre,
+//! each with the Gaussian prior `0 +- sigma`: `alpha = (gamma1 dx + gamma2 dy, gamma2 dx - gamma1 dy)`,
 //! scaled by `f(z_s)` as every deflection. The non-negative solver takes each signed component
 //! as the difference of two layers of unit shear 0.1 (`+gamma1`, `-gamma1`, `+gamma2`,
 //! `-gamma2`; [`crate::external_shear_layers`]), each with the prior `C = 1 +- s`,
-//! `s = 0.1 / (0.1 sqrt 2)`, so that a pair's difference has the prior `0 +- 0.1` and its sum,
-//! which moves nothing, is held. It has no mass; it is in the deflection, shear and
+//! `s = sigma / (0.1 sqrt 2)`, so that a pair's difference has the prior `0 +- sigma` and its
+//! sum, which moves nothing, is held. It has no mass; it is in the deflection, shear and
 //! magnification maps and the critical curves (a Lenstool model's Einstein radius counts its
 //! shear too), and `summary.json` gives it as `external_shear` (`gamma`, `angle_deg` as
 //! Lenstool's `gamma`, `angle_pos`). Measured in BENCHMARKS.md ("The tidal field of mass
-//! beyond the grid").
+//! beyond the grid"): it brings AS1063's and A2744's Einstein radii to their published models'
+//! and finds the published axis of AS1063's shear, but it is off by default, since on MACS
+//! J1149 a least-mass regulariser traded most of the map's mass for a shear of 0.8 (a prior
+//! of 0.1 or 0.03 does not hold it: the regulariser costs cells, not the shear).
 //!
 //! **The brightest cluster galaxy.** Lenstool set-ups often model the BCG as its own
 //! `potentiel` in the `.par` and leave it out of the potfile catalogue. A grid of cells several

@@ -33,9 +33,11 @@ test('uploading the AS1063 catalogues reconstructs them', async () => {
     // (tests/inversion/reconstruct.rs measures the same run natively). Default iterations (8000).
     await setField(page, '#set-reconstruct-members-c_prior_sigma', 0.1);
     await setField(page, '#set-reconstruct-products-size_arcsec', '');
+    // The external shear, a setting (off by default).
+    await setField(page, '#set-reconstruct-grid-external_shear_sigma', 0.1);
     await runToMap(page, '#reconstruct', 120_000);
     // The published CATS model's Einstein radius at z_s = 2 is 29.8 arcsec (tests/inversion/reconstruct.rs
-    // evaluates it); the issue asks for 25%.
+    // evaluates it); the issue asks for 25% (29.7 natively with the external shear).
     const caption = await page.textContent('#summary');
     const thetaE = Number(caption.match(/Einstein radius (?:≥ )?([\d.]+)/)[1]);
     assert.ok(Math.abs(thetaE - 29.8) <= 0.25 * 29.8, caption);

@@ -48,6 +48,8 @@ fn run(sigma: Option<f64>) -> wslap::Reconstruction {
 
 #[test]
 fn the_fitted_external_shear_is_lenstronomys() {
+    // A setting, off by default (BENCHMARKS.md: MACS J1149).
+    assert_eq!(ReconstructConfig::default().grid.external_shear_sigma, None);
     let (_, (g1, g2)) = truth();
     let r = run(Some(0.1));
     let fit = r.external_shear().unwrap();
