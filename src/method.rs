@@ -276,8 +276,8 @@
 //! **External shear.** Mass beyond the grid (a neighbouring group, the cluster's own mass
 //! outside the field) puts a nearly uniform tidal field on it, which no positive mass inside
 //! can make: the cells bend into a lopsided map to mimic it, and the Einstein radius grows.
-//! With the **setting** `grid.external_shear_sigma` (say 0.1; default `null`, none, as in the
-//! paper and `wslap paper`) the map has an external shear of its own, Lenstool's profile 14
+//! By default (`grid.external_shear_sigma` = 0.1; `null`: none, as in the paper and `wslap
+//! paper`) the map has an external shear of its own, Lenstool's profile 14
 //! with sky-frame components `gamma1`, `gamma2` at `D_ls/D_s = 1` about the field's centre,
 //! each with the Gaussian prior `0 +- sigma`: `alpha = (gamma1 dx + gamma2 dy, gamma2 dx - gamma1 dy)`,
 //! scaled by `f(z_s)` as every deflection. The non-negative solver takes each signed component
@@ -287,11 +287,18 @@
 //! sum, which moves nothing, is held. It has no mass; it is in the deflection, shear and
 //! magnification maps and the critical curves (a Lenstool model's Einstein radius counts its
 //! shear too), and `summary.json` gives it as `external_shear` (`gamma`, `angle_deg` as
-//! Lenstool's `gamma`, `angle_pos`). Measured in BENCHMARKS.md ("The tidal field of mass
-//! beyond the grid"): it brings AS1063's and A2744's Einstein radii to their published models'
-//! and finds the published axis of AS1063's shear, but it is off by default, since on MACS
-//! J1149 a least-mass regulariser traded most of the map's mass for a shear of 0.8 (a prior
-//! of 0.1 or 0.03 does not hold it: the regulariser costs cells, not the shear).
+//! Lenstool's `gamma`, `angle_pos`). **Not with the least-mass regulariser**
+//! ([`crate::ReconstructConfig::external_shear_fitted`]): `integral Sigma^2` charges the grid
+//! for every unit of mass and the shear for nothing beyond its prior, so together they trade
+//! the map's mass for a shear (on MACS J1149 a shear of 0.8, eight times its prior, and an
+//! Einstein radius 12% too large). Gradient and curvature do not charge for mass itself. So
+//! "auto" leaves the least-mass regulariser out of its candidates when a shear is asked for
+//! ([`crate::reconstruct::strength_candidates`]; tried without the shear beside the others
+//! with it, it was chosen on MACS J1149 with the member factor at 2). What that costs: on the
+//! simulated cluster of `wslap paper` its own point catalogue, where only the least mass held
+//! the mass-sheet-like direction (§9), gives a deflection error of 7.5″
+//! instead of 2.7″. Measured in BENCHMARKS.md ("The tidal field of mass beyond the grid" and
+//! "The external shear by default").
 //!
 //! **The brightest cluster galaxy.** Lenstool set-ups often model the BCG as its own
 //! `potentiel` in the `.par` and leave it out of the potfile catalogue. A grid of cells several
@@ -584,7 +591,8 @@
 //! images; it is fixed at the first solve. With `objective.strength = "auto"` (default) every
 //! candidate is cross-validated: each regulariser of `objective.auto_regularisers` (default
 //! gradient, curvature and density: the first two cost nothing for a uniform sheet of mass,
-//! which images at similar redshifts hardly measure; density, the least mass, does) at each
+//! which images at similar redshifts hardly measure; density, the least mass, does, but it is
+//! not tried beside the default external shear, §4) at each
 //! strength of `objective.candidates` (default 0.01, 0.1, 1),
 //! on each grid of `objective.auto_grid_scales` (default a half, three quarters and all of
 //! `grid.cells` a side: 16, 24 and 32 cells, the same field; a coarser grid is a stronger

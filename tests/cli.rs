@@ -1949,3 +1949,50 @@ fn out_naming_a_file_is_refused_first() {
     );
     assert_eq!(fs::read_to_string(&file).unwrap(), "keep me");
 }
+
+/// The run's line names the external shear it fitted (on by default), or says that the
+/// least-mass regulariser fitted none, as summary.json does.
+#[test]
+fn reconstruct_says_which_external_shear_it_fitted() {
+    let dir = temp_dir("external-shear");
+    let images = teaching_images(&dir);
+    for (regulariser, said) in [
+        ("gradient", "; external shear "),
+        (
+            "density",
+            "; no external shear (the least-mass regulariser fits none)",
+        ),
+    ] {
+        let config = dir.join(format!("{regulariser}.json"));
+        let text = format!(
+            r#"{{"grid": {{"cells": 16}}, "objective": {{"strength": 0.1, "regulariser": "{regulariser}"}}, "products": {{"pixels": 64}}}}"#
+        );
+        fs::write(&config, text).unwrap();
+        let out_dir = dir.join(regulariser);
+        let out = wslap(&[
+            "reconstruct",
+            "--images",
+            images.to_str().unwrap(),
+            "--z-lens",
+            "0.3",
+            "--config",
+            config.to_str().unwrap(),
+            "--out",
+            out_dir.to_str().unwrap(),
+        ]);
+        let printed = format!(
+            "{}{}",
+            String::from_utf8_lossy(&out.stdout),
+            String::from_utf8_lossy(&out.stderr)
+        );
+        assert!(out.status.success(), "{printed}");
+        assert!(printed.contains(said), "{regulariser}: {printed}");
+        let s = summary(&out_dir);
+        assert_eq!(
+            s["external_shear"].is_null(),
+            regulariser == "density",
+            "{s}"
+        );
+        assert_eq!(s["settings"]["grid"]["external_shear_sigma"], 0.1);
+    }
+}

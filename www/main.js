@@ -237,7 +237,10 @@ function caption(info) {
   const factors = c.length ? `member factor C = ${c.map((v) => v.toFixed(2)).join(', ')}${unmeasured}; ` : '';
   // The tidal field of mass beyond the grid, fitted with the map (Lenstool's gamma, angle_pos).
   const xs = info.summary.external_shear;
-  const external = xs ? `external shear γ = ${xs.gamma.toFixed(3)} along ${xs.angle_deg.toFixed(0)}°; ` : '';
+  // Asked for but not fitted: the least-mass regulariser fits none (it would trade mass for it).
+  const asked = info.summary.settings?.grid?.external_shear_sigma != null;
+  const external = xs ? `external shear γ = ${xs.gamma.toFixed(3)} along ${xs.angle_deg.toFixed(0)}°; `
+    : asked ? 'no external shear (the least-mass regulariser fits none); ' : '';
   // Observed images against the predicted ones: the median (the typical image) and the rms
   // (which one image whose pair has merged can dominate); then the same for the held-out
   // systems: how well the model predicts images it was not given.
@@ -300,7 +303,8 @@ async function showResult(info) {
   caption(info);
   runNotes(info.summary);
   showStrengthChoice(info.summary?.strength_choice,
-    (info.summary?.free_redshifts?.systems ?? []).map(([id]) => id));
+    (info.summary?.free_redshifts?.systems ?? []).map(([id]) => id),
+    info.summary?.settings?.grid?.external_shear_sigma != null);
   showDownloads(info.kind, app);
   showIterates(info.kind === 'reconstruct' ? (await ask('iterates')).iterates : null);
   showEnsemble(info.summary?.ensemble_members ? await ask('ensembleInfo') : null, app);

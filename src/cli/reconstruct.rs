@@ -533,12 +533,17 @@ fn one_line(r: &Reconstruction, out: &Path) -> String {
         .strength_choice
         .as_ref()
         .map_or(String::new(), |c| format!("; regulariser {}", c.describe()));
-    let shear = r.external_shear().map_or(String::new(), |g| {
-        format!(
+    let shear = match r.external_shear() {
+        Some(g) => format!(
             "; external shear {:.3} along {:.0} deg",
             g.gamma, g.angle_deg
-        )
-    });
+        ),
+        // Asked for, but the least-mass regulariser fits none.
+        None if r.config.grid.external_shear_sigma.is_some() => {
+            "; no external shear (the least-mass regulariser fits none)".to_string()
+        }
+        None => String::new(),
+    };
     format!(
         "wrote {} ({} systems, {} constraint pixels, {} iterations{}{shear}; grid mass {:.3e} Msun; Einstein radius at z_s = {}: {}; image offsets: rms {}, median {}{choice})",
         out.display(),

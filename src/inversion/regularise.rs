@@ -153,8 +153,9 @@ pub struct ObjectiveConfig {
     /// curvature and density: gradient and curvature each predicted better on some of the
     /// synthetic clusters of tests/data/fidelity; neither costs a uniform sheet of mass, so
     /// where the images leave the mass-sheet-like direction open only density, the least
-    /// mass, holds it, as on the simulated cluster of `wslap paper` (BENCHMARKS.md)). With a
-    /// number for the strength, `regulariser` alone is used.
+    /// mass, holds it, as on the simulated cluster of `wslap paper` (BENCHMARKS.md); density
+    /// is not tried beside an external shear, [`crate::reconstruct::strength_candidates`]).
+    /// With a number for the strength, `regulariser` alone is used.
     pub auto_regularisers: Vec<Regulariser>,
     /// The grids "auto" tries, each with every regulariser and strength, as fractions of
     /// `grid.cells` a side: a grid of `round(scale * grid.cells)` cells a side (at least 1)

@@ -143,6 +143,20 @@ impl ReconstructConfig {
         Ok(config)
     }
 
+    /// The prior width of the external shear this run fits: `grid.external_shear_sigma`, but
+    /// none with the least-mass regulariser ([`Regulariser::Density`]). That one charges the
+    /// grid for every unit of mass and the shear for nothing beyond its prior, so together
+    /// they trade the map's mass for a shear (MACS J1149: a shear of 0.79 and an Einstein
+    /// radius 12% too large, BENCHMARKS.md); the smoothness regularisers do not charge for
+    /// mass itself. An "auto" strength does not try it beside a shear
+    /// ([`super::strength_candidates`]).
+    pub fn external_shear_fitted(&self) -> Option<f64> {
+        match self.objective.regulariser {
+            Regulariser::Density => None,
+            _ => self.grid.external_shear_sigma,
+        }
+    }
+
     /// The paper's method: QADP stopped after `solver.iterations` on the source-plane chi^2,
     /// with no regulariser and every member factor free (what `wslap paper` reproduces).
     pub fn paper() -> Self {

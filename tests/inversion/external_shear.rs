@@ -3,7 +3,7 @@
 //! 60 degrees; its `truth.json` and `make_clusters.py` beside it).
 
 use wslap::{parse_image_catalog, parse_member_catalog, reconstruct, ConstraintSource};
-use wslap::{Cosmology, Inputs, LayerSource, LensPlane, ReconstructConfig, Strength};
+use wslap::{Cosmology, Inputs, LayerSource, LensPlane, ReconstructConfig, Regulariser, Strength};
 
 fn quiet(_: &wslap::ConvergenceRecord) -> wslap::Control {
     wslap::Control::Continue
@@ -22,9 +22,9 @@ fn truth() -> (f64, (f64, f64)) {
     (t["z_lens"].as_f64().unwrap(), (g("gamma1"), g("gamma2")))
 }
 
-/// A small run of the cluster (16 x 16 cells, a fixed strength, 64-pixel maps) with `sigma`
-/// as `grid.external_shear_sigma`.
-fn run(sigma: Option<f64>) -> wslap::Reconstruction {
+/// A small run of the cluster (16 x 16 cells, `regulariser` at a fixed strength, 64-pixel
+/// maps) with `sigma` as `grid.external_shear_sigma`.
+fn run_with(sigma: Option<f64>, regulariser: Regulariser) -> wslap::Reconstruction {
     let read = |f: &str| std::fs::read_to_string(format!("{DIR}/{f}")).unwrap();
     let (catalog, _) = parse_image_catalog(&read("images.cat"), "images.cat", None).unwrap();
     let (members, _) =
@@ -40,16 +40,25 @@ fn run(sigma: Option<f64>) -> wslap::Reconstruction {
     };
     let mut config = ReconstructConfig::default();
     config.objective.strength = Strength::Value(0.1);
+    config.objective.regulariser = regulariser;
     config.grid.cells = 16;
     config.grid.external_shear_sigma = sigma;
     config.products.pixels = 64;
     reconstruct(&inputs, &config, &mut quiet).unwrap()
 }
 
+/// [`run_with`] the default regulariser (gradient).
+fn run(sigma: Option<f64>) -> wslap::Reconstruction {
+    run_with(sigma, Regulariser::Gradient)
+}
+
 #[test]
 fn the_fitted_external_shear_is_lenstronomys() {
-    // A setting, off by default (BENCHMARKS.md: MACS J1149).
-    assert_eq!(ReconstructConfig::default().grid.external_shear_sigma, None);
+    // On by default, with the prior width run here.
+    assert_eq!(
+        ReconstructConfig::default().grid.external_shear_sigma,
+        Some(0.1)
+    );
     let (_, (g1, g2)) = truth();
     let r = run(Some(0.1));
     let fit = r.external_shear().unwrap();
@@ -86,4 +95,21 @@ fn the_fitted_external_shear_is_lenstronomys() {
         with < without,
         "fitted images' median: {with} with the shear, {without} without"
     );
+}
+
+/// The least-mass regulariser fits no shear, whatever the setting: it would trade the map's
+/// mass for one (BENCHMARKS.md, MACS J1149). Its run has the members' layer alone.
+#[test]
+fn the_least_mass_regulariser_fits_no_external_shear() {
+    let mut config = ReconstructConfig::default();
+    assert_eq!(config.external_shear_fitted(), Some(0.1));
+    config.objective.regulariser = Regulariser::Density;
+    assert_eq!(config.external_shear_fitted(), None);
+    config.objective.regulariser = Regulariser::Curvature;
+    assert_eq!(config.external_shear_fitted(), Some(0.1));
+    let r = run_with(Some(0.1), Regulariser::Density);
+    assert!(r.external_shear().is_none());
+    assert_eq!(r.layer_factors().len(), 1);
+    let summary: serde_json::Value = serde_json::to_value(r.summary()).unwrap();
+    assert!(summary["external_shear"].is_null());
 }

@@ -10,7 +10,7 @@ export const FIELDS = [
   { path: 'reconstruct.grid.cell_sigma_factor', label: 'Cell width (Gaussian σ / cell size)', type: 'number', step: 0.05 },
   { path: 'reconstruct.grid.width_arcsec', label: 'Field width [arcsec] (empty: automatic)', type: 'optional' },
   { path: 'reconstruct.grid.external_shear_sigma', label: 'External shear: prior width on γ1, γ2 (empty: none)', type: 'optional',
-    hint: 'e.g. 0.1: the map gets the tidal field of mass beyond the grid (Lenstool\'s profile 14), fitted with it and given in the caption; off by default, since with a least-mass regulariser the fit can trade the map\'s mass for a large shear' },
+    hint: 'the map gets the tidal field of mass beyond the grid (Lenstool\'s profile 14), fitted with it and given in the caption (default 0.1, the scale of published clusters\' shears; empty: no shear, as in the paper)' },
   { path: 'reconstruct.grid.refinements', label: 'Grid refinements (0 to 4)', type: 'int',
     hint: 'multi-resolution grid: after each solution the quarter of the cells with the most mass are split in four and the fit runs again' },
   { path: 'reconstruct.members.mass_to_light', label: 'Members M/L [Msun/Lsun]', type: 'number', step: 1 },
