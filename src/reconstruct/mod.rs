@@ -547,7 +547,7 @@ fn with_own_priors(r: &mut Reconstruction, config: &ReconstructConfig) {
 /// The estimated peak memory of [`reconstruct`] with `config` on `inputs`, checked against
 /// [`MemoryLimit::here`] before any work (the `memory` module says what it counts). The
 /// member layers are counted from `members.layers` and the catalogue (an upper bound), with an
-/// external shear's four; an
+/// external shear's four when one may be fitted; an
 /// "auto" strength's candidates, which natively run side by side, count once per core.
 pub fn check_memory(
     inputs: &Inputs<'_>,
@@ -560,11 +560,7 @@ pub fn check_memory(
         LayerSource::Members(catalog) => {
             layer_count(config.members.layers, Some(catalog.members.len()))
         }
-    } + if config.grid.external_shear_sigma.is_some() {
-        4
-    } else {
-        0
-    };
+    } + if fits_external_shear(config) { 4 } else { 0 };
     let (pixels, systems) = (constraints.pixels.len(), constraints.systems.len());
     let mut estimate = RunSize::of(config, pixels, systems, layers).memory(config);
     if config.objective.strength.value().is_none() {
@@ -579,6 +575,18 @@ pub fn check_memory(
     }
     estimate.check(MemoryLimit::here())?;
     Ok(estimate)
+}
+
+/// Whether a run with `config` may fit an external shear: the fixed regulariser's rule
+/// ([`ReconstructConfig::external_shear_fitted`]), or for an "auto" strength that of any
+/// candidate (an upper bound for [`check_memory`]).
+fn fits_external_shear(config: &ReconstructConfig) -> bool {
+    match config.objective.strength.value() {
+        Some(_) => config.external_shear_fitted().is_some(),
+        None => strength_candidates(config)
+            .iter()
+            .any(|c| c.apply(config).external_shear_fitted().is_some()),
+    }
 }
 
 /// How many of `runs` independent reconstructions of `inputs` with `config` (ensemble
@@ -1925,6 +1933,23 @@ mod tests {
         let default = ReconstructConfig::default();
         assert!(default.objective.auto_regularisers.contains(&d));
         assert!(!regularisers(&default).contains(&d));
+    }
+
+    /// The memory estimate counts the shear's layers only when the run may fit one: not for
+    /// the least-mass regulariser, fixed or the only candidate.
+    #[test]
+    fn the_memory_estimate_counts_a_shear_only_where_one_is_fitted() {
+        let mut config = ReconstructConfig::default();
+        assert!(fits_external_shear(&config));
+        config.objective.auto_regularisers = vec![Regulariser::Density];
+        assert!(!fits_external_shear(&config));
+        config.objective.strength = Strength::Value(0.1);
+        config.objective.regulariser = Regulariser::Density;
+        assert!(!fits_external_shear(&config));
+        config.objective.regulariser = Regulariser::Curvature;
+        assert!(fits_external_shear(&config));
+        config.grid.external_shear_sigma = None;
+        assert!(!fits_external_shear(&config));
     }
 
     /// The choice in words, as the CLI prints it.
