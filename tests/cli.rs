@@ -1994,5 +1994,10 @@ fn reconstruct_says_which_external_shear_it_fitted() {
             "{s}"
         );
         assert_eq!(s["settings"]["grid"]["external_shear_sigma"], 0.1);
+        // The reason the line gives is summary.json's, which the app's caption shows.
+        match s["external_shear_left_out"].as_str() {
+            Some(why) => assert!(said.contains(why), "{s}"),
+            None => assert_eq!(regulariser, "gradient", "{s}"),
+        }
     }
 }

@@ -237,10 +237,10 @@ function caption(info) {
   const factors = c.length ? `member factor C = ${c.map((v) => v.toFixed(2)).join(', ')}${unmeasured}; ` : '';
   // The tidal field of mass beyond the grid, fitted with the map (Lenstool's gamma, angle_pos).
   const xs = info.summary.external_shear;
-  // Asked for but not fitted: the least-mass regulariser fits none (it would trade mass for it).
-  const asked = info.summary.settings?.grid?.external_shear_sigma != null;
+  // Asked for but not fitted: the core says why (the least-mass regulariser fits none).
+  const leftOut = info.summary.external_shear_left_out;
   const external = xs ? `external shear γ = ${xs.gamma.toFixed(3)} along ${xs.angle_deg.toFixed(0)}°; `
-    : asked ? 'no external shear (the least-mass regulariser fits none); ' : '';
+    : leftOut ? `no external shear (${leftOut}); ` : '';
   // Observed images against the predicted ones: the median (the typical image) and the rms
   // (which one image whose pair has merged can dominate); then the same for the held-out
   // systems: how well the model predicts images it was not given.

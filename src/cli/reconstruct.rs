@@ -538,11 +538,9 @@ fn one_line(r: &Reconstruction, out: &Path) -> String {
             "; external shear {:.3} along {:.0} deg",
             g.gamma, g.angle_deg
         ),
-        // Asked for, but the least-mass regulariser fits none.
-        None if r.config.grid.external_shear_sigma.is_some() => {
-            "; no external shear (the least-mass regulariser fits none)".to_string()
-        }
-        None => String::new(),
+        None => r
+            .external_shear_left_out()
+            .map_or(String::new(), |why| format!("; no external shear ({why})")),
     };
     format!(
         "wrote {} ({} systems, {} constraint pixels, {} iterations{}{shear}; grid mass {:.3e} Msun; Einstein radius at z_s = {}: {}; image offsets: rms {}, median {}{choice})",

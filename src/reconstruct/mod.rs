@@ -413,6 +413,12 @@ impl Reconstruction {
         self.solved().external_shear()
     }
 
+    /// Why no external shear was fitted where the settings ask for one; `None` when one was
+    /// fitted or none was asked for (`summary.json`'s `external_shear_left_out`).
+    pub fn external_shear_left_out(&self) -> Option<&'static str> {
+        self.solved().external_shear_left_out()
+    }
+
     /// Total mass of the grid cells in Msun.
     pub fn grid_mass_msun(&self) -> f64 {
         self.solved().grid_mass_msun()

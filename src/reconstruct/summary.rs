@@ -56,6 +56,15 @@ impl<'a> Solved<'a> {
         external_shear_of(&self.system.layers, &self.layer_factors())
     }
 
+    /// Why no external shear was fitted where the settings ask for one
+    /// (`grid.external_shear_sigma`), in words for the run's line and the app's caption;
+    /// `None` when one was fitted or none was asked for. The one reason today: the chosen
+    /// regulariser is least mass ([`ReconstructConfig::external_shear_fitted`]).
+    pub fn external_shear_left_out(&self) -> Option<&'static str> {
+        let asked = self.config.grid.external_shear_sigma.is_some();
+        (asked && self.external_shear().is_none()).then_some("the least-mass regulariser fits none")
+    }
+
     /// Total mass of the grid cells in Msun: the sum of the cell unknowns times the mass unit.
     pub fn grid_mass_msun(&self) -> f64 {
         let cells = self.x.get(self.system.cell_columns()).unwrap_or(&[]);
@@ -144,6 +153,7 @@ impl<'a> Solved<'a> {
                 .map(|(_, share)| *share)
                 .collect(),
             external_shear: self.external_shear(),
+            external_shear_left_out: self.external_shear_left_out(),
             c_unmeasured: s.members_unmeasured(),
             grid_mass_msun: self.grid_mass_msun(),
             grid_cells: s.grid.cells.len(),
@@ -189,6 +199,9 @@ pub struct ReconstructSummary<'a> {
     /// The tidal field of mass beyond the grid, fitted with the map
     /// ([`crate::inversion::external_shear_layers`]); `None` without one.
     pub external_shear: Option<ExternalShearFit>,
+    /// Why no external shear was fitted although the settings ask for one
+    /// ([`super::Reconstruction::external_shear_left_out`]); `None` otherwise.
+    pub external_shear_left_out: Option<&'static str>,
     /// True when the data hardly measure `C` ([`LinearSystem::members_unmeasured`]; the
     /// warnings say why).
     pub c_unmeasured: bool,

@@ -135,6 +135,11 @@ test('Cancel during the candidates stops every worker and a later Reconstruct wo
     assert.match(await page.textContent('#summary'), /Einstein radius/);
     // A fixed strength has no curve to show.
     assert.equal(await page.isHidden('#strength-box'), true);
+    assert.match(await page.textContent('#summary'), /external shear γ = /);
+    // The least-mass regulariser fits no shear, and the caption says why (summary.json's words).
+    await setField(page, '#set-reconstruct-objective-regulariser', 'density');
+    await runToMap(page, '#reconstruct', 120_000);
+    assert.match(await page.textContent('#summary'), /no external shear \(the least-mass regulariser fits none\)/);
     assert.deepEqual(app.consoleErrors, []);
   } finally {
     await app.close();
