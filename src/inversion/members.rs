@@ -393,6 +393,20 @@ impl LayerKind {
     }
 }
 
+/// Pairs each member layer of `layers` (galaxies, not an external shear's) with its value
+/// in `per_layer` (one value per layer, in order): the one filter behind every "C" a user
+/// reads (the summary's factors and their measurability, the convergence record, the
+/// warnings).
+pub fn member_layers_with<T>(
+    layers: &[Layer],
+    per_layer: impl IntoIterator<Item = T>,
+) -> impl Iterator<Item = (&Layer, T)> {
+    layers
+        .iter()
+        .zip(per_layer)
+        .filter(|(layer, _)| layer.kind.is_galaxies())
+}
+
 impl Layer {
     /// A layer made directly from mass components (e.g. the true galaxies of a test).
     pub fn from_components(name: &str, components: Vec<Box<dyn MassComponent>>) -> Self {
@@ -838,6 +852,25 @@ pub struct MissingBcg {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// Only the galaxies' layers keep their values, in order; an external shear's do not.
+    #[test]
+    fn member_layers_with_skips_the_shear_layers() {
+        let mut shear = Layer::from_components("shear", Vec::new());
+        shear.kind = LayerKind::ExternalShear {
+            component: 1,
+            negative: false,
+        };
+        let layers = [
+            Layer::from_components("members", Vec::new()),
+            shear,
+            Layer::from_components("bcg", Vec::new()),
+        ];
+        let kept: Vec<(&str, f64)> = member_layers_with(&layers, [1.0, 2.0, 3.0])
+            .map(|(l, c)| (l.name.as_str(), c))
+            .collect();
+        assert_eq!(kept, [("members", 1.0), ("bcg", 3.0)]);
+    }
 
     /// A member of `luminosity_lstar` with `L*` at mag 20.
     fn halo(id: &str, x: f64, y: f64, luminosity_lstar: f64) -> Member {

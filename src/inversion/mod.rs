@@ -32,8 +32,8 @@ pub(crate) use members::BCG_MIN_LSTAR;
 pub(crate) use members::MAX_MAG_FROM_L_STAR;
 pub(crate) use members::MAX_MASS_TO_LIGHT;
 pub use members::{
-    build_member_layers, missing_bcg_warning, HaloProfile, Layer, LayerKind, LayerSplit,
-    MemberConfig, MemberHalo, MemberModel, MembersError, MAX_SINGLE_LAYERS,
+    build_member_layers, member_layers_with, missing_bcg_warning, HaloProfile, Layer, LayerKind,
+    LayerSplit, MemberConfig, MemberHalo, MemberModel, MembersError, MAX_SINGLE_LAYERS,
 };
 pub use npy::{export_system, npy_header, write_f64s, write_npy, NpyError};
 pub use regularise::{

@@ -41,7 +41,7 @@ use thiserror::Error;
 
 use super::cells::{CellGrid, GridError, GridMass};
 use super::constraints::ConstraintSet;
-use super::members::Layer;
+use super::members::{member_layers_with, Layer};
 use super::regularise::{cell_penalty, Regulariser};
 use super::shear::{kappa_gamma, ShearSet};
 use crate::cosmology::{CosmologyError, LensPlane};
@@ -423,10 +423,7 @@ impl LinearSystem {
         let Some(factors) = x.get(self.layer_columns()) else {
             return Vec::new();
         };
-        self.layers
-            .iter()
-            .zip(factors)
-            .filter(|(layer, _)| layer.kind.is_galaxies())
+        member_layers_with(&self.layers, factors)
             .filter_map(|(layer, &c)| {
                 let sigma = layer.prior_sigma?;
                 let pull = (c - 1.0) / sigma;
@@ -486,10 +483,7 @@ impl LinearSystem {
                  grid, give the data more say"
             )];
         }
-        self.layers
-            .iter()
-            .zip(self.layer_independence())
-            .filter(|(layer, _)| layer.kind.is_galaxies())
+        member_layers_with(&self.layers, self.layer_independence())
             .filter_map(|(layer, share)| {
                 let share = share.filter(|&s| s < LAYER_SHARE_WARN)?;
                 Some(format!(

@@ -57,9 +57,10 @@ use crate::catalog::{ArcletCatalog, ImageCatalog, Member, MemberCatalog};
 use crate::cosmology::LensPlane;
 use crate::image_search::ImageError;
 use crate::inversion::{
-    build_constraints, build_member_layers, capped_inverse_jacobian, missing_bcg_warning, CellGrid,
-    ConstraintError, ConstraintSet, ConstraintSource, GridError, GridMass, Layer, LinearSystem,
-    MemberConfig, MembersError, ObjectiveTerms, Regulariser, ShearSet, Strength, SystemError,
+    build_constraints, build_member_layers, capped_inverse_jacobian, member_layers_with,
+    missing_bcg_warning, CellGrid, ConstraintError, ConstraintSet, ConstraintSource, GridError,
+    GridMass, Layer, LinearSystem, MemberConfig, MembersError, ObjectiveTerms, Regulariser,
+    ShearSet, Strength, SystemError,
 };
 use crate::map::MapGeometry;
 use crate::products::{ProductOptions, Products, ProductsError};
@@ -182,11 +183,8 @@ impl ConvergenceRecord {
             iteration: p.iteration,
             objective: p.objective,
             grid_mass_msun: p.x[system.cell_columns()].iter().sum::<f64>() * system.mass_unit_msun,
-            c: system
-                .layer_columns()
-                .zip(&system.layers)
-                .filter(|(_, l)| l.kind.is_galaxies())
-                .map(|(j, _)| p.x[j])
+            c: member_layers_with(&system.layers, &p.x[system.layer_columns()])
+                .map(|(_, &c)| c)
                 .collect(),
             beta_arcsec: system
                 .beta_x_columns()

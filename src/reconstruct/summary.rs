@@ -11,7 +11,7 @@ use super::{
     CrossvalTotals, FreeZSummary, ReconstructConfig, SourceReport, StageTimings, StrengthChoice,
     Verdict,
 };
-use crate::inversion::{external_shear_of, ExternalShearFit, LinearSystem};
+use crate::inversion::{external_shear_of, member_layers_with, ExternalShearFit, LinearSystem};
 use crate::products::Summary;
 
 /// A solved system: what the summary is made of.
@@ -42,11 +42,7 @@ impl<'a> Solved<'a> {
 
     /// `C_l` of the member layers alone (not an external shear's): the factors "C" a user reads.
     pub fn member_factors(&self) -> Vec<f64> {
-        let layers = &self.system.layers;
-        layers
-            .iter()
-            .zip(self.layer_factors())
-            .filter(|(l, _)| l.kind.is_galaxies())
+        member_layers_with(&self.system.layers, self.layer_factors())
             .map(|(_, c)| c)
             .collect()
     }
@@ -138,18 +134,11 @@ impl<'a> Solved<'a> {
                 .iter()
                 .map(|e| format!("{} ({})", e.id, e.reason))
                 .collect(),
-            layers: s
-                .layers
-                .iter()
-                .filter(|l| l.kind.is_galaxies())
-                .map(|l| l.name.as_str())
+            layers: member_layers_with(&s.layers, std::iter::repeat(()))
+                .map(|(l, _)| l.name.as_str())
                 .collect(),
             c_per_layer: self.member_factors(),
-            c_independence: s
-                .layers
-                .iter()
-                .zip(s.layer_independence())
-                .filter(|(l, _)| l.kind.is_galaxies())
+            c_independence: member_layers_with(&s.layers, s.layer_independence())
                 .map(|(_, share)| *share)
                 .collect(),
             external_shear: self.external_shear(),
