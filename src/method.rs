@@ -292,13 +292,13 @@
 //! for every unit of mass and the shear for nothing beyond its prior, so together they trade
 //! the map's mass for a shear (on MACS J1149 a shear of 0.8, eight times its prior, and an
 //! Einstein radius 12% too large). Gradient and curvature do not charge for mass itself. So
-//! "auto" leaves the least-mass regulariser out of its candidates when a shear is asked for
-//! ([`crate::reconstruct::strength_candidates`]; tried without the shear beside the others
-//! with it, it was chosen on MACS J1149 with the member factor at 2). What that costs: on the
-//! simulated cluster of `wslap paper` its own point catalogue, where only the least mass held
-//! the mass-sheet-like direction (§9), gives a deflection error of 7.5″
-//! instead of 2.7″. Measured in BENCHMARKS.md ("The tidal field of mass beyond the grid" and
-//! "The external shear by default").
+//! "auto" tries the least-mass regulariser without a shear beside the others with one
+//! ([`crate::reconstruct::strength_candidates`]); since it charges the members' mass too
+//! (§9), it cannot win the held-out images by moving mass into them. On the simulated
+//! cluster of `wslap paper` its own point catalogue, where only the least mass holds the
+//! mass-sheet-like direction (§9), it is chosen. Measured in BENCHMARKS.md ("The tidal field
+//! of mass beyond the grid", "The external shear by default" and "Least mass counts the
+//! members' mass").
 //!
 //! **The brightest cluster galaxy.** Lenstool set-ups often model the BCG as its own
 //! `potentiel` in the `.par` and leave it out of the potfile catalogue. A grid of cells several
@@ -584,15 +584,22 @@
 //! (**setting** `objective.regulariser`, or `"none"`). `R` is a Gram matrix, hence positive
 //! semi-definite, and depends only on the surface density, not on how the cells are laid out.
 //! Among the many cell maps that fit the images equally well, it picks the smoothest. The
-//! member factors and source positions are not regularised.
+//! source positions are not regularised, nor the member factors under gradient and curvature
+//! (which judge the shape of the smooth mass, not the galaxies'). Density, the least mass,
+//! charges the members' mass as the cells': member layer `l` at `C_l` counts as cell masses
+//! `C_l P_jl`, its mass inside cell `j`'s square (midpoint rule on 6 x 6 points), so the
+//! term is `(m + P C)^T R (m + P C)`, the least total surface density at the grid's
+//! resolution. Left uncharged, the least mass moved the cells' mass into the members (MACS
+//! J1149: `C` = 2.04 and an Einstein radius 25% too large; BENCHMARKS.md, "Least mass
+//! counts the members' mass").
 //!
 //! **Strength.** `lambda` is scaled by the trace of the cells' block of the data term's normal
 //! matrix, `A_cells`, so that `strength` means the same for any mass unit, field or number of
 //! images; it is fixed at the first solve. With `objective.strength = "auto"` (default) every
 //! candidate is cross-validated: each regulariser of `objective.auto_regularisers` (default
 //! gradient, curvature and density: the first two cost nothing for a uniform sheet of mass,
-//! which images at similar redshifts hardly measure; density, the least mass, does, but it is
-//! not tried beside the default external shear, §4) at each
+//! which images at similar redshifts hardly measure; density, the least mass, does, and is
+//! fitted without the default external shear, §4) at each
 //! strength of `objective.candidates` (default 0.01, 0.1, 1),
 //! on each grid of `objective.auto_grid_scales` (default a half, three quarters and all of
 //! `grid.cells` a side: 16, 24 and 32 cells, the same field; a coarser grid is a stronger

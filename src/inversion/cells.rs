@@ -75,7 +75,7 @@ pub struct GridConfig {
     /// `gamma1`, `gamma2` with the Gaussian prior `0 +- external_shear_sigma` each (see
     /// [`super::external_shear_layers`]). Default 0.1 (the tidal shears of published cluster
     /// models are 0.05 - 0.2); `null`: none, as in the paper. Never with the least-mass
-    /// regulariser, which "auto" then does not try
+    /// regulariser, whose "auto" candidates fit none
     /// ([`crate::ReconstructConfig::external_shear_fitted`]). Allowed (0, 1].
     pub external_shear_sigma: Option<f64>,
 }

@@ -30,6 +30,12 @@
 //!   and each derivative order multiplies it by `|k|^2`, i.e. applies `-laplacian` to `h`).
 //!   `R` is a Gram matrix, so positive semi-definite, and it does not depend on how the cells
 //!   are laid out: a refined grid is regularised as the same surface density.
+//! - Density, the least mass, also charges the member galaxies' mass, coarse-grained to the
+//!   cells: layer `l` at `C_l` counts as the cell masses `C_l P_jl` (its mass inside cell
+//!   `j`'s square), so the term is `(m + P C)^T R (m + P C)`
+//!   (`LinearSystem::member_mass_in_cells`). Otherwise the least mass would move the cells'
+//!   mass into the members, which cost nothing. Gradient and curvature judge the smooth
+//!   mass's shape and leave the members uncharged.
 //! - `lambda = strength * tr(A_cells) / tr(R)`, with `A_cells` the cells' block of the data
 //!   term's normal matrix (source-plane weights), so that `strength` means the same for any
 //!   mass unit, field or number of images. It is fixed at the first solve and kept while the
@@ -154,7 +160,7 @@ pub struct ObjectiveConfig {
     /// synthetic clusters of tests/data/fidelity; neither costs a uniform sheet of mass, so
     /// where the images leave the mass-sheet-like direction open only density, the least
     /// mass, holds it, as on the simulated cluster of `wslap paper` (BENCHMARKS.md); density
-    /// is not tried beside an external shear, [`crate::reconstruct::strength_candidates`]).
+    /// fits no external shear, [`crate::reconstruct::strength_candidates`]).
     /// With a number for the strength, `regulariser` alone is used.
     pub auto_regularisers: Vec<Regulariser>,
     /// The grids "auto" tries, each with every regulariser and strength, as fractions of

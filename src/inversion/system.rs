@@ -230,6 +230,10 @@ pub struct LinearSystem {
     rows_per_block: usize,
 }
 
+/// Points per side of a cell's square on which [`LinearSystem::member_mass_in_cells`]
+/// integrates a member layer's convergence.
+const MEMBER_MASS_SAMPLES: usize = 6;
+
 /// Calls `fill(first_item, chunk)` on consecutive chunks of `out` (`stride` values per item),
 /// split over `threads` threads (in this thread when 1).
 fn parallel_fill<F>(out: &mut [f64], stride: usize, threads: usize, fill: F)
@@ -379,13 +383,8 @@ impl LinearSystem {
                     data[col * n + col] -= 1.0 / (sigma * sigma);
                 }
             }
-            let n_cells = self.grid.len();
             let r = cell_penalty(&self.grid, self.terms.regulariser);
-            for j in 0..n_cells {
-                for k in 0..n_cells {
-                    data[j * n + k] -= lambda * r[j * n_cells + k];
-                }
-            }
+            self.add_scaled_penalty(&mut data, &r, -lambda);
             crate::solver::column_independence(&data, n, &layer_cols)
         })
     }
@@ -734,8 +733,8 @@ impl LinearSystem {
         Ok(())
     }
 
-    /// Adds `lambda R` to the cells' block of `a` and records `lambda` in
-    /// `terms.penalty_weight` (see the `regularise` module).
+    /// Adds `lambda R` to `a` and records `lambda` in `terms.penalty_weight` (see the
+    /// `regularise` module).
     fn add_penalty(&mut self, a: &mut [f64]) {
         let terms = &mut self.terms;
         if terms.regulariser == Regulariser::None {
@@ -753,11 +752,88 @@ impl LinearSystem {
                 0.0
             }
         });
+        self.add_scaled_penalty(a, &r, lambda);
+    }
+
+    /// Adds `scale R` to `a`, `R` the regulariser's matrix over the unknowns: `r` (from
+    /// [`cell_penalty`]) on the cells' block and, for least mass, the member layers' blocks
+    /// too. Least mass charges the galaxies' mass as the cells': the member layer `l` at
+    /// `C_l` counts as the cell masses `C_l P_jl` (its mass inside each cell's square,
+    /// [`Self::member_mass_in_cells`]), so the regulariser is
+    /// `(m + P C)^T R_cells (m + P C)`, the least total surface density at the cells'
+    /// resolution. Without it the least mass moves the cells' mass into the members, which
+    /// cost nothing (MACS J1149: `C` = 2.04 and an Einstein radius 25% too large).
+    fn add_scaled_penalty(&self, a: &mut [f64], r: &[f64], scale: f64) {
+        let (n, n_cells) = (self.columns.len(), self.grid.len());
         for j in 0..n_cells {
             for k in 0..n_cells {
-                a[j * n + k] += lambda * r[j * n_cells + k];
+                a[j * n + k] += scale * r[j * n_cells + k];
             }
         }
+        if self.terms.regulariser != Regulariser::Density
+            || !self.layers.iter().any(|l| l.kind.is_galaxies())
+        {
+            return;
+        }
+        let p = self.member_mass_in_cells();
+        let cols = self.layer_columns();
+        let layers = cols.len();
+        // (R P)_jl at [j * layers + l].
+        let mut rp = vec![0.0; n_cells * layers];
+        for j in 0..n_cells {
+            for k in 0..n_cells {
+                let rjk = r[j * n_cells + k];
+                for l in 0..layers {
+                    rp[j * layers + l] += rjk * p[k * layers + l];
+                }
+            }
+        }
+        for j in 0..n_cells {
+            for (l, c) in cols.clone().enumerate() {
+                a[j * n + c] += scale * rp[j * layers + l];
+                a[c * n + j] += scale * rp[j * layers + l];
+            }
+        }
+        for (l, cl) in cols.clone().enumerate() {
+            for (m, cm) in cols.clone().enumerate() {
+                let ptrp: f64 = (0..n_cells)
+                    .map(|j| p[j * layers + l] * rp[j * layers + m])
+                    .sum();
+                a[cl * n + cm] += scale * ptrp;
+            }
+        }
+    }
+
+    /// Per cell `j` and layer `l` at `[j * L + l]`: the mass of galaxy layer `l` at `C_l = 1`
+    /// inside cell `j`'s square, in mass units (0 for an external shear's layers), by the
+    /// midpoint rule on 6 x 6 points of the square (`MEMBER_MASS_SAMPLES`). Coarse (a galaxy's
+    /// core falls between points), which a regulariser's weight on it tolerates.
+    pub fn member_mass_in_cells(&self) -> Vec<f64> {
+        let layers = self.layers.len();
+        let mut p = vec![0.0; self.grid.len() * layers];
+        // Sigma_cr at D_ls/D_s = 1 in mass units per arcsec^2: kappa 1 over the arcsec^2.
+        let arcsec2_per_sr = crate::units::ARCSEC_PER_RAD * crate::units::ARCSEC_PER_RAD;
+        let sigma_cr = crate::units::c2_over_4pi_g_msun_per_mpc() * self.d_l_mpc
+            / arcsec2_per_sr
+            / self.mass_unit_msun;
+        let k = MEMBER_MASS_SAMPLES;
+        for (j, cell) in self.grid.cells.iter().enumerate() {
+            let h = cell.size_arcsec / k as f64;
+            let corner = cell.center - DVec2::splat(cell.size_arcsec / 2.0);
+            for (l, layer) in self.layers.iter().enumerate() {
+                if !layer.kind.is_galaxies() {
+                    continue;
+                }
+                let kappa: f64 = (0..k * k)
+                    .map(|i| {
+                        let q = DVec2::new((i % k) as f64 + 0.5, (i / k) as f64 + 0.5);
+                        layer.lens.kappa(corner + q * h)
+                    })
+                    .sum();
+                p[j * layers + l] = kappa * h * h * sigma_cr;
+            }
+        }
+        p
     }
 
     /// Checks that `x` has one value per column.

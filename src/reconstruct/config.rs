@@ -148,7 +148,7 @@ impl ReconstructConfig {
     /// grid for every unit of mass and the shear for nothing beyond its prior, so together
     /// they trade the map's mass for a shear (MACS J1149: a shear of 0.79 and an Einstein
     /// radius 12% too large, BENCHMARKS.md); the smoothness regularisers do not charge for
-    /// mass itself. An "auto" strength does not try it beside a shear
+    /// mass itself. An "auto" strength tries it without a shear beside the others with one
     /// ([`super::strength_candidates`]).
     pub fn external_shear_fitted(&self) -> Option<f64> {
         match self.objective.regulariser {

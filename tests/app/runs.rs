@@ -422,9 +422,9 @@ fn auto_strength_in_pieces_equals_one_auto_run() {
     s.set_field("reconstruct.objective.candidates", json!([0.01, 1.0]))
         .unwrap();
     let (candidates, folds) = s.strength_plan().unwrap().expect("auto has a plan");
-    use wslap::{Candidate, Regulariser::Curvature, Regulariser::Gradient};
+    use wslap::{Candidate, Regulariser::Curvature, Regulariser::Density, Regulariser::Gradient};
     // Each grid (the default scales 0.5, 0.75 and 1 of grid.cells, coarsest first) with each
-    // regulariser and strength; not the least-mass one, which fits no external shear.
+    // regulariser and strength (the least-mass one fitted without the external shear).
     let n = s.settings.reconstruct.grid.cells;
     let grids = [0.5, 0.75, 1.0].map(|f: f64| (f * n as f64).round() as usize);
     let expected: Vec<Candidate> = grids
@@ -435,6 +435,8 @@ fn auto_strength_in_pieces_equals_one_auto_run() {
                 (Gradient, 1.0),
                 (Curvature, 0.01),
                 (Curvature, 1.0),
+                (Density, 0.01),
+                (Density, 1.0),
             ]
             .map(|(regulariser, strength)| Candidate {
                 regulariser,

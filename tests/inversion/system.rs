@@ -10,10 +10,10 @@ use glam::DVec2;
 use wslap::gram_weighted;
 use wslap::{
     build_constraints, build_member_layers, npy_header, CellGrid, ColumnInfo, ConstraintConfig,
-    ConstraintSource, GridConfig, Layer, LinearSystem, MemberConfig, RowBlock, SystemConfig,
-    SystemError,
+    ConstraintSource, GridConfig, Layer, LinearSystem, MemberConfig, ObjectiveTerms, Regulariser,
+    RowBlock, SystemConfig, SystemError,
 };
-use wslap::{MassComponent, Nfw, TruncatedNfw};
+use wslap::{Gaussian, MassComponent, Nfw, TruncatedNfw};
 
 /// Row-by-row `Gamma X` vs the lens equation with the reconstructed lens: the same sums in a
 /// different order (arcsec, for deflections of tens of arcsec).
@@ -429,4 +429,76 @@ fn export_ends_with_the_prior_rows() {
     assert_eq!(weights.last(), Some(&4.0));
     assert_eq!(theta.len(), sys.n_rows);
     std::fs::remove_dir_all(&dir).unwrap();
+}
+
+/// Least mass charges a member layer's mass as the cells' ([method §4]): the layer's mass in
+/// the cells adds up to its own (a Gaussian of known mass well inside the grid), the
+/// penalty of `C = 1` equals that of the cells holding that mass, and the smoothness
+/// regularisers leave the layer uncharged.
+///
+/// [method §4]: wslap::method#4-member-galaxies
+#[test]
+fn least_mass_charges_a_member_layer_as_cell_mass() {
+    let plane = plane();
+    let constraints = build_constraints(
+        ConstraintSource::Catalog(&three_systems()),
+        &ConstraintConfig::default(),
+        &[],
+    )
+    .unwrap();
+    let positions: Vec<DVec2> = constraints.pixels.iter().map(|p| p.position).collect();
+    let grid = CellGrid::from_config(
+        &GridConfig {
+            cells: 4,
+            ..GridConfig::default()
+        },
+        &positions,
+    )
+    .unwrap();
+    let mass_msun = 3e12;
+    let galaxy = Gaussian::new(DVec2::new(3.0, -2.0), mass_msun, 2.0, &plane).unwrap();
+    let layers = [Layer::from_components("galaxy", vec![Box::new(galaxy)])];
+    let build = |regulariser| {
+        let terms = ObjectiveTerms {
+            regulariser,
+            penalty_weight: Some(1.0),
+            ..ObjectiveTerms::default()
+        };
+        let config = SystemConfig::default();
+        LinearSystem::build_with(&grid, &layers, &constraints, &plane, &config, terms).unwrap()
+    };
+    let none = build(Regulariser::None);
+    let p = none.member_mass_in_cells();
+    assert_rel(
+        "layer mass in the cells (Msun)",
+        p.iter().sum::<f64>() * none.mass_unit_msun,
+        mass_msun,
+        1e-3,
+    );
+    let n = none.n_columns();
+    let penalty = |sys: &LinearSystem, x: &[f64]| -> f64 {
+        (0..n)
+            .flat_map(|j| (0..n).map(move |k| (j, k)))
+            .map(|(j, k)| x[j] * (sys.a[j * n + k] - none.a[j * n + k]) * x[k])
+            .sum()
+    };
+    let mut as_member = vec![0.0; n];
+    as_member[none.layer_columns().start] = 1.0;
+    let mut as_cells = vec![0.0; n];
+    as_cells[none.cell_columns()].copy_from_slice(&p);
+    let density = build(Regulariser::Density);
+    assert!(penalty(&density, &as_cells) > 0.0);
+    assert_rel(
+        "penalty of C = 1 against its mass in the cells",
+        penalty(&density, &as_member),
+        penalty(&density, &as_cells),
+        1e-9,
+    );
+    let gradient = build(Regulariser::Gradient);
+    assert_abs(
+        "gradient's penalty of C = 1",
+        penalty(&gradient, &as_member),
+        0.0,
+        0.0,
+    );
 }

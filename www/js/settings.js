@@ -42,7 +42,7 @@ export const FIELDS = [
     hint: 'exact (default): the minimiser of the stated objective (image-plane misfit plus the regulariser), whatever the start; QADP stopped early is the paper\'s method (the iteration count regularises; set the regulariser to none); the best fit (accelerated gradient) over-fits extended arcs without a regulariser' },
   { path: 'reconstruct.objective.regulariser', label: 'Regulariser', type: 'select',
     options: [['gradient', 'smoothest mass (default)'], ['curvature', 'least curved'], ['density', 'least concentrated'], ['none', 'none (QADP\'s early stop)']],
-    hint: 'among the maps that fit the images, the one the regulariser prefers; its strength is chosen by cross-validation (the held-out images); least concentrated fits no external shear, and "auto" does not try it beside one' },
+    hint: 'among the maps that fit the images, the one the regulariser prefers; its strength is chosen by cross-validation (the held-out images); least concentrated (least mass, the members counted too) fits no external shear' },
   { path: 'reconstruct.objective.strength', label: 'Regulariser strength ("auto" or a number)', type: 'strength',
     options: ['auto', '0.001', '0.01', '0.1', '1', '10'],
     hint: 'auto (default): each candidate strength, with each regulariser and three grids, is cross-validated in parallel workers, and the one whose held-out images are predicted best is used; a number fixes it (0: no regulariser) and keeps the regulariser and grid set here' },

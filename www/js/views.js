@@ -165,7 +165,7 @@ const fmt = (v, d = 2) => (v == null ? '–' : Number(v).toFixed(d));
  * and the fitted images' median; the chosen row is marked. `null` (or a choice without
  * candidates) hides it. `estimated`: ids of the systems whose redshift the run estimated
  * (summary.json's `free_redshifts`), which the candidates' folds do not hold. `shear`: the
- * settings ask for an external shear, beside which the least-mass (density) regulariser is not tried. */
+ * settings ask for an external shear, whose fit the least-mass (density) regulariser leaves out. */
 export function showStrengthChoice(choice, estimated = [], shear = false) {
   const box = document.getElementById('strength-box');
   const rows = choice?.candidates ?? [];
@@ -209,8 +209,8 @@ export function showStrengthChoice(choice, estimated = [], shear = false) {
     the systems and predicts their images, so the held-out offsets say how well the map finds images it was not
     given (smaller is better), while the fitted median says how closely it reproduces those it was given.
     Offsets from the predictions in arcsec${unmatched ? '; unmatched: held-out images with no predicted image, which count first' : ''}.${
-  shear && !kinds.has('density') ? ` The least-mass regulariser (density) is not tried beside the external
-    shear: it charges the map for its mass and the shear for nothing, and would trade the one for the other.` : ''}${
+  shear && kinds.has('density') ? ` The least-mass regulariser (density) is fitted without the external shear:
+    it charges the map for its mass and the shear for nothing, and would trade the one for the other.` : ''}${
   estimatedNote(choice, estimated, byKind, byGrid)}</p>
     <div class="table-scroll"><table id="strength-table">
     <thead><tr><th scope="col">${byKind || byGrid ? 'candidate' : 'strength'}</th><th scope="col">held-out median</th>
