@@ -10,8 +10,8 @@ use glam::DVec2;
 use wslap::gram_weighted;
 use wslap::{
     build_constraints, build_member_layers, npy_header, CellGrid, ColumnInfo, ConstraintConfig,
-    ConstraintSource, GridConfig, Layer, LinearSystem, MemberConfig, ObjectiveTerms, Regulariser,
-    RowBlock, SystemConfig, SystemError,
+    ConstraintSet, ConstraintSource, GridConfig, Layer, LinearSystem, MemberConfig, ObjectiveTerms,
+    Regulariser, RowBlock, SystemConfig, SystemError,
 };
 use wslap::{Gaussian, MassComponent, Nfw, TruncatedNfw};
 
@@ -34,23 +34,12 @@ fn lcg(state: &mut u64) -> f64 {
     (*state >> 11) as f64 / (1u64 << 53) as f64
 }
 
-/// A 4 x 4 grid, one true layer (a truncated NFW and an NFW) and the member layers of
-/// `split`, and the ellipse pixels of the three systems.
-fn small_system(split: &str, config: &SystemConfig) -> LinearSystem {
-    small_system_with_prior(split, config, None)
-}
-
-/// [`small_system`] with `c_prior_sigma` on the member layers (the true layer has none).
-fn small_system_with_prior(
-    split: &str,
-    config: &SystemConfig,
-    c_prior_sigma: Option<f64>,
-) -> LinearSystem {
-    let plane = plane();
+/// The ellipse pixels (of `pixel_arcsec`) of the three systems and a 4 x 4 grid over them.
+fn three_systems_on_4x4(pixel_arcsec: f64) -> (ConstraintSet, CellGrid) {
     let constraints = build_constraints(
         ConstraintSource::Catalog(&three_systems()),
         &ConstraintConfig {
-            pixel_arcsec: 0.25,
+            pixel_arcsec,
             ..ConstraintConfig::default()
         },
         &[],
@@ -65,6 +54,23 @@ fn small_system_with_prior(
         &positions,
     )
     .unwrap();
+    (constraints, grid)
+}
+
+/// A 4 x 4 grid, one true layer (a truncated NFW and an NFW) and the member layers of
+/// `split`, and the ellipse pixels of the three systems.
+fn small_system(split: &str, config: &SystemConfig) -> LinearSystem {
+    small_system_with_prior(split, config, None)
+}
+
+/// [`small_system`] with `c_prior_sigma` on the member layers (the true layer has none).
+fn small_system_with_prior(
+    split: &str,
+    config: &SystemConfig,
+    c_prior_sigma: Option<f64>,
+) -> LinearSystem {
+    let plane = plane();
+    let (constraints, grid) = three_systems_on_4x4(0.25);
     let truth = Layer::from_components(
         "truth",
         vec![
@@ -440,21 +446,7 @@ fn export_ends_with_the_prior_rows() {
 #[test]
 fn least_mass_charges_a_member_layer_as_cell_mass() {
     let plane = plane();
-    let constraints = build_constraints(
-        ConstraintSource::Catalog(&three_systems()),
-        &ConstraintConfig::default(),
-        &[],
-    )
-    .unwrap();
-    let positions: Vec<DVec2> = constraints.pixels.iter().map(|p| p.position).collect();
-    let grid = CellGrid::from_config(
-        &GridConfig {
-            cells: 4,
-            ..GridConfig::default()
-        },
-        &positions,
-    )
-    .unwrap();
+    let (constraints, grid) = three_systems_on_4x4(ConstraintConfig::default().pixel_arcsec);
     let mass_msun = 3e12;
     let galaxy = Gaussian::new(DVec2::new(3.0, -2.0), mass_msun, 2.0, &plane).unwrap();
     let layers = [Layer::from_components("galaxy", vec![Box::new(galaxy)])];
