@@ -189,6 +189,11 @@ pub struct ObjectiveTerms {
     /// The absolute weight `lambda` of the regulariser, to keep one objective while the
     /// transforms change; `None`: `strength * tr(A_cells) / tr(R)` of this system.
     pub penalty_weight: Option<f64>,
+    /// Least mass only: the member layers' mass in the cells
+    /// ([`LinearSystem::member_mass_in_cells`]), resolved by the first build and carried, like
+    /// `penalty_weight`, to the systems built again on the same grid and layers (the
+    /// image-plane passes); `None`, or a length that does not fit: computed by the build.
+    pub member_mass_in_cells: Option<std::sync::Arc<[f64]>>,
 }
 
 /// The assembled system: column layout, normal equations and what is needed to make rows and
@@ -736,13 +741,20 @@ impl LinearSystem {
     /// Adds `lambda R` to `a` and records `lambda` in `terms.penalty_weight` (see the
     /// `regularise` module).
     fn add_penalty(&mut self, a: &mut [f64]) {
-        let terms = &mut self.terms;
-        if terms.regulariser == Regulariser::None {
-            terms.penalty_weight = Some(0.0);
+        if self.terms.regulariser == Regulariser::None {
+            self.terms.penalty_weight = Some(0.0);
             return;
         }
-        let (n, n_cells) = (self.columns.len(), self.grid.len());
-        let r = cell_penalty(&self.grid, terms.regulariser);
+        if self.charges_members() {
+            let fits = |p: &[f64]| p.len() == self.grid.len() * self.layers.len();
+            if !self.terms.member_mass_in_cells.as_deref().is_some_and(fits) {
+                self.terms.member_mass_in_cells = Some(self.member_mass_in_cells().into());
+            }
+        }
+        let n_cells = self.grid.len();
+        let r = cell_penalty(&self.grid, self.terms.regulariser);
+        let n = self.columns.len();
+        let terms = &mut self.terms;
         let lambda = *terms.penalty_weight.get_or_insert_with(|| {
             let trace_a: f64 = (0..n_cells).map(|j| a[j * n + j]).sum();
             let trace_r: f64 = (0..n_cells).map(|j| r[j * n_cells + j]).sum();
@@ -753,6 +765,12 @@ impl LinearSystem {
             }
         });
         self.add_scaled_penalty(a, &r, lambda);
+    }
+
+    /// Whether the regulariser charges the member layers too (least mass with galaxies).
+    fn charges_members(&self) -> bool {
+        self.terms.regulariser == Regulariser::Density
+            && self.layers.iter().any(|l| l.kind.is_galaxies())
     }
 
     /// Adds `scale R` to `a`, `R` the regulariser's matrix over the unknowns: `r` (from
@@ -770,12 +788,17 @@ impl LinearSystem {
                 a[j * n + k] += scale * r[j * n_cells + k];
             }
         }
-        if self.terms.regulariser != Regulariser::Density
-            || !self.layers.iter().any(|l| l.kind.is_galaxies())
-        {
+        if !self.charges_members() {
             return;
         }
-        let p = self.member_mass_in_cells();
+        let computed;
+        let p = match self.terms.member_mass_in_cells.as_deref() {
+            Some(p) => p,
+            None => {
+                computed = self.member_mass_in_cells();
+                &computed
+            }
+        };
         let cols = self.layer_columns();
         let layers = cols.len();
         // (R P)_jl at [j * layers + l].
@@ -811,28 +834,33 @@ impl LinearSystem {
     pub fn member_mass_in_cells(&self) -> Vec<f64> {
         let layers = self.layers.len();
         let mut p = vec![0.0; self.grid.len() * layers];
+        if layers == 0 {
+            return p;
+        }
         // Sigma_cr at D_ls/D_s = 1 in mass units per arcsec^2: kappa 1 over the arcsec^2.
         let arcsec2_per_sr = crate::units::ARCSEC_PER_RAD * crate::units::ARCSEC_PER_RAD;
         let sigma_cr = crate::units::c2_over_4pi_g_msun_per_mpc() * self.d_l_mpc
             / arcsec2_per_sr
             / self.mass_unit_msun;
         let k = MEMBER_MASS_SAMPLES;
-        for (j, cell) in self.grid.cells.iter().enumerate() {
-            let h = cell.size_arcsec / k as f64;
-            let corner = cell.center - DVec2::splat(cell.size_arcsec / 2.0);
-            for (l, layer) in self.layers.iter().enumerate() {
-                if !layer.kind.is_galaxies() {
-                    continue;
+        parallel_fill(&mut p, layers, self.threads, |j0, chunk| {
+            for (cell, row) in self.grid.cells[j0..].iter().zip(chunk.chunks_mut(layers)) {
+                let h = cell.size_arcsec / k as f64;
+                let corner = cell.center - DVec2::splat(cell.size_arcsec / 2.0);
+                for (out, layer) in row.iter_mut().zip(&self.layers) {
+                    if !layer.kind.is_galaxies() {
+                        continue;
+                    }
+                    let kappa: f64 = (0..k * k)
+                        .map(|i| {
+                            let q = DVec2::new((i % k) as f64 + 0.5, (i / k) as f64 + 0.5);
+                            layer.lens.kappa(corner + q * h)
+                        })
+                        .sum();
+                    *out = kappa * h * h * sigma_cr;
                 }
-                let kappa: f64 = (0..k * k)
-                    .map(|i| {
-                        let q = DVec2::new((i % k) as f64 + 0.5, (i / k) as f64 + 0.5);
-                        layer.lens.kappa(corner + q * h)
-                    })
-                    .sum();
-                p[j * layers + l] = kappa * h * h * sigma_cr;
             }
-        }
+        });
         p
     }
 

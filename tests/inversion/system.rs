@@ -493,4 +493,19 @@ fn least_mass_charges_a_member_layer_as_cell_mass() {
         0.0,
         0.0,
     );
+    // The build keeps the member masses in its terms; a system built again from them (the
+    // image-plane passes) has the same matrix, and masses of another grid's length are
+    // computed again, not used.
+    assert_eq!(density.terms.member_mass_in_cells.as_deref(), Some(&p[..]));
+    let config = SystemConfig::default();
+    let again = |terms| {
+        LinearSystem::build_with(&grid, &layers, &constraints, &plane, &config, terms).unwrap()
+    };
+    assert_eq!(again(density.terms.clone()).a, density.a);
+    let wrong = ObjectiveTerms {
+        member_mass_in_cells: Some(vec![1.0; p.len() + 1].into()),
+        ..density.terms.clone()
+    };
+    assert_eq!(again(wrong).a, density.a);
+    assert_eq!(gradient.terms.member_mass_in_cells, None);
 }
