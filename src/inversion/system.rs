@@ -743,14 +743,19 @@ impl LinearSystem {
     fn add_penalty(&mut self, a: &mut [f64]) {
         if self.terms.regulariser == Regulariser::None {
             self.terms.penalty_weight = Some(0.0);
+            self.terms.member_mass_in_cells = None;
             return;
         }
-        if self.charges_members() {
-            let fits = |p: &[f64]| p.len() == self.grid.len() * self.layers.len();
-            if !self.terms.member_mass_in_cells.as_deref().is_some_and(fits) {
-                self.terms.member_mass_in_cells = Some(self.member_mass_in_cells().into());
-            }
-        }
+        // The member masses are kept exactly when the regulariser charges them, so that
+        // `add_scaled_penalty` (here and in `layer_independence`) reads them from the terms.
+        let fits = |p: &[f64]| p.len() == self.grid.len() * self.layers.len();
+        self.terms.member_mass_in_cells = match self.charges_members() {
+            false => None,
+            true => match self.terms.member_mass_in_cells.take() {
+                Some(p) if fits(&p) => Some(p),
+                _ => Some(self.member_mass_in_cells().into()),
+            },
+        };
         let n_cells = self.grid.len();
         let r = cell_penalty(&self.grid, self.terms.regulariser);
         let n = self.columns.len();
@@ -788,16 +793,9 @@ impl LinearSystem {
                 a[j * n + k] += scale * r[j * n_cells + k];
             }
         }
-        if !self.charges_members() {
+        // Set by `add_penalty` when (and only when) the regulariser charges the members.
+        let Some(p) = self.terms.member_mass_in_cells.as_deref() else {
             return;
-        }
-        let computed;
-        let p = match self.terms.member_mass_in_cells.as_deref() {
-            Some(p) => p,
-            None => {
-                computed = self.member_mass_in_cells();
-                &computed
-            }
         };
         let cols = self.layer_columns();
         let layers = cols.len();
