@@ -5,6 +5,7 @@ Nothing here uses this project's code: the lenses, the image positions and every
 come from lenstronomy (and astropy for the cosmology). Run from the repository root:
 
     /tmp/refenv/bin/python tests/data/fidelity/make_clusters.py [--only NAME] [--out DIR]
+        [--seed-offset K]
 
 Deterministic: every cluster has its own seed (numpy default_rng); the same lenstronomy,
 numpy and astropy versions give the same files.
@@ -647,11 +648,19 @@ def main():
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--out", default=os.path.dirname(os.path.abspath(__file__)))
     ap.add_argument("--only", action="append", help="cluster name (repeatable)")
+    ap.add_argument("--seed-offset", type=int, default=0,
+                    help="draw each recipe again with its seed plus this (members, sources and "
+                         "scatter change, the halos stay); the folder is NAME-seedS. The "
+                         "committed clusters are offset 0; other offsets test that the defaults "
+                         "were not fitted to these draws (BENCHMARKS.md)")
     args = ap.parse_args()
     log = lambda s: print(s, flush=True)
     for spec in CLUSTERS:
         if args.only and spec["name"] not in args.only:
             continue
+        if args.seed_offset:
+            spec = dict(spec, seed=spec["seed"] + args.seed_offset)
+            spec["name"] = f"{spec['name']}-seed{spec['seed']}"
         make_cluster(spec, args.out, log)
 
 
