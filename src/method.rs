@@ -605,14 +605,8 @@
 //! `grid.cells` a side: 16, 24 and 32 cells, the same field; a coarser grid is a stronger
 //! prior of smoothness on scales the regulariser does not reach, and the data say which they
 //! support), over `objective.folds` (default 4) folds of the systems, keeping the one whose
-//! held-out images land closest to their predictions (first the fewest mispredicted held-out
-//! images, then the smallest median offset). A held-out image is mispredicted when the map
-//! predicts no image for its source, or when its system is predicted more than twice as many
-//! images as observed, plus one (the verdict's rule,
-//! [`crate::predicts_far_more`]): each observed image is matched to
-//! its nearest predicted one, and a map whose critical curves wind through the images' region
-//! predicts a crowd of images (MACS J1149: up to 92 for 6 seen), one of which is always near,
-//! so its offsets would flatter it. A held-out system is predicted from the
+//! held-out images land closest to their predictions (first fewest held-out images without any
+//! prediction, then the smallest median offset). A held-out system is predicted from the
 //! source `beta = (sum_k W_k)^-1 sum_k W_k beta_k`, its images `theta_k` back-projected to
 //! `beta_k` and weighted by `W_k = M_k^T M_k` (`M_k` the capped inverse Jacobian above): to
 //! first order the source whose images land closest to the observed ones, the image-plane

@@ -9,7 +9,7 @@
 //!   (a system drawn twice counts once), the others (about a third) are left out;
 //! - **the regulariser, its strength and the grid chosen again on that draw**, when the main
 //!   run's were "auto": the main run's cross-validation is not rerun, but its rule (fewest
-//!   mispredicted, then smallest median held-out offset) is applied to the held-out offsets of
+//!   unmatched, then smallest median held-out offset) is applied to the held-out offsets of
 //!   the systems the member drew, each counted as often as drawn
 //!   ([`StrengthChoice::best_for`]). Candidates the data cannot tell apart then share the
 //!   members, so the choice's own uncertainty is in the spread (on the six synthetic

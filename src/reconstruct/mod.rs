@@ -47,8 +47,8 @@ pub use sources::{
 };
 pub use summary::{ReconstructSummary, Solved, WeakLensingFit};
 pub use verdict::{
-    members_with_own_curves, predicts_far_more, BcgFacts, SystemCheck, Trust, Verdict,
-    VerdictInputs, FAR_MORE_PREDICTED_FACTOR, FLAG_OFFSET_ARCSEC, GOOD_FIT_OFFSET_ARCSEC,
+    members_with_own_curves, BcgFacts, SystemCheck, Trust, Verdict, VerdictInputs,
+    FAR_MORE_PREDICTED_FACTOR, FLAG_OFFSET_ARCSEC, GOOD_FIT_OFFSET_ARCSEC,
     GOOD_HOLDOUT_OFFSET_ARCSEC, LOST_IMAGE_ARCSEC, LOST_SYSTEMS_SHARE, MAIN_CURVE_MIN_SHARE,
     ON_CURVE_MAGNIFICATION, ON_CURVE_SHARE, SMALL_SCALE_OFFSET_ARCSEC, WORST_SHOWN,
 };
@@ -332,13 +332,6 @@ pub struct StrengthCandidate {
     pub holdout_rms_arcsec: Option<f64>,
     /// Held-out images with no predicted image at all.
     pub holdout_unmatched: usize,
-    /// Held-out images of systems for which the map predicts far more images than are
-    /// observed ([`predicts_far_more`], the verdict's rule): each may have a predicted image
-    /// near it, but among a crowd of others the catalogue does not show, so the nearest one
-    /// says little (more predicted images only make it nearer). The choice counts them with
-    /// the unmatched. 0 in results saved before they were counted.
-    #[serde(default)]
-    pub holdout_overpredicted: usize,
     /// Median offset of the fitted images in the folds (arcsec).
     pub fit_median_arcsec: Option<f64>,
     /// Per held-out system, its images' offsets from their predictions (arcsec; `None` for an
@@ -357,12 +350,6 @@ impl StrengthCandidate {
             cells: self.cells,
         }
     }
-
-    /// Held-out images the candidate did not predict: unmatched, or of a system it predicts
-    /// far too many images for (the first key of the choice).
-    pub fn holdout_mispredicted(&self) -> usize {
-        self.holdout_unmatched + self.holdout_overpredicted
-    }
 }
 
 /// The held-out images of one system and their offsets (arcsec; `None`: no predicted image).
@@ -370,27 +357,6 @@ impl StrengthCandidate {
 pub struct SystemOffsets {
     pub id: String,
     pub offsets_arcsec: Vec<Option<f64>>,
-    /// The images the map predicts for the system (shown: `|mu| >=`
-    /// [`SHOWN_MIN_MAGNIFICATION`]); 0 in results saved before they were counted.
-    #[serde(default)]
-    pub predicted: usize,
-}
-
-impl SystemOffsets {
-    /// The map predicts far more images for the system than are observed
-    /// ([`predicts_far_more`]).
-    pub fn overpredicted(&self) -> bool {
-        predicts_far_more(self.offsets_arcsec.len(), self.predicted)
-    }
-
-    /// Its images that count as mispredicted: all of them when [`Self::overpredicted`],
-    /// else those with no predicted image.
-    pub fn mispredicted(&self) -> usize {
-        match self.overpredicted() {
-            true => self.offsets_arcsec.len(),
-            false => self.offsets_arcsec.iter().filter(|o| o.is_none()).count(),
-        }
-    }
 }
 
 /// The curve "auto" chose the strength from (`summary.json`'s `strength_choice`).
@@ -863,15 +829,6 @@ pub fn strength_trial(
     if cancelled {
         return Err(ReconstructError::Cancelled);
     }
-    let holdout_by_system: Vec<SystemOffsets> = cv
-        .systems
-        .iter()
-        .map(|s| SystemOffsets {
-            id: s.report.id.clone(),
-            offsets_arcsec: s.report.observed.iter().map(|i| i.offset_arcsec).collect(),
-            predicted: s.report.predicted.iter().filter(|p| p.is_shown()).count(),
-        })
-        .collect();
     Ok(StrengthCandidate {
         regulariser: candidate.regulariser,
         strength: candidate.strength,
@@ -879,13 +836,15 @@ pub fn strength_trial(
         holdout_median_arcsec: cv.totals.holdout_image_offset_median_arcsec,
         holdout_rms_arcsec: cv.totals.holdout_image_plane_rms_arcsec,
         holdout_unmatched: cv.totals.holdout_images_unmatched,
-        holdout_overpredicted: holdout_by_system
-            .iter()
-            .filter(|s| s.overpredicted())
-            .map(|s| s.offsets_arcsec.len())
-            .sum(),
         fit_median_arcsec: cv.totals.fit_image_offset_median_arcsec,
-        holdout_by_system,
+        holdout_by_system: cv
+            .systems
+            .iter()
+            .map(|s| SystemOffsets {
+                id: s.report.id.clone(),
+                offsets_arcsec: s.report.observed.iter().map(|i| i.offset_arcsec).collect(),
+            })
+            .collect(),
     })
 }
 
@@ -907,7 +866,7 @@ impl StrengthChoice {
     }
 
     /// For each regulariser among the candidates other than the chosen one, its best
-    /// candidate by the choice's own rule (the fewest mispredicted, then the smallest median
+    /// candidate by the choice's own rule (the fewest unmatched, then the smallest median
     /// offset of held-out images), in the candidates' order: the other ways of drawing the
     /// map that the run tried. Held-out systems lie among the others, so they hardly tell how
     /// each regulariser extends the map beyond them (least mass lets it fall off, smoothest
@@ -973,9 +932,8 @@ impl StrengthChoice {
 
     /// The candidate (regulariser, strength, grid) this choice's rule picks when the held-out
     /// systems count `weight(id)` times each (a bootstrap draw: 0 for a system not drawn, 2
-    /// for one drawn twice): the fewest mispredicted images
-    /// ([`StrengthCandidate::holdout_mispredicted`]), then the smallest median offset, both
-    /// over the drawn systems' images. `None` without the candidates' per-system
+    /// for one drawn twice): the fewest unmatched images, then the smallest median offset,
+    /// both over the drawn systems' images. `None` without the candidates' per-system
     /// offsets (a choice made before they were kept) or when no drawn system was predicted.
     ///
     /// An ensemble member re-makes the choice this way on its own draw, so that the
@@ -983,17 +941,19 @@ impl StrengthChoice {
     /// the ensemble's spread without running the cross-validation again.
     pub fn best_for(&self, weight: impl Fn(&str) -> usize) -> Option<Candidate> {
         let score = |c: &StrengthCandidate| {
-            let mut mispredicted = 0;
+            let mut unmatched = 0;
             let mut offsets = Vec::new();
             for system in &c.holdout_by_system {
                 let w = weight(&system.id);
-                mispredicted += w * system.mispredicted();
-                for o in system.offsets_arcsec.iter().flatten() {
-                    offsets.extend(std::iter::repeat_n(*o, w));
+                for o in &system.offsets_arcsec {
+                    match o {
+                        Some(o) => offsets.extend(std::iter::repeat_n(*o, w)),
+                        None => unmatched += w,
+                    }
                 }
             }
             let median = summary::median_arcsec(offsets)?;
-            Some((mispredicted, median))
+            Some((unmatched, median))
         };
         if self
             .candidates
@@ -1020,10 +980,8 @@ impl StrengthChoice {
         }
     }
 
-    /// The choice among the `trials` of `config`'s candidates: the fewest mispredicted
-    /// held-out images (with no predicted image, or of a system predicted far more images
-    /// than observed: [`StrengthCandidate::holdout_mispredicted`]), then the smallest
-    /// held-out median offset. With fewer than 2 folds
+    /// The choice among the `trials` of `config`'s candidates: the fewest held-out images with
+    /// no predicted image, then the smallest held-out median offset. With fewer than 2 folds
     /// (no trials), the middle candidate, and said so.
     pub fn from_trials(
         config: &ReconstructConfig,
@@ -1058,9 +1016,8 @@ impl StrengthChoice {
             chosen_regulariser: chosen.regulariser,
             chosen_cells: chosen.cells,
             rule: format!(
-                "the fewest mispredicted (unmatched, or of a system predicted far more images \
-                 than observed), then the smallest median offset of held-out images over \
-                 {folds} folds"
+                "the fewest unmatched, then the smallest median offset of held-out images \
+                 over {folds} folds"
             ),
             before_estimates: None,
         }
@@ -1076,12 +1033,12 @@ fn describe_candidate(c: &Candidate) -> String {
 }
 
 /// The order of an "auto" choice: `Less` when `p` predicted the held-out images better than
-/// `q` (fewer mispredicted, then a smaller median offset; no median counts as an infinite
-/// one).
+/// `q` (fewer with no predicted image, then a smaller median offset; no median counts as an
+/// infinite one).
 fn predicts_better(p: &StrengthCandidate, q: &StrengthCandidate) -> std::cmp::Ordering {
     let median = |c: &StrengthCandidate| c.holdout_median_arcsec.unwrap_or(f64::INFINITY);
-    p.holdout_mispredicted()
-        .cmp(&q.holdout_mispredicted())
+    p.holdout_unmatched
+        .cmp(&q.holdout_unmatched)
         .then(median(p).total_cmp(&median(q)))
 }
 
@@ -1791,15 +1748,12 @@ mod tests {
             holdout_median_arcsec: None,
             holdout_rms_arcsec: None,
             holdout_unmatched: 0,
-            holdout_overpredicted: 0,
             fit_median_arcsec: None,
             holdout_by_system: systems
                 .iter()
                 .map(|(id, o)| SystemOffsets {
                     id: id.to_string(),
                     offsets_arcsec: o.to_vec(),
-                    // As many predicted as observed, unless a test says otherwise.
-                    predicted: o.iter().flatten().count(),
                 })
                 .collect(),
         }
@@ -1882,58 +1836,7 @@ mod tests {
         );
     }
 
-    /// A held-out system for which a candidate predicts far more images than observed (here
-    /// 8 for 3: more than twice as many plus one) counts as mispredicted, however near its
-    /// images lie to some predicted image: before the median, in the trials' choice and in
-    /// a draw's. 7 for 3 does not.
-    #[test]
-    fn a_system_predicted_far_too_often_counts_as_mispredicted() {
-        let g = Regulariser::Gradient;
-        let c = Regulariser::Curvature;
-        let crowded = |predicted| {
-            let mut candidate = candidate(
-                g,
-                0.01,
-                &[
-                    ("1", &[Some(0.1), Some(0.1), Some(0.1)]),
-                    ("2", &[Some(0.1), Some(0.1)]),
-                ],
-            );
-            candidate.holdout_by_system[0].predicted = predicted;
-            candidate.holdout_median_arcsec = Some(0.1);
-            candidate.holdout_overpredicted = match candidate.holdout_by_system[0].overpredicted() {
-                true => 3,
-                false => 0,
-            };
-            candidate
-        };
-        let mut sparse = candidate(
-            c,
-            0.1,
-            &[
-                ("1", &[Some(0.5), Some(0.5), Some(0.5)]),
-                ("2", &[Some(0.5), Some(0.5)]),
-            ],
-        );
-        sparse.holdout_median_arcsec = Some(0.5);
-        assert_eq!(crowded(8).holdout_mispredicted(), 3);
-        assert_eq!(crowded(7).holdout_mispredicted(), 0);
-
-        let choice = choice(vec![crowded(8), sparse.clone()]);
-        assert_eq!(choice.best_for(|_| 1), Some(pick(c, 0.1, 32)));
-        // A draw without the crowded system: the nearer predictions win.
-        assert_eq!(
-            choice.best_for(|id| usize::from(id == "2")),
-            Some(pick(g, 0.01, 24))
-        );
-        let config = ReconstructConfig::default();
-        let trials = StrengthChoice::from_trials(&config, 2, vec![crowded(8), sparse.clone()]);
-        assert_eq!(trials.chosen_candidate(), pick(c, 0.1, 32));
-        let trials = StrengthChoice::from_trials(&config, 2, vec![crowded(7), sparse]);
-        assert_eq!(trials.chosen_candidate(), pick(g, 0.01, 24));
-    }
-
-    /// The other regularisers' best candidates, by the choice's own rule (mispredicted images
+    /// The other regularisers' best candidates, by the choice's own rule (unmatched images
     /// first), one per regulariser in the candidates' order; the chosen one's never.
     #[test]
     fn each_other_regulariser_gives_its_best_candidate() {

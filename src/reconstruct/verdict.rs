@@ -70,14 +70,6 @@ pub const MAIN_CURVE_MIN_SHARE: f64 = 0.5;
 /// the app's teaching catalogue reconstructed without its model (7 - 28 images a pair).
 pub const FAR_MORE_PREDICTED_FACTOR: usize = 2;
 
-/// Whether a system with `observed` images for which a map predicts `predicted` (shown,
-/// `|mu| >=` [`super::SHOWN_MIN_MAGNIFICATION`]) has far more predicted than observed: more
-/// than [`FAR_MORE_PREDICTED_FACTOR`] times as many, plus one. The verdict flags such a
-/// system, and the "auto" choice counts a held-out one as mispredicted.
-pub fn predicts_far_more(observed: usize, predicted: usize) -> bool {
-    predicted > FAR_MORE_PREDICTED_FACTOR * observed + 1
-}
-
 /// An observed image where the map's `|mu|` exceeds this sits on a critical curve (within a
 /// few tenths of an arcsec of it): a giant arc's centroid may, most images do not.
 pub const ON_CURVE_MAGNIFICATION: f64 = 100.0;
@@ -206,9 +198,9 @@ impl SystemCheck {
     }
 
     /// More than [`FAR_MORE_PREDICTED_FACTOR`] times as many predicted images as observed,
-    /// plus one ([`predicts_far_more`]).
+    /// plus one.
     pub fn far_more_predicted(&self) -> bool {
-        predicts_far_more(self.observed, self.predicted)
+        self.predicted > FAR_MORE_PREDICTED_FACTOR * self.observed + 1
     }
 
     /// Ordering key, worst first: more images lost, then the larger offset (none is worst).

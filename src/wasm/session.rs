@@ -228,7 +228,7 @@ impl AppSession {
     /// The cross-validation of one candidate of the plan, `{regulariser, strength, cells}`
     /// (`cells` optional: the settings' grid; or a bare strength with the settings' regulariser
     /// and grid): a row of `strength_choice`, `{regulariser, strength, cells, holdout_median_arcsec, holdout_rms_arcsec, holdout_unmatched,
-    /// holdout_overpredicted, fit_median_arcsec, holdout_by_system}`. `progress` gets the reports as [`AppSession::run`]'s, with
+    /// fit_median_arcsec, holdout_by_system}`. `progress` gets the reports as [`AppSession::run`]'s, with
     /// `strength`. The session's result is not touched.
     pub fn strength_trial(
         &self,

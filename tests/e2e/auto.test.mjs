@@ -88,10 +88,8 @@ test('AS1063 gold with the strength "auto": the candidates run in workers and th
     assert.equal(Number(chosenRow.cells), choice.chosen_cells);
     // The reconstruction was made on the chosen grid.
     assert.equal(summary.grid_cells, choice.chosen_cells ** 2);
-    // The rule: the fewest mispredicted held-out images (unmatched, or of a system predicted
-    // far more images than observed), then the smallest held-out median.
-    const missed = (c) => c.holdout_unmatched + c.holdout_overpredicted;
-    const best = [...choice.candidates].sort((a, b) => missed(a) - missed(b)
+    // The rule: the fewest unmatched held-out images, then the smallest held-out median.
+    const best = [...choice.candidates].sort((a, b) => a.holdout_unmatched - b.holdout_unmatched
       || a.holdout_median_arcsec - b.holdout_median_arcsec)[0];
     assert.equal(choice.chosen, best.strength);
     if (choice.chosen_regulariser !== undefined) assert.equal(choice.chosen_regulariser, best.regulariser);

@@ -177,7 +177,6 @@ export function showStrengthChoice(choice, estimated = [], shear = false) {
   const medians = rows.map((r) => r.holdout_median_arcsec).filter((v) => v != null);
   const top = Math.max(...medians, 1e-9);
   const unmatched = rows.some((r) => r.holdout_unmatched > 0);
-  const crowded = rows.some((r) => r.holdout_overpredicted > 0);
   // The regulariser and the grid in the candidate's name when several were tried.
   const kinds = new Set(rows.map((r) => r.regulariser).filter((k) => k != null));
   const byKind = kinds.size > 1;
@@ -198,7 +197,7 @@ export function showStrengthChoice(choice, estimated = [], shear = false) {
       <th scope="row">${name}${chosen ? mark : ''}</th>
       <td><span class="bar-cell"><span class="value">${fmt(r.holdout_median_arcsec)}</span>${bar(r.holdout_median_arcsec)}</span></td>
       <td>${fmt(r.holdout_rms_arcsec)}</td><td>${fmt(r.fit_median_arcsec)}</td>${
-  unmatched ? `<td>${r.holdout_unmatched}</td>` : ''}${crowded ? `<td>${r.holdout_overpredicted ?? 0}</td>` : ''}</tr>`;
+  unmatched ? `<td>${r.holdout_unmatched}</td>` : ''}</tr>`;
   }).join('');
   const what = (byKind && choice.chosen_regulariser != null
     ? `${esc(choice.chosen_regulariser)} at strength ${esc(choice.chosen)}` : `strength ${esc(choice.chosen)}`)
@@ -209,16 +208,13 @@ export function showStrengthChoice(choice, estimated = [], shear = false) {
     predicted best. Each candidate was tried over ${choice.folds} folds: every fold fits the lens without some of
     the systems and predicts their images, so the held-out offsets say how well the map finds images it was not
     given (smaller is better), while the fitted median says how closely it reproduces those it was given.
-    Offsets from the predictions in arcsec.${unmatched || crowded ? ` Held-out images count first as mispredicted
-    when no image is predicted for them (unmatched) or when their system is predicted more than twice as many images as
-    observed, plus one (crowded: one of the crowd always lies near).` : ''}${
+    Offsets from the predictions in arcsec${unmatched ? '; unmatched: held-out images with no predicted image, which count first' : ''}.${
   shear && kinds.has('density') ? ` The least-mass regulariser (density) is fitted without the external shear:
     it charges the map for its mass and the shear for nothing, and would trade the one for the other.` : ''}${
   estimatedNote(choice, estimated, byKind, byGrid)}</p>
     <div class="table-scroll"><table id="strength-table">
     <thead><tr><th scope="col">${byKind || byGrid ? 'candidate' : 'strength'}</th><th scope="col">held-out median</th>
-    <th scope="col">held-out rms</th><th scope="col">fitted median</th>${unmatched ? '<th scope="col">unmatched</th>' : ''}${
-  crowded ? '<th scope="col">crowded</th>' : ''}</tr></thead>
+    <th scope="col">held-out rms</th><th scope="col">fitted median</th>${unmatched ? '<th scope="col">unmatched</th>' : ''}</tr></thead>
     <tbody>${body}</tbody></table></div>`;
   box.hidden = false;
 }
