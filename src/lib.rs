@@ -158,26 +158,27 @@ pub use solver::{
 
 // A reconstruction: inputs, settings, the run, cross-validation.
 pub use reconstruct::{
-    check_ensemble_size, check_memory, cross_validate, estimate_redshift, fitted_system_ids,
-    fold_groups, holdable_system_ids, image_regions, layer_count, product_options, reconstruct,
-    reconstruct_with_choice, refit_for_second_choice, run_ensemble, second_choice, second_round,
-    strength_candidates, strength_folds, strength_trial, ArrivalTimes, Bytes, Calibration,
-    Candidate, ConvergenceRecord, CrossValidation, CrossvalTotals, Dataset, DatasetError, Ensemble,
-    EnsembleMaps, EnsembleMember, EnsemblePlan, EstimatedRedshifts, FoldRun, FreeZSummary, Heap,
-    ImageReport, InputText, InputTexts, Inputs, InterpolatedLens, KappaSpread, LayerSource,
-    LeftOutImage, MemberDraw, MemberRun, MemoryEstimate, MemoryLimit, PredictedImage,
-    PredictedSystem, ProductConfig, ReconstructConfig, ReconstructError, ReconstructSummary,
-    Reconstruction, RedshiftEstimate, RunSize, RunStatus, SecondRound, Solved, SolverConfig,
-    SolverMethod, SourceReport, StrengthCandidate, StrengthChoice, SystemCheck, TooMuchMemory,
-    Trust, Verdict, VerdictInputs, WeakLensingFit, CALIBRATION_MIN_IMAGES,
-    CALIBRATION_MIN_PREDICTIONS, CHOICE_MAP_PIXELS, DEFAULT_FOLDS, FALLBACK_MEMORY_LIMIT_BYTES,
+    avoid_crowded_map, check_ensemble_size, check_memory, cross_validate, estimate_redshift,
+    fitted_system_ids, fold_groups, holdable_system_ids, image_regions, layer_count,
+    product_options, reconstruct, reconstruct_with_choice, refit_for_second_choice, run_ensemble,
+    second_choice, second_round, strength_candidates, strength_folds, strength_trial,
+    with_uncrowded_map, ArrivalTimes, Bytes, Calibration, Candidate, ConvergenceRecord,
+    CrossValidation, CrossvalTotals, CrowdedMap, Dataset, DatasetError, Ensemble, EnsembleMaps,
+    EnsembleMember, EnsemblePlan, EstimatedRedshifts, FoldRun, FreeZSummary, Heap, ImageReport,
+    InputText, InputTexts, Inputs, InterpolatedLens, KappaSpread, LayerSource, LeftOutImage,
+    MemberDraw, MemberRun, MemoryEstimate, MemoryLimit, PredictedImage, PredictedSystem,
+    ProductConfig, ReconstructConfig, ReconstructError, ReconstructSummary, Reconstruction,
+    RedshiftEstimate, RunSize, RunStatus, SecondRound, Solved, SolverConfig, SolverMethod,
+    SourceReport, StrengthCandidate, StrengthChoice, SystemCheck, TooMuchMemory, Trust, Verdict,
+    VerdictInputs, WeakLensingFit, CALIBRATION_MIN_IMAGES, CALIBRATION_MIN_PREDICTIONS,
+    CHOICE_MAP_PIXELS, CROWDED_MAP_RETRIES, DEFAULT_FOLDS, FALLBACK_MEMORY_LIMIT_BYTES,
     FALLBACK_SIGMA_ARCSEC, MAX_ENSEMBLE_MEMBERS, PAR_GALAXY_MAX_LSTAR, SHOWN_MIN_MAGNIFICATION,
     WASM_MEMORY_LIMIT_BYTES,
 };
 
 // The verdict on a reconstruction and its thresholds.
 pub use reconstruct::{
-    members_with_own_curves, BcgFacts, FAR_MORE_PREDICTED_FACTOR, FLAG_OFFSET_ARCSEC,
+    members_with_own_curves, BcgFacts, Crowding, FAR_MORE_PREDICTED_FACTOR, FLAG_OFFSET_ARCSEC,
     GOOD_FIT_OFFSET_ARCSEC, GOOD_HOLDOUT_OFFSET_ARCSEC, LOST_IMAGE_ARCSEC, LOST_SYSTEMS_SHARE,
     MAIN_CURVE_MIN_SHARE, ON_CURVE_MAGNIFICATION, ON_CURVE_SHARE, SMALL_SCALE_OFFSET_ARCSEC,
     WORST_SHOWN,

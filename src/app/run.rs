@@ -9,12 +9,12 @@ use crate::inversion::{build_constraints, Layer, LinearSystem, ObjectiveTerms};
 use crate::products::{own_map_side, ProductOptions, Products};
 use crate::reconstruct::{add_external_shear, member_layers, shear_set, BcgFacts, Verdict};
 use crate::reconstruct::{
-    check_memory, cross_validate, fitted_system_ids, grid_of, map_geometry, product_options,
-    reconstruct, reconstruct_with_choice, refit_for_second_choice, second_choice, second_round,
-    strength_candidates, strength_folds, Candidate, ConvergenceRecord, CrossValidation, Dataset,
-    DatasetError, Ensemble, EstimatedRedshifts, Inputs, MemoryLimit, ReconstructConfig,
-    ReconstructError, Reconstruction, RunSize, RunStatus, SecondRound, SourceReport, StageTimings,
-    StrengthCandidate, StrengthChoice, DEFAULT_FOLDS,
+    avoid_crowded_map, check_memory, cross_validate, fitted_system_ids, grid_of, map_geometry,
+    product_options, reconstruct, reconstruct_with_choice, refit_for_second_choice, second_choice,
+    second_round, strength_candidates, strength_folds, with_uncrowded_map, Candidate,
+    ConvergenceRecord, CrossValidation, Dataset, DatasetError, Ensemble, EstimatedRedshifts,
+    Inputs, MemoryLimit, ReconstructConfig, ReconstructError, Reconstruction, RunSize, RunStatus,
+    SecondRound, SourceReport, StageTimings, StrengthCandidate, StrengthChoice, DEFAULT_FOLDS,
 };
 use crate::solver::{Control, Iterate};
 
@@ -277,9 +277,17 @@ impl Session {
             .and_then(SessionResult::reconstruction)
             .ok_or_else(missing)?;
         let choice = second_choice(r, trials).ok_or_else(missing)?;
-        let refit = self.with_inputs(|inputs, _, parsed| {
+        let (choice, refit) = self.with_inputs(|inputs, _, parsed| {
             let refit = refit_for_second_choice(inputs, r, &choice, progress).map_err(run_error)?;
-            Ok(refit.map(|r| reconstruction_result(r, parsed)))
+            // The map the choice ends with, unless it is crowded.
+            let (choice, other) =
+                avoid_crowded_map(inputs, refit.as_ref().unwrap_or(r), &choice, progress)
+                    .map_err(run_error)?;
+            let refit = other.or(refit).map(|mut m| {
+                m.strength_choice = Some(choice.clone());
+                reconstruction_result(m, parsed)
+            });
+            Ok((choice, refit))
         })?;
         let before_ms = self.result.as_ref().map_or(0.0, |x| x.elapsed_ms);
         let Some(mut result) = refit else {
@@ -312,6 +320,11 @@ impl Session {
             let config = keeping_iterates(config);
             let r =
                 reconstruct_with_choice(inputs, &config, choice, progress).map_err(run_error)?;
+            // The map stands unless crowded, when it is the last round's.
+            let r = match second_round(&r) {
+                Some(_) => r,
+                None => with_uncrowded_map(inputs, r, progress).map_err(run_error)?,
+            };
             Ok(reconstruction_result(r, parsed))
         })?;
         result.elapsed_ms = t.ms();

@@ -47,7 +47,7 @@ pub use sources::{
 };
 pub use summary::{ReconstructSummary, Solved, WeakLensingFit};
 pub use verdict::{
-    members_with_own_curves, BcgFacts, SystemCheck, Trust, Verdict, VerdictInputs,
+    members_with_own_curves, BcgFacts, Crowding, SystemCheck, Trust, Verdict, VerdictInputs,
     FAR_MORE_PREDICTED_FACTOR, FLAG_OFFSET_ARCSEC, GOOD_FIT_OFFSET_ARCSEC,
     GOOD_HOLDOUT_OFFSET_ARCSEC, LOST_IMAGE_ARCSEC, LOST_SYSTEMS_SHARE, MAIN_CURVE_MIN_SHARE,
     ON_CURVE_MAGNIFICATION, ON_CURVE_SHARE, SMALL_SCALE_OFFSET_ARCSEC, WORST_SHOWN,
@@ -378,6 +378,20 @@ pub struct StrengthChoice {
     /// ([`second_round`]); `None` when no redshift was estimated.
     #[serde(default)]
     pub before_estimates: Option<Candidate>,
+    /// The candidates that predicted best but whose maps the verdict would distrust for
+    /// crowding, in the order they were passed over ([`avoid_crowded_map`]); empty when the
+    /// chosen candidate's map was the first made.
+    #[serde(default)]
+    pub crowded_maps: Vec<CrowdedMap>,
+}
+
+/// A candidate passed over because its map was crowded ([`avoid_crowded_map`]).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct CrowdedMap {
+    #[serde(flatten)]
+    pub candidate: Candidate,
+    #[serde(flatten)]
+    pub crowding: Crowding,
 }
 
 impl Reconstruction {
@@ -523,7 +537,11 @@ pub(crate) fn reconstruct_free_z(
     let mut r = match choice {
         Some(choice) => with_choice(inputs, config, choice, free_z, progress).and_then(|r| {
             crate::threads::with_limit(config.system.threads, || {
-                choose_again_with_estimates(inputs, r, progress)
+                let r = choose_again_with_estimates(inputs, r, progress)?;
+                match free_z {
+                    true => with_uncrowded_map(inputs, r, progress),
+                    false => Ok(r),
+                }
             })
         }),
         None => crate::threads::with_limit(config.system.threads, || {
@@ -764,6 +782,137 @@ fn choose_again_with_estimates(
     Ok(r)
 }
 
+/// How many more candidates [`avoid_crowded_map`] fits when the chosen one's map is crowded.
+pub const CROWDED_MAP_RETRIES: usize = 3;
+
+/// What becomes of `r`, the map of an "auto" `choice`'s last round, when the verdict would
+/// distrust it for crowding ([`Crowding::distrusted`]: more than a third of its systems
+/// predicted far more images than observed): the next candidates in the choice's order are
+/// fitted in turn, at most [`CROWDED_MAP_RETRIES`] of them (the systems at an estimated
+/// redshift at `r`'s estimates, made consistent with each map as before), and the first
+/// map that is not crowded is kept, else the least crowded. Returns the choice `r` is to
+/// carry ([`StrengthChoice::crowded_maps`] lists the candidates passed over) and the map to
+/// use instead of `r`'s, if another (carrying that choice); `choice` itself and `None` when
+/// `r`'s map is not crowded or `choice` was not cross-validated. `r` itself is left as it
+/// was, so that an error loses nothing.
+///
+/// Why: the choice scores a held-out image by its nearest predicted image, and a map whose
+/// critical curves wind through the images' region predicts a crowd of images, one of which
+/// is always near (Jauzac et al.'s MACS J1149: 17 of 45 systems with up to 99 images each;
+/// the published model 3 - 7). Ranking the candidates by their folds' crowding instead did
+/// not work: the folds' maps, fitted to fewer systems, are less crowded than the map of all
+/// of them (24% against 38% there), and which maps crowd moves with the estimated redshifts
+/// (BENCHMARKS.md).
+pub fn avoid_crowded_map(
+    inputs: &Inputs<'_>,
+    r: &Reconstruction,
+    choice: &StrengthChoice,
+    progress: &mut dyn FnMut(&ConvergenceRecord) -> Control,
+) -> Result<(StrengthChoice, Option<Reconstruction>), ReconstructError> {
+    let crowding = Crowding::of(&r.sources);
+    if !choice.was_cross_validated() || r.status == SolveStatus::Cancelled {
+        return Ok((choice.clone(), None));
+    }
+    let mut next: Vec<&StrengthCandidate> = choice
+        .candidates
+        .iter()
+        .filter(|c| !choice.is_chosen(c))
+        .collect();
+    next.sort_by(|p, q| predicts_better(p, q));
+    let next: Vec<Candidate> = next.iter().map(|c| c.candidate()).collect();
+    let config = &r.config;
+    let free = r.free_z.as_ref().filter(|f| !f.systems.is_empty());
+    let (map, used, passed) = first_uncrowded(
+        crowding,
+        choice.chosen_candidate(),
+        &next,
+        |r: &Reconstruction| Crowding::of(&r.sources),
+        |candidate| {
+            let fixed = candidate.apply(config);
+            let mut fit = match free {
+                Some(free) => {
+                    let first = free_z::fit_at_estimates(inputs, &fixed, free.clone(), progress)?;
+                    let last = free_z::fit_consistently(inputs, &fixed, &first, None, progress)?;
+                    last.unwrap_or(first)
+                }
+                None => reconstruct_limited(inputs, &fixed, progress)?,
+            };
+            if fit.status == SolveStatus::Cancelled {
+                return Ok::<_, ReconstructError>(None);
+            }
+            fit.config = config.clone();
+            Ok(Some(fit))
+        },
+    )?;
+    let mut choice = choice.with_chosen(used);
+    choice.crowded_maps = passed.into_iter().filter(|p| p.candidate != used).collect();
+    let map = map.map(|mut m| {
+        m.strength_choice = Some(choice.clone());
+        with_own_priors(&mut m, config);
+        m
+    });
+    Ok((choice, map))
+}
+
+/// [`avoid_crowded_map`] of `r` with its own "auto" choice: `r` with the choice updated, or
+/// the map kept instead; `r` as it is without a choice.
+pub fn with_uncrowded_map(
+    inputs: &Inputs<'_>,
+    r: Reconstruction,
+    progress: &mut dyn FnMut(&ConvergenceRecord) -> Control,
+) -> Result<Reconstruction, ReconstructError> {
+    let Some(choice) = r.strength_choice.clone() else {
+        return Ok(r);
+    };
+    Ok(match avoid_crowded_map(inputs, &r, &choice, progress)? {
+        (_, Some(map)) => map,
+        (choice, None) => Reconstruction {
+            strength_choice: Some(choice),
+            ..r
+        },
+    })
+}
+
+/// The logic of [`avoid_crowded_map`] on any kind of map `M`: the first map (made with
+/// `chosen`, crowded `first`) stands when it is not crowded; else the first of `next` (at
+/// most [`CROWDED_MAP_RETRIES`]) whose map `fit` makes is not crowded, else the least crowded
+/// of those made (the earlier on a tie). Returns the map kept (`None`: the first), its
+/// candidate, and every candidate whose map was crowded, in the order fitted. `fit` returning
+/// `None` (cancelled) ends the search with the maps made so far.
+fn first_uncrowded<M, E>(
+    first: Crowding,
+    chosen: Candidate,
+    next: &[Candidate],
+    crowding: impl Fn(&M) -> Crowding,
+    mut fit: impl FnMut(Candidate) -> Result<Option<M>, E>,
+) -> Result<(Option<M>, Candidate, Vec<CrowdedMap>), E> {
+    if !first.distrusted() {
+        return Ok((None, chosen, Vec::new()));
+    }
+    let mut passed = vec![CrowdedMap {
+        candidate: chosen,
+        crowding: first,
+    }];
+    let mut least = (first, None, chosen);
+    for &candidate in next.iter().take(CROWDED_MAP_RETRIES) {
+        let Some(map) = fit(candidate)? else {
+            break;
+        };
+        let c = crowding(&map);
+        if !c.distrusted() {
+            return Ok((Some(map), candidate, passed));
+        }
+        passed.push(CrowdedMap {
+            candidate,
+            crowding: c,
+        });
+        if c.less_than(&least.0) {
+            least = (c, Some(map), candidate);
+        }
+    }
+    Ok((least.1, least.2, passed))
+}
+
 /// The candidates an "auto" strength tries: every grid of `objective.auto_grid_scales`
 /// (the distinct cell counts, coarsest first) with every one of `objective.auto_regularisers`
 /// and every one of `objective.candidates`.
@@ -900,10 +1049,27 @@ impl StrengthChoice {
             ),
             None => String::new(),
         };
+        let crowded = match self.crowded_maps.as_slice() {
+            [] => String::new(),
+            passed => format!(
+                "; passed over for maps that predict far more images than observed for more \
+                 than a third of the systems: {}",
+                passed
+                    .iter()
+                    .map(|p| format!(
+                        "{} ({} of {})",
+                        describe_candidate(&p.candidate),
+                        p.crowding.crowded_systems,
+                        p.crowding.systems
+                    ))
+                    .collect::<Vec<_>>()
+                    .join(", ")
+            ),
+        };
         match self.candidates.len() {
             0 => format!("{what} ({})", self.rule),
             n => format!(
-                "{what}, chosen by {}-fold cross-validation of {n} candidates{again}",
+                "{what}, chosen by {}-fold cross-validation of {n} candidates{again}{crowded}",
                 self.folds
             ),
         }
@@ -998,6 +1164,7 @@ impl StrengthChoice {
                 chosen_cells: None,
                 rule: "too few fitted systems to hold any out, so the middle candidate".to_string(),
                 before_estimates: None,
+                crowded_maps: Vec::new(),
             };
         }
         let best = trials.iter().min_by(|p, q| predicts_better(p, q));
@@ -1020,6 +1187,7 @@ impl StrengthChoice {
                  over {folds} folds"
             ),
             before_estimates: None,
+            crowded_maps: Vec::new(),
         }
     }
 }
@@ -1776,6 +1944,7 @@ mod tests {
             chosen_cells: None,
             rule: String::new(),
             before_estimates: None,
+            crowded_maps: Vec::new(),
         }
     }
 
@@ -1963,6 +2132,90 @@ mod tests {
             "gradient at strength 0.1 (too few fitted systems to hold any out, so the middle \
              candidate)"
         );
+        c.crowded_maps = vec![CrowdedMap {
+            candidate: pick(Regulariser::Density, 0.01, 32),
+            crowding: Crowding {
+                crowded_systems: 22,
+                systems: 45,
+            },
+        }];
+        assert_eq!(
+            c.describe(),
+            "curvature at strength 0.1 on 24 x 24 cells, chosen by 2-fold cross-validation \
+             of 1 candidates; passed over for maps that predict far more images than observed \
+             for more than a third of the systems: density at strength 0.01 on 32 x 32 cells \
+             (22 of 45)"
+        );
+    }
+
+    fn crowding(crowded_systems: usize) -> Crowding {
+        Crowding {
+            crowded_systems,
+            systems: 30,
+        }
+    }
+
+    /// `first_uncrowded` with maps that are their crowding: which map is kept, which
+    /// candidates are fitted and which passed over.
+    fn uncrowded(first: usize, maps: &[usize]) -> (Option<usize>, f64, Vec<f64>, Vec<f64>) {
+        let next: Vec<Candidate> = (1..=maps.len())
+            .map(|i| pick(Regulariser::Curvature, i as f64, 16))
+            .collect();
+        let mut fitted = Vec::new();
+        let (map, used, passed) = first_uncrowded::<Crowding, ()>(
+            crowding(first),
+            pick(Regulariser::Curvature, 0.0, 16),
+            &next,
+            |m| *m,
+            |c| {
+                fitted.push(c.strength);
+                Ok(Some(crowding(maps[c.strength as usize - 1])))
+            },
+        )
+        .unwrap();
+        let passed = passed.iter().map(|p| p.candidate.strength).collect();
+        (
+            map.map(|m| m.crowded_systems),
+            used.strength,
+            fitted,
+            passed,
+        )
+    }
+
+    /// The chosen map stands unless more than a third of its systems are crowded (10 of 30
+    /// is not more); then the next candidates are fitted in order until one is not, at most
+    /// `CROWDED_MAP_RETRIES`, and when every one is crowded the least crowded is kept (the
+    /// earlier on a tie).
+    #[test]
+    fn a_crowded_map_gives_way_to_the_next_candidate_that_is_not() {
+        assert_eq!(uncrowded(10, &[0, 0]), (None, 0.0, vec![], vec![]));
+        assert_eq!(
+            uncrowded(11, &[12, 3, 0]),
+            (Some(3), 2.0, vec![1.0, 2.0], vec![0.0, 1.0])
+        );
+        // Every one crowded: at most three more fitted, the least crowded kept, on a tie
+        // the earlier.
+        assert_eq!(
+            uncrowded(20, &[15, 12, 12, 0]),
+            (Some(12), 2.0, vec![1.0, 2.0, 3.0], vec![0.0, 1.0, 2.0, 3.0])
+        );
+        // The first map the least crowded: none replaces it.
+        assert_eq!(
+            uncrowded(11, &[15, 12]),
+            (None, 0.0, vec![1.0, 2.0], vec![0.0, 1.0, 2.0])
+        );
+        assert_eq!(CROWDED_MAP_RETRIES, 3);
+        // A cancelled fit ends the search with what was made.
+        let next = [pick(Regulariser::Curvature, 1.0, 16)];
+        let (map, used, passed) = first_uncrowded::<Crowding, ()>(
+            crowding(11),
+            pick(Regulariser::Curvature, 0.0, 16),
+            &next,
+            |m| *m,
+            |_| Ok(None),
+        )
+        .unwrap();
+        assert_eq!((map, used.strength, passed.len()), (None, 0.0, 1));
     }
 
     #[test]

@@ -51,6 +51,38 @@ pub const LOST_IMAGE_ARCSEC: f64 = 3.0;
 /// awkward systems near a critical curve that any model of a real cluster has.
 pub const LOST_SYSTEMS_SHARE: f64 = 1.0 / 3.0;
 
+/// How many of a map's systems it predicts far more images for than are observed
+/// ([`SystemCheck::far_more_predicted`]), of how many.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+pub struct Crowding {
+    pub crowded_systems: usize,
+    pub systems: usize,
+}
+
+impl Crowding {
+    /// The crowding of the map `sources` were predicted on (every system, fitted or held out).
+    pub fn of(sources: &[SourceReport]) -> Self {
+        Self {
+            crowded_systems: sources
+                .iter()
+                .filter(|s| SystemCheck::of(s).far_more_predicted())
+                .count(),
+            systems: sources.len(),
+        }
+    }
+
+    /// More than [`LOST_SYSTEMS_SHARE`] of the systems crowded: the verdict says "do not trust
+    /// the small scales" for it (the critical curves wind through the images' region).
+    pub fn distrusted(&self) -> bool {
+        self.systems > 0 && self.crowded_systems as f64 > LOST_SYSTEMS_SHARE * self.systems as f64
+    }
+
+    /// Whether this map is less crowded than `other` (a smaller share of its systems).
+    pub fn less_than(&self, other: &Crowding) -> bool {
+        self.crowded_systems * other.systems < other.crowded_systems * self.systems
+    }
+}
+
 /// A system whose largest image offset exceeds this (arcsec) is listed among the worst (twice
 /// [`GOOD_FIT_OFFSET_ARCSEC`]: an image the map places clearly worse than the typical one).
 pub const FLAG_OFFSET_ARCSEC: f64 = 2.0;
@@ -416,7 +448,11 @@ impl Verdict {
                 c.observed
             )
         };
-        if n > 0 && far_more as f64 > LOST_SYSTEMS_SHARE * n as f64 {
+        let crowding = Crowding {
+            crowded_systems: far_more,
+            systems: n,
+        };
+        if crowding.distrusted() {
             bad.push(far_more_words());
         }
         let between = |m: f64, good: f64| m > good && m <= SMALL_SCALE_OFFSET_ARCSEC;
@@ -441,7 +477,7 @@ impl Verdict {
                 if lost == 1 { "has" } else { "have" }
             ));
         }
-        if far_more > 0 && far_more as f64 <= LOST_SYSTEMS_SHARE * n as f64 {
+        if far_more > 0 && !crowding.distrusted() {
             care.push(far_more_words());
         }
         // One system is always fitted (its images fix the mass inside them): nothing in the
@@ -794,6 +830,27 @@ mod tests {
             "{}",
             v.reasons
         );
+        // The crowding the "auto" choice reads is the verdict's.
+        let crowding = Crowding::of(&sources);
+        assert_eq!((crowding.crowded_systems, crowding.systems), (2, 5));
+        assert!(crowding.distrusted());
+        sources[0] = good(0);
+        let one = Crowding::of(&sources);
+        assert_eq!(one.crowded_systems, 1);
+        assert!(!one.distrusted());
+        assert!(one.less_than(&crowding) && !crowding.less_than(&one));
+        // 1 of 3 is a third, not more; 2 of 6 against 1 of 3: the same share.
+        let (third, sixth) = (
+            Crowding {
+                crowded_systems: 1,
+                systems: 3,
+            },
+            Crowding {
+                crowded_systems: 2,
+                systems: 6,
+            },
+        );
+        assert!(!third.distrusted() && !third.less_than(&sixth) && !sixth.less_than(&third));
     }
 
     /// Most observed images on a critical curve (|mu| > 100) is an over-focused fit; a few

@@ -386,11 +386,31 @@ fn second_round_in_pieces_equals_one_auto_run() {
     let (pieces, whole) = summaries_before_and_after_one_run(&mut s);
     let choice = &whole["strength_choice"];
     assert_eq!(pieces["strength_choice"], *choice);
-    // Here the second round moves to a finer grid (8 -> 16 cells a side), so what the pieces
-    // and the whole run compare is the refit at the estimated redshift.
+    // Here the second round prefers a finer grid (8 -> 16 cells a side), whose map predicts
+    // far more images than observed for every system: it is passed over for the next
+    // candidate, whose map is not crowded, in the pieces as in the whole run. So what they
+    // compare is that candidate's refit at the estimated redshift.
     let first = &choice["before_estimates"];
     assert!(first["strength"].is_f64(), "{choice}");
-    assert_ne!(first["cells"], choice["chosen_cells"], "{choice}");
+    let crowded = &choice["crowded_maps"];
+    assert_eq!(crowded.as_array().map(Vec::len), Some(1), "{choice}");
+    assert_eq!(crowded[0]["cells"], 16, "{choice}");
+    let share =
+        |c: &serde_json::Value, n: &serde_json::Value| c.as_f64().unwrap() / n.as_f64().unwrap();
+    assert!(
+        share(&crowded[0]["crowded_systems"], &crowded[0]["systems"]) > 1.0 / 3.0,
+        "{choice}"
+    );
+    let verdict = &whole["verdict"];
+    assert!(
+        share(&verdict["systems_far_more_predicted"], &verdict["systems"]) <= 1.0 / 3.0,
+        "{verdict}"
+    );
+    assert_ne!(
+        (&first["strength"], &first["cells"]),
+        (&choice["chosen"], &choice["chosen_cells"]),
+        "{choice}"
+    );
     assert!(
         choice["rule"].as_str().unwrap().contains("estimated"),
         "{choice}"

@@ -181,3 +181,42 @@ test('a pool worker that fails fails the run with its message, and the app still
     await app.close();
   }
 });
+
+test('a choice that passed over a crowded map says so, at 1280 px and on a phone', async () => {
+  // The shape of Jauzac et al.'s MACS J1149 run (BENCHMARKS.md): least mass 0.01 predicted the
+  // held-out images best but its map crowded 22 of 45 systems, so gradient 0.1 was used.
+  const row = (regulariser, strength, median) => ({
+    regulariser, strength, cells: 32, holdout_median_arcsec: median, holdout_rms_arcsec: 2 * median,
+    holdout_unmatched: 0, fit_median_arcsec: 0.3, holdout_by_system: [],
+  });
+  const choice = {
+    folds: 4,
+    candidates: [row('density', 0.01, 0.66), row('gradient', 0.1, 0.68), row('curvature', 1, 0.9)],
+    chosen: 0.1, chosen_regulariser: 'gradient', chosen_cells: 32, rule: '', before_estimates: null,
+    crowded_maps: [{ regulariser: 'density', strength: 0.01, cells: 32, crowded_systems: 22, systems: 45 }],
+  };
+  const app = await openApp();
+  try {
+    const { page } = app;
+    await waitStatus(page, /^Ready/);
+    await page.evaluate(async (c) => (await import('./js/views.js')).showStrengthChoice(c), choice);
+    const box = page.locator('#strength-box');
+    await box.scrollIntoViewIfNeeded();
+    assert.match(await page.textContent('#strength-table tr.chosen th'), /^gradient 0\.1 ✓ chosen/);
+    const first = await page.textContent('#strength-table tbody tr:first-child th');
+    assert.match(first, /density 0\.01\s+crowded map: 22 of 45 systems, passed over/);
+    // The other rows carry no such mark.
+    assert.equal(await page.locator('#strength-table .mark.passed').count(), 1);
+    const summary = (await page.textContent('#strength-summary')).replace(/\s+/g, ' ');
+    assert.match(summary, /predicted best of those whose maps are not crowded\./);
+    assert.match(summary, /One candidate that predicted better was passed over: its map predicts more than twice as many images as observed for more than a third of the systems\./);
+    await box.screenshot({ path: join(ARTIFACTS, 'app-auto-crowded.png') });
+    await page.setViewportSize({ width: 390, height: 844 });
+    const overflow = await page.evaluate(() => document.documentElement.scrollWidth - window.innerWidth);
+    assert.ok(overflow <= 0, `page is ${overflow}px wider than a phone`);
+    await box.screenshot({ path: join(ARTIFACTS, 'app-auto-crowded-phone.png') });
+    assert.deepEqual(app.consoleErrors, []);
+  } finally {
+    await app.close();
+  }
+});

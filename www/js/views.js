@@ -189,12 +189,20 @@ export function showStrengthChoice(choice, estimated = [], shear = false) {
   const bar = (v) => `<span class="bar-track" aria-hidden="true">${v == null ? ''
     : `<span class="bar" style="width:${(100 * v / top).toFixed(1)}%"></span>`}</span>`;
   const mark = ' <span class="mark">✓ chosen</span>';
+  // Candidates that predicted best but whose maps were crowded, passed over (the core's
+  // avoid_crowded_map).
+  const passed = choice.crowded_maps ?? [];
+  const passedOf = (r) => passed.find((p) => p.strength === r.strength
+    && (p.regulariser == null || r.regulariser == null || p.regulariser === r.regulariser)
+    && (p.cells == null || r.cells == null || p.cells === r.cells));
   const body = rows.map((r) => {
     const chosen = isChosen(r);
+    const crowded = passedOf(r);
     // The candidate: its strength, after its regulariser and before its grid when several were tried.
     const name = `${byKind ? `${esc(r.regulariser)} ` : ''}${esc(r.strength)}${byGrid && r.cells != null ? `, ${grid(r.cells)}` : ''}`;
     return `<tr${chosen ? ' class="chosen"' : ''} data-strength="${esc(r.strength)}" data-regulariser="${esc(r.regulariser ?? '')}" data-cells="${esc(r.cells ?? '')}">
-      <th scope="row">${name}${chosen ? mark : ''}</th>
+      <th scope="row">${name}${chosen ? mark : ''}${crowded ? ` <span class="mark passed">crowded map: ${
+  crowded.crowded_systems} of ${crowded.systems} systems, passed over</span>` : ''}</th>
       <td><span class="bar-cell"><span class="value">${fmt(r.holdout_median_arcsec)}</span>${bar(r.holdout_median_arcsec)}</span></td>
       <td>${fmt(r.holdout_rms_arcsec)}</td><td>${fmt(r.fit_median_arcsec)}</td>${
   unmatched ? `<td>${r.holdout_unmatched}</td>` : ''}</tr>`;
@@ -205,13 +213,17 @@ export function showStrengthChoice(choice, estimated = [], shear = false) {
   const tried = [byKind && 'regulariser', 'strength', byGrid && 'grid'].filter(Boolean);
   box.innerHTML = `<h3>Regulariser ${what}, chosen by cross-validation</h3>
     <p id="strength-summary">The ${tried.length > 1 ? `${tried.slice(0, -1).join(', ')} and ${tried.at(-1)}` : 'strength'} whose held-out images were
-    predicted best. Each candidate was tried over ${choice.folds} folds: every fold fits the lens without some of
+    predicted best${passed.length ? ' of those whose maps are not crowded' : ''}. Each candidate was tried over ${choice.folds} folds: every fold fits the lens without some of
     the systems and predicts their images, so the held-out offsets say how well the map finds images it was not
     given (smaller is better), while the fitted median says how closely it reproduces those it was given.
     Offsets from the predictions in arcsec${unmatched ? '; unmatched: held-out images with no predicted image, which count first' : ''}.${
   shear && kinds.has('density') ? ` The least-mass regulariser (density) is fitted without the external shear:
     it charges the map for its mass and the shear for nothing, and would trade the one for the other.` : ''}${
-  estimatedNote(choice, estimated, byKind, byGrid)}</p>
+  estimatedNote(choice, estimated, byKind, byGrid)}${passed.length ? ` ${passed.length === 1 ? 'One candidate' : `${passed.length} candidates`}
+    that predicted better ${passed.length === 1 ? 'was' : 'were'} passed over: ${passed.length === 1 ? 'its map predicts' : 'their maps predict'}
+    more than twice as many images as observed for more than a third of the systems. Such a map's critical curves wind
+    through the images' region, and a crowd of predicted images always has one near a held-out image, which flatters its
+    offsets; the verdict would not trust its small scales, so the next candidate whose map is not crowded was used.` : ''}</p>
     <div class="table-scroll"><table id="strength-table">
     <thead><tr><th scope="col">${byKind || byGrid ? 'candidate' : 'strength'}</th><th scope="col">held-out median</th>
     <th scope="col">held-out rms</th><th scope="col">fitted median</th>${unmatched ? '<th scope="col">unmatched</th>' : ''}</tr></thead>
