@@ -798,18 +798,17 @@ pub const CROWDED_MAP_RETRIES: usize = 3;
 ///
 /// Why: the choice scores a held-out image by its nearest predicted image, and a map whose
 /// critical curves wind through the images' region predicts a crowd of images, one of which
-/// is always near (Jauzac et al.'s MACS J1149: 17 of 45 systems with up to 99 images each;
-/// the published model 3 - 7). Ranking the candidates by their folds' crowding instead did
-/// not work: the folds' maps, fitted to fewer systems, are less crowded than the map of all
-/// of them (24% against 38% there), and which maps crowd moves with the estimated redshifts
-/// (BENCHMARKS.md).
+/// is always near (Jauzac et al.'s MACS J1149: 22 of 45 systems, up to 92 images for 6
+/// observed; the published model 3 - 7). Ranking the candidates by their folds' crowding
+/// instead did not work: the folds' maps, fitted to fewer systems, are less crowded than the
+/// map of all of them (there 24% of the folds' systems against 38% and more of the map's),
+/// and which maps crowd moves with the estimated redshifts (BENCHMARKS.md).
 pub fn avoid_crowded_map(
     inputs: &Inputs<'_>,
     r: &Reconstruction,
     choice: &StrengthChoice,
     progress: &mut dyn FnMut(&ConvergenceRecord) -> Control,
 ) -> Result<(StrengthChoice, Option<Reconstruction>), ReconstructError> {
-    let crowding = Crowding::of(&r.sources);
     if !choice.was_cross_validated() || r.status == SolveStatus::Cancelled {
         return Ok((choice.clone(), None));
     }
@@ -823,7 +822,7 @@ pub fn avoid_crowded_map(
     let config = &r.config;
     let free = r.free_z.as_ref().filter(|f| !f.systems.is_empty());
     let (map, used, passed) = first_uncrowded(
-        crowding,
+        Crowding::of(&r.sources),
         choice.chosen_candidate(),
         &next,
         |r: &Reconstruction| Crowding::of(&r.sources),

@@ -182,9 +182,12 @@ export function showStrengthChoice(choice, estimated = [], shear = false) {
   const byKind = kinds.size > 1;
   const grids = new Set(rows.map((r) => r.cells).filter((c) => c != null));
   const byGrid = grids.size > 1;
-  const isChosen = (r) => r.strength === choice.chosen
-    && (choice.chosen_regulariser == null || r.regulariser == null || r.regulariser === choice.chosen_regulariser)
-    && (choice.chosen_cells == null || r.cells == null || r.cells === choice.chosen_cells);
+  // Two candidates are the same when their strengths are and their regulariser and grid, where
+  // both say one (results saved before those were candidates do not).
+  const same = (a, b) => a.strength === b.strength
+    && (a.regulariser == null || b.regulariser == null || a.regulariser === b.regulariser)
+    && (a.cells == null || b.cells == null || a.cells === b.cells);
+  const isChosen = (r) => same(r, { strength: choice.chosen, regulariser: choice.chosen_regulariser, cells: choice.chosen_cells });
   const grid = (cells) => `${esc(cells)} × ${esc(cells)} cells`;
   const bar = (v) => `<span class="bar-track" aria-hidden="true">${v == null ? ''
     : `<span class="bar" style="width:${(100 * v / top).toFixed(1)}%"></span>`}</span>`;
@@ -192,9 +195,7 @@ export function showStrengthChoice(choice, estimated = [], shear = false) {
   // Candidates that predicted best but whose maps were crowded, passed over (the core's
   // avoid_crowded_map).
   const passed = choice.crowded_maps ?? [];
-  const passedOf = (r) => passed.find((p) => p.strength === r.strength
-    && (p.regulariser == null || r.regulariser == null || p.regulariser === r.regulariser)
-    && (p.cells == null || r.cells == null || p.cells === r.cells));
+  const passedOf = (r) => passed.find((p) => same(p, r));
   const body = rows.map((r) => {
     const chosen = isChosen(r);
     const crowded = passedOf(r);
