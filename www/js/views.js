@@ -224,7 +224,8 @@ export function showStrengthChoice(choice, estimated = [], shear = false) {
     that predicted better ${passed.length === 1 ? 'was' : 'were'} passed over: ${passed.length === 1 ? 'its map predicts' : 'their maps predict'}
     more than twice as many images as observed for more than a third of the systems. Such a map's critical curves wind
     through the images' region, and a crowd of predicted images always has one near a held-out image, which flatters its
-    offsets; the verdict would not trust its small scales, so the next candidate whose map is not crowded was used.` : ''}</p>
+    offsets; the verdict would not trust its small scales, so the next candidates in order were fitted (at most three)
+    and the first map that is not crowded was used, else the least crowded.` : ''}</p>
     <div class="table-scroll"><table id="strength-table">
     <thead><tr><th scope="col">${byKind || byGrid ? 'candidate' : 'strength'}</th><th scope="col">held-out median</th>
     <th scope="col">held-out rms</th><th scope="col">fitted median</th>${unmatched ? '<th scope="col">unmatched</th>' : ''}</tr></thead>
