@@ -391,8 +391,18 @@ fn write_ensemble(
         .map_or("n/a".to_string(), |[a, b]| {
             format!("{a:.2} - {b:.2} arcsec")
         });
+    // Members whose first map was crowded and who fitted their draw's next candidates.
+    let moved = ensemble
+        .members
+        .iter()
+        .filter(|m| !m.crowded_maps.is_empty())
+        .count();
+    let moved = match moved {
+        0 => String::new(),
+        k => format!("; {k} passed over crowded maps for their next candidates"),
+    };
     println!(
-        "wrote {} ({} members: Einstein radius (16th - 84th percentile) {radius}; \
+        "wrote {} ({} members: Einstein radius (16th - 84th percentile) {radius}{moved}; \
          kappa-mean.fits, kappa-std.fits, magnif-p16/p50/p84.fits, range/)",
         out.join("ensemble.json").display(),
         ensemble.members.len()

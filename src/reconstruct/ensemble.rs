@@ -14,7 +14,12 @@
 //!   ([`StrengthChoice::best_for`]). Candidates the data cannot tell apart then share the
 //!   members, so the choice's own uncertainty is in the spread (on the six synthetic
 //!   clusters of `tests/data/fidelity`, 20 members: the main run's choice in 3 to 16 of
-//!   them);
+//!   them). A candidate whose map the main run passed over as crowded
+//!   ([`avoid_crowded_map`](super::avoid_crowded_map)) is none of the members' choices, and a
+//!   member whose own map is crowded moves on to the next candidates of its draw's ranking
+//!   as the main run does ([`MemberDraw::then`]; [`EnsembleMember::crowding`] says how
+//!   crowded the map it kept is), so that the spread describes maps the verdict would let
+//!   stand;
 //! - **the grid moved** by up to half a cell in x and y (uniform), so that where the cells fall
 //!   is not mistaken for structure;
 //! - **the members' mass-to-light law drawn**, when the run has a member catalogue: a factor
@@ -25,9 +30,10 @@
 //!
 //! The start is not varied: the default objective has one minimiser, which the exact solver
 //! finds from any start ([method §9]). Catalogue redshifts are not drawn (they carry no
-//! uncertainty); a system whose redshift the main run estimated is fitted by each member at a
-//! redshift drawn from that estimate (a normal of the interval's width on each side of the
-//! most probable value, not below the interval).
+//! uncertainty); a system whose redshift the main run estimated is drawn like the others and
+//! fitted, by each member that draws it, at a redshift drawn from that estimate (a normal of
+//! the interval's width on each side of the most probable value, not below the interval); a
+//! member that leaves it out does not predict it (its redshift came from the other systems).
 //!
 //! Every member's maps are sampled on the main run's map. The ensemble describes that map,
 //! the one the run reports:
@@ -55,8 +61,9 @@ use glam::DVec2;
 use serde::{Deserialize, Serialize};
 
 use super::{
-    fitted_system_ids, reconstruct, reconstruct_with_choice, Candidate, ConvergenceRecord, Inputs,
-    LayerSource, ReconstructConfig, ReconstructError, Reconstruction, Regulariser, StrengthChoice,
+    avoid_crowded_map_trying, fitted_system_ids, reconstruct, reconstruct_with_choice, Candidate,
+    ConvergenceRecord, CrowdedMap, Crowding, Inputs, LayerSource, ReconstructConfig,
+    ReconstructError, Reconstruction, Regulariser, StrengthChoice, CROWDED_MAP_RETRIES,
 };
 use crate::curves::CriticalCurves;
 use crate::error::BadFieldValue;
@@ -92,6 +99,15 @@ pub struct EnsembleMember {
     /// The grid's cells a side it used (`None`: the main run's).
     #[serde(default)]
     pub cells: Option<usize>,
+    /// How crowded its map is (systems predicted far more images than observed, of all):
+    /// the verdict's rule, [`Crowding::distrusted`]. `None` in an ensemble made before it
+    /// was kept.
+    #[serde(default)]
+    pub crowding: Option<Crowding>,
+    /// The candidates its draw ranked first whose maps were crowded, passed over for the one
+    /// it used ([`MemberDraw::then`]), in the order fitted.
+    #[serde(default)]
+    pub crowded_maps: Vec<CrowdedMap>,
     /// The factor on the members' mass-to-light law it used (drawn from
     /// `members.mass_to_light_scatter_dex`; 1 without member galaxies).
     #[serde(default = "unit_factor")]
@@ -254,7 +270,8 @@ pub struct EnsembleMaps {
 }
 
 const NOTE: &str = "Members differ in the systems fitted (bootstrap over systems), in the \
-     regulariser and strength an \"auto\" choice makes on those systems, in the grid's \
+     regulariser and strength an \"auto\" choice makes on those systems (passing over \
+     crowded maps as the main run does), in the grid's \
      placement (up to half a cell), in the redshifts of the systems whose redshift was \
      estimated (drawn from the estimate) and in the member galaxies' mass-to-light law \
      (drawn from members.mass_to_light_scatter_dex). The intervals and kappa-std describe \
@@ -505,6 +522,13 @@ pub struct MemberDraw {
     /// The grid's cells a side it uses with them (`None`: the main run's choice or settings).
     #[serde(default)]
     pub cells: Option<usize>,
+    /// The candidates its draw ranks next (at most [`CROWDED_MAP_RETRIES`]), fitted in turn
+    /// when its own map is crowded, as the main run's are
+    /// ([`avoid_crowded_map`](super::avoid_crowded_map)). Candidates
+    /// whose map the main run passed over as crowded are not among its own nor these
+    /// ([`StrengthChoice::ranked_for`]).
+    #[serde(default)]
+    pub then: Vec<Candidate>,
     /// The factor on the members' mass-to-light law it fits with: `10^(s n)`, `n` a
     /// standard normal and `s` = `members.mass_to_light_scatter_dex` (1 when the run has no
     /// member catalogue).
@@ -563,9 +587,9 @@ impl EnsemblePlan {
         seed: u64,
     ) -> Result<Self, ReconstructError> {
         check_ensemble_size(members)?;
-        // Systems whose redshift the main run estimated are fitted by every member, at a
-        // redshift drawn from the estimate (from a stream of their own: the other draws are
-        // those of an ensemble without them).
+        // Systems whose redshift the main run estimated are drawn like the others and fitted
+        // at a redshift drawn from the estimate (from a stream of their own: the other draws
+        // are those of an ensemble without them).
         let estimated = super::free_z::estimates_of(&main.sources);
         let mut fitting = config.clone();
         fitting.constraints.z_estimates = super::free_z::most_probable_of(&estimated);
@@ -603,8 +627,12 @@ impl EnsemblePlan {
                         .collect()
                 };
                 let shift = DVec2::new(rng.range(-0.5, 0.5), rng.range(-0.5, 0.5)) * cell;
-                let choice = main.strength_choice.as_ref().and_then(|c| {
-                    c.best_for(|id| ids.iter().position(|i| i == id).map_or(0, |k| counts[k]))
+                let ranked = main.strength_choice.as_ref().and_then(|c| {
+                    c.ranked_for(|id| ids.iter().position(|i| i == id).map_or(0, |k| counts[k]))
+                });
+                let choice = ranked.as_ref().and_then(|r| r.first().copied());
+                let then = ranked.map_or_else(Vec::new, |r| {
+                    r.into_iter().skip(1).take(CROWDED_MAP_RETRIES).collect()
                 });
                 MemberDraw {
                     member,
@@ -619,6 +647,7 @@ impl EnsemblePlan {
                     regulariser: choice.map(|c| c.regulariser),
                     strength: choice.map(|c| c.strength),
                     cells: choice.and_then(|c| c.cells),
+                    then,
                     member_mass_factor: 10f64.powf(law_scatter * law_rng.normal()),
                 }
             })
@@ -696,7 +725,7 @@ impl EnsemblePlan {
             holdout: &left_out,
             ..*inputs
         };
-        let r = match &self.strength_choice {
+        let mut r = match &self.strength_choice {
             Some(c) => {
                 let choice = match (draw.regulariser, draw.strength) {
                     (Some(regulariser), Some(strength)) => c.with_chosen(Candidate {
@@ -713,6 +742,23 @@ impl EnsemblePlan {
         if r.status == SolveStatus::Cancelled {
             return Ok(None);
         }
+        // A crowded map gives way to the next candidates of the draw's ranking, as the main
+        // run's does: the spread then describes maps the verdict would let stand.
+        let mut crowded_maps = Vec::new();
+        let mut used = (draw.regulariser, draw.strength, draw.cells);
+        if let Some(choice) = r.strength_choice.clone() {
+            let (choice, map) =
+                avoid_crowded_map_trying(&member_inputs, &r, &choice, &draw.then, progress)?;
+            crowded_maps.clone_from(&choice.crowded_maps);
+            match map {
+                Some(map) => {
+                    let c = choice.chosen_candidate();
+                    used = (Some(c.regulariser), Some(c.strength), c.cells);
+                    r = map;
+                }
+                None => r.strength_choice = Some(choice),
+            }
+        }
         let (kappa, magnif) = sampled_maps(&r, self.geometry);
         let summary = r.products.summary();
         let record = EnsembleMember {
@@ -720,9 +766,11 @@ impl EnsemblePlan {
             fitted: draw.fitted.clone(),
             grid_shift_arcsec: draw.grid_shift_arcsec,
             redshifts: draw.redshifts.clone(),
-            regulariser: draw.regulariser,
-            strength: draw.strength,
-            cells: draw.cells,
+            regulariser: used.0,
+            strength: used.1,
+            cells: used.2,
+            crowding: Some(Crowding::of(&r.sources)),
+            crowded_maps,
             member_mass_factor: draw.member_mass_factor,
             status: r.status.name().to_string(),
             c: r.member_factors(),
@@ -937,6 +985,8 @@ mod tests {
             regulariser: None,
             strength: None,
             cells: None,
+            crowding: None,
+            crowded_maps: Vec::new(),
             member_mass_factor: 1.0,
             status: "Converged".to_string(),
             c: Vec::new(),

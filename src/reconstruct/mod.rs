@@ -809,9 +809,6 @@ pub fn avoid_crowded_map(
     choice: &StrengthChoice,
     progress: &mut dyn FnMut(&ConvergenceRecord) -> Control,
 ) -> Result<(StrengthChoice, Option<Reconstruction>), ReconstructError> {
-    if !choice.was_cross_validated() || r.status == SolveStatus::Cancelled {
-        return Ok((choice.clone(), None));
-    }
     let mut next: Vec<&StrengthCandidate> = choice
         .candidates
         .iter()
@@ -819,12 +816,28 @@ pub fn avoid_crowded_map(
         .collect();
     next.sort_by(|p, q| predicts_better(p, q));
     let next: Vec<Candidate> = next.iter().map(|c| c.candidate()).collect();
+    avoid_crowded_map_trying(inputs, r, choice, &next, progress)
+}
+
+/// [`avoid_crowded_map`] trying `next` (the candidates after the chosen one, in the order to
+/// try them) when `r`'s map is crowded: an ensemble member tries them in the order its own
+/// draw ranks them ([`MemberDraw::then`]).
+pub(crate) fn avoid_crowded_map_trying(
+    inputs: &Inputs<'_>,
+    r: &Reconstruction,
+    choice: &StrengthChoice,
+    next: &[Candidate],
+    progress: &mut dyn FnMut(&ConvergenceRecord) -> Control,
+) -> Result<(StrengthChoice, Option<Reconstruction>), ReconstructError> {
+    if !choice.was_cross_validated() || r.status == SolveStatus::Cancelled {
+        return Ok((choice.clone(), None));
+    }
     let config = &r.config;
     let free = r.free_z.as_ref().filter(|f| !f.systems.is_empty());
     let (map, used, passed) = first_uncrowded(
         Crowding::of(&r.sources),
         choice.chosen_candidate(),
-        &next,
+        next,
         |r: &Reconstruction| Crowding::of(&r.sources),
         |candidate| {
             let fixed = candidate.apply(config);
@@ -1097,14 +1110,23 @@ impl StrengthChoice {
 
     /// The candidate (regulariser, strength, grid) this choice's rule picks when the held-out
     /// systems count `weight(id)` times each (a bootstrap draw: 0 for a system not drawn, 2
-    /// for one drawn twice): the fewest unmatched images, then the smallest median offset,
-    /// both over the drawn systems' images. `None` without the candidates' per-system
-    /// offsets (a choice made before they were kept) or when no drawn system was predicted.
+    /// for one drawn twice): the first of [`Self::ranked_for`].
     ///
     /// An ensemble member re-makes the choice this way on its own draw, so that the
     /// uncertainty of the choice itself (which candidates the data cannot tell apart) enters
     /// the ensemble's spread without running the cross-validation again.
     pub fn best_for(&self, weight: impl Fn(&str) -> usize) -> Option<Candidate> {
+        self.ranked_for(weight)?.into_iter().next()
+    }
+
+    /// The candidates in the order this choice's rule ranks them when the held-out systems
+    /// count `weight(id)` times each: the fewest unmatched images, then the smallest median
+    /// offset, both over the drawn systems' images (the candidates' order on a tie). Left
+    /// out: candidates none of whose drawn systems was predicted, and those whose map of every
+    /// system was passed over as crowded ([`Self::crowded_maps`]; a draw's map would be much
+    /// the same). `None` without the candidates' per-system offsets (a choice made before
+    /// they were kept).
+    pub fn ranked_for(&self, weight: impl Fn(&str) -> usize) -> Option<Vec<Candidate>> {
         let score = |c: &StrengthCandidate| {
             let mut unmatched = 0;
             let mut offsets = Vec::new();
@@ -1127,11 +1149,19 @@ impl StrengthChoice {
         {
             return None;
         }
-        self.candidates
+        let passed_over = |c: &StrengthCandidate| {
+            self.crowded_maps
+                .iter()
+                .any(|p| p.candidate == c.candidate())
+        };
+        let mut scored: Vec<((usize, f64), Candidate)> = self
+            .candidates
             .iter()
-            .filter_map(|c| Some((score(c)?, c)))
-            .min_by(|(a, _), (b, _)| a.0.cmp(&b.0).then(a.1.total_cmp(&b.1)))
-            .map(|(_, c)| c.candidate())
+            .filter(|c| !passed_over(c))
+            .filter_map(|c| Some((score(c)?, c.candidate())))
+            .collect();
+        scored.sort_by(|(a, _), (b, _)| a.0.cmp(&b.0).then(a.1.total_cmp(&b.1)));
+        Some(scored.into_iter().map(|(_, c)| c).collect())
     }
 
     /// The same choice with `chosen` used instead of the chosen candidate (an ensemble
@@ -1983,6 +2013,18 @@ mod tests {
         );
         // Nothing drawn that was predicted: no choice.
         assert_eq!(choice.best_for(|_| 0), None);
+        assert_eq!(
+            choice.ranked_for(|_| 1),
+            Some(vec![pick(c, 0.1, 32), pick(g, 0.01, 24)])
+        );
+        // A candidate whose map of every system was passed over as crowded is no draw's.
+        let mut passed = choice.clone();
+        passed.crowded_maps = vec![CrowdedMap {
+            candidate: pick(c, 0.1, 32),
+            crowding: crowding(20),
+        }];
+        assert_eq!(passed.ranked_for(|_| 1), Some(vec![pick(g, 0.01, 24)]));
+        assert_eq!(passed.best_for(|_| 1), Some(pick(g, 0.01, 24)));
     }
 
     #[test]

@@ -450,3 +450,62 @@ fn an_old_or_corrupt_stored_ensemble_still_opens_the_project() {
         assert!(t.result().unwrap().reconstruction().is_some(), "{case}");
     }
 }
+
+/// An ensemble of an "auto" run whose chosen map was crowded: no member uses the candidate
+/// passed over for it, each records its own map's crowding, and a member whose first map is
+/// crowded moves on to the next candidates of its own draw's ranking as the main run does.
+/// The setting's finer grid crowds every system (`crowding_auto_session`). Natively only: an "auto" run with its folds takes minutes in a wasm test.
+#[cfg(not(target_arch = "wasm32"))]
+#[test]
+fn ensemble_members_pass_over_crowded_maps() {
+    use wslap::Candidate;
+    let mut s = crate::fixtures::crowding_auto_session();
+    s.set_field("ensemble.members", json!(6)).unwrap();
+    s.set_field("ensemble.seed", json!(3)).unwrap();
+    s.run(RunKind::Reconstruct, &mut |_| Control::Continue)
+        .unwrap();
+    let plan = s.ensemble_plan().unwrap().unwrap();
+    let choice = plan.strength_choice.as_ref().expect("auto");
+    let passed: Vec<Candidate> = choice.crowded_maps.iter().map(|p| p.candidate).collect();
+    assert!(!passed.is_empty(), "{choice:?}");
+    let runs: Vec<_> = (1..=plan.members())
+        .map(|k| {
+            s.ensemble_member(&plan, k, &mut |_| Control::Continue)
+                .unwrap()
+        })
+        .collect();
+    let used = |r: &EnsembleMember| Candidate {
+        regulariser: r.regulariser.unwrap(),
+        strength: r.strength.unwrap(),
+        cells: r.cells,
+    };
+    let mut moved = 0;
+    for (draw, run) in plan.draws.iter().zip(&runs) {
+        let r = &run.record;
+        assert!(!passed.contains(&used(r)), "member {}: {r:?}", r.member);
+        assert!(draw.then.iter().all(|c| !passed.contains(c)), "{draw:?}");
+        let crowding = r.crowding.expect("recorded");
+        assert_eq!(crowding.systems, 4);
+        if r.crowded_maps.is_empty() {
+            // Its first map stood, so it was not crowded.
+            assert!(!crowding.distrusted(), "member {}: {r:?}", r.member);
+            assert_eq!(used(r).strength, draw.strength.unwrap());
+        } else {
+            // It tried its draw's next candidates in order and kept the first uncrowded map,
+            // else the least crowded.
+            moved += 1;
+            let tried: Vec<Candidate> = r.crowded_maps.iter().map(|p| p.candidate).collect();
+            assert_eq!(tried[0].strength, draw.strength.unwrap(), "{r:?}");
+            assert_eq!(&tried[1..], &draw.then[..tried.len() - 1], "{r:?}");
+            assert!(r.crowded_maps.iter().all(|p| p.crowding.distrusted()));
+            assert!(!tried.contains(&used(r)), "{r:?}");
+        }
+    }
+    eprintln!(
+        "members that moved off a crowded map: {moved} of {}",
+        runs.len()
+    );
+    s.set_ensemble(&plan, runs, true).unwrap();
+    let json: serde_json::Value = serde_json::from_str(&s.ensemble_json().unwrap()).unwrap();
+    assert!(json["members"][0]["crowding"]["systems"].is_u64(), "{json}");
+}

@@ -340,19 +340,7 @@ fn a_refined_grid_runs_and_its_project_asks_for_a_new_solve() {
 #[cfg(not(target_arch = "wasm32"))]
 #[test]
 fn second_round_in_pieces_equals_one_auto_run() {
-    let mut s = teaching_session();
-    for (path, value) in [
-        ("reconstruct.objective.strength", json!("auto")),
-        ("reconstruct.objective.candidates", json!([0.01, 1.0])),
-        ("reconstruct.objective.auto_grid_scales", json!([0.5, 1.0])),
-        (
-            "reconstruct.objective.auto_regularisers",
-            json!(["gradient"]),
-        ),
-        ("reconstruct.constraints.free_z_systems", json!(["4"])),
-    ] {
-        s.set_field(path, value).unwrap();
-    }
+    let mut s = crate::fixtures::crowding_auto_session();
     let (candidates, folds) = s.strength_plan().unwrap().expect("auto has a plan");
     assert_eq!((candidates.len(), folds), (4, 3));
     let trials = |s: &Session, e: Option<&wslap::EstimatedRedshifts>| -> Vec<_> {

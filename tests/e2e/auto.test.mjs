@@ -208,7 +208,7 @@ test('a choice that passed over a crowded map says so, at 1280 px and on a phone
     // The other rows carry no such mark.
     assert.equal(await page.locator('#strength-table .mark.passed').count(), 1);
     const summary = (await page.textContent('#strength-summary')).replace(/\s+/g, ' ');
-    assert.match(summary, /predicted best of those whose maps are not crowded\./);
+    assert.match(summary, /predicted best, crowded maps passed over \(below\)\./);
     assert.match(summary, /One candidate that predicted better was passed over: its map predicts more than twice as many images as observed for more than a third of the systems\./);
     await box.screenshot({ path: join(ARTIFACTS, 'app-auto-crowded.png') });
     await page.setViewportSize({ width: 390, height: 844 });

@@ -88,6 +88,9 @@ test('an ensemble of the built-in example gives the spread view, the downloads a
     // Every member says where it predicts the images of the systems it left out; where three
     // of them predict one image, the box says how their misses compare with their spread.
     assert.ok(ensemble.members.every((m) => Array.isArray(m.left_out_images)));
+    // Every member says how crowded its map is; the box says when a member's first one was.
+    assert.ok(ensemble.members.every((m) => Number.isInteger(m.crowding?.systems)));
+    assert.equal(await page.isVisible('#ensemble-crowded'), ensemble.members.some((m) => m.crowded_maps.length > 0));
     assert.equal(await page.isVisible('#ensemble-calibration'), ensemble.calibration != null);
     if (ensemble.calibration) {
       assert.match(await page.innerText('#ensemble-calibration'), /miss by a median of \d+\.\d\d″ for a spread of/);
@@ -100,6 +103,42 @@ test('an ensemble of the built-in example gives the spread view, the downloads a
     const overflow = await page.evaluate(() => document.documentElement.scrollWidth - window.innerWidth);
     assert.ok(overflow <= 0, `page is ${overflow}px wider than a phone`);
     await page.locator('#ensemble-box').screenshot({ path: join(ARTIFACTS, 'app-ensemble-result-phone.png') });
+    assert.deepEqual(app.consoleErrors, []);
+  } finally {
+    await app.close();
+  }
+});
+
+test('members that passed over crowded maps are said under the views, at 1280 px and on a phone', async () => {
+  // The shape of Jauzac et al.'s MACS J1149 ensemble (BENCHMARKS.md): of four members, one
+  // kept its first map, two moved off crowded ones, and one found none uncrowded.
+  const member = (k, crowded, passed) => ({
+    member: k, fitted: [], grid_shift_arcsec: [0, 0], redshifts: [], regulariser: 'gradient', strength: 0.1,
+    cells: 32, crowding: { crowded_systems: crowded, systems: 40 }, member_mass_factor: 1, status: 'Converged',
+    c: [0.5], einstein_radius_arcsec: 24 + k, mass_within_arcsec: [], left_out_image_offset_median_arcsec: 0.8,
+    left_out_images: [], elapsed_ms: 1000,
+    crowded_maps: passed.map((n) => ({ regulariser: 'density', strength: 0.01, cells: 32, crowded_systems: n, systems: 40 })),
+  });
+  const ensemble = {
+    status: 'Completed', seed: 1, z_source: 2, note: 'What the spread includes.', maps: false,
+    members: [member(1, 2, []), member(2, 3, [20]), member(3, 8, [25, 18]), member(4, 16, [30, 22, 19])],
+    einstein_radius_interval_arcsec: [22.1, 27.9], mass_within_interval_msun: [], calibration: null,
+  };
+  const app = await openApp();
+  try {
+    const { page } = app;
+    await waitStatus(page, /^Ready/);
+    await page.evaluate(async (e) => (await import('./js/ensemble.js')).showEnsemble(e, {}), ensemble);
+    const text = (await page.innerText('#ensemble-crowded')).replace(/\s+/g, ' ');
+    assert.match(text, /^3 of 4 members' first maps predicted far more images than observed for more than a third of the systems/);
+    assert.match(text, /, and 1 found none better and kept the least crowded\.$/);
+    const box = page.locator('#ensemble-box');
+    await box.scrollIntoViewIfNeeded();
+    await box.screenshot({ path: join(ARTIFACTS, 'app-ensemble-crowded.png') });
+    await page.setViewportSize({ width: 390, height: 844 });
+    const overflow = await page.evaluate(() => document.documentElement.scrollWidth - window.innerWidth);
+    assert.ok(overflow <= 0, `page is ${overflow}px wider than a phone`);
+    await box.screenshot({ path: join(ARTIFACTS, 'app-ensemble-crowded-phone.png') });
     assert.deepEqual(app.consoleErrors, []);
   } finally {
     await app.close();

@@ -204,12 +204,20 @@ export function showEnsemble(ensemble, app) {
     the members' predictions miss by a median of ${fixed(c.miss_median_arcsec, 2)}″ for a spread of
     ${fixed(c.spread_median_arcsec, 2)}″ (ratio ${fixed(c.ratio, 2)}, 1 when the spread is the error): ${c.factor > 1
     ? `the intervals and κ's spread are widened ×${fixed(c.factor, 2)}` : 'the intervals are the members\' own spread'}.</p>` : '';
+  // Members whose first map was crowded (the verdict's rule) and who fitted their draw's next
+  // candidates, as the main run does; some may have found none uncrowded.
+  const moved = ensemble.members.filter((m) => m.crowded_maps?.length);
+  const still = moved.filter((m) => m.crowding && 3 * m.crowding.crowded_systems > m.crowding.systems);
+  const crowded = moved.length ? `<p id="ensemble-crowded">${moved.length} of ${n} members' first maps predicted far
+    more images than observed for more than a third of the systems (critical curves winding through the images):
+    those members fitted the next candidates of their own draw instead, as this map's choice does${still.length
+    ? `, and ${still.length} found none better and kept the least crowded` : ''}.</p>` : '';
   box.innerHTML = `<h3>Ensemble of ${n} members (seed ${ensemble.seed})</h3>
     <p id="ensemble-summary">How sure the map is: ${n} more reconstructions, each fitting a bootstrap draw of the
     systems on a grid moved by up to half a cell. Einstein radius at z_s = ${ensemble.z_source}, 68% interval
     about this map: <b>${r ? `${fixed(r[0], 2)} – ${fixed(r[1], 2)}″` : 'none'}</b>${radii.length ? ` (members
     ${fixed(Math.min(...radii), 2)} – ${fixed(Math.max(...radii), 2)}″)` : ''}. Projected mass:</p>
-    <ul id="ensemble-masses">${masses}</ul>${calibration}
+    <ul id="ensemble-masses">${masses}</ul>${calibration}${crowded}
     <p class="hint">${ensemble.note}${maps ? ` The tab "Ensemble spread" shows κ's spread about this map; a click
     on the mass map reads out the magnification's 16th – 84th percentiles over the members.` : ''}</p>`;
   box.append(...buttons(), missing());

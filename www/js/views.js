@@ -214,7 +214,7 @@ export function showStrengthChoice(choice, estimated = [], shear = false) {
   const tried = [byKind && 'regulariser', 'strength', byGrid && 'grid'].filter(Boolean);
   box.innerHTML = `<h3>Regulariser ${what}, chosen by cross-validation</h3>
     <p id="strength-summary">The ${tried.length > 1 ? `${tried.slice(0, -1).join(', ')} and ${tried.at(-1)}` : 'strength'} whose held-out images were
-    predicted best${passed.length ? ' of those whose maps are not crowded' : ''}. Each candidate was tried over ${choice.folds} folds: every fold fits the lens without some of
+    predicted best${passed.length ? ', crowded maps passed over (below)' : ''}. Each candidate was tried over ${choice.folds} folds: every fold fits the lens without some of
     the systems and predicts their images, so the held-out offsets say how well the map finds images it was not
     given (smaller is better), while the fitted median says how closely it reproduces those it was given.
     Offsets from the predictions in arcsec${unmatched ? '; unmatched: held-out images with no predicted image, which count first' : ''}.${
