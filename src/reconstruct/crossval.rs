@@ -8,6 +8,11 @@
 //! inverse lens Jacobian as the image-plane fit weighs them, then the lens equation solved
 //! forward). So every system is predicted once, by a lens that never saw it.
 //!
+//! With an "auto" strength each fold makes the whole choice again on the systems it fits,
+//! crowded maps passed over as in the whole run (their crowding counted over the fold's
+//! fitted systems only, so that the group it predicts has no say in its map); each fold's
+//! `chosen`, `crowded_maps` and `crowding` in `crossval.json` say what it used.
+//!
 //! A fit's own image offsets say how well the model reproduces its constraints; these say how
 //! well it predicts, which is what matters when a model is used to look for new images or to
 //! choose between settings. A free-form grid with many more cells than constraints can fit
@@ -19,8 +24,8 @@ use serde::{Deserialize, Serialize};
 
 use super::summary::{image_offsets_arcsec, median_arcsec, rms_arcsec};
 use super::{
-    reconstruct_free_z, ConvergenceRecord, Inputs, ReconstructConfig, ReconstructError,
-    Reconstruction, SourceReport,
+    reconstruct_free_z, Candidate, ConvergenceRecord, CrowdedMap, Crowding, Inputs,
+    ReconstructConfig, ReconstructError, Reconstruction, SourceReport,
 };
 use crate::curves::CriticalCurves;
 use crate::fits::{write_image, Card, FitsWriteOptions};
@@ -62,6 +67,16 @@ pub struct FoldRun {
     pub fit_image_offset_median_arcsec: Option<f64>,
     /// Median offset of the held-out systems' images from their predictions (arcsec).
     pub holdout_image_offset_median_arcsec: Option<f64>,
+    /// With an "auto" strength, what the fold's own choice used (`None`: a fixed strength).
+    #[serde(default)]
+    pub chosen: Option<Candidate>,
+    /// The candidates its choice passed over because their maps were crowded, as the whole
+    /// run's does ([`super::avoid_crowded_map`]).
+    #[serde(default)]
+    pub crowded_maps: Vec<CrowdedMap>,
+    /// How crowded its map is over the systems it fitted ([`Crowding::of_fitted`]).
+    #[serde(default)]
+    pub crowding: Option<Crowding>,
     /// Wall-clock time of the fold (ms).
     pub elapsed_ms: f64,
 }
@@ -448,6 +463,12 @@ fn run_fold(
         mass_within_arcsec: summary.mass_within_arcsec,
         fit_image_offset_median_arcsec: r.image_offset_median_arcsec(false),
         holdout_image_offset_median_arcsec: median_arcsec(image_offsets_arcsec(predicted.iter())),
+        chosen: r.strength_choice.as_ref().map(|c| c.chosen_candidate()),
+        crowded_maps: r
+            .strength_choice
+            .as_ref()
+            .map_or_else(Vec::new, |c| c.crowded_maps.clone()),
+        crowding: Some(Crowding::of_fitted(&r.sources)),
         elapsed_ms: clock.ms(),
     };
     Ok(Some(FoldOutcome {

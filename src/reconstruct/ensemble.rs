@@ -99,8 +99,9 @@ pub struct EnsembleMember {
     /// The grid's cells a side it used (`None`: the main run's).
     #[serde(default)]
     pub cells: Option<usize>,
-    /// How crowded its map is (systems predicted far more images than observed, of all):
-    /// the verdict's rule, [`Crowding::distrusted`]. `None` in an ensemble made before it
+    /// How crowded its map is over the systems it fitted (those predicted far more images
+    /// than observed, of all it fitted: [`Crowding::of_fitted`], what its choice looked at;
+    /// the verdict's rule, [`Crowding::distrusted`]). `None` in an ensemble made before it
     /// was kept.
     #[serde(default)]
     pub crowding: Option<Crowding>,
@@ -769,7 +770,7 @@ impl EnsemblePlan {
             regulariser: used.0,
             strength: used.1,
             cells: used.2,
-            crowding: Some(Crowding::of(&r.sources)),
+            crowding: Some(Crowding::of_fitted(&r.sources)),
             crowded_maps,
             member_mass_factor: draw.member_mass_factor,
             status: r.status.name().to_string(),

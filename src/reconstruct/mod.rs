@@ -519,6 +519,8 @@ pub fn reconstruct(
 
 /// [`reconstruct`], and with `free_z` false without estimating any redshift (the systems
 /// without one stay out: cross-validation folds, which compare the fits of the same systems).
+/// Either way an "auto" choice whose map is crowded gives way to the next candidates
+/// ([`with_uncrowded_map`]): a fold runs the method the whole run does.
 pub(crate) fn reconstruct_free_z(
     inputs: &Inputs<'_>,
     config: &ReconstructConfig,
@@ -538,10 +540,7 @@ pub(crate) fn reconstruct_free_z(
         Some(choice) => with_choice(inputs, config, choice, free_z, progress).and_then(|r| {
             crate::threads::with_limit(config.system.threads, || {
                 let r = choose_again_with_estimates(inputs, r, progress)?;
-                match free_z {
-                    true => with_uncrowded_map(inputs, r, progress),
-                    false => Ok(r),
-                }
+                with_uncrowded_map(inputs, r, progress)
             })
         }),
         None => crate::threads::with_limit(config.system.threads, || {
@@ -787,7 +786,9 @@ pub const CROWDED_MAP_RETRIES: usize = 3;
 
 /// What becomes of `r`, the map of an "auto" `choice`'s last round, when the verdict would
 /// distrust it for crowding ([`Crowding::distrusted`]: more than a third of its systems
-/// predicted far more images than observed): the next candidates in the choice's order are
+/// predicted far more images than observed; counted over the systems it fits,
+/// [`Crowding::of_fitted`], so that held-out systems test the choice and do not make it):
+/// the next candidates in the choice's order are
 /// fitted in turn, at most [`CROWDED_MAP_RETRIES`] of them (the systems at an estimated
 /// redshift at `r`'s estimates, made consistent with each map as before), and the first
 /// map that is not crowded is kept, else the least crowded. Returns the choice `r` is to
@@ -835,10 +836,10 @@ pub(crate) fn avoid_crowded_map_trying(
     let config = &r.config;
     let free = r.free_z.as_ref().filter(|f| !f.systems.is_empty());
     let (map, used, passed) = first_uncrowded(
-        Crowding::of(&r.sources),
+        Crowding::of_fitted(&r.sources),
         choice.chosen_candidate(),
         next,
-        |r: &Reconstruction| Crowding::of(&r.sources),
+        |r: &Reconstruction| Crowding::of_fitted(&r.sources),
         |candidate| {
             let fixed = candidate.apply(config);
             let mut fit = match free {

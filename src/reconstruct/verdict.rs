@@ -60,14 +60,28 @@ pub struct Crowding {
 }
 
 impl Crowding {
-    /// The crowding of the map `sources` were predicted on (every system, fitted or held out).
+    /// The crowding of the map `sources` were predicted on (every system, fitted or held out):
+    /// what the verdict says of the map.
     pub fn of(sources: &[SourceReport]) -> Self {
+        Self::of_systems(sources.iter())
+    }
+
+    /// The crowding of the systems the map was fitted to, those held out left aside: what a
+    /// choice of the map may look at without using the systems it is tested on (a fold's
+    /// group, the `--holdout` systems, an ensemble member's left-out draw).
+    pub fn of_fitted(sources: &[SourceReport]) -> Self {
+        Self::of_systems(sources.iter().filter(|s| !s.held_out))
+    }
+
+    fn of_systems<'a>(sources: impl Iterator<Item = &'a SourceReport>) -> Self {
+        let (mut crowded_systems, mut systems) = (0, 0);
+        for s in sources {
+            systems += 1;
+            crowded_systems += usize::from(SystemCheck::of(s).far_more_predicted());
+        }
         Self {
-            crowded_systems: sources
-                .iter()
-                .filter(|s| SystemCheck::of(s).far_more_predicted())
-                .count(),
-            systems: sources.len(),
+            crowded_systems,
+            systems,
         }
     }
 
@@ -839,6 +853,19 @@ mod tests {
         assert_eq!(one.crowded_systems, 1);
         assert!(!one.distrusted());
         assert!(one.less_than(&crowding) && !crowding.less_than(&one));
+        // A held-out system counts for the verdict, which describes the map, not for the
+        // choice of the map, which it tests.
+        let mut held = sources.clone();
+        held[0] = pair_with("Q", 20);
+        held[0].held_out = true;
+        assert_eq!(Crowding::of(&held).crowded_systems, 2);
+        assert_eq!(
+            Crowding::of_fitted(&held),
+            Crowding {
+                crowded_systems: 1,
+                systems: 4
+            }
+        );
         // 1 of 3 is a third, not more; 2 of 6 against 1 of 3: the same share.
         let (third, sixth) = (
             Crowding {

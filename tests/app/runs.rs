@@ -332,6 +332,39 @@ fn a_refined_grid_runs_and_its_project_asks_for_a_new_solve() {
     assert_eq!(report.result, "solve_needed", "{}", report.message);
 }
 
+/// Cross-validation of an "auto" run: each fold makes the choice again on the systems it fits
+/// and, as the whole run does, passes over a map crowded over those systems (the group it
+/// predicts has no say). Natively only, as the test below.
+#[cfg(not(target_arch = "wasm32"))]
+#[test]
+fn folds_pass_over_crowded_maps_as_the_whole_run_does() {
+    let mut s = crate::fixtures::crowding_auto_session();
+    s.run(RunKind::Reconstruct, &mut |_| Control::Continue)
+        .unwrap();
+    // System 4's redshift was estimated: every fold fits it, and holds out one of the others.
+    let cv = s.cross_validate(3, &mut |_, _| Control::Continue).unwrap();
+    assert_eq!(cv.runs.len(), 3);
+    let mut moved = 0;
+    for run in &cv.runs {
+        let chosen = run.chosen.expect("an auto choice");
+        let crowding = run.crowding.expect("recorded");
+        assert_eq!(crowding.systems, 4 - run.held_out.len(), "{run:?}");
+        if run.crowded_maps.is_empty() {
+            assert!(!crowding.distrusted(), "{run:?}");
+        } else {
+            moved += 1;
+            assert!(
+                run.crowded_maps
+                    .iter()
+                    .all(|p| p.crowding.distrusted() && p.candidate != chosen),
+                "{run:?}"
+            );
+        }
+    }
+    eprintln!("folds that passed over a crowded map: {moved} of 3");
+    assert!(moved > 0, "{:?}", cv.runs);
+}
+
 /// A run that estimates a redshift chooses its strength twice: from the systems with a
 /// redshift, then again with the estimated one fitted in every fold. In pieces, as the app's
 /// workers run it (the first round's trials, the reconstruction, the second round's trials

@@ -220,3 +220,39 @@ test('a choice that passed over a crowded map says so, at 1280 px and on a phone
     await app.close();
   }
 });
+
+test('a cross-validation of an "auto" run says what each fold chose, at 1280 px and on a phone', async () => {
+  // Three folds of an "auto" run: two chose gradient 0.1, one passed over a crowded least-mass map.
+  const run = (fold, chosen, passed) => ({
+    fold, held_out: [String(fold)], status: 'Converged', iterations: 12, c: [0.5], grid_mass_msun: 1e14,
+    einstein_radius_arcsec: 24 + fold / 10, einstein_radius_z_source: 2, mass_within_arcsec: [],
+    fit_image_offset_median_arcsec: 0.3, holdout_image_offset_median_arcsec: 0.7, elapsed_ms: 1000,
+    chosen, crowding: { crowded_systems: 2, systems: 30 },
+    crowded_maps: passed ? [{ regulariser: 'density', strength: 0.01, cells: 32, crowded_systems: 14, systems: 30 }] : [],
+  });
+  const gradient = { regulariser: 'gradient', strength: 0.1, cells: 32 };
+  const cv = {
+    folds: 3, status: 'Completed', holdout_images: 30, holdout_images_unmatched: 0,
+    holdout_image_offset_median_arcsec: 0.7, holdout_image_plane_rms_arcsec: 1.4, fit_image_offset_median_arcsec: 0.3,
+    runs: [run(1, gradient, false), run(2, gradient, true), run(3, { regulariser: 'curvature', strength: 1, cells: 16 }, false)],
+    always_fitted: [], systems: [],
+  };
+  const app = await openApp();
+  try {
+    const { page } = app;
+    await waitStatus(page, /^Ready/);
+    await page.evaluate(async (c) => (await import('./js/views.js')).showCrossval(c, () => {}), cv);
+    const text = (await page.textContent('#crossval-summary')).replace(/\s+/g, ' ');
+    assert.match(text, /each fold chose again on its own systems: gradient 0\.1 on 32 × 32 cells \(2 folds\), curvature 1 on 16 × 16 cells \(1 fold\); 1 of 3 passed over a crowded map first, as the reconstruction does\./);
+    const box = page.locator('#crossval-box');
+    await box.scrollIntoViewIfNeeded();
+    await box.screenshot({ path: join(ARTIFACTS, 'app-crossval-auto.png') });
+    await page.setViewportSize({ width: 390, height: 844 });
+    const overflow = await page.evaluate(() => document.documentElement.scrollWidth - window.innerWidth);
+    assert.ok(overflow <= 0, `page is ${overflow}px wider than a phone`);
+    await box.screenshot({ path: join(ARTIFACTS, 'app-crossval-auto-phone.png') });
+    assert.deepEqual(app.consoleErrors, []);
+  } finally {
+    await app.close();
+  }
+});

@@ -299,6 +299,18 @@ export function showCrossval(cv, onDownload, files = []) {
   const spread = runs.length < 2 ? '' : ` Across the folds the Einstein radius at z_s = ${runs[0].einstein_radius_z_source} is
     ${span(thetas, 1)}″${factors.length ? ` and the member factor C is ${factors.join(', ')}` : ''}: how much the answer
     depends on which systems are fitted.${masses.length ? ` Their projected mass: ${masses.join('; ')}.` : ''}`;
+  // With an "auto" strength each fold chose again on its own systems (crossval.json's `chosen`),
+  // passing over crowded maps as the run does.
+  const choices = new Map();
+  for (const r of runs.filter((r) => r.chosen)) {
+    const c = r.chosen;
+    const key = `${esc(c.regulariser)} ${esc(c.strength)}${c.cells != null ? ` on ${esc(c.cells)} × ${esc(c.cells)} cells` : ''}`;
+    choices.set(key, (choices.get(key) ?? 0) + 1);
+  }
+  const passedOver = runs.filter((r) => r.crowded_maps?.length).length;
+  const chose = choices.size ? ` With the "auto" strength each fold chose again on its own systems: ${[...choices]
+    .map(([key, n]) => `${key} (${n} ${n === 1 ? 'fold' : 'folds'})`).join(', ')}${passedOver ? `; ${passedOver} of
+    ${runs.length} passed over a crowded map first, as the reconstruction does` : ''}.` : '';
   const rows = cv.systems.map((s) => `<tr><th scope="row">${esc(s.id)}</th><td>${s.fold}</td><td>${fmt(s.z, 3)}</td>
     ${offsetsCell(s.observed)}
     <td>${fmt(s.image_plane_rms_arcsec)}</td></tr>`).join('');
@@ -307,7 +319,7 @@ export function showCrossval(cv, onDownload, files = []) {
     that group's images, so every system is predicted once by a lens that never saw it. Held-out images lie ${fmt(cv.holdout_image_offset_median_arcsec)}″ from
     their predictions (median; rms ${fmt(cv.holdout_image_plane_rms_arcsec)}″), the fitted ones
     ${fmt(cv.fit_image_offset_median_arcsec)}″: the first says how well these settings find images the model
-    was not given.${spread}${always}${unmatched}${cancelled}</p>
+    was not given.${spread}${chose}${always}${unmatched}${cancelled}</p>
     <details id="crossval-systems"><summary>Per system (${cv.systems.length})</summary>
     <p class="table-caption" id="crossval-caption">Per held-out system: the fold that left it out, its redshift, each
     observed image's offset from the nearest predicted image (arcsec) with the fold's magnification there, and their rms</p>
