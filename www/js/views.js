@@ -159,6 +159,9 @@ const esc = (text) => String(text).replace(/[&<>"']/g, (c) => `&#${c.charCodeAt(
 /** A number with `d` decimals, or a dash when there is none. */
 const fmt = (v, d = 2) => (v == null ? '–' : Number(v).toFixed(d));
 
+/** A candidate's grid of `cells` a side, in words. */
+const grid = (cells) => `${esc(cells)} × ${esc(cells)} cells`;
+
 /** The curve an "auto" regulariser strength was chosen from (summary.json's
  * `strength_choice`): per candidate strength (and regulariser, when several were tried) the
  * held-out images' median and rms offsets from their predictions, with a bar for the median,
@@ -188,7 +191,6 @@ export function showStrengthChoice(choice, estimated = [], shear = false) {
     && (a.regulariser == null || b.regulariser == null || a.regulariser === b.regulariser)
     && (a.cells == null || b.cells == null || a.cells === b.cells);
   const isChosen = (r) => same(r, { strength: choice.chosen, regulariser: choice.chosen_regulariser, cells: choice.chosen_cells });
-  const grid = (cells) => `${esc(cells)} × ${esc(cells)} cells`;
   const bar = (v) => `<span class="bar-track" aria-hidden="true">${v == null ? ''
     : `<span class="bar" style="width:${(100 * v / top).toFixed(1)}%"></span>`}</span>`;
   const mark = ' <span class="mark">✓ chosen</span>';
@@ -248,7 +250,7 @@ function estimatedNote(choice, estimated, byKind, byGrid) {
   const same = first.strength === choice.chosen && first.regulariser === choice.chosen_regulariser
     && first.cells === choice.chosen_cells;
   const named = `${byKind ? `${esc(first.regulariser)} at strength ` : 'strength '}${esc(first.strength)}${
-    byGrid && first.cells != null ? ` on ${esc(first.cells)} × ${esc(first.cells)} cells` : ''}`;
+    byGrid && first.cells != null ? ` on ${grid(first.cells)}` : ''}`;
   return ` ${which} had no redshift: ${one ? 'its redshift was' : 'their redshifts were'} estimated on the map the
     systems with one chose (${named}), then every candidate was tried again with ${one ? 'it' : 'them'} fitted in
     every fold at ${one ? 'that redshift' : 'those redshifts'}, as the map fits ${one ? 'it' : 'them'}, and only the
@@ -304,7 +306,7 @@ export function showCrossval(cv, onDownload, files = []) {
   const choices = new Map();
   for (const r of runs.filter((r) => r.chosen)) {
     const c = r.chosen;
-    const key = `${esc(c.regulariser)} ${esc(c.strength)}${c.cells != null ? ` on ${esc(c.cells)} × ${esc(c.cells)} cells` : ''}`;
+    const key = `${esc(c.regulariser)} ${esc(c.strength)}${c.cells != null ? ` on ${grid(c.cells)}` : ''}`;
     choices.set(key, (choices.get(key) ?? 0) + 1);
   }
   const passedOver = runs.filter((r) => r.crowded_maps?.length).length;
