@@ -454,7 +454,8 @@ fn an_old_or_corrupt_stored_ensemble_still_opens_the_project() {
 /// An ensemble of an "auto" run whose chosen map was crowded: no member uses the candidate
 /// passed over for it, each records its own map's crowding, and a member whose first map is
 /// crowded moves on to the next candidates of its own draw's ranking as the main run does.
-/// The setting's finer grid crowds every system (`crowding_auto_session`). Natively only: an "auto" run with its folds takes minutes in a wasm test.
+/// The setting's finer grid crowds every system (`crowding_auto_session`). Natively only: an
+/// "auto" run with its folds takes minutes in a wasm test.
 #[cfg(not(target_arch = "wasm32"))]
 #[test]
 fn ensemble_members_pass_over_crowded_maps() {
@@ -515,6 +516,8 @@ fn ensemble_members_pass_over_crowded_maps() {
         "members that moved off a crowded map: {moved} of {}",
         runs.len()
     );
+    // The path this test is for: some member's own first map was crowded.
+    assert!(moved > 0, "no member moved");
     s.set_ensemble(&plan, runs, true).unwrap();
     let json: serde_json::Value = serde_json::from_str(&s.ensemble_json().unwrap()).unwrap();
     assert!(json["members"][0]["crowding"]["systems"].is_u64(), "{json}");
