@@ -6,7 +6,7 @@ import { test } from 'node:test';
 import assert from 'node:assert/strict';
 import { join } from 'node:path';
 import { readFile } from 'node:fs/promises';
-import { openApp, runToMap, ARTIFACTS, ROOT, setField, waitStatus } from './browser.mjs';
+import { openApp, phoneShot, runToMap, ARTIFACTS, ROOT, setField, waitStatus } from './browser.mjs';
 
 const AS1063 = join(ROOT, '..', 'shared', 'data', 'AS1063', 'lenstool_cats');
 // The pool workers' URLs carry `worker=pool-N` (lens-client.js).
@@ -101,10 +101,7 @@ test('AS1063 gold with the strength "auto": the candidates run in workers and th
 
     await page.locator('#strength-box').scrollIntoViewIfNeeded();
     await page.screenshot({ path: join(ARTIFACTS, 'app-auto-result.png'), fullPage: true });
-    await page.setViewportSize({ width: 390, height: 844 });
-    const overflow = await page.evaluate(() => document.documentElement.scrollWidth - window.innerWidth);
-    assert.ok(overflow <= 0, `page is ${overflow}px wider than a phone`);
-    await page.locator('#strength-box').screenshot({ path: join(ARTIFACTS, 'app-auto-result-phone.png') });
+    await phoneShot(page, page.locator('#strength-box'), 'app-auto-result-phone.png');
     assert.deepEqual(app.consoleErrors, []);
     console.log(`AS1063 gold, auto, ${candidates} candidates in ${workers} pool workers: ${seconds.toFixed(1)} s`);
   } finally {
@@ -211,10 +208,7 @@ test('a choice that passed over a crowded map says so, at 1280 px and on a phone
     assert.match(summary, /predicted best, crowded maps passed over \(below\)\./);
     assert.match(summary, /One candidate that predicted better was passed over: its map predicts more than twice as many images as observed for more than a third of the systems\./);
     await box.screenshot({ path: join(ARTIFACTS, 'app-auto-crowded.png') });
-    await page.setViewportSize({ width: 390, height: 844 });
-    const overflow = await page.evaluate(() => document.documentElement.scrollWidth - window.innerWidth);
-    assert.ok(overflow <= 0, `page is ${overflow}px wider than a phone`);
-    await box.screenshot({ path: join(ARTIFACTS, 'app-auto-crowded-phone.png') });
+    await phoneShot(page, box, 'app-auto-crowded-phone.png');
     assert.deepEqual(app.consoleErrors, []);
   } finally {
     await app.close();
@@ -247,10 +241,7 @@ test('a cross-validation of an "auto" run says what each fold chose, at 1280 px 
     const box = page.locator('#crossval-box');
     await box.scrollIntoViewIfNeeded();
     await box.screenshot({ path: join(ARTIFACTS, 'app-crossval-auto.png') });
-    await page.setViewportSize({ width: 390, height: 844 });
-    const overflow = await page.evaluate(() => document.documentElement.scrollWidth - window.innerWidth);
-    assert.ok(overflow <= 0, `page is ${overflow}px wider than a phone`);
-    await box.screenshot({ path: join(ARTIFACTS, 'app-crossval-auto-phone.png') });
+    await phoneShot(page, box, 'app-crossval-auto-phone.png');
     assert.deepEqual(app.consoleErrors, []);
   } finally {
     await app.close();

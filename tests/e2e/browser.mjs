@@ -1,5 +1,6 @@
 // Shared by the end-to-end tests: serve www/ on a free localhost port and drive Debian's
 // Chromium through playwright-core (no downloaded browser).
+import assert from 'node:assert/strict';
 import { mkdir } from 'node:fs/promises';
 import { dirname, join } from 'node:path';
 import { fileURLToPath } from 'node:url';
@@ -52,6 +53,16 @@ export async function openApp({ width = 1280, height = 900, query = '?app', serv
       await new Promise((r) => server.close(r));
     },
   };
+}
+
+/** Narrows the page to a phone (390 x 844), checks that nothing is wider than the screen, and
+ * saves a screenshot of `locator` as `name` in test-artifacts/ (a box the test just looked at
+ * at desktop width, seen as a phone shows it). */
+export async function phoneShot(page, locator, name) {
+  await page.setViewportSize({ width: 390, height: 844 });
+  const overflow = await page.evaluate(() => document.documentElement.scrollWidth - window.innerWidth);
+  assert.ok(overflow <= 0, `page is ${overflow}px wider than a phone`);
+  await locator.screenshot({ path: join(ARTIFACTS, name) });
 }
 
 const PNG_SIGNATURE = [0x89, 0x50, 0x4e, 0x47, 0x0d, 0x0a, 0x1a, 0x0a];

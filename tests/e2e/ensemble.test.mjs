@@ -7,7 +7,7 @@ import { test } from 'node:test';
 import assert from 'node:assert/strict';
 import { readFile } from 'node:fs/promises';
 import { join } from 'node:path';
-import { idb, openApp, ARTIFACTS, fitsAxes, imageStats, renderCount, savedProject, setField, waitStatus, waitView } from './browser.mjs';
+import { idb, openApp, phoneShot, ARTIFACTS, fitsAxes, imageStats, renderCount, savedProject, setField, waitStatus, waitView } from './browser.mjs';
 
 // The pool workers' URLs carry `worker=pool-N` (lens-client.js).
 const POOL = /[?&]worker=pool-\d+/;
@@ -99,10 +99,7 @@ test('an ensemble of the built-in example gives the spread view, the downloads a
 
     await page.locator('#ensemble-box').scrollIntoViewIfNeeded();
     await page.screenshot({ path: join(ARTIFACTS, 'app-ensemble-result.png'), fullPage: true });
-    await page.setViewportSize({ width: 390, height: 844 });
-    const overflow = await page.evaluate(() => document.documentElement.scrollWidth - window.innerWidth);
-    assert.ok(overflow <= 0, `page is ${overflow}px wider than a phone`);
-    await page.locator('#ensemble-box').screenshot({ path: join(ARTIFACTS, 'app-ensemble-result-phone.png') });
+    await phoneShot(page, page.locator('#ensemble-box'), 'app-ensemble-result-phone.png');
     assert.deepEqual(app.consoleErrors, []);
   } finally {
     await app.close();
@@ -135,10 +132,7 @@ test('members that passed over crowded maps are said under the views, at 1280 px
     const box = page.locator('#ensemble-box');
     await box.scrollIntoViewIfNeeded();
     await box.screenshot({ path: join(ARTIFACTS, 'app-ensemble-crowded.png') });
-    await page.setViewportSize({ width: 390, height: 844 });
-    const overflow = await page.evaluate(() => document.documentElement.scrollWidth - window.innerWidth);
-    assert.ok(overflow <= 0, `page is ${overflow}px wider than a phone`);
-    await box.screenshot({ path: join(ARTIFACTS, 'app-ensemble-crowded-phone.png') });
+    await phoneShot(page, box, 'app-ensemble-crowded-phone.png');
     assert.deepEqual(app.consoleErrors, []);
   } finally {
     await app.close();
@@ -230,10 +224,7 @@ test('a restarted worker and a reload show the ensemble again: caption, spread v
     await page.click('#downloads-panel summary');
     await page.locator('#ensemble-box').scrollIntoViewIfNeeded();
     await page.screenshot({ path: join(ARTIFACTS, 'app-ensemble-reloaded-box.png') });
-    await page.setViewportSize({ width: 390, height: 844 });
-    const overflow = await page.evaluate(() => document.documentElement.scrollWidth - window.innerWidth);
-    assert.ok(overflow <= 0, `page is ${overflow}px wider than a phone`);
-    await page.locator('#ensemble-box').screenshot({ path: join(ARTIFACTS, 'app-ensemble-reloaded-phone.png') });
+    await phoneShot(page, page.locator('#ensemble-box'), 'app-ensemble-reloaded-phone.png');
 
     // A project that kept the intervals only (maps above the size a project keeps): the caption
     // and the intervals, no spread view, and the page says why and what to do.
