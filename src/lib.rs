@@ -119,9 +119,9 @@ pub use fits::{
 #[cfg(not(target_arch = "wasm32"))]
 pub use lenstool_par::load_lenstool_model;
 pub use lenstool_par::{
-    parse_par, parse_par_with, GalaxyWithoutMag, LenstoolModel, LenstoolPar, ParComponent,
-    ParError, ParGalaxies, ParHalo, ParOptions, ParRedshiftPrior, ParSourceZ, ParWarning, Radius,
-    UnknownSourceZ, GALAXY_MAX_CORE_KPC, LENSTOOL_DEFAULT_Z_SOURCE,
+    parse_par, parse_par_with, FreeMass, GalaxyWithoutMag, LenstoolModel, LenstoolPar,
+    ParComponent, ParError, ParGalaxies, ParHalo, ParOptions, ParRedshiftPrior, ParSourceZ,
+    ParWarning, Radius, UnknownSourceZ, GALAXY_MAX_CORE_KPC, LENSTOOL_DEFAULT_Z_SOURCE,
 };
 pub use limits::{
     with_line_feeds, InputKind, TooLarge, MAX_ARCS_BYTES, MAX_ARC_PIXELS, MAX_CATALOG_BYTES,

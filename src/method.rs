@@ -317,7 +317,13 @@
 //! a `mag` takes the commented row where it lies, or else the magnitude whose halo mass is
 //! its dPIE's total mass `pi b0 r_cut Sigma_cr` (`(3/2) pi v_disp^2 r_cut / G` when round),
 //! up to 100 `L*` (beyond, a group's or cluster's halo with a small core, left to the grid
-//! even when a member lies at its centre: MACS J1149's northern group on member 1824). A
+//! even when a member lies at its centre: MACS J1149's northern group on member 1824). Where
+//! the `.par`'s `limit` block leaves that mass free (uniform priors on `v_disp` or the radii:
+//! a starting model, whose written values are where its fit begins), the galaxy is taken at
+//! the priors' low ends (the written value where one starts at 0) and given a layer of its own ([`crate::lenstool_par::FreeMass`]): the
+//! grid can add mass near it but never take any away, and its factor is not the members',
+//! whereas a start fourteen times too heavy in the members' layer pulls every member's `C`
+//! down (MACS J1149's CATS `m1149.par`: C 0.21). A
 //! galaxy the member catalogue lists already is not added again (a `best.par` writes every
 //! potfile member out); a `potentiel` the `.par` writes twice is two galaxies, as Lenstool
 //! reads it, and a note says so. The run

@@ -284,6 +284,7 @@ fn parse_members(
         fitted_bcgs: None,
         par_galaxies: Vec::new(),
         par_source: None,
+        free_mass_galaxies: Vec::new(),
     };
     Ok((catalog, warnings))
 }

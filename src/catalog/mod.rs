@@ -134,6 +134,13 @@ pub struct MemberCatalog {
     /// rather than asking for a `.par`.
     #[serde(default)]
     pub par_source: Option<String>,
+    /// Ids of the `.par` galaxies whose mass its `limit` blocks leave free (a starting model:
+    /// [`crate::lenstool_par::FreeMass`]), made members at the least mass of those priors:
+    /// each has a layer of its own rather than sharing the luminosity-scaled members' factor
+    /// (one galaxy's mass is no measure of the others'; where the images do not measure its
+    /// factor, the prior of an unmeasured layer holds it near 1, the least mass).
+    #[serde(default)]
+    pub free_mass_galaxies: Vec<String>,
 }
 
 impl ImageCatalog {

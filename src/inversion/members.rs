@@ -607,7 +607,13 @@ pub fn build_member_layers(
     let warnings = outside_warning(catalog, &outside, grid.width_arcsec, margin)
         .into_iter()
         .collect();
-    let layers = split_layers(config.layers, &halos, components, config.c_prior_sigma);
+    let layers = split_layers(
+        config.layers,
+        &halos,
+        components,
+        config.c_prior_sigma,
+        &catalog.free_mass_galaxies,
+    );
     Ok(MemberModel {
         halos,
         layers,
@@ -616,24 +622,40 @@ pub fn build_member_layers(
 }
 
 /// Groups the halos (with their components, in the same order) into layers, each with the
-/// prior `prior_sigma` on its factor.
+/// prior `prior_sigma` on its factor. The members named in `free_mass` (the `.par` galaxies
+/// whose mass it leaves free: [`MemberCatalog::free_mass_galaxies`]) come first, one layer
+/// each; then `split` groups the others.
 fn split_layers(
     split: LayerSplit,
     halos: &[MemberHalo],
     components: Vec<Box<dyn MassComponent>>,
     prior_sigma: Option<f64>,
+    free_mass: &[String],
 ) -> Vec<Layer> {
+    if split == LayerSplit::None {
+        return Vec::new();
+    }
+    let mut slots: Vec<Option<Box<dyn MassComponent>>> = components.into_iter().map(Some).collect();
+    let mut layers = Vec::new();
+    let (free, bound): (Vec<usize>, Vec<usize>) =
+        (0..halos.len()).partition(|&k| free_mass.contains(&halos[k].id));
+    for k in free {
+        layers.push(Layer {
+            name: format!("galaxy {} (mass free in the .par)", halos[k].id),
+            members: vec![halos[k].member],
+            lens: Arc::new(Lens::new(slots[k].take().into_iter().collect())),
+            prior_sigma,
+            kind: LayerKind::Galaxies,
+        });
+    }
     let n_alone = match split {
-        LayerSplit::None => return Vec::new(),
-        LayerSplit::Single => 0,
+        LayerSplit::None | LayerSplit::Single => 0,
         LayerSplit::Bcg => 1,
         LayerSplit::Brightest(n) => n,
     }
-    .min(halos.len());
-    let mut order: Vec<usize> = (0..halos.len()).collect();
+    .min(bound.len());
+    let mut order = bound;
     order.sort_by(|&i, &j| halos[i].mag.total_cmp(&halos[j].mag).then(i.cmp(&j)));
-    let mut slots: Vec<Option<Box<dyn MassComponent>>> = components.into_iter().map(Some).collect();
-    let mut layers = Vec::new();
     for (rank, &k) in order[..n_alone].iter().enumerate() {
         let name = if split == LayerSplit::Bcg {
             "bcg".to_string()

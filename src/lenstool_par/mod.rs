@@ -5,7 +5,9 @@
 //! `image` block (the priors on the redshifts of multiple-image systems, which a
 //! reconstruction takes: [`ParRedshiftPrior`]). Every other block (`limit`, `grille`,
 //! `cline`, ...) and keyword is skipped: a model is evaluated with the values written in its
-//! `potentiel` blocks, which in a `bestopt.par` are the fitted ones.
+//! `potentiel` blocks, which in a `bestopt.par` are the fitted ones. `limit` blocks are read
+//! for one thing only: the uniform priors a starting `.par` puts on a galaxy's mass
+//! ([`FreeMass`]), which a reconstruction takes instead of the written start.
 //!
 //! The file is read as Lenstool reads it ([`parse_par_with`]): `#` comments anywhere, any
 //! whitespace, CR line ends; lines between blocks that do not open a Lenstool block (the stray
@@ -29,6 +31,9 @@
 //!   magnitude `mag0` with `L/L* = 10^(-0.4 (mag - mag0))`:
 //!   `sigma = sigma* (L/L*)^(1/vdslope)`, `r_cut = r_cut* (L/L*)^(2/slope)`,
 //!   `r_core = r_core* (L/L*)^(1/2)`.
+//! - The k-th `limit` block belongs to the k-th `potentiel`, whatever number its header
+//!   writes (Lenstool-HPC's `module_readParameters.cpp`); a line `v_disp 1 150 450 0.1` is a
+//!   uniform prior on `[150, 450]` (mode 3: a normal of mean and width; 0: fixed).
 //! - Radii in kpc become arcsec with the lens plane's `mpc_per_arcsec`; in a `potentiel`
 //!   block the kpc value wins when both are given, in a `potfile` the arcsec one (as Lenstool).
 //! - The shear `gamma` is at `D_ls/D_s = 1` like every Lenstool deflection; its `kappa`
@@ -222,6 +227,10 @@ pub struct GalaxyWithoutMag {
     pub axis_ratio: f64,
     /// Position angle, degrees counter-clockwise from +x.
     pub pa_deg: f64,
+    /// When its `limit` block leaves its mass free ([`FreeMass`]), `mass_msun` is the dPIE at
+    /// the priors' low ends: that block's line and the dPIE's `[v_disp (km/s), core (kpc),
+    /// cut (kpc)]`.
+    pub at_prior_low_end: Option<(usize, [f64; 3])>,
 }
 
 /// One mass component of a `potentiel` block (positions in arcsec, angles in degrees
@@ -256,6 +265,31 @@ pub struct ParPotential {
     pub mag: Option<f64>,
     /// The block's own `z_lens` (before a single-plane approximation moved it).
     pub z_lens: f64,
+    /// The uniform priors its `limit` block puts on its mass (see [`FreeMass`]), when it puts
+    /// any.
+    pub free_mass: Option<FreeMass>,
+}
+
+/// The low ends of the uniform priors (`limit` lines of mode 1, `v_disp 1 150 450 0.1`) a
+/// `.par`'s `limit` block puts on a dPIE's velocity dispersion and radii: in a starting
+/// `.par` the `potentiel` block's values are where Lenstool's fit starts, not a mass it
+/// measured (MACS J1149's CATS `m1149.par` writes the lens of SN Refsdal at 311 km/s with a
+/// 206 kpc cut radius, outside its own prior of 30 - 70 kpc; the fit found 162 km/s and 55
+/// kpc). A reconstruction takes such a galaxy at its least mass within the priors, the
+/// written value where a prior starts at 0 ([`LenstoolPar::galaxies`]), in a layer of its
+/// own: the grid adds what the images ask for, but cannot take mass away. The model itself ([`LenstoolPar::build`]) is evaluated with the written values, as
+/// Lenstool evaluates it.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct FreeMass {
+    /// The `limit` block's first line.
+    pub line: usize,
+    /// The low end of `v_disp`'s prior (km/s); `None` without a prior or when it starts at 0
+    /// (no least mass: the written value stays).
+    pub sigma_v_km_s: Option<f64>,
+    /// The low end of the core radius's prior, likewise.
+    pub r_core: Option<Radius>,
+    /// The low end of the cut radius's prior, likewise.
+    pub r_cut: Option<Radius>,
 }
 
 /// A `potfile` block: the member catalogue and the `L*` galaxy of the scaling relations.
@@ -497,10 +531,22 @@ impl LenstoolPar {
             let Some(mag) = p.mag else {
                 // A massless potential (a node of a grid model) is no galaxy to fit.
                 if sigma_v_km_s > 0.0 {
-                    let (core, cut) = (r_core.arcsec(&plane), r_cut.arcsec(&plane));
-                    let mass_msun = Dpie::new(center_arcsec, sigma_v_km_s, core, cut, e, pa_deg)
+                    // Where a `limit` block leaves the mass free, its least mass there.
+                    let low = p.free_mass.unwrap_or(FreeMass {
+                        line: 0,
+                        sigma_v_km_s: None,
+                        r_core: None,
+                        r_cut: None,
+                    });
+                    let sigma = low.sigma_v_km_s.unwrap_or(sigma_v_km_s);
+                    let (core, cut) = (
+                        low.r_core.unwrap_or(r_core).arcsec(&plane),
+                        low.r_cut.unwrap_or(r_cut).arcsec(&plane),
+                    );
+                    let mass_msun = Dpie::new(center_arcsec, sigma, core, cut, e, pa_deg)
                         .ok()
                         .map(|d| d.total_mass_msun(&plane));
+                    let kpc = 1.0e3 * plane.mpc_per_arcsec;
                     without_mag.push(GalaxyWithoutMag {
                         block: p.block.clone(),
                         id: id.to_string(),
@@ -509,6 +555,9 @@ impl LenstoolPar {
                         mass_msun,
                         axis_ratio,
                         pa_deg,
+                        at_prior_low_end: p
+                            .free_mass
+                            .map(|f| (f.line, [sigma, core * kpc, cut * kpc])),
                     });
                 }
                 continue;

@@ -7,8 +7,8 @@ use std::collections::HashMap;
 use glam::DVec2;
 
 use super::{
-    LenstoolPar, ParComponent, ParError, ParOptions, ParPotential, ParPotfile, ParRedshiftPrior,
-    ParSourceZ, ParWarning, Radius, Z_MATCH_TOL,
+    FreeMass, LenstoolPar, ParComponent, ParError, ParOptions, ParPotential, ParPotfile,
+    ParRedshiftPrior, ParSourceZ, ParWarning, Radius, Z_MATCH_TOL,
 };
 use crate::cosmology::{Cosmology, LensPlane};
 use crate::inversion::RedshiftPrior;
@@ -68,6 +68,10 @@ pub fn parse_par_with(
     let mut potfiles = Vec::new();
     let mut redshift_priors = Vec::new();
     let mut source_z = ParSourceZ::default();
+    // Lenstool gives the k-th `limit` block to the k-th potential, whatever number its header
+    // writes (Lenstool-HPC's `module_readParameters_limit`; MACS J1149's CATS `m1149.par`
+    // writes `limit 2` after two potentials and `limit 5` after its sixth).
+    let mut limits = Vec::new();
     // (z, block, index in potentials or potfiles, is a potfile)
     let mut z_values: Vec<(f64, &Block, usize, bool)> = Vec::new();
     for b in &blocks {
@@ -82,6 +86,8 @@ pub fn parse_par_with(
             let (p, z) = cx.potfile(b)?;
             z_values.push((z, b, potfiles.len(), true));
             potfiles.push(p);
+        } else if name.starts_with("limit") {
+            limits.push(b);
         } else if name.starts_with("image") {
             redshift_priors.extend(b.repeated.iter().flat_map(|e| cx.redshift_priors(e)));
         } else if name == "source" {
@@ -91,6 +97,11 @@ pub fn parse_par_with(
                 z_source: raw("z_source"),
                 dist_z: raw("dist_z"),
             };
+        }
+    }
+    for (p, b) in potentials.iter_mut().zip(limits) {
+        if matches!(p.component, ParComponent::Dpie { .. }) {
+            p.free_mass = free_mass(b);
         }
     }
     let cosmology = cosmology.ok_or_else(|| cx.model("no `cosmologie` block"))?;
@@ -126,6 +137,12 @@ pub fn parse_par_with(
         } else if let ParComponent::Dpie { r_core, r_cut, .. } = &mut potentials[k].component {
             to_arcsec(r_core);
             to_arcsec(r_cut);
+            if let Some(f) = &mut potentials[k].free_mass {
+                f.r_core
+                    .iter_mut()
+                    .chain(f.r_cut.iter_mut())
+                    .for_each(to_arcsec);
+            }
         }
         cx.warn_about(
             b.line,
@@ -148,6 +165,46 @@ pub fn parse_par_with(
         redshift_priors,
         source_z,
         warnings: cx.warnings.into_inner(),
+    })
+}
+
+/// The uniform priors (mode 1: `v_disp 1 150 450 0.1`) the `limit` block `b` puts on a dPIE's
+/// mass: `v_disp`, the core and the cut radius (kpc wins over arcsec, as in a `potentiel`
+/// block); `None` when it puts none. A prior's low end is kept where it is above 0 (one from 0
+/// gives no least mass: the written value stays). Lines of another mode, and lines that do not
+/// read as `mode low high` with `0 <= low <= high`, are passed over: the block was only ever
+/// read for this, and the model is evaluated without it.
+fn free_mass(b: &Block) -> Option<FreeMass> {
+    // Some(the low end if above 0) for a uniform prior; None for anything else.
+    let prior = |key: &str| {
+        let e = b.entries.get(key)?;
+        let v: Vec<f64> = e
+            .values
+            .iter()
+            .take(3)
+            .map_while(|v| v.parse().ok())
+            .collect();
+        match v[..] {
+            [mode, low, high] if mode == 1.0 && low >= 0.0 && low <= high && high.is_finite() => {
+                Some((low > 0.0).then_some(low))
+            }
+            _ => None,
+        }
+    };
+    let radius = |kpc: &str, arcsec: &str| match prior(kpc) {
+        Some(low) => Some(low.map(Radius::Kpc)),
+        None => prior(arcsec).map(|low| low.map(Radius::Arcsec)),
+    };
+    let (sigma, core, cut) = (
+        prior("v_disp"),
+        radius("core_radius_kpc", "core_radius"),
+        radius("cut_radius_kpc", "cut_radius"),
+    );
+    (sigma.is_some() || core.is_some() || cut.is_some()).then_some(FreeMass {
+        line: b.line,
+        sigma_v_km_s: sigma.flatten(),
+        r_core: core.flatten(),
+        r_cut: cut.flatten(),
     })
 }
 
@@ -739,6 +796,7 @@ impl Ctx<'_> {
             component,
             mag: self.opt(b, "mag", 0)?,
             z_lens: z,
+            free_mass: None,
         };
         Ok((p, z))
     }

@@ -292,6 +292,8 @@ impl Dataset {
         let law = &config.members;
         let mag_star = law.mag_star_on(plane);
         let mut by_mass = Vec::new();
+        // The lines of those taken at their priors' least mass (a layer of their own each).
+        let mut free_mass = Vec::new();
         for g in &without_mag {
             // A halo of a group's mass centred on a galaxy (MACS J1149's northern group `O4`
             // on member 1824) is not that galaxy: it is left to the grid, whatever lies there.
@@ -326,6 +328,19 @@ impl Dataset {
                 ));
                 continue;
             };
+            // A starting `.par`'s galaxy whose mass its `limit` block leaves free: its least
+            // mass there ([`crate::lenstool_par::FreeMass`]), in a layer of its own, said.
+            if let Some((limit, [sigma, core, cut])) = g.at_prior_low_end {
+                notes.push(format!(
+                    "{name}: line {}: `{}`'s mass is left free by its `limit` block (line \
+                     {limit}), so its written values are where a fit starts, not a mass: it is \
+                     taken at the priors' low ends where they are above 0 (v_disp {sigma:.0} \
+                     km/s, core {core:.2} kpc, cut {cut:.0} kpc), in a layer of its own: its \
+                     factor C is not the members'",
+                    g.line, g.block
+                ));
+                free_mass.push(g.line);
+            }
             by_mass.push(Member {
                 id: g.id.clone(),
                 position: g.centre,
@@ -407,6 +422,7 @@ impl Dataset {
             fitted_bcgs: None,
             par_galaxies: Vec::new(),
             par_source: None,
+            free_mass_galaxies: Vec::new(),
         });
         members.par_source = Some(name.clone());
         // Galaxies the catalogue lists already (a `best.par` writes every potfile member out
@@ -444,6 +460,9 @@ impl Dataset {
                 ));
             }
             members.note_par_galaxy(g.id.clone());
+            if k >= with_mag && free_mass.contains(&g.line) {
+                members.free_mass_galaxies.push(g.id.clone());
+            }
             members.members.push(g);
         }
         if !repeated.is_empty() {

@@ -842,6 +842,103 @@ mod galaxies_of_a_par {
         );
     }
 
+    /// A starting `.par` writes where its fit begins, not a mass: MACS J1149's CATS
+    /// `m1149.par` gives the lens of SN Refsdal (O7, no catalogue row) 311 km/s and a 206 kpc
+    /// cut, outside its own prior of 30 - 70 kpc (the fit: 162 km/s, 55 kpc), and fitted as a
+    /// member of that mass it dragged every member's factor to 0.21. A galaxy whose `limit`
+    /// block gives uniform priors on its mass is taken at their low ends, and named for a
+    /// layer of its own (`free_mass_galaxies`); the k-th `limit`
+    /// block is the k-th potential's whatever its header's number (as Lenstool-HPC reads
+    /// them); a prior from 0 gives no least mass, so the written value stays; a posterior
+    /// (mode 3) keeps the written values, and the model itself is evaluated as written.
+    #[test]
+    fn a_galaxy_whose_mass_a_limit_block_frees_is_taken_at_its_least_mass() {
+        let galaxy = |name: &str, x: f64| {
+            format!(
+                "potentiel {name}\n    profil 81\n    x_centre {x}\n    y_centre 0.\n    \
+                 v_disp 310.\n    core_radius_kpc 0.15\n    cut_radius_kpc 205.\n    \
+                 z_lens 0.35\n    end\n"
+            )
+        };
+        let text = format!(
+            "runmode\n    reference 3 292.95682 -26.575718\n    end\ncosmologie\n    H0 70.\n    \
+             omega 0.3\n    lambda 0.7\n    end\n\
+             potentiel 1\n    profil 81\n    v_disp 1000.\n    core_radius_kpc 50.\n    \
+             cut_radius_kpc 1000.\n    z_lens 0.35\n    end\n\
+             limit 1\n    v_disp 1 800. 1300. 0.1\n    end\n\
+             {}limit 6\n    v_disp 1 150. 450. 0.1\n    cut_radius_kpc 1 30. 70. 0.1\n    \
+             core_radius_kpc 1 0.01 0.18 0.1\n    ellipticite 1 0. 0.7 0.1\n    end\n\
+             {}limit 2\n    v_disp 1 0. 450. 0.1\n    end\n\
+             {}limit O9\n    v_disp 3 162. 7. 0.1\n    end\n",
+            galaxy("O7", 10.0),
+            galaxy("O8", 20.0),
+            galaxy("O9", 30.0),
+        );
+        let par = parse_par(&text, "start.par").unwrap();
+        // The second `limit` block (`limit 6`, line 28) is the second potential's.
+        assert_eq!(
+            par.potentials[1].free_mass,
+            Some(wslap::FreeMass {
+                line: 28,
+                sigma_v_km_s: Some(150.0),
+                r_core: Some(wslap::Radius::Kpc(0.01)),
+                r_cut: Some(wslap::Radius::Kpc(30.0)),
+            })
+        );
+        assert_eq!(
+            par.potentials[2].free_mass,
+            Some(wslap::FreeMass {
+                line: 43,
+                sigma_v_km_s: None,
+                r_core: None,
+                r_cut: None,
+            })
+        );
+        assert_eq!(
+            par.potentials[3].free_mass, None,
+            "a posterior is not a free mass"
+        );
+        // The model is Lenstool's: O7 as written.
+        let wslap::ParComponent::Dpie { sigma_v_km_s, .. } = par.potentials[1].component else {
+            panic!("{:?}", par.potentials[1])
+        };
+        assert_eq!(sigma_v_km_s, 310.0);
+        let mut data = Dataset::default();
+        let notes = add_galaxies(&mut data, &par);
+        let said = |n: &str| notes.contains(&n.to_string());
+        assert!(
+            said(
+                "start.par: line 19: `potentiel O7`'s mass is left free by its `limit` block \
+                 (line 28), so its written values are where a fit starts, not a mass: it is \
+                 taken at the priors' low ends where they are above 0 (v_disp 150 km/s, core \
+                 0.01 kpc, cut 30 kpc), in a layer of its own: its factor C is not the members'"
+            ),
+            "{notes:?}"
+        );
+        assert!(
+            said(
+                "start.par: line 34: `potentiel O8`'s mass is left free by its `limit` block \
+                 (line 43), so its written values are where a fit starts, not a mass: it is \
+                 taken at the priors' low ends where they are above 0 (v_disp 310 km/s, core \
+                 0.15 kpc, cut 205 kpc), in a layer of its own: its factor C is not the members'"
+            ),
+            "{notes:?}"
+        );
+        let members = data.members.unwrap();
+        assert_eq!(members.par_galaxies, ["O7", "O8", "O9"]);
+        assert_eq!(members.free_mass_galaxies, ["O7", "O8"]);
+        let masses = [(150.0, 30.0), (310.0, 205.0), (310.0, 205.0)];
+        for (m, (sigma, cut)) in members.members.iter().zip(masses) {
+            let dpie = 1.5 * std::f64::consts::PI * sigma * sigma * cut / G_KPC;
+            let mass = law_mass(m, &par);
+            assert!(
+                (mass / dpie - 1.0).abs() < 1e-3,
+                "{} {mass:e} {dpie:e}",
+                m.id
+            );
+        }
+    }
+
     /// Every dPIE of the lens plane with a core too wide for a galaxy is named in a note,
     /// with its line and core: the cluster's halos, a group's with a `mag`, and a galaxy a
     /// set-up fits one by one with a wide core (COOL J1153's three, 7 - 19 kpc, no `mag`;
@@ -934,24 +1031,33 @@ mod galaxies_of_a_par {
             ("potentiel 3", 66, DVec2::ZERO)
         );
         // Without a member catalogue its magnitude is the one its starting mass implies
-        // (v_disp 100 km/s, cut 100 kpc).
+        // (v_disp 100 km/s, cut 100 kpc: its `limit` priors start at 0, which gives no least
+        // mass), in a layer of its own.
         let mut data = Dataset::default();
         let notes = add_galaxies(&mut data, &par);
-        assert_eq!(notes.len(), 2, "{notes:?}");
+        assert_eq!(notes.len(), 3, "{notes:?}");
         assert_eq!(
-            notes[1],
+            notes[0],
+            "m1931.par: line 66: `potentiel 3`'s mass is left free by its `limit` block (line \
+             77), so its written values are where a fit starts, not a mass: it is taken at the \
+             priors' low ends where they are above 0 (v_disp 100 km/s, core 0.12 kpc, cut 100 \
+             kpc), in a layer of its own: its factor C is not the members'"
+        );
+        assert_eq!(
+            notes[2],
             "m1931.par: `potentiel 1` (line 28, core 50 kpc) and `potentiel 2` (line 47, core \
              50 kpc) have cores wider than a galaxy's (over 5 kpc): not fitted as members; the \
              grid models their mass"
         );
         assert!(
-            notes[0].starts_with(
+            notes[1].starts_with(
                 "m1931.par: line 66: galaxy 3 has no `mag`: fitted as a member of mag "
             ),
             "{notes:?}"
         );
         let alone = data.members.as_ref().unwrap();
         assert_eq!(alone.par_galaxies, ["3"]);
+        assert_eq!(alone.free_mass_galaxies, ["3"]);
         let dpie = 1.5 * std::f64::consts::PI * 100.0 * 100.0 * 100.0 / G_KPC;
         let mass = law_mass(&alone.members[0], &par);
         // Its ellipticity (0.273) lowers a dPIE's mass by 1 - eps^2 (eps the Kassiola-Kovner

@@ -97,5 +97,6 @@ pub fn members() -> MemberCatalog {
         fitted_bcgs: None,
         par_galaxies: Vec::new(),
         par_source: None,
+        free_mass_galaxies: Vec::new(),
     }
 }

@@ -177,6 +177,45 @@ fn layer_splits_partition_the_members() {
     }
     assert_eq!(layers_of("bcg")[0].name, "bcg");
     assert!(layers_of("none").is_empty());
+
+    // A `.par` galaxy whose mass the `.par` leaves free has a layer of its own, first, and
+    // the split groups the others (the BCG is then the brightest of those).
+    let free_id = cat.members[2].id.clone();
+    let freed = MemberCatalog {
+        free_mass_galaxies: vec![free_id.clone()],
+        ..members()
+    };
+    for (split, expected) in [
+        ("single", vec![vec![2], vec![0, 1, 3, 4, 5]]),
+        ("bcg", vec![vec![2], vec![0], vec![1, 3, 4, 5]]),
+        (
+            "brightest:2",
+            vec![vec![2], vec![0], vec![5], vec![1, 3, 4]],
+        ),
+    ] {
+        let config = MemberConfig {
+            layers: split.parse().unwrap(),
+            mag_star: Some(19.0),
+            ..MemberConfig::default()
+        };
+        let layers = build_member_layers(&freed, &config, &plane, &grid)
+            .unwrap()
+            .layers;
+        let got: Vec<Vec<usize>> = layers.iter().map(|l| l.members.clone()).collect();
+        assert_eq!(got, expected, "{split}");
+        assert_eq!(
+            layers[0].name,
+            format!("galaxy {free_id} (mass free in the .par)")
+        );
+        let total: DVec2 = layers.iter().map(|l| l.deflection(p)).sum();
+        assert_abs("freed sum x", total.x, single[0].deflection(p).x, 1e-13);
+    }
+    let none = MemberConfig {
+        layers: LayerSplit::None,
+        ..MemberConfig::default()
+    };
+    let no_layers = build_member_layers(&freed, &none, &plane, &grid).unwrap();
+    assert!(no_layers.layers.is_empty());
     let json = serde_json::to_string(&LayerSplit::Brightest(3)).unwrap();
     assert_eq!(json, "\"brightest:3\"");
     assert_eq!(
