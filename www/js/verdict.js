@@ -99,7 +99,7 @@ export function showVerdict(verdict, { fitRows = null, modelGalaxies = [], fitMo
       : modelGalaxies.length <= 3 ? `galaxies (${named})`
         : `${modelGalaxies.length} galaxies (${named}; …)`;
     offer('fit-model-galaxies', `Fit the .par's ${which} and reconstruct again`,
-      'The loaded Lenstool .par models these galaxies on their own (a core of at most 5 kpc, with a magnitude; without one, the member catalogue\'s commented row where it lies, or else the magnitude whose halo mass is its dPIE\'s): fits them as members (the setting "Galaxies and redshift priors from the .par", which also takes the redshift priors of its z_m_limit lines), as wslap reconstruct --par does, and runs the reconstruction again.',
+      'The loaded Lenstool .par models these galaxies on their own (a core of at most 5 kpc, with a magnitude; without one, the member catalogue\'s commented row where it lies, or else the magnitude whose halo mass is its dPIE\'s, at the least mass its limit priors allow where a starting .par leaves it free): fits them as members (the setting "Galaxies and redshift priors from the .par", which also takes the redshift priors of its z_m_limit lines), as wslap reconstruct --par does, and runs the reconstruction again.',
       fitModel);
   }
 }
