@@ -3,8 +3,8 @@
 //! [`Dpie`]) and 14 (external shear, [`ExternalShear`]), `potfile` blocks (cluster members
 //! from a catalogue, scaled with luminosity), `cosmologie`, and the `z_m_limit` lines of the
 //! `image` block (the priors on the redshifts of multiple-image systems, which a
-//! reconstruction takes: [`ParRedshiftPrior`]). Every other block (`limit`, `grille`,
-//! `cline`, ...) and keyword is skipped: a model is evaluated with the values written in its
+//! reconstruction takes: [`ParRedshiftPrior`]). Every other block (`grille`, `cline`, ...)
+//! and keyword is skipped: a model is evaluated with the values written in its
 //! `potentiel` blocks, which in a `bestopt.par` are the fitted ones. `limit` blocks are read
 //! for one thing only: the uniform priors a starting `.par` puts on a galaxy's mass
 //! ([`FreeMass`]), which a reconstruction takes instead of the written start.
@@ -277,8 +277,8 @@ pub struct ParPotential {
 /// 206 kpc cut radius, outside its own prior of 30 - 70 kpc; the fit found 162 km/s and 55
 /// kpc). A reconstruction takes such a galaxy at its least mass within the priors, the
 /// written value where a prior starts at 0 ([`LenstoolPar::galaxies`]), in a layer of its
-/// own: the grid adds what the images ask for, but cannot take mass away. The model itself ([`LenstoolPar::build`]) is evaluated with the written values, as
-/// Lenstool evaluates it.
+/// own: the grid adds what the images ask for, but cannot take mass away. The model itself
+/// ([`LenstoolPar::build`]) is evaluated with the written values, as Lenstool evaluates it.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct FreeMass {
     /// The `limit` block's first line.
