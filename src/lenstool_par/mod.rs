@@ -532,16 +532,11 @@ impl LenstoolPar {
                 // A massless potential (a node of a grid model) is no galaxy to fit.
                 if sigma_v_km_s > 0.0 {
                     // Where a `limit` block leaves the mass free, its least mass there.
-                    let low = p.free_mass.unwrap_or(FreeMass {
-                        line: 0,
-                        sigma_v_km_s: None,
-                        r_core: None,
-                        r_cut: None,
-                    });
-                    let sigma = low.sigma_v_km_s.unwrap_or(sigma_v_km_s);
+                    let free = p.free_mass.as_ref();
+                    let sigma = free.and_then(|f| f.sigma_v_km_s).unwrap_or(sigma_v_km_s);
                     let (core, cut) = (
-                        low.r_core.unwrap_or(r_core).arcsec(&plane),
-                        low.r_cut.unwrap_or(r_cut).arcsec(&plane),
+                        free.and_then(|f| f.r_core).unwrap_or(r_core).arcsec(&plane),
+                        free.and_then(|f| f.r_cut).unwrap_or(r_cut).arcsec(&plane),
                     );
                     let mass_msun = Dpie::new(center_arcsec, sigma, core, cut, e, pa_deg)
                         .ok()
