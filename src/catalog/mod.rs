@@ -121,26 +121,29 @@ pub struct MemberCatalog {
     /// (`Dataset::fit_commented_bcgs`); a run's warnings carry their note.
     #[serde(default)]
     pub fitted_bcgs: Option<CommentedBcgs>,
-    /// Ids of the members a Lenstool `.par` models on its own (`Dataset::add_par_galaxies`:
-    /// added from it, or named by a galaxy of it without a `mag`, commented-out rows
-    /// included; not the potfile members a `best.par` writes out again): the set-up's own
-    /// choice of the galaxies that need it, its BCGs among them. One near the multiple images
-    /// counts as their BCG, whatever its magnitude: none is then said to be missing or looked
-    /// for among the commented rows.
+    /// The members (indices into [`Self::members`]) a Lenstool `.par` models on its own
+    /// (`Dataset::add_par_galaxies`: added from it, or named by a galaxy of it without a
+    /// `mag`, commented-out rows included; not the potfile members a `best.par` writes out
+    /// again): the set-up's own choice of the galaxies that need it, its BCGs among them. One
+    /// near the multiple images counts as their BCG, whatever its magnitude: none is then said
+    /// to be missing or looked for among the commented rows. Indices, not ids: a `.par` names
+    /// its potentials `1`, `2`, ... as a catalogue often numbers its rows, and a catalogue
+    /// member that shares a `.par` galaxy's name is not that galaxy.
     #[serde(default)]
-    pub par_galaxies: Vec<String>,
+    pub par_galaxies: Vec<usize>,
     /// The name of the `.par` whose galaxies were looked for (`Dataset::add_par_galaxies`),
     /// if one was: a missing BCG's warning then says that file models none near the images,
     /// rather than asking for a `.par`.
     #[serde(default)]
     pub par_source: Option<String>,
-    /// Ids of the `.par` galaxies whose mass its `limit` blocks leave free (a starting model:
+    /// The `.par` galaxies (indices into [`Self::members`], as [`Self::par_galaxies`]) whose
+    /// mass its `limit` blocks leave free (a starting model:
     /// [`crate::lenstool_par::FreeMass`]), made members at the least mass of those priors:
     /// each has a layer of its own rather than sharing the luminosity-scaled members' factor
     /// (one galaxy's mass is no measure of the others'; where the images do not measure its
     /// factor, the prior of an unmeasured layer holds it near 1, the least mass).
     #[serde(default)]
-    pub free_mass_galaxies: Vec<String>,
+    pub free_mass_galaxies: Vec<usize>,
 }
 
 impl ImageCatalog {
@@ -201,11 +204,21 @@ impl ImageCatalog {
 }
 
 impl MemberCatalog {
-    /// Records member `id` as one the `.par` models on its own ([`Self::par_galaxies`]), once.
-    pub fn note_par_galaxy(&mut self, id: String) {
-        if !self.par_galaxies.contains(&id) {
-            self.par_galaxies.push(id);
+    /// Records member `index` (into [`Self::members`]) as one the `.par` models on its own
+    /// ([`Self::par_galaxies`]), once.
+    pub fn note_par_galaxy(&mut self, index: usize) {
+        if !self.par_galaxies.contains(&index) {
+            self.par_galaxies.push(index);
         }
+    }
+
+    /// The ids of the members at `indices` (into [`Self::members`]; e.g.
+    /// [`Self::par_galaxies`]), in that order.
+    pub fn ids(&self, indices: &[usize]) -> Vec<&str> {
+        indices
+            .iter()
+            .map(|&k| self.members[k].id.as_str())
+            .collect()
     }
 
     /// The catalogue in the arcsec frame of `to` (see [`ImageCatalog::reframed`]).

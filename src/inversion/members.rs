@@ -622,15 +622,15 @@ pub fn build_member_layers(
 }
 
 /// Groups the halos (with their components, in the same order) into layers, each with the
-/// prior `prior_sigma` on its factor. The members named in `free_mass` (the `.par` galaxies
-/// whose mass it leaves free: [`MemberCatalog::free_mass_galaxies`]) come first, one layer
-/// each; then `split` groups the others.
+/// prior `prior_sigma` on its factor. The members at the indices `free_mass` (the `.par`
+/// galaxies whose mass it leaves free: [`MemberCatalog::free_mass_galaxies`]) come first, one
+/// layer each; then `split` groups the others.
 fn split_layers(
     split: LayerSplit,
     halos: &[MemberHalo],
     components: Vec<Box<dyn MassComponent>>,
     prior_sigma: Option<f64>,
-    free_mass: &[String],
+    free_mass: &[usize],
 ) -> Vec<Layer> {
     if split == LayerSplit::None {
         return Vec::new();
@@ -638,7 +638,7 @@ fn split_layers(
     let mut slots: Vec<Option<Box<dyn MassComponent>>> = components.into_iter().map(Some).collect();
     let mut layers = Vec::new();
     let (free, bound): (Vec<usize>, Vec<usize>) =
-        (0..halos.len()).partition(|&k| free_mass.contains(&halos[k].id));
+        (0..halos.len()).partition(|&k| free_mass.contains(&halos[k].member));
     for k in free {
         layers.push(Layer {
             name: format!("galaxy {} (mass free in the .par)", halos[k].id),

@@ -305,7 +305,7 @@ impl Dataset {
             if let Some((mass, _, lstar)) = by_law.filter(|b| b.2 > PAR_GALAXY_MAX_LSTAR) {
                 let on = self
                     .member_near(to_data(g.centre))
-                    .map_or(String::new(), |id| {
+                    .map_or(String::new(), |(_, id)| {
                         format!(" (centred on member {id}, which is fitted as a member)")
                     });
                 notes.push(format!(
@@ -459,9 +459,10 @@ impl Dataset {
                     g.line, g.id, g.mag
                 ));
             }
-            members.note_par_galaxy(g.id.clone());
+            let index = members.members.len();
+            members.note_par_galaxy(index);
             if k >= with_mag && free_mass.contains(&g.line) {
-                members.free_mass_galaxies.push(g.id.clone());
+                members.free_mass_galaxies.push(index);
             }
             members.members.push(g);
         }
@@ -500,14 +501,15 @@ impl Dataset {
         Ok(notes)
     }
 
-    /// The id of the member within [`SAME_GALAXY_ARCSEC`] of `at` (arcsec, the data's frame).
-    fn member_near(&self, at: DVec2) -> Option<String> {
+    /// The index (in [`MemberCatalog::members`]) and id of the member within
+    /// [`SAME_GALAXY_ARCSEC`] of `at` (arcsec, the data's frame).
+    fn member_near(&self, at: DVec2) -> Option<(usize, String)> {
         let members = self.members.as_ref()?;
-        let m = members
+        let index = members
             .members
             .iter()
-            .find(|m| m.position.distance(at) <= SAME_GALAXY_ARCSEC)?;
-        Some(m.id.clone())
+            .position(|m| m.position.distance(at) <= SAME_GALAXY_ARCSEC)?;
+        Some((index, members.members[index].id.clone()))
     }
 
     /// What becomes of the `.par`'s galaxy `block` (at `line`) without a `mag`, centred at `at`
@@ -523,17 +525,17 @@ impl Dataset {
         let near = |m: &&Member| m.position.distance(at) <= SAME_GALAXY_ARCSEC;
         let on_member = self.member_near(at);
         if let Some(members) = self.members.as_mut() {
-            if let Some(id) = on_member {
+            if let Some((index, id)) = on_member {
                 let note = format!(
                     "{name}: line {line}: `{block}` (no `mag`) is member {id} of {} already",
                     members.source_name
                 );
-                members.note_par_galaxy(id);
+                members.note_par_galaxy(index);
                 return Some(note);
             }
             if let Some(k) = members.commented.iter().position(|m| near(&m)) {
                 let row = members.commented.remove(k);
-                members.note_par_galaxy(row.id.clone());
+                members.note_par_galaxy(members.members.len());
                 let note = format!(
                     "{name}: line {line}: `{block}` has no `mag`; the row {} comments out \
                      there (line {}, galaxy {}, mag {:.2}) is fitted as a member",

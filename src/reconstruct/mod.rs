@@ -1626,8 +1626,8 @@ fn bcg_candidates<'a>(
     plane: &LensPlane,
 ) -> Vec<(&'a Member, f64)> {
     let mut members = with_luminosity(&catalog.members, config, plane);
-    for (m, lstar) in &mut members {
-        if catalog.par_galaxies.contains(&m.id) {
+    for (k, (_, lstar)) in members.iter_mut().enumerate() {
+        if catalog.par_galaxies.contains(&k) {
             *lstar = lstar.max(crate::inversion::BCG_MIN_LSTAR);
         }
     }

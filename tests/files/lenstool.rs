@@ -708,7 +708,8 @@ mod galaxies_of_a_par {
             notes[0].contains("is member O3 of members.cat already: not added twice"),
             "{notes:?}"
         );
-        assert_eq!(data.members.as_ref().unwrap().par_galaxies, ["O3"]);
+        let named = data.members.as_ref().unwrap();
+        assert_eq!(named.ids(&named.par_galaxies), ["O3"]);
         // Without a member catalogue it makes one, in the images' frame.
         let mut alone = as1063(false);
         add_galaxies(&mut alone, &par);
@@ -764,7 +765,7 @@ mod galaxies_of_a_par {
             "{notes:?}"
         );
         let members = data.members.as_ref().unwrap();
-        assert_eq!(members.par_galaxies, ["1", "2", "3"]);
+        assert_eq!(members.ids(&members.par_galaxies), ["1", "2", "3"]);
         for (m, (sigma, cut)) in
             members
                 .members
@@ -795,7 +796,8 @@ mod galaxies_of_a_par {
             )),
             "{notes:?}"
         );
-        assert_eq!(data.members.unwrap().par_galaxies, ["1", "3"]);
+        let named = data.members.as_ref().unwrap();
+        assert_eq!(named.ids(&named.par_galaxies), ["1", "3"]);
         // A block written twice is two galaxies to Lenstool, and here, with a note; a
         // neighbour within 1 arcsec is a galaxy of its own.
         let twice = format!(
@@ -815,9 +817,9 @@ mod galaxies_of_a_par {
             ),
             "{notes:?}"
         );
-        // (Galaxy 2 is the group's halo above.)
+        // (Galaxy 2 is the group's halo above.) Both of galaxy 1's blocks are the `.par`'s.
         let members = data.members.unwrap();
-        assert_eq!(members.par_galaxies, ["1", "3", "5"]);
+        assert_eq!(members.ids(&members.par_galaxies), ["1", "3", "1", "5"]);
         let ids: Vec<&str> = members.members.iter().map(|m| m.id.as_str()).collect();
         assert_eq!(ids, ["1", "3", "1", "5"]);
         // The same halo centred on a catalogue member (MACS J1149's northern group `O4` on
@@ -925,8 +927,8 @@ mod galaxies_of_a_par {
             "{notes:?}"
         );
         let members = data.members.unwrap();
-        assert_eq!(members.par_galaxies, ["O7", "O8", "O9"]);
-        assert_eq!(members.free_mass_galaxies, ["O7", "O8"]);
+        assert_eq!(members.ids(&members.par_galaxies), ["O7", "O8", "O9"]);
+        assert_eq!(members.ids(&members.free_mass_galaxies), ["O7", "O8"]);
         let masses = [(150.0, 30.0), (310.0, 205.0), (310.0, 205.0)];
         for (m, (sigma, cut)) in members.members.iter().zip(masses) {
             let dpie = 1.5 * std::f64::consts::PI * sigma * sigma * cut / G_KPC;
@@ -992,7 +994,8 @@ mod galaxies_of_a_par {
             ),
             "{notes:?}"
         );
-        assert_eq!(data.members.unwrap().par_galaxies, ["G3"]);
+        let named = data.members.as_ref().unwrap();
+        assert_eq!(named.ids(&named.par_galaxies), ["G3"]);
         let one = format!("{head}{}", block("O1", 0.0, 1000.0, 80.0, ""));
         let par = parse_par(&one, "one.par").unwrap();
         let mut data = Dataset::default();
@@ -1056,8 +1059,8 @@ mod galaxies_of_a_par {
             "{notes:?}"
         );
         let alone = data.members.as_ref().unwrap();
-        assert_eq!(alone.par_galaxies, ["3"]);
-        assert_eq!(alone.free_mass_galaxies, ["3"]);
+        assert_eq!(alone.ids(&alone.par_galaxies), ["3"]);
+        assert_eq!(alone.ids(&alone.free_mass_galaxies), ["3"]);
         let dpie = 1.5 * std::f64::consts::PI * 100.0 * 100.0 * 100.0 / G_KPC;
         let mass = law_mass(&alone.members[0], &par);
         // Its ellipticity (0.273) lowers a dPIE's mass by 1 - eps^2 (eps the Kassiola-Kovner
@@ -1067,6 +1070,49 @@ mod galaxies_of_a_par {
         assert!(
             (mass / (dpie * (1.0 - eps * eps)) - 1.0).abs() < 1e-3,
             "{mass:e} {dpie:e}"
+        );
+        // A catalogue member named `3` elsewhere is not `potentiel 3`: a `.par` numbers its
+        // potentials as catalogues number their rows. Only the `.par`'s galaxy is its own,
+        // with its mass free, in a layer of its own.
+        let (catalog, _) = wslap::parse_member_catalog(
+            "#REFERENCE 3 292.95682 -26.575718\n3 20.0 0.0 1 1 0 18.5\n",
+            "gal.cat",
+            None,
+        )
+        .unwrap();
+        let mut data = Dataset {
+            members: Some(catalog),
+            ..Dataset::default()
+        };
+        add_galaxies(&mut data, &par);
+        let both = data.members.as_ref().unwrap();
+        assert_eq!(both.ids(&[0, 1]), ["3", "3"]);
+        assert_eq!(both.members[0].line, 2);
+        assert_eq!(
+            (
+                both.par_galaxies.as_slice(),
+                both.free_mass_galaxies.as_slice()
+            ),
+            (&[1][..], &[1][..])
+        );
+        let config = wslap::MemberConfig {
+            layers: "bcg".parse().unwrap(),
+            ..wslap::MemberConfig::default()
+        };
+        let grid = wslap::CellGrid::regular(DVec2::ZERO, 80.0, 8, 0.75).unwrap();
+        let layers = wslap::build_member_layers(both, &config, &par.lens_plane().unwrap(), &grid)
+            .unwrap()
+            .layers;
+        let members: Vec<(&str, &[usize])> = layers
+            .iter()
+            .map(|l| (l.name.as_str(), l.members.as_slice()))
+            .collect();
+        assert_eq!(
+            members,
+            [
+                ("galaxy 3 (mass free in the .par)", &[1][..]),
+                ("bcg", &[0][..])
+            ]
         );
         // With it, the commented row there becomes a member, once; and the set-up's own
         // galaxy is recorded, so no BCG is looked for among the commented rows.
@@ -1097,7 +1143,7 @@ mod galaxies_of_a_par {
         let bcg = members.members.last().unwrap();
         assert_eq!((bcg.id.as_str(), bcg.mag, bcg.line), ("1009.0", 17.325, 10));
         assert!(!members.commented.iter().any(|m| m.id == "1009.0"));
-        assert_eq!(members.par_galaxies, ["1009.0"]);
+        assert_eq!(members.ids(&members.par_galaxies), ["1009.0"]);
         let notes = add_galaxies(&mut data, &par);
         assert!(
             notes[0].ends_with("`potentiel 3` (no `mag`) is member 1009.0 of m1931.cat already"),
@@ -1168,7 +1214,7 @@ fn a_published_set_up_s_par_gives_its_priors_and_bcg() {
         "{notes:?}"
     );
     let m = data.members.as_ref().unwrap();
-    assert_eq!(m.par_galaxies, ["4"]);
+    assert_eq!(m.ids(&m.par_galaxies), ["4"]);
     assert!(m.members.iter().any(|g| g.id == "4" && g.line == 5));
 }
 

@@ -179,12 +179,15 @@ fn layer_splits_partition_the_members() {
     assert!(layers_of("none").is_empty());
 
     // A `.par` galaxy whose mass the `.par` leaves free has a layer of its own, first, and
-    // the split groups the others (the BCG is then the brightest of those).
+    // the split groups the others (the BCG is then the brightest of those). Member 3 shares
+    // its name (a `.par` names potentials `1`, `2`, ... as catalogues number their rows):
+    // it is not that galaxy, and stays with the others.
     let free_id = cat.members[2].id.clone();
-    let freed = MemberCatalog {
-        free_mass_galaxies: vec![free_id.clone()],
+    let mut freed = MemberCatalog {
+        free_mass_galaxies: vec![2],
         ..members()
     };
+    freed.members[3].id = free_id.clone();
     for (split, expected) in [
         ("single", vec![vec![2], vec![0, 1, 3, 4, 5]]),
         ("bcg", vec![vec![2], vec![0], vec![1, 3, 4, 5]]),

@@ -1237,7 +1237,8 @@ fn a_commented_out_bcg_row_is_fitted_unless_the_settings_say_not() {
     let mut data = read_macs();
     data.add_par_galaxies(&par, &par.lens_plane().unwrap(), &Default::default())
         .unwrap();
-    assert_eq!(data.members.as_ref().unwrap().par_galaxies, ["G1"]);
+    let named = data.members.as_ref().unwrap();
+    assert_eq!(named.ids(&named.par_galaxies), ["G1"]);
     assert!(data.fit_commented_bcgs(&plane, &config).is_empty());
     assert_eq!(data.members.as_ref().unwrap().members.len(), members + 1);
     assert_eq!(
