@@ -105,6 +105,10 @@ pub struct EnsembleMember {
     /// was kept.
     #[serde(default)]
     pub crowding: Option<Crowding>,
+    /// Whether the map it kept is crowded by the verdict's rule ([`Crowding::distrusted`] of
+    /// [`Self::crowding`]): every candidate it tried was, and it kept the least crowded.
+    #[serde(default)]
+    pub crowded: bool,
     /// The candidates its draw ranked first whose maps were crowded, passed over for the one
     /// it used ([`MemberDraw::then`]), in the order fitted.
     #[serde(default)]
@@ -762,6 +766,7 @@ impl EnsemblePlan {
         }
         let (kappa, magnif) = sampled_maps(&r, self.geometry);
         let summary = r.products.summary();
+        let crowding = Crowding::of_fitted(&r.sources);
         let record = EnsembleMember {
             member,
             fitted: draw.fitted.clone(),
@@ -770,7 +775,8 @@ impl EnsemblePlan {
             regulariser: used.0,
             strength: used.1,
             cells: used.2,
-            crowding: Some(Crowding::of_fitted(&r.sources)),
+            crowding: Some(crowding),
+            crowded: crowding.distrusted(),
             crowded_maps,
             member_mass_factor: draw.member_mass_factor,
             status: r.status.name().to_string(),
@@ -987,6 +993,7 @@ mod tests {
             strength: None,
             cells: None,
             crowding: None,
+            crowded: false,
             crowded_maps: Vec::new(),
             member_mass_factor: 1.0,
             status: "Converged".to_string(),

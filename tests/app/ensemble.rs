@@ -486,8 +486,15 @@ fn ensemble_members_pass_over_crowded_maps() {
         assert!(!passed.contains(&used(r)), "member {}: {r:?}", r.member);
         assert!(draw.then.iter().all(|c| !passed.contains(c)), "{draw:?}");
         let crowding = r.crowding.expect("recorded");
-        // Over the systems it fitted: those it left out test it.
+        // Over the systems it fitted: those it left out test it. The app's box says the
+        // members that kept a crowded map from `crowded`, not from the rule again.
         assert_eq!(crowding.systems, draw.fitted.len());
+        assert_eq!(
+            r.crowded,
+            crowding.distrusted(),
+            "member {}: {r:?}",
+            r.member
+        );
         if r.crowded_maps.is_empty() {
             // Its first map stood, so it was not crowded.
             assert!(!crowding.distrusted(), "member {}: {r:?}", r.member);

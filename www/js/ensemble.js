@@ -207,7 +207,7 @@ export function showEnsemble(ensemble, app) {
   // Members whose first map was crowded (the verdict's rule) and who fitted their draw's next
   // candidates, as the main run does; some may have found none uncrowded.
   const moved = ensemble.members.filter((m) => m.crowded_maps?.length);
-  const still = moved.filter((m) => m.crowding && 3 * m.crowding.crowded_systems > m.crowding.systems);
+  const still = moved.filter((m) => m.crowded);
   const crowded = moved.length ? `<p id="ensemble-crowded">${moved.length} of ${n} members' first maps predicted far
     more images than observed for more than a third of the systems (critical curves winding through the images):
     those members fitted the next candidates of their own draw instead, as this map's choice does${still.length
