@@ -101,7 +101,7 @@ pub fn parse_par_with(
     }
     for (p, b) in potentials.iter_mut().zip(limits) {
         if matches!(p.component, ParComponent::Dpie { .. }) {
-            p.free_mass = free_mass(b);
+            p.free_mass = free_mass(b, &cx);
         }
     }
     let cosmology = cosmology.ok_or_else(|| cx.model("no `cosmologie` block"))?;
@@ -171,10 +171,11 @@ pub fn parse_par_with(
 /// The uniform priors (mode 1: `v_disp 1 150 450 0.1`) the `limit` block `b` puts on a dPIE's
 /// mass: `v_disp`, the core and the cut radius (kpc wins over arcsec, as in a `potentiel`
 /// block); `None` when it puts none. A prior's low end is kept where it is above 0 (one from 0
-/// gives no least mass: the written value stays). Lines of another mode, and lines that do not
-/// read as `mode low high` with `0 <= low <= high`, are passed over: the block was only ever
-/// read for this, and the model is evaluated without it.
-fn free_mass(b: &Block) -> Option<FreeMass> {
+/// gives no least mass: the written value stays). Lines of another mode are passed over (the
+/// block is only read for this; the model is evaluated without it); a line of mode 1 that does
+/// not read as `1 low high` with `0 <= low <= high` is passed over with a warning on `cx`
+/// naming it, since that value is then taken as written.
+fn free_mass(b: &Block, cx: &Ctx<'_>) -> Option<FreeMass> {
     // Some(the low end if above 0) for a uniform prior; None for anything else.
     let prior = |key: &str| {
         let e = b.entries.get(key)?;
@@ -187,6 +188,19 @@ fn free_mass(b: &Block) -> Option<FreeMass> {
         match v[..] {
             [mode, low, high] if mode == 1.0 && low >= 0.0 && low <= high && high.is_finite() => {
                 Some((low > 0.0).then_some(low))
+            }
+            [1.0, ..] => {
+                cx.warn(
+                    e.line,
+                    format!(
+                        "`{key} {}` in `{}` (line {}) is not a uniform prior `1 low high` with \
+                         0 <= low <= high: not read, so `{key}` keeps its written value",
+                        e.values.join(" "),
+                        b.header,
+                        b.line
+                    ),
+                );
+                None
             }
             _ => None,
         }

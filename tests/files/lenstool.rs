@@ -900,6 +900,22 @@ mod galaxies_of_a_par {
             par.potentials[3].free_mass, None,
             "a posterior is not a free mass"
         );
+        assert!(par.warnings.is_empty(), "{:?}", par.warnings);
+        // A uniform prior written upside down is not read, and said: v_disp is as written.
+        let upside_down = text.replace("v_disp 1 150. 450. 0.1", "v_disp 1 450. 150. 0.1");
+        let par_ud = parse_par(&upside_down, "start.par").unwrap();
+        let free = par_ud.potentials[1].free_mass.as_ref().unwrap();
+        assert_eq!(free.sigma_v_km_s, None);
+        assert_eq!(free.r_cut, Some(wslap::Radius::Kpc(30.0)));
+        let said: Vec<String> = par_ud.warnings.iter().map(|w| w.to_string()).collect();
+        assert_eq!(
+            said,
+            [
+                "start.par:29: `v_disp 1 450. 150. 0.1` in `limit 6` (line 28) is not a uniform \
+              prior `1 low high` with 0 <= low <= high: not read, so `v_disp` keeps its \
+              written value"
+            ]
+        );
         // The model is Lenstool's: O7 as written.
         let wslap::ParComponent::Dpie { sigma_v_km_s, .. } = par.potentials[1].component else {
             panic!("{:?}", par.potentials[1])
