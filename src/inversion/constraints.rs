@@ -247,6 +247,18 @@ impl ConstraintConfig {
                 || (z.is_none() && self.default_z.is_none()))
     }
 
+    /// The redshift at which the system `id` (catalogue redshift `z`) is predicted when it is
+    /// held out of a fit, and whether it is assumed: the one its own prior fixes (a `.par`'s
+    /// `z_m_limit` with flag 0, whatever the catalogue says), else the catalogue's, else
+    /// `default_z` (assumed); `None` when none is known. A fitted system takes the same,
+    /// unless its redshift is estimated.
+    pub fn held_out_z(&self, id: &str, z: Option<f64>) -> Option<(f64, bool)> {
+        match self.z_fixed(id).or(z) {
+            Some(z) => Some((z, false)),
+            None => self.default_z.map(|z| (z, true)),
+        }
+    }
+
     /// The redshift `z_priors` fixes for `id`, if it does.
     fn z_fixed(&self, id: &str) -> Option<f64> {
         match self.z_priors.get(id) {
@@ -610,6 +622,14 @@ pub fn build_constraints(
             fixed.or(c.z).or(config.default_z)
         };
         let exclusion = if hold_out.contains(&c.id) {
+            if config.held_out_z(&c.id, c.z).is_none() && estimate.is_none() {
+                set.warnings.push(format!(
+                    "{source_name}: system {} is held out but has no redshift to predict its \
+                     images at (none in the catalogue, no prior of its own fixes one, no \
+                     default_z): it is left out and not predicted",
+                    c.id
+                ));
+            }
             Err(Exclusion::HeldOut)
         } else if c.images.len() < 2 && c.single_is_one_image {
             set.warnings.push(format!(

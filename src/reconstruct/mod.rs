@@ -1478,7 +1478,7 @@ fn reconstruct_limited(
         &lens,
         &products,
         inputs,
-        config.constraints.default_z,
+        &config.constraints,
         config.objective.max_stretch,
     )?;
     timings.sources_ms = t.ms();

@@ -9,7 +9,9 @@ use crate::ds9::{write_marks, Mark};
 use crate::image_search::{
     find_images, magnification_at, source_position, ImageError, ImageSearch, SearchGrid,
 };
-use crate::inversion::{capped_inverse_jacobian, ConstraintSource, LinearSystem, RedshiftPrior};
+use crate::inversion::{
+    capped_inverse_jacobian, ConstraintConfig, ConstraintSource, LinearSystem, RedshiftPrior,
+};
 use crate::map::{LensMaps, Map};
 use crate::potential::{arrival_time_days, potential_at, potential_map};
 use crate::products::Products;
@@ -241,7 +243,7 @@ pub(super) fn report(
     lens: &Lens,
     products: &Products,
     inputs: &Inputs<'_>,
-    default_z: Option<f64>,
+    constraints: &ConstraintConfig,
     max_stretch: f64,
 ) -> Result<Vec<SourceReport>, ReconstructError> {
     let betas = system.betas_arcsec(x)?;
@@ -303,8 +305,9 @@ pub(super) fn report(
         let Some((z, observed)) = held_out_images(inputs, id) else {
             continue;
         };
-        let z_assumed = z.is_none();
-        let z = z.or(default_z).unwrap_or(f64::NAN);
+        let Some((z, z_assumed)) = constraints.held_out_z(id, z) else {
+            continue;
+        };
         let Ok(f) = inputs.plane.distance_ratio(z) else {
             continue;
         };

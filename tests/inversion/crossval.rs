@@ -467,3 +467,68 @@ fn an_auto_choice_inside_a_fold_counts_only_the_systems_it_can_hold_out() {
     assert_eq!(cv.runs.len(), 3);
     assert_eq!(cv.always_fitted, ids(&["3"]));
 }
+
+/// A system whose redshift only its own prior fixes (a `.par`'s `z_m_limit` with flag 0,
+/// the catalogue's z 0) is held out and predicted at that redshift, by `--holdout` and by every
+/// fold, exactly as when the catalogue gives it. Before, its held-out images were dropped
+/// without a word (a Lenstool set-up whose `.par` carries the redshifts, MACS J0308's: no
+/// candidate of "auto" had a held-out offset). One with no redshift at all is said.
+#[test]
+fn a_system_whose_own_prior_fixes_its_redshift_is_held_out_and_predicted() {
+    let cat = catalog();
+    let mut unknown = catalog();
+    let z3 = unknown.systems[2].z.take().unwrap();
+    assert_eq!(unknown.systems[2].id, "3");
+    let mut config = config();
+    config.objective.strength = wslap::Strength::Value(0.1);
+    let mut fixed = config.clone();
+    fixed
+        .constraints
+        .z_priors
+        .insert("3".to_string(), wslap::RedshiftPrior::Fixed(z3));
+    let offsets = |r: &wslap::SourceReport| -> Vec<Option<f64>> {
+        r.observed.iter().map(|o| o.offset_arcsec).collect()
+    };
+    let three = ids(&["3"]);
+    let given = reconstruct(&inputs(&cat, &three), &config, &mut quiet).unwrap();
+    let by_prior = reconstruct(&inputs(&unknown, &three), &fixed, &mut quiet).unwrap();
+    let report = |r: &wslap::Reconstruction| r.sources.iter().find(|s| s.id == "3").cloned();
+    let (a, b) = (report(&given).unwrap(), report(&by_prior).unwrap());
+    assert!(b.held_out && !b.z_assumed && b.z == z3, "{b:?}");
+    assert!(offsets(&b).iter().all(Option::is_some), "{b:?}");
+    assert_eq!(offsets(&a), offsets(&b));
+    assert!(!by_prior.warnings.iter().any(|w| w.contains("held out")));
+
+    let none: Vec<String> = Vec::new();
+    let cv = |cat: &ImageCatalog, c: &ReconstructConfig| {
+        cross_validate(&inputs(cat, &none), c, 4, None, &mut |_, _| {
+            Control::Continue
+        })
+        .unwrap()
+    };
+    let (given, by_prior) = (cv(&cat, &config), cv(&unknown, &fixed));
+    let held: Vec<&str> = by_prior
+        .systems
+        .iter()
+        .map(|s| s.report.id.as_str())
+        .collect();
+    assert_eq!(held, ["1", "2", "3", "4"]);
+    for (a, b) in given.systems.iter().zip(&by_prior.systems) {
+        assert_eq!(offsets(&a.report), offsets(&b.report), "{}", a.report.id);
+    }
+
+    // Neither the catalogue nor a prior nor default_z: left out, and said.
+    config.constraints.free_z_prior = None;
+    let alone = reconstruct(&inputs(&unknown, &three), &config, &mut quiet).unwrap();
+    assert!(report(&alone).is_none());
+    assert!(
+        alone.warnings.contains(
+            &"images.cat: system 3 is held out but has no redshift to predict its images at \
+              (none in the catalogue, no prior of its own fixes one, no default_z): it is left \
+              out and not predicted"
+                .to_string()
+        ),
+        "{:?}",
+        alone.warnings
+    );
+}
