@@ -1178,24 +1178,35 @@ impl StrengthChoice {
 
     /// The choice among the `trials` of `config`'s candidates: the fewest held-out images with
     /// no predicted image, then the smallest held-out median offset. With fewer than 2 folds
-    /// (no trials), the middle candidate, and said so.
+    /// (no trials), or when no trial predicted any held-out image (nothing to rank them by),
+    /// the middle candidate, and said so.
     pub fn from_trials(
         config: &ReconstructConfig,
         folds: usize,
         trials: Vec<StrengthCandidate>,
     ) -> Self {
         let candidates = &config.objective.candidates;
+        let middle = |rule: String| Self {
+            folds: 0,
+            candidates: Vec::new(),
+            chosen: candidates[candidates.len() / 2],
+            chosen_regulariser: config.objective.regulariser,
+            chosen_cells: None,
+            rule,
+            before_estimates: None,
+            crowded_maps: Vec::new(),
+        };
         if folds < 2 || trials.is_empty() {
-            return Self {
-                folds: 0,
-                candidates: Vec::new(),
-                chosen: candidates[candidates.len() / 2],
-                chosen_regulariser: config.objective.regulariser,
-                chosen_cells: None,
-                rule: "too few fitted systems to hold any out, so the middle candidate".to_string(),
-                before_estimates: None,
-                crowded_maps: Vec::new(),
-            };
+            return middle(
+                "too few fitted systems to hold any out, so the middle candidate".into(),
+            );
+        }
+        if trials.iter().all(|t| t.holdout_median_arcsec.is_none()) {
+            return middle(format!(
+                "none of {} candidates predicted an image of the systems {folds} folds held \
+                 out, so the middle candidate",
+                trials.len()
+            ));
         }
         let best = trials.iter().min_by(|p, q| predicts_better(p, q));
         let chosen = best.map_or(
@@ -2174,6 +2185,18 @@ mod tests {
             "gradient at strength 0.1 (too few fitted systems to hold any out, so the middle \
              candidate)"
         );
+        // Trials that predicted nothing rank nothing: not "chosen by cross-validation".
+        let blind = vec![
+            candidate(Regulariser::Gradient, 0.01, &[("1", &[None, None])]),
+            candidate(Regulariser::Curvature, 1.0, &[("1", &[None, None])]),
+        ];
+        let none = StrengthChoice::from_trials(&config, 4, blind);
+        assert_eq!(
+            none.describe(),
+            "gradient at strength 0.1 (none of 2 candidates predicted an image of the systems 4 \
+             folds held out, so the middle candidate)"
+        );
+        assert!(!none.was_cross_validated());
         c.crowded_maps = vec![CrowdedMap {
             candidate: pick(Regulariser::Density, 0.01, 32),
             crowding: Crowding {
