@@ -423,12 +423,26 @@ impl LinearSystem {
     /// more than [`PRIOR_PULL_SIGMA`] of the prior's width from 1: "given the prior" (the
     /// warning of [`Self::measurability_warnings`], said before the solve) is then not "at 1"
     /// (the HFF catalogues end at C = 0.6 - 0.7 with the prior 1 +- 0.1).
+    ///
+    /// Where the data hardly measure the layer's factor (as [`Self::measurability_warnings`]
+    /// said before the solve), the sentence says that the regulariser, weighed against the
+    /// prior, set it: the images would fit as well at 1 with the grid standing in, so
+    /// "the images make the members lighter" would contradict the warning before it.
     pub fn prior_pull_warnings(&self, x: &[f64]) -> Vec<String> {
         let Some(factors) = x.get(self.layer_columns()) else {
             return Vec::new();
         };
-        member_layers_with(&self.layers, factors)
-            .filter_map(|(layer, &c)| {
+        // As `measurability_warnings` judged them (its cached shares; none with fewer rows).
+        let measured: Vec<bool> = match self.n_rows < self.n_columns() {
+            true => vec![false; self.layers.len()],
+            false => self
+                .layer_independence()
+                .iter()
+                .map(|share| share.is_none_or(|s| s >= LAYER_SHARE_WARN))
+                .collect(),
+        };
+        member_layers_with(&self.layers, factors.iter().zip(measured))
+            .filter_map(|(layer, (&c, measured))| {
                 let sigma = layer.prior_sigma?;
                 let pull = (c - 1.0) / sigma;
                 (pull.abs() > PRIOR_PULL_SIGMA).then(|| {
@@ -436,11 +450,18 @@ impl LinearSystem {
                         true => ("below", "lighter"),
                         false => ("above", "heavier"),
                     };
+                    let why = match measured {
+                        true => format!("the images and the regulariser make the members {mass}"),
+                        false => format!(
+                            "the images hardly measure C (the grid can stand in for the \
+                             members), so the regulariser, weighed against the prior, sets it \
+                             and makes the members {mass}"
+                        ),
+                    };
                     format!(
                         "member layer \"{}\": C ends at {c:.2}, {:.1} sigma {side} its prior C = \
-                         1 +- {sigma}: the images and the regulariser make the members {mass} \
-                         than the luminosity law as set (members.mass_to_light), and the map \
-                         keeps the fitted C",
+                         1 +- {sigma}: {why} than the luminosity law as set \
+                         (members.mass_to_light), and the map keeps the fitted C",
                         layer.name,
                         pull.abs()
                     )

@@ -224,8 +224,9 @@ fn an_unmeasured_member_factor_is_held_near_one() {
         held.system.prior_pull_warnings(&x),
         [format!(
             "member layer \"{name}\": C ends at 0.50, 5.0 sigma below its prior C = 1 +- 0.1: \
-             the images and the regulariser make the members lighter than the luminosity law as \
-             set (members.mass_to_light), and the map keeps the fitted C"
+             the images hardly measure C (the grid can stand in for the members), so the \
+             regulariser, weighed against the prior, sets it and makes the members lighter than \
+             the luminosity law as set (members.mass_to_light), and the map keeps the fitted C"
         )]
     );
     config.members.c_prior_sigma_unmeasured = None;
