@@ -488,8 +488,9 @@
 //! warning. A reconstruction given the `.par` also takes the `z_m_limit n id flag v1 v2 prec`
 //! lines of its `image` block: system `id`'s redshift fixed at `v1` (flag 0, as a `best.par`
 //! writes the fitted value; a redshift of its own, at which a fold or `--holdout` predicts
-//! the system: [`crate::ConstraintConfig::held_out_z`]), uniform on `[v1, v2]` (1) or normal of mean `v1` and width `v2`
-//! (3, a `bestopt.par`'s posterior); an id matches a catalogue system as text or as a number.
+//! the system: [`crate::ConstraintConfig::given_z`]), uniform on `[v1, v2]` (1) or normal of
+//! mean `v1` and width `v2` (3, a `bestopt.par`'s posterior); an id matches a catalogue system
+//! as text or as a number.
 //!
 //! **HFF-style lens-model FITS maps.** One 2-D image per quantity, at the reference
 //! normalisation except the magnification: the HFF names are `<model>_kappa.fits`,

@@ -247,12 +247,12 @@ impl ConstraintConfig {
                 || (z.is_none() && self.default_z.is_none()))
     }
 
-    /// The redshift at which the system `id` (catalogue redshift `z`) is predicted when it is
-    /// held out of a fit, and whether it is assumed: the one its own prior fixes (a `.par`'s
-    /// `z_m_limit` with flag 0, whatever the catalogue says), else the catalogue's, else
-    /// `default_z` (assumed); `None` when none is known. A fitted system takes the same,
-    /// unless its redshift is estimated.
-    pub fn held_out_z(&self, id: &str, z: Option<f64>) -> Option<(f64, bool)> {
+    /// The redshift given for the system `id` (catalogue redshift `z`), and whether it is
+    /// assumed: the one its own prior fixes (a `.par`'s `z_m_limit` with flag 0, whatever the
+    /// catalogue says), else the catalogue's, else `default_z` (assumed); `None` when none is
+    /// given. A fit takes it unless the redshift is estimated ([`Self::is_free_z`]); a system
+    /// held out of a fit (`--holdout`, a fold) is predicted at it.
+    pub fn given_z(&self, id: &str, z: Option<f64>) -> Option<(f64, bool)> {
         match self.z_fixed(id).or(z) {
             Some(z) => Some((z, false)),
             None => self.default_z.map(|z| (z, true)),
@@ -615,14 +615,15 @@ pub fn build_constraints(
     for c in candidates {
         let free = config.is_free_z(&c.id, c.z);
         let estimate = config.z_estimate(&c.id).filter(|_| free);
-        let fixed = config.z_fixed(&c.id);
+        let given = config.given_z(&c.id, c.z);
         let z = if free {
             estimate
         } else {
-            fixed.or(c.z).or(config.default_z)
+            given.map(|(z, _)| z)
         };
         let exclusion = if hold_out.contains(&c.id) {
-            if config.held_out_z(&c.id, c.z).is_none() && estimate.is_none() {
+            // Predicted at the given redshift (`given_z`), whether or not the fit estimates it.
+            if given.is_none() && estimate.is_none() {
                 set.warnings.push(format!(
                     "{source_name}: system {} is held out but has no redshift to predict its \
                      images at (none in the catalogue, no prior of its own fixes one, no \
@@ -650,7 +651,7 @@ pub fn build_constraints(
         };
         match exclusion {
             Ok(z) => {
-                let assumed = c.z.is_none() && estimate.is_none() && fixed.is_none();
+                let assumed = !free && given.is_some_and(|(_, assumed)| assumed);
                 if assumed {
                     set.warnings.push(format!(
                         "{source_name}: system {} has no redshift: default_z = {z} assumed",

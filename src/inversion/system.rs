@@ -57,6 +57,12 @@ use crate::units::point_mass_deflection_arcsec2;
 /// members of its `members.cat` (the app's example and `wslap reconstruct`).
 pub const LAYER_SHARE_WARN: f64 = 1e-3;
 
+/// Whether a layer's independent share ([`LinearSystem::layer_independence`]) says the data
+/// hardly measure its factor: below [`LAYER_SHARE_WARN`].
+fn hardly_measured(share: f64) -> bool {
+    share < LAYER_SHARE_WARN
+}
+
 /// How many prior widths from 1 a layer's fitted factor `C` may end before the run says so
 /// ([`LinearSystem::prior_pull_warnings`]).
 pub const PRIOR_PULL_SIGMA: f64 = 3.0;
@@ -438,7 +444,7 @@ impl LinearSystem {
             false => self
                 .layer_independence()
                 .iter()
-                .map(|share| share.is_none_or(|s| s >= LAYER_SHARE_WARN))
+                .map(|share| !share.is_some_and(hardly_measured))
                 .collect(),
         };
         member_layers_with(&self.layers, factors.iter().zip(measured))
@@ -510,7 +516,7 @@ impl LinearSystem {
         }
         member_layers_with(&self.layers, self.layer_independence())
             .filter_map(|(layer, share)| {
-                let share = share.filter(|&s| s < LAYER_SHARE_WARN)?;
+                let share = share.filter(|&s| hardly_measured(s))?;
                 Some(format!(
                     "member layer \"{}\": the grid cells and source positions reproduce all but \
                      {share:.1e} of its deflection at the constraints, so the data hardly \

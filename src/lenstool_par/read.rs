@@ -186,7 +186,7 @@ fn free_mass(b: &Block, cx: &Ctx<'_>) -> Option<FreeMass> {
             .map_while(|v| v.parse().ok())
             .collect();
         match v[..] {
-            [mode, low, high] if mode == 1.0 && low >= 0.0 && low <= high && high.is_finite() => {
+            [1.0, low, high] if low >= 0.0 && low <= high && high.is_finite() => {
                 Some((low > 0.0).then_some(low))
             }
             [1.0, ..] => {

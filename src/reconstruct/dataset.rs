@@ -535,7 +535,9 @@ impl Dataset {
             }
             if let Some(k) = members.commented.iter().position(|m| near(&m)) {
                 let row = members.commented.remove(k);
-                members.note_par_galaxy(members.members.len());
+                // Its index once pushed below.
+                let index = members.members.len();
+                members.note_par_galaxy(index);
                 let note = format!(
                     "{name}: line {line}: `{block}` has no `mag`; the row {} comments out \
                      there (line {}, galaxy {}, mag {:.2}) is fitted as a member",

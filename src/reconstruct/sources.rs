@@ -305,7 +305,7 @@ pub(super) fn report(
         let Some((z, observed)) = held_out_images(inputs, id) else {
             continue;
         };
-        let Some((z, z_assumed)) = constraints.held_out_z(id, z) else {
+        let Some((z, z_assumed)) = constraints.given_z(id, z) else {
             continue;
         };
         let Ok(f) = inputs.plane.distance_ratio(z) else {
