@@ -320,8 +320,10 @@
 //! even when a member lies at its centre: MACS J1149's northern group on member 1824). Where
 //! the `.par`'s `limit` block leaves that mass free (uniform priors on `v_disp` or the radii:
 //! a starting model, whose written values are where its fit begins), the galaxy is taken at
-//! the priors' low ends (the written value where one starts at 0; a mode-1 line that does
-//! not read as `1 low high`, `0 <= low <= high`, is named in a warning and not used) and
+//! the priors' low ends (the written value where one starts at 0; a radius's kpc line wins
+//! over its arcsec line, as in a `potentiel` block; a mode-1 line that does not read as
+//! `1 low high`, `0 <= low <= high`, or a line of a mode other than 0, 1 and 3, is named in a
+//! warning and not used) and
 //! given a layer of its own ([`crate::lenstool_par::FreeMass`]): the grid can add mass near it
 //! but never take any away, and its factor is not the members', whereas a start fourteen
 //! times too heavy in the members' layer pulls every member's `C` down (MACS J1149's CATS

@@ -169,14 +169,18 @@ pub fn parse_par_with(
 }
 
 /// The uniform priors (mode 1: `v_disp 1 150 450 0.1`) the `limit` block `b` puts on a dPIE's
-/// mass: `v_disp`, the core and the cut radius (kpc wins over arcsec, as in a `potentiel`
-/// block); `None` when it puts none. A prior's low end is kept where it is above 0 (one from 0
-/// gives no least mass: the written value stays). Lines of another mode are passed over (the
-/// block is only read for this; the model is evaluated without it); a line of mode 1 that does
-/// not read as `1 low high` with `0 <= low <= high` is passed over with a warning on `cx`
-/// naming it, since that value is then taken as written.
+/// mass: `v_disp`, the core and the cut radius; `None` when it puts none. A prior's low end is
+/// kept where it is above 0 (one from 0 gives no least mass: the written value stays). As in a
+/// `potentiel` block, a radius's kpc line wins over its arcsec line whatever it says, so the
+/// arcsec line is read only where the block has no kpc line. Lines of mode 0 (fixed) and 3
+/// (a Gaussian, which a `bestopt.par` writes for every fitted value) keep the written value
+/// without a word: the block is only read for this, and the model is evaluated without it. A
+/// line of mode 1 that does not read as `1 low high` with `0 <= low <= high`, or of any other
+/// mode, is passed over with a warning on `cx` naming it, since the value is then taken as
+/// written.
 fn free_mass(b: &Block, cx: &Ctx<'_>) -> Option<FreeMass> {
-    // Some(the low end if above 0) for a uniform prior; None for anything else.
+    // None without the line; Some(None) for one that frees nothing here; Some(Some(the low
+    // end if above 0)) for a uniform prior.
     let prior = |key: &str| {
         let e = b.entries.get(key)?;
         let v: Vec<f64> = e
@@ -185,32 +189,34 @@ fn free_mass(b: &Block, cx: &Ctx<'_>) -> Option<FreeMass> {
             .take(3)
             .map_while(|v| v.parse().ok())
             .collect();
+        let not_read = |what: &str| {
+            cx.warn(
+                e.line,
+                format!(
+                    "`{key} {}` in `{}` (line {}) is not {what}: not read, so `{key}` keeps its \
+                     written value",
+                    e.values.join(" "),
+                    b.header,
+                    b.line
+                ),
+            );
+            Some(None)
+        };
         match v[..] {
             [1.0, low, high] if low >= 0.0 && low <= high && high.is_finite() => {
-                Some((low > 0.0).then_some(low))
+                Some(Some((low > 0.0).then_some(low)))
             }
-            [1.0, ..] => {
-                cx.warn(
-                    e.line,
-                    format!(
-                        "`{key} {}` in `{}` (line {}) is not a uniform prior `1 low high` with \
-                         0 <= low <= high: not read, so `{key}` keeps its written value",
-                        e.values.join(" "),
-                        b.header,
-                        b.line
-                    ),
-                );
-                None
-            }
-            _ => None,
+            [1.0, ..] => not_read("a uniform prior `1 low high` with 0 <= low <= high"),
+            [0.0 | 3.0, ..] => Some(None),
+            _ => not_read("a prior of mode 0 (fixed), 1 (uniform) or 3 (Gaussian)"),
         }
     };
     let radius = |kpc: &str, arcsec: &str| match prior(kpc) {
-        Some(low) => Some(low.map(Radius::Kpc)),
-        None => prior(arcsec).map(|low| low.map(Radius::Arcsec)),
+        Some(low) => low.map(|low| low.map(Radius::Kpc)),
+        None => prior(arcsec).flatten().map(|low| low.map(Radius::Arcsec)),
     };
     let (sigma, core, cut) = (
-        prior("v_disp"),
+        prior("v_disp").flatten(),
         radius("core_radius_kpc", "core_radius"),
         radius("cut_radius_kpc", "cut_radius"),
     );

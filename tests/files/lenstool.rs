@@ -916,6 +916,48 @@ mod galaxies_of_a_par {
               written value"
             ]
         );
+        // A radius's kpc line wins over its arcsec line whatever it says (as in a `potentiel`
+        // block): a malformed kpc line keeps the written cut, said, and the arcsec line's
+        // prior is not used instead.
+        let both = text.replace(
+            "cut_radius_kpc 1 30. 70. 0.1",
+            "cut_radius_kpc 1 70. 30. 0.1\n    cut_radius 1 5. 10. 0.1",
+        );
+        let par_both = parse_par(&both, "start.par").unwrap();
+        let free = par_both.potentials[1].free_mass.as_ref().unwrap();
+        assert_eq!(free.sigma_v_km_s, Some(150.0));
+        assert_eq!(
+            free.r_cut, None,
+            "the arcsec line is not read beside a kpc line"
+        );
+        assert_eq!(par_both.warnings.len(), 1, "{:?}", par_both.warnings);
+        assert!(
+            par_both.warnings[0]
+                .to_string()
+                .contains("`cut_radius_kpc 1 70. 30. 0.1` in `limit 6`"),
+            "{:?}",
+            par_both.warnings
+        );
+        // Without the kpc line the arcsec line's prior is the cut's.
+        let arcsec = text.replace("cut_radius_kpc 1 30. 70. 0.1", "cut_radius 1 5. 10. 0.1");
+        let par_arcsec = parse_par(&arcsec, "start.par").unwrap();
+        let free = par_arcsec.potentials[1].free_mass.as_ref().unwrap();
+        assert_eq!(free.r_cut, Some(wslap::Radius::Arcsec(5.0)));
+        assert!(par_arcsec.warnings.is_empty(), "{:?}", par_arcsec.warnings);
+        // A mode this reader does not know is said too; the value stays as written.
+        let mode_2 = text.replace("v_disp 1 150. 450. 0.1", "v_disp 2 150. 450. 0.1");
+        let par_2 = parse_par(&mode_2, "start.par").unwrap();
+        let free = par_2.potentials[1].free_mass.as_ref().unwrap();
+        assert_eq!(free.sigma_v_km_s, None);
+        let said: Vec<String> = par_2.warnings.iter().map(|w| w.to_string()).collect();
+        assert_eq!(
+            said,
+            [
+                "start.par:29: `v_disp 2 150. 450. 0.1` in `limit 6` (line 28) is not a prior \
+                 of mode 0 (fixed), 1 (uniform) or 3 (Gaussian): not read, so `v_disp` keeps \
+                 its written value"
+            ]
+        );
         // The model is Lenstool's: O7 as written.
         let wslap::ParComponent::Dpie { sigma_v_km_s, .. } = par.potentials[1].component else {
             panic!("{:?}", par.potentials[1])
