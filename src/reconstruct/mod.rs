@@ -1208,15 +1208,14 @@ impl StrengthChoice {
                 trials.len()
             ));
         }
-        let best = trials.iter().min_by(|p, q| predicts_better(p, q));
-        let chosen = best.map_or(
-            Candidate {
-                regulariser: config.objective.regulariser,
-                strength: candidates[0],
-                cells: None,
-            },
-            StrengthCandidate::candidate,
-        );
+        // `trials` is not empty here, so there is a best.
+        let Some(chosen) = trials
+            .iter()
+            .min_by(|p, q| predicts_better(p, q))
+            .map(StrengthCandidate::candidate)
+        else {
+            return middle("no candidate to choose from, so the middle candidate".into());
+        };
         Self {
             folds,
             candidates: trials,
