@@ -104,9 +104,9 @@ pub use radial::{radial_profile, rect_disc_area, RadialBins, RadialError, Radial
 pub use arcs::{arcs_from_regions, parse_arcs, ArcCatalog, ArcSystem, ArcsError};
 pub use catalog::{
     arclet_ellipticity, parse_arclet_catalog, parse_arclet_catalog_with, parse_image_catalog,
-    parse_member_catalog, parse_potfile_catalog, Arclet, ArcletCatalog, ArcletUnknownZ,
-    CatalogError, CatalogRow, CommentedBcgs, Image, ImageCatalog, ImageSystem, Member,
-    MemberCatalog, DEGREE_LOOKALIKE, FIELD_ERROR_DEG, FIELD_WARN_DEG, MAG_NO_MEASUREMENT,
+    parse_member_catalog, parse_potfile_catalog, system_of_image, Arclet, ArcletCatalog,
+    ArcletUnknownZ, CatalogError, CatalogRow, CommentedBcgs, Image, ImageCatalog, ImageSystem,
+    Member, MemberCatalog, DEGREE_LOOKALIKE, FIELD_ERROR_DEG, FIELD_WARN_DEG, MAG_NO_MEASUREMENT,
     Z_AGREEMENT_TOL,
 };
 pub use ds9::{

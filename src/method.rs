@@ -439,9 +439,12 @@
 //!
 //! # 7. File formats
 //!
-//! **Lenstool image catalogue.** One image per row: `id x y a b theta z [mag]`. The id is
-//! `system.image` (e.g. `4.2`): everything before the first `.` names the system; an id
-//! without a `.` names it by all but its last character, as Lenstool does (`4b`, `A3c`).
+//! **Lenstool image catalogue.** One image per row: `id x y a b theta z [mag]`. Images are
+//! grouped into systems as Lenstool groups them into families, by all but the id's last
+//! character (`4b` and `4c`: system `4`; `A3c`: `A3`; `12.6c`: `12.6`, so `12.6c` and
+//! `12.5c` are two sources: two knots of one galaxy, fitted apart as Lenstool fits them),
+//! without a `.` that would end it (`4.2`: `4`). An id `system.number` names the text before
+//! its last `.` (`4.12`: `4`, where Lenstool would start a family `4.1`).
 //! `a`, `b` are the ellipse semi-axes in arcsec, `theta` its position angle in degrees (§1),
 //! `z` the source redshift with `0` meaning unknown, `mag` optional. Lines starting with `#`
 //! are comments, anywhere; fields are separated by any whitespace. The images of a system

@@ -16,8 +16,9 @@
 //!   setting, aligned on the frame's origin) that fall inside it, or its centre when none does;
 //!   a `point` is one pixel at its position. Regions with the same label add up to one image
 //!   (each pixel once).
-//! - The label is the region's `text={...}`: the image id `system.image` (the system is the
-//!   text before the first '.', as in a Lenstool catalogue), then optionally `z=VALUE`. The
+//! - The label is the region's `text={...}`: the image id `system.image` (its system as a
+//!   Lenstool catalogue's, [`crate::catalog::system_of_image`]: `1.2` and `2.1a` are images
+//!   of systems `1` and `2.1`), then optionally `z=VALUE`. The
 //!   images of a system must agree on z ([`redshifts_agree`]) and the system's z is the mean
 //!   of its labels', as in a catalogue; a system with no z takes it from the caller's lookup (the app: the loaded
 //!   image catalogue's system of that id), or is left without one (`--default-z`, or left out
@@ -233,8 +234,11 @@ impl Label {
         let Some(image) = tokens.next() else {
             return Err(format!("a region without a label: {HOW}"));
         };
-        let system = match image.split_once('.') {
-            Some((system, rest)) if !system.is_empty() && !rest.is_empty() => system,
+        let system = match (
+            image.split_once('.'),
+            crate::catalog::system_of_image(image),
+        ) {
+            (Some((first, rest)), Some(system)) if !first.is_empty() && !rest.is_empty() => system,
             _ => {
                 return Err(format!(
                     "label '{text}': '{image}' is not an image id of the form system.image; {HOW}"

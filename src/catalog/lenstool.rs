@@ -32,18 +32,30 @@ pub const MAG_NO_MEASUREMENT: f64 = 90.0;
 const IMAGE_LAYOUT: &str = "id x y a b theta z [mag]";
 const MEMBER_LAYOUT: &str = "id x y a b theta mag [lum]";
 
-/// The system an image id names, as this reader and Lenstool group images: the text before
-/// the first '.' (`4.2`: `4`), or for an id without one all but its last character (`4b`:
-/// `4`; `A3c`: `A3`). `None` when that leaves nothing on either side.
+/// The system an image id names, as Lenstool groups images into families: all but the id's
+/// last character (`4b`: `4`; `A3c`: `A3`; `12.6c`: `12.6`, so `12.6c` and `12.5c` are two
+/// sources, two knots of one galaxy as Lenstool fits them), without a `.` that would end it
+/// (`4.2`: `4`). An id whose text after its last `.` is a number names the text before that
+/// `.` (`4.12`: `4`, `14c.1`: `14c`), so that a tenth image stays in its system where Lenstool
+/// would start another. `None` when that leaves nothing, or for an id ending in `.`.
 pub fn system_of_image(id: &str) -> Option<&str> {
-    match id.split_once('.') {
-        Some((system, image)) => (!system.is_empty() && !image.is_empty()).then_some(system),
-        None => id
-            .char_indices()
-            .last()
-            .map(|(i, _)| &id[..i])
-            .filter(|system| !system.is_empty()),
+    system_and_rule(id).map(|(system, _)| system)
+}
+
+/// [`system_of_image`], and whether the system is the id but its last character (not the text
+/// before a `.` and a number).
+pub(super) fn system_and_rule(id: &str) -> Option<(&str, bool)> {
+    if id.ends_with('.') {
+        return None;
     }
+    if let Some((system, image)) = id.rsplit_once('.') {
+        if image.bytes().all(|b| b.is_ascii_digit()) {
+            return (!system.is_empty()).then_some((system, false));
+        }
+    }
+    let (last, _) = id.char_indices().last()?;
+    let system = id[..last].strip_suffix('.').unwrap_or(&id[..last]);
+    (!system.is_empty()).then_some((system, true))
 }
 
 /// Parses a Lenstool multiple-image catalogue: rows `id x y a b theta z [mag]`.
@@ -54,9 +66,9 @@ pub fn system_of_image(id: &str) -> Option<&str> {
 /// `y = (Dec - Dec0) 3600` arcsec; relative catalogues in another frame are re-projected
 /// through (RA, Dec). `a`, `b` are arcsec (>= 0), `theta` degrees, `mag` 0 when missing.
 ///
-/// Ids are `system.image`: the system is the text before the first '.' (`4.2a` and `14c.1`
-/// are systems `4` and `14c`); an id without a '.' is grouped as Lenstool groups it, by all
-/// but its last character (`1a`, `1b`: system `1`; `A3c`: system `A3`; said in a warning).
+/// Ids are grouped as Lenstool groups them ([`system_of_image`]): `4.2` and `14c.1` are
+/// systems `4` and `14c`; an id not of the form `system.number` is its system and one last
+/// character (`1a`, `1b`: system `1`; `A3c`: `A3`; `12.6c`: `12.6`; said in a warning).
 /// `z = 0` means unknown (`None`); images of one system must agree within
 /// [`Z_AGREEMENT_TOL`] (their mean is used, with a warning when they differ or some are
 /// unknown). Warnings: single-image systems, extra columns (ignored). Positions that do not
@@ -75,7 +87,7 @@ pub fn parse_image_catalog(
     let mut seen: HashMap<&str, usize> = HashMap::new();
     let mut parsed = Vec::with_capacity(table.rows.len());
     let mut positions = Vec::with_capacity(table.rows.len());
-    // The first row whose id has no '.' (its system is the id but its last character).
+    // The first row whose id's system is the id but its last character.
     let mut undotted: Option<(usize, String, String)> = None;
     for row in &table.rows {
         let f = Fields {
@@ -85,8 +97,8 @@ pub fn parse_image_catalog(
         };
         f.require(IMAGE_LAYOUT, &mut extra_lines)?;
         let id = row.fields[0];
-        let (system, no_dot) = f.system_id()?;
-        if no_dot && undotted.is_none() {
+        let (system, by_last) = f.system_id()?;
+        if by_last && undotted.is_none() {
             undotted = Some((row.line, id.to_string(), system.clone()));
         }
         if let Some(&first_line) = seen.get(id) {
@@ -119,8 +131,8 @@ pub fn parse_image_catalog(
             source_name: source_name.into(),
             line,
             message: format!(
-                "image ids without a '.' are grouped as Lenstool groups them, by all but their \
-                 last character: '{id}' is an image of system {system}"
+                "image ids not of the form system.number are grouped as Lenstool groups them, \
+                 by all but their last character: '{id}' is an image of system {system}"
             ),
         });
     }

@@ -50,7 +50,7 @@ pub struct Image {
     pub line: usize,
 }
 
-/// The images of one source: the part of the id before the first '.'.
+/// The images of one source, grouped by their ids as Lenstool groups them ([`system_of_image`]).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct ImageSystem {
     /// System id, e.g. `"4"`.

@@ -231,12 +231,12 @@ impl Fields<'_, '_> {
         }
     }
 
-    /// The system part of an image id ([`super::system_of_image`]), and whether the id has
-    /// no '.' (its system is all but its last character).
+    /// The system part of an image id ([`super::system_of_image`]), and whether it is the id
+    /// but its last character (not the text before a `.` and a number).
     pub(super) fn system_id(&self) -> Result<(String, bool), CatalogError> {
         let id = self.row.fields[0];
-        match (super::system_of_image(id), id.split_once('.')) {
-            (Some(system), dotted) => Ok((system.into(), dotted.is_none())),
+        match (super::lenstool::system_and_rule(id), id.split_once('.')) {
+            (Some((system, by_last)), _) => Ok((system.into(), by_last)),
             (None, Some(("", _))) => Err(self.bad(0, "has no system part before the '.'")),
             (None, Some(_)) => Err(self.bad(0, "has no image part after the '.'")),
             (None, None) => Err(self.bad(

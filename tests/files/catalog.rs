@@ -354,7 +354,7 @@ fn commented_rows_are_kept_aside_in_the_frame() {
 #[cfg_attr(target_arch = "wasm32", wasm_bindgen_test::wasm_bindgen_test)]
 fn whitespace_comments_and_ids_as_people_write_them() {
     let text = "\u{feff}# gold list\r\n\
-        \t4.2a\t342.1945   -44.526998\t0.1 0.1 0.0 1.5 24.0   \r\n\
+        \t4.2\t342.1945   -44.526998\t0.1 0.1 0.0 1.5 24.0   \r\n\
         \r\n\
         \x20  #4.9 342.19 -44.52 0.1 0.1 0 1.5 0  (commented out)\r\n\
         4.1 342.1959 -44.528965 0.1 0.1 0.0 1.5\r\n\
@@ -369,10 +369,7 @@ fn whitespace_comments_and_ids_as_people_write_them() {
     assert_eq!(ids, [("4", 2), ("14c", 2)]);
     assert_eq!((cat.systems[0].z, cat.systems[1].z), (Some(1.5), None));
     let first = &cat.systems[0].images[0];
-    assert_eq!(
-        (first.id.as_str(), first.line, first.mag),
-        ("4.2a", 2, 24.0)
-    );
+    assert_eq!((first.id.as_str(), first.line, first.mag), ("4.2", 2, 24.0));
     assert_eq!(cat.systems[0].images[1].mag, 0.0, "missing mag is 0");
     assert_eq!(cat.systems[1].images[0].theta_deg, 30.0);
     assert_eq!(warnings.len(), 1, "{warnings:?}");
@@ -597,13 +594,16 @@ fn duplicate_image_ids() {
     );
 }
 
-/// Ids without a '.' are grouped as Lenstool groups them (its manual's example: `C1a`, `C1b`,
-/// `C1c` are one source), by all but their last character; the rows here are of the form
-/// public catalogues use (`1A 1B`, `A3a A3b`, `1a 1b`), mixed with dotted ids. A file of
+/// Ids are grouped as Lenstool groups them (its manual's example: `C1a`, `C1b`, `C1c` are one
+/// source), by all but their last character; the rows here are of the form public catalogues
+/// use (`1A 1B`, `A3a A3b`, `1a 1b`), mixed with dotted ids. Knots of one galaxy written
+/// `2.1a 2.1b 2.2a 2.2b` (Bergamini et al. 2022's MACS J0416 catalogue) are two sources, as
+/// Lenstool fits them (its `chires.dat` lists families `12.6`, `12.5`, ... for `12.6c`,
+/// `12.5c`); `system.number` ids keep their system past a tenth image (`6.10`). A file of
 /// them says once how it was read; a one-character id names no system.
 #[cfg_attr(not(target_arch = "wasm32"), test)]
 #[cfg_attr(target_arch = "wasm32", wasm_bindgen_test::wasm_bindgen_test)]
-fn ids_without_a_dot_are_grouped_as_lenstool_groups_them() {
+fn ids_are_grouped_as_lenstool_groups_them() {
     let text = "5.1 342.1 -44.5 0 0 0 1.5 0\n\
                 1A 342.101 -44.5 0 0 0 1.2 0\n\
                 1B 342.102 -44.5 0 0 0 1.2 0\n\
@@ -635,10 +635,40 @@ fn ids_without_a_dot_are_grouped_as_lenstool_groups_them() {
     assert_eq!(
         messages,
         [
-            "w.cat: line 2: image ids without a '.' are grouped as Lenstool groups them, by all \
-          but their last character: '1A' is an image of system 1"
+            "w.cat: line 2: image ids not of the form system.number are grouped as Lenstool \
+             groups them, by all but their last character: '1A' is an image of system 1"
         ]
     );
+    // Two knots of one galaxy, three images each, and a system with ten images.
+    let mut knots = String::new();
+    for (k, id) in ["2.1a", "2.1b", "2.1c", "2.2a", "2.2b", "2.2c"]
+        .iter()
+        .enumerate()
+    {
+        knots += &format!("{id} 64.04{k} -24.06 0.37 0.37 90 6.145 25\n");
+    }
+    for k in 1..=10 {
+        let ra = 64.05 + 0.001 * k as f64;
+        knots += &format!("6.{k} {ra} -24.07 0.37 0.37 90 1.5 25\n");
+    }
+    let (cat, warnings) = parse_image_catalog(&knots, "knots.cat", None).unwrap();
+    let systems: Vec<(&str, usize)> = cat
+        .systems
+        .iter()
+        .map(|s| (s.id.as_str(), s.images.len()))
+        .collect();
+    assert_eq!(systems, [("2.1", 3), ("2.2", 3), ("6", 10)]);
+    let messages: Vec<String> = warnings.iter().map(ToString::to_string).collect();
+    assert_eq!(
+        messages,
+        [
+            "knots.cat: line 1: image ids not of the form system.number are grouped as Lenstool \
+             groups them, by all but their last character: '2.1a' is an image of system 2.1"
+        ]
+    );
+    assert_eq!(wslap::system_of_image("14c.1"), Some("14c"));
+    assert_eq!(wslap::system_of_image("1.a"), Some("1"));
+    assert_eq!(wslap::system_of_image("1."), None);
     let err = image_err("1.1 342.1 -44.5 0 0 0 1.2 0\n7 342.2 -44.5 0 0 0 1.2 0\n");
     assert_eq!(
         err,
