@@ -103,11 +103,11 @@ pub use radial::{radial_profile, rect_disc_area, RadialBins, RadialError, Radial
 // The inputs: catalogues, arcs, regions, Lenstool models, FITS.
 pub use arcs::{arcs_from_regions, parse_arcs, ArcCatalog, ArcSystem, ArcsError};
 pub use catalog::{
-    arclet_ellipticity, parse_arclet_catalog, parse_arclet_catalog_with, parse_image_catalog,
-    parse_member_catalog, parse_potfile_catalog, system_of_image, Arclet, ArcletCatalog,
-    ArcletUnknownZ, CatalogError, CatalogRow, CommentedBcgs, Image, ImageCatalog, ImageSystem,
-    Member, MemberCatalog, DEGREE_LOOKALIKE, FIELD_ERROR_DEG, FIELD_WARN_DEG, MAG_NO_MEASUREMENT,
-    Z_AGREEMENT_TOL,
+    arclet_ellipticity, galaxy_of_system, parse_arclet_catalog, parse_arclet_catalog_with,
+    parse_image_catalog, parse_member_catalog, parse_potfile_catalog, system_of_image, Arclet,
+    ArcletCatalog, ArcletUnknownZ, CatalogError, CatalogRow, CommentedBcgs, Image, ImageCatalog,
+    ImageSystem, Member, MemberCatalog, DEGREE_LOOKALIKE, FIELD_ERROR_DEG, FIELD_WARN_DEG,
+    MAG_NO_MEASUREMENT, Z_AGREEMENT_TOL,
 };
 pub use ds9::{
     polyline_is_open, read_regions, write_marks, write_regions, Ds9Error, Ds9Frame, Mark, Region,
@@ -159,9 +159,9 @@ pub use solver::{
 // A reconstruction: inputs, settings, the run, cross-validation.
 pub use reconstruct::{
     avoid_crowded_map, check_ensemble_size, check_memory, cross_validate, estimate_redshift,
-    fitted_system_ids, fold_groups, holdable_system_ids, image_regions, layer_count,
-    product_options, reconstruct, reconstruct_with_choice, refit_for_second_choice, run_ensemble,
-    second_choice, second_round, strength_candidates, strength_folds, strength_trial,
+    fitted_system_ids, fold_groups, holdable_sources, holdable_system_ids, image_regions,
+    layer_count, product_options, reconstruct, reconstruct_with_choice, refit_for_second_choice,
+    run_ensemble, second_choice, second_round, strength_candidates, strength_folds, strength_trial,
     with_uncrowded_map, ArrivalTimes, Bytes, Calibration, Candidate, ConvergenceRecord,
     CrossValidation, CrossvalTotals, CrowdedMap, Dataset, DatasetError, Ensemble, EnsembleMaps,
     EnsembleMember, EnsemblePlan, EstimatedRedshifts, FoldRun, FreeZSummary, Heap, ImageReport,

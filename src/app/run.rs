@@ -9,7 +9,7 @@ use crate::inversion::{build_constraints, Layer, LinearSystem, ObjectiveTerms};
 use crate::products::{own_map_side, ProductOptions, Products};
 use crate::reconstruct::{add_external_shear, member_layers, shear_set, BcgFacts, Verdict};
 use crate::reconstruct::{
-    avoid_crowded_map, check_memory, cross_validate, fitted_system_ids, grid_of, map_geometry,
+    avoid_crowded_map, check_memory, cross_validate, grid_of, holdable_sources, map_geometry,
     product_options, reconstruct, reconstruct_with_choice, refit_for_second_choice, second_choice,
     second_round, strength_candidates, strength_folds, with_uncrowded_map, Candidate,
     ConvergenceRecord, CrossValidation, Dataset, DatasetError, Ensemble, EstimatedRedshifts,
@@ -332,12 +332,13 @@ impl Session {
         Ok(())
     }
 
-    /// The app's number of cross-validation folds: [`DEFAULT_FOLDS`], or one per fitted system
-    /// when there are fewer.
+    /// The app's number of cross-validation folds: [`DEFAULT_FOLDS`], or one per source a fold
+    /// can hold out when there are fewer ([`crate::reconstruct::holdable_sources`]: systems at
+    /// a redshift of their own, the knots of one galaxy counted once).
     pub fn default_folds(&self) -> Result<usize, AppError> {
         self.with_inputs(|inputs, config, _| {
-            let ids = fitted_system_ids(inputs, config).map_err(run_error)?;
-            Ok(DEFAULT_FOLDS.min(ids.len()))
+            let sources = holdable_sources(inputs, config).map_err(run_error)?;
+            Ok(DEFAULT_FOLDS.min(sources.len()))
         })
     }
 

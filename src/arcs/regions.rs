@@ -17,7 +17,7 @@
 //!   a `point` is one pixel at its position. Regions with the same label add up to one image
 //!   (each pixel once).
 //! - The label is the region's `text={...}`: the image id `system.image` (its system as a
-//!   Lenstool catalogue's, [`crate::catalog::system_of_image`]: `1.2` and `2.1a` are images
+//!   Lenstool catalogue's, [`crate::system_of_image`]: `1.2` and `2.1a` are images
 //!   of systems `1` and `2.1`), then optionally `z=VALUE`. The
 //!   images of a system must agree on z ([`redshifts_agree`]) and the system's z is the mean
 //!   of its labels', as in a catalogue; a system with no z takes it from the caller's lookup (the app: the loaded

@@ -42,6 +42,17 @@ pub fn system_of_image(id: &str) -> Option<&str> {
     system_and_rule(id).map(|(system, _)| system)
 }
 
+/// The galaxy a system is a source of: the text of its id before the first `.` (systems
+/// `2.1` and `2.2`, the knots of images `2.1a` and `2.2a`, are two sources of galaxy `2`), or
+/// the whole id. Knots of one galaxy lie a fraction of an arcsec apart behind the lens, so one
+/// predicts the other: cross-validation holds them out together.
+pub fn galaxy_of_system(system: &str) -> &str {
+    match system.split_once('.') {
+        Some((galaxy, _)) if !galaxy.is_empty() => galaxy,
+        _ => system,
+    }
+}
+
 /// [`system_of_image`], and whether the system is the id but its last character (not the text
 /// before a `.` and a number).
 pub(super) fn system_and_rule(id: &str) -> Option<(&str, bool)> {

@@ -27,8 +27,8 @@ pub use arclets::{
 pub use error::{CatalogError, CatalogWarning};
 pub(crate) use frame::{mean_position, reframe, sexagesimal};
 pub use lenstool::{
-    parse_image_catalog, parse_member_catalog, parse_potfile_catalog, redshifts_agree,
-    system_of_image, MAG_NO_MEASUREMENT, Z_AGREEMENT_TOL,
+    galaxy_of_system, parse_image_catalog, parse_member_catalog, parse_potfile_catalog,
+    redshifts_agree, system_of_image, MAG_NO_MEASUREMENT, Z_AGREEMENT_TOL,
 };
 pub use units::{DEGREE_LOOKALIKE, FIELD_ERROR_DEG, FIELD_WARN_DEG};
 

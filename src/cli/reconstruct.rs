@@ -7,7 +7,7 @@ use clap::Args;
 use serde::Serialize;
 use wslap::{
     check_ensemble_size, check_memory, cross_validate, export_system, fold_groups,
-    holdable_system_ids, image_regions, parse_par_with, reconstruct, run_ensemble, ColorScale,
+    holdable_sources, image_regions, parse_par_with, reconstruct, run_ensemble, ColorScale,
     Control, ConvergenceRecord, Cosmology, CrossValidation, Dataset, InputKind, InputText,
     InputTexts, Inputs, LensPlane, LenstoolPar, ParOptions, ReconstructConfig, ReconstructError,
     Reconstruction, SolverMethod,
@@ -418,14 +418,15 @@ fn usable_folds(
     config: &ReconstructConfig,
     asked: usize,
 ) -> Result<usize, String> {
-    let holdable = holdable_system_ids(inputs, config)
+    let holdable = holdable_sources(inputs, config)
         .map_err(|e| e.to_string())?
         .len();
     let folds = match asked > holdable && holdable >= 2 {
         true => {
             eprintln!(
                 "note: --folds {asked}: {holdable} systems can be held out (those fitted at a \
-                 redshift of their own), so {holdable} folds, one system each"
+                 redshift of their own, the knots of one galaxy counted once), so {holdable} \
+                 folds, one system each"
             );
             holdable
         }

@@ -27,6 +27,7 @@ use super::{
     reconstruct_free_z, Candidate, ConvergenceRecord, CrowdedMap, Crowding, Inputs,
     ReconstructConfig, ReconstructError, Reconstruction, SourceReport,
 };
+use crate::catalog::galaxy_of_system;
 use crate::curves::CriticalCurves;
 use crate::fits::{write_image, Card, FitsWriteOptions};
 use crate::inversion::build_constraints;
@@ -309,25 +310,47 @@ pub fn holdable_system_ids(
     fitted_system_ids(inputs, &own_redshifts)
 }
 
+/// The systems a fold may hold out ([`holdable_system_ids`]) by the galaxy they are sources
+/// of ([`crate::galaxy_of_system`]: the knots `2.1` and `2.2` of galaxy `2` together,
+/// since one predicts the other), galaxies in the order of their first system. Without knots,
+/// one system each.
+pub fn holdable_sources(
+    inputs: &Inputs<'_>,
+    config: &ReconstructConfig,
+) -> Result<Vec<Vec<String>>, ReconstructError> {
+    let mut sources: Vec<Vec<String>> = Vec::new();
+    for id in holdable_system_ids(inputs, config)? {
+        let galaxy = galaxy_of_system(&id);
+        match sources
+            .iter_mut()
+            .find(|s| galaxy_of_system(&s[0]) == galaxy)
+        {
+            Some(source) => source.push(id),
+            None => sources.push(vec![id]),
+        }
+    }
+    Ok(sources)
+}
+
 /// The groups of system ids that [`cross_validate`] holds out in turn: the systems `inputs`
 /// fits ([`fitted_system_ids`]) but those fitted at an estimated redshift
-/// (`constraints.z_estimates`), the k-th to group `k mod folds`. Needs `2 <= folds <=` the
-/// number of such systems.
+/// (`constraints.z_estimates`), by galaxy ([`holdable_sources`]), the k-th galaxy's to group
+/// `k mod folds`. Needs `2 <= folds <=` the number of such galaxies.
 pub fn fold_groups(
     inputs: &Inputs<'_>,
     config: &ReconstructConfig,
     folds: usize,
 ) -> Result<Vec<Vec<String>>, ReconstructError> {
-    let ids = holdable_system_ids(inputs, config)?;
-    if folds < 2 || folds > ids.len() {
+    let sources = holdable_sources(inputs, config)?;
+    if folds < 2 || folds > sources.len() {
         return Err(ReconstructError::Folds {
             folds,
-            systems: ids.len(),
+            systems: sources.len(),
         });
     }
     let mut groups = vec![Vec::new(); folds];
-    for (k, id) in ids.into_iter().enumerate() {
-        groups[k % folds].push(id);
+    for (k, ids) in sources.into_iter().enumerate() {
+        groups[k % folds].extend(ids);
     }
     Ok(groups)
 }

@@ -5,7 +5,8 @@
 //! settings and with
 //!
 //! - **the systems fitted drawn at random** (bootstrap over systems): as many draws with
-//!   replacement as there are fitted systems; the systems drawn at least once are fitted
+//!   replacement as there are fitted systems (sources: the knots of one galaxy, systems `2.1`
+//!   and `2.2`, are drawn together); the systems drawn at least once are fitted
 //!   (a system drawn twice counts once), the others (about a third) are left out;
 //! - **the regulariser, its strength and the grid chosen again on that draw**, when the main
 //!   run's were "auto": the main run's cross-validation is not rerun, but its rule (fewest
@@ -65,6 +66,7 @@ use super::{
     ConvergenceRecord, CrowdedMap, Crowding, Inputs, LayerSource, ReconstructConfig,
     ReconstructError, Reconstruction, Regulariser, StrengthChoice, CROWDED_MAP_RETRIES,
 };
+use crate::catalog::galaxy_of_system;
 use crate::curves::CriticalCurves;
 use crate::error::BadFieldValue;
 use crate::fits::{write_image, Card, FitsWriteOptions};
@@ -612,14 +614,28 @@ impl EnsemblePlan {
             LayerSource::Members(_) => config.members.mass_to_light_scatter_dex,
             _ => 0.0,
         };
+        // The bootstrap draws sources: the knots of one galaxy (systems 2.1 and 2.2) together,
+        // as a fold holds them out together. Without knots, one system each.
+        let mut galaxies: Vec<&str> = Vec::new();
+        let galaxy_of: Vec<usize> = ids
+            .iter()
+            .map(|id| {
+                let g = galaxy_of_system(id);
+                galaxies.iter().position(|&x| x == g).unwrap_or_else(|| {
+                    galaxies.push(g);
+                    galaxies.len() - 1
+                })
+            })
+            .collect();
         let draws = (1..=members)
             .map(|member| {
-                // How many times each system was drawn.
+                // How many times each system was drawn (its galaxy's draws).
                 let counts = loop {
-                    let mut counts = vec![0usize; ids.len()];
-                    for _ in 0..ids.len() {
-                        counts[rng.index(ids.len())] += 1;
+                    let mut drawn = vec![0usize; galaxies.len()];
+                    for _ in 0..galaxies.len() {
+                        drawn[rng.index(galaxies.len())] += 1;
                     }
+                    let counts: Vec<usize> = galaxy_of.iter().map(|&g| drawn[g]).collect();
                     if counts.iter().filter(|&&n| n > 0).count() >= 2 {
                         break counts;
                     }

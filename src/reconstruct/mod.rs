@@ -23,8 +23,8 @@ use thiserror::Error;
 
 pub use config::{ProductConfig, ReconstructConfig, SolverConfig, SolverMethod};
 pub use crossval::{
-    cross_validate, fitted_system_ids, fold_groups, holdable_system_ids, CrossValidation,
-    CrossvalTotals, FoldRun, KappaSpread, PredictedSystem, DEFAULT_FOLDS,
+    cross_validate, fitted_system_ids, fold_groups, holdable_sources, holdable_system_ids,
+    CrossValidation, CrossvalTotals, FoldRun, KappaSpread, PredictedSystem, DEFAULT_FOLDS,
 };
 pub(crate) use dataset::arclet_unknown_z;
 pub use dataset::{Dataset, DatasetError, InputText, InputTexts, PAR_GALAXY_MAX_LSTAR};
@@ -112,8 +112,8 @@ pub enum ReconstructError {
 /// Why `folds` groups cannot be held out in turn from `systems` systems that can be (those
 /// fitted at a redshift of their own), and what to do.
 fn folds_message(folds: usize, systems: usize) -> String {
-    let which = "systems with a redshift of their own; a system whose redshift is estimated is \
-                 never held out";
+    let which = "systems with a redshift of their own, the knots of one galaxy (2.1, 2.2) \
+                 counted once; a system whose redshift is estimated is never held out";
     match (folds, systems) {
         (_, 0 | 1) => format!(
             "folds = {folds}: holding systems out needs at least 2 that can be, and there {} \
@@ -961,14 +961,14 @@ pub fn strength_candidates(config: &ReconstructConfig) -> Vec<Candidate> {
 }
 
 /// The folds an "auto" strength is cross-validated with: `objective.folds`, at most one per
-/// system a fold can hold out (below 2: too few systems to hold any out). Systems fitted at
+/// source a fold can hold out (below 2: too few systems to hold any out). Systems fitted at
 /// an estimated redshift (`constraints.z_estimates`) are fitted by every fold and count for
-/// none ([`holdable_system_ids`]).
+/// none; the knots of one galaxy count once ([`holdable_sources`]).
 pub fn strength_folds(
     inputs: &Inputs<'_>,
     config: &ReconstructConfig,
 ) -> Result<usize, ReconstructError> {
-    let holdable = holdable_system_ids(inputs, config)?.len();
+    let holdable = holdable_sources(inputs, config)?.len();
     Ok(config.objective.folds.min(holdable))
 }
 

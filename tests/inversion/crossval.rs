@@ -155,8 +155,22 @@ fn fold_groups_deal_the_fitted_systems_out_in_turn() {
     assert_eq!(
         err.to_string(),
         "folds = 5: holding systems out needs at least 2 that can be, and there is 1 (systems \
-         with a redshift of their own; a system whose redshift is estimated is never held out): \
-         run without folds"
+         with a redshift of their own, the knots of one galaxy (2.1, 2.2) counted once; a \
+         system whose redshift is estimated is never held out): run without folds"
+    );
+    // Two knots of one galaxy (systems 2.1 and 2.2, as images 2.1a and 2.2a name them) are
+    // held out together: one predicts the other. So three sources, at most three folds.
+    let mut knots = cat.clone();
+    knots.systems[1].id = "2.1".into();
+    knots.systems[2].id = "2.2".into();
+    let groups = fold_groups(&inputs(&knots, &none), &config(), 2).unwrap();
+    assert_eq!(groups, [ids(&["1", "4"]), ids(&["2.1", "2.2"])]);
+    let groups = fold_groups(&inputs(&knots, &none), &config(), 3).unwrap();
+    assert_eq!(groups, [ids(&["1"]), ids(&["2.1", "2.2"]), ids(&["4"])]);
+    let err = fold_groups(&inputs(&knots, &none), &config(), 4).unwrap_err();
+    assert!(
+        matches!(err, ReconstructError::Folds { systems: 3, .. }),
+        "{err}"
     );
 }
 
@@ -530,5 +544,30 @@ fn a_system_whose_own_prior_fixes_its_redshift_is_held_out_and_predicted() {
         ),
         "{:?}",
         alone.warnings
+    );
+}
+
+/// An ensemble's bootstrap draws sources, as the folds hold them out: the knots of one galaxy
+/// (systems 2.1 and 2.2) are fitted together or left out together, never one without the
+/// other.
+#[test]
+fn an_ensemble_draws_the_knots_of_one_galaxy_together() {
+    let mut knots = catalog();
+    knots.systems[1].id = "2.1".into();
+    knots.systems[2].id = "2.2".into();
+    let none: Vec<String> = Vec::new();
+    let inputs = inputs(&knots, &none);
+    let mut c = config();
+    c.objective.strength = wslap::Strength::Value(0.01);
+    let main = reconstruct(&inputs, &c, &mut quiet).unwrap();
+    let plan = wslap::EnsemblePlan::new(&inputs, &c, &main, 40, 7).unwrap();
+    let fits = |d: &wslap::MemberDraw, id: &str| d.fitted.iter().any(|f| f == id);
+    for d in &plan.draws {
+        assert_eq!(fits(d, "2.1"), fits(d, "2.2"), "{:?}", d.fitted);
+    }
+    let together = plan.draws.iter().filter(|d| fits(d, "2.1")).count();
+    assert!(
+        0 < together && together < 40,
+        "{together} of 40 fit the knots"
     );
 }
