@@ -426,7 +426,7 @@ impl LinearSystem {
 
     /// One sentence per member layer (not an external shear's) with a prior whose factor `C`
     /// in the solution `x` ends
-    /// more than [`PRIOR_PULL_SIGMA`] of the prior's width from 1: "given the prior" (the
+    /// more than [`PRIOR_PULL_SIGMA`] of the prior's width from 1: "fitted with a prior" (the
     /// warning of [`Self::measurability_warnings`], said before the solve) is then not "at 1"
     /// (the HFF catalogues end at C = 0.6 - 0.7 with the prior 1 +- 0.1).
     ///
@@ -485,8 +485,10 @@ impl LinearSystem {
         let regularised = self.terms.penalty_weight.unwrap_or(0.0) > 0.0;
         let held = |layer: &Layer| match layer.prior_sigma {
             // Said before the solve: the prior is given, where C ends is the run's to say
-            // (the data and the regulariser can still pull it several sigma away).
-            Some(sigma) => format!("it is given the prior C = 1 +- {sigma}"),
+            // (the data and the regulariser can still pull it several sigma away, said then).
+            Some(sigma) => format!(
+                "it is fitted with a prior C = 1 +- {sigma}, which the regulariser can outweigh"
+            ),
             None if regularised => "nothing holds it (members.c_prior_sigma would)".to_string(),
             None => "the start and the iteration count set it".to_string(),
         };

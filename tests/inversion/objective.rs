@@ -210,7 +210,8 @@ fn an_unmeasured_member_factor_is_held_near_one() {
     let held = reconstruct(&inputs, &config, &mut quiet).unwrap();
     let c = held.layer_factors()[0];
     assert!((c - 1.0).abs() < 0.2, "C = {c}");
-    assert!(held.warnings[0].contains("it is given the prior C = 1 +- 0.1"));
+    assert!(held.warnings[0]
+        .contains("it is fitted with a prior C = 1 +- 0.1, which the regulariser can outweigh"));
     // Within the prior's reach nothing more is said; a factor ending 5 sigma below it is.
     assert!(
         !held.warnings.iter().any(|w| w.contains("C ends at")),
