@@ -415,7 +415,8 @@ const SAME_IMAGE_NAMED: usize = 5;
 
 /// Warns of two rows at one position (within [`SAME_IMAGE_ARCSEC`]): an image has one source,
 /// so in two systems it asks the map for two sources at one place, and in one it is counted
-/// twice. Catalogues converted by hand or merged from two lists do this (a helper session
+/// twice; in two knots of one galaxy ([`galaxy_of_system`]: `14.1c` and `14.2c`) it is two
+/// knots blended, which the catalogue means, and the warning says how it is fitted. Catalogues converted by hand or merged from two lists do this (a helper session
 /// found it in two public ones). Positions are bucketed on a lattice of that width, so the
 /// scan is linear in the rows.
 fn warn_same_positions(
@@ -440,11 +441,23 @@ fn warn_same_positions(
                 .flatten()
                 .find(|(_, other)| other.position.distance(image.position) <= SAME_IMAGE_ARCSEC);
             if let Some((other_system, other)) = twin {
-                let what = match other_system.id == system.id {
-                    true => format!("in system {}: it is counted twice", system.id),
-                    false => format!(
+                let knots = other_system.id != system.id
+                    && galaxy_of_system(&other_system.id) == galaxy_of_system(&system.id);
+                let what = match (other_system.id == system.id, knots) {
+                    (true, _) => format!(
+                        "in system {}: it is counted twice; delete one row if it is the same \
+                         image",
+                        system.id
+                    ),
+                    // Two knots of one galaxy blended in one image: the catalogue means it.
+                    (false, true) => format!(
+                        "as knots {} and {} of one galaxy blended in one image: it is fitted \
+                         as an image of each, as Lenstool fits it",
+                        other_system.id, system.id
+                    ),
+                    (false, false) => format!(
                         "in systems {} and {}: an image has one source, so the map is asked \
-                         for two at one place",
+                         for two at one place; delete one row if it is the same image",
                         other_system.id, system.id
                     ),
                 };
@@ -452,8 +465,7 @@ fn warn_same_positions(
                     source_name: source_name.into(),
                     line: image.line,
                     message: format!(
-                        "image '{}' lies where image '{}' (line {}) does, {what}; delete one row \
-                         if it is the same image",
+                        "image '{}' lies where image '{}' (line {}) does, {what}",
                         image.id, other.id, other.line
                     ),
                 });

@@ -666,6 +666,19 @@ fn ids_are_grouped_as_lenstool_groups_them() {
              groups them, by all but their last character: '2.1a' is an image of system 2.1"
         ]
     );
+    // Two knots blended in one image (Bergamini et al.'s 14.1c and 14.2c): said as such.
+    let blended = "14.1a 64.041 -24.06 0.37 0.37 90 1.6 25\n\
+                   14.1c 64.042 -24.06 0.37 0.37 90 1.6 25\n\
+                   14.2a 64.043 -24.06 0.37 0.37 90 1.6 25\n\
+                   14.2c 64.042 -24.06 0.37 0.37 90 1.6 25\n";
+    let (_, warnings) = parse_image_catalog(blended, "b.cat", None).unwrap();
+    let messages: Vec<String> = warnings.iter().map(ToString::to_string).collect();
+    assert_eq!(
+        messages[1],
+        "b.cat: line 4: image '14.2c' lies where image '14.1c' (line 2) does, as knots 14.1 and \
+         14.2 of one galaxy blended in one image: it is fitted as an image of each, as Lenstool \
+         fits it"
+    );
     assert_eq!(wslap::system_of_image("14c.1"), Some("14c"));
     assert_eq!(wslap::system_of_image("1.a"), Some("1"));
     assert_eq!(wslap::system_of_image("1."), None);
