@@ -234,11 +234,8 @@ impl Label {
         let Some(image) = tokens.next() else {
             return Err(format!("a region without a label: {HOW}"));
         };
-        let system = match (
-            image.split_once('.'),
-            crate::catalog::system_of_image(image),
-        ) {
-            (Some((first, rest)), Some(system)) if !first.is_empty() && !rest.is_empty() => system,
+        let system = match crate::catalog::system_of_image(image) {
+            Some(system) if image.contains('.') => system,
             _ => {
                 return Err(format!(
                     "label '{text}': '{image}' is not an image id of the form system.image; {HOW}"

@@ -53,6 +53,24 @@ pub fn galaxy_of_system(system: &str) -> &str {
     }
 }
 
+/// For each of the system ids `ids`, the index of its galaxy ([`galaxy_of_system`]) among
+/// the galaxies in the order of their first system, and how many galaxies there are. Without
+/// knots, `0, 1, 2, ...`: one galaxy per system.
+pub(crate) fn galaxy_indices(ids: &[String]) -> (Vec<usize>, usize) {
+    let mut galaxies: Vec<&str> = Vec::new();
+    let indices = ids
+        .iter()
+        .map(|id| {
+            let g = galaxy_of_system(id);
+            galaxies.iter().position(|&x| x == g).unwrap_or_else(|| {
+                galaxies.push(g);
+                galaxies.len() - 1
+            })
+        })
+        .collect();
+    (indices, galaxies.len())
+}
+
 /// [`system_of_image`], and whether the system is the id but its last character (not the text
 /// before a `.` and a number).
 pub(super) fn system_and_rule(id: &str) -> Option<(&str, bool)> {
@@ -416,9 +434,10 @@ const SAME_IMAGE_NAMED: usize = 5;
 /// Warns of two rows at one position (within [`SAME_IMAGE_ARCSEC`]): an image has one source,
 /// so in two systems it asks the map for two sources at one place, and in one it is counted
 /// twice; in two knots of one galaxy ([`galaxy_of_system`]: `14.1c` and `14.2c`) it is two
-/// knots blended, which the catalogue means, and the warning says how it is fitted. Catalogues converted by hand or merged from two lists do this (a helper session
-/// found it in two public ones). Positions are bucketed on a lattice of that width, so the
-/// scan is linear in the rows.
+/// knots blended, which the catalogue means, and the warning says how it is fitted.
+/// Catalogues converted by hand or merged from two lists do this (a helper session found it
+/// in two public ones). Positions are bucketed on a lattice of that width, so the scan is
+/// linear in the rows.
 fn warn_same_positions(
     systems: &[ImageSystem],
     source_name: &str,

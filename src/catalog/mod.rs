@@ -26,6 +26,7 @@ pub use arclets::{
 };
 pub use error::{CatalogError, CatalogWarning};
 pub(crate) use frame::{mean_position, reframe, sexagesimal};
+pub(crate) use lenstool::galaxy_indices;
 pub use lenstool::{
     galaxy_of_system, parse_image_catalog, parse_member_catalog, parse_potfile_catalog,
     redshifts_agree, system_of_image, MAG_NO_MEASUREMENT, Z_AGREEMENT_TOL,

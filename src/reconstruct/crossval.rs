@@ -27,7 +27,7 @@ use super::{
     reconstruct_free_z, Candidate, ConvergenceRecord, CrowdedMap, Crowding, Inputs,
     ReconstructConfig, ReconstructError, Reconstruction, SourceReport,
 };
-use crate::catalog::galaxy_of_system;
+use crate::catalog::galaxy_indices;
 use crate::curves::CriticalCurves;
 use crate::fits::{write_image, Card, FitsWriteOptions};
 use crate::inversion::build_constraints;
@@ -318,16 +318,11 @@ pub fn holdable_sources(
     inputs: &Inputs<'_>,
     config: &ReconstructConfig,
 ) -> Result<Vec<Vec<String>>, ReconstructError> {
-    let mut sources: Vec<Vec<String>> = Vec::new();
-    for id in holdable_system_ids(inputs, config)? {
-        let galaxy = galaxy_of_system(&id);
-        match sources
-            .iter_mut()
-            .find(|s| galaxy_of_system(&s[0]) == galaxy)
-        {
-            Some(source) => source.push(id),
-            None => sources.push(vec![id]),
-        }
+    let ids = holdable_system_ids(inputs, config)?;
+    let (galaxy, galaxies) = galaxy_indices(&ids);
+    let mut sources = vec![Vec::new(); galaxies];
+    for (id, g) in ids.into_iter().zip(galaxy) {
+        sources[g].push(id);
     }
     Ok(sources)
 }

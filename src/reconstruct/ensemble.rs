@@ -66,7 +66,7 @@ use super::{
     ConvergenceRecord, CrowdedMap, Crowding, Inputs, LayerSource, ReconstructConfig,
     ReconstructError, Reconstruction, Regulariser, StrengthChoice, CROWDED_MAP_RETRIES,
 };
-use crate::catalog::galaxy_of_system;
+use crate::catalog::galaxy_indices;
 use crate::curves::CriticalCurves;
 use crate::error::BadFieldValue;
 use crate::fits::{write_image, Card, FitsWriteOptions};
@@ -616,24 +616,14 @@ impl EnsemblePlan {
         };
         // The bootstrap draws sources: the knots of one galaxy (systems 2.1 and 2.2) together,
         // as a fold holds them out together. Without knots, one system each.
-        let mut galaxies: Vec<&str> = Vec::new();
-        let galaxy_of: Vec<usize> = ids
-            .iter()
-            .map(|id| {
-                let g = galaxy_of_system(id);
-                galaxies.iter().position(|&x| x == g).unwrap_or_else(|| {
-                    galaxies.push(g);
-                    galaxies.len() - 1
-                })
-            })
-            .collect();
+        let (galaxy_of, galaxies) = galaxy_indices(&ids);
         let draws = (1..=members)
             .map(|member| {
                 // How many times each system was drawn (its galaxy's draws).
                 let counts = loop {
-                    let mut drawn = vec![0usize; galaxies.len()];
-                    for _ in 0..galaxies.len() {
-                        drawn[rng.index(galaxies.len())] += 1;
+                    let mut drawn = vec![0usize; galaxies];
+                    for _ in 0..galaxies {
+                        drawn[rng.index(galaxies)] += 1;
                     }
                     let counts: Vec<usize> = galaxy_of.iter().map(|&g| drawn[g]).collect();
                     if counts.iter().filter(|&&n| n > 0).count() >= 2 {
