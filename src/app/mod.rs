@@ -78,6 +78,18 @@ impl AppError {
     }
 }
 
+/// A galaxy the loaded Lenstool `.par` would add to the members ([`Session::model_galaxies`]).
+#[derive(Debug, Clone, PartialEq)]
+pub struct ModelGalaxy {
+    /// The member it would be (its `line` the `.par`'s, or the member catalogue's for a
+    /// commented-out row that stands for it).
+    pub member: Member,
+    /// The `.par` writes it no `mag` and no catalogue row stands for it: `member.mag` is the
+    /// magnitude whose halo mass under the member law is its dPIE's
+    /// ([`crate::catalog::MemberCatalog::mass_galaxies`]), not one a file wrote.
+    pub mag_from_mass: bool,
+}
+
 /// Loaded data, settings and the last result of one app session.
 #[derive(Debug, Default)]
 pub struct Session {
@@ -185,7 +197,7 @@ impl Session {
     /// `members_from_model` is off: what the verdict of a run that lacks its BCG offers to
     /// fit. Not the members a `best.par` lists again. Empty without a `.par`, or when it or
     /// the data cannot be read.
-    pub fn model_galaxies(&self) -> Vec<Member> {
+    pub fn model_galaxies(&self) -> Vec<ModelGalaxy> {
         if self.settings.members_from_model {
             return Vec::new();
         }
@@ -208,12 +220,19 @@ impl Session {
         {
             return Vec::new();
         }
-        trial
+        let Some(members) = trial.members else {
+            return Vec::new();
+        };
+        let by_mass = &members.mass_galaxies;
+        members
             .members
-            .map(|m| m.members)
-            .unwrap_or_default()
-            .into_iter()
-            .filter(|g| !before.contains(g))
+            .iter()
+            .enumerate()
+            .filter(|(_, g)| !before.contains(g))
+            .map(|(k, g)| ModelGalaxy {
+                member: g.clone(),
+                mag_from_mass: by_mass.contains(&k),
+            })
             .collect()
     }
 

@@ -326,6 +326,7 @@ fn parse_members(
         par_galaxies: Vec::new(),
         par_source: None,
         free_mass_galaxies: Vec::new(),
+        mass_galaxies: Vec::new(),
     };
     Ok((catalog, warnings))
 }

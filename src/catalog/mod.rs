@@ -145,6 +145,11 @@ pub struct MemberCatalog {
     /// factor, the prior of an unmeasured layer holds it near 1, the least mass).
     #[serde(default)]
     pub free_mass_galaxies: Vec<usize>,
+    /// The `.par` galaxies (indices into [`Self::members`]) without a `mag` that no member
+    /// or commented-out row stands for, made members of the magnitude whose halo mass under
+    /// the member law is their dPIE's: their `mag` is that law's, not one a file wrote.
+    #[serde(default)]
+    pub mass_galaxies: Vec<usize>,
 }
 
 impl ImageCatalog {

@@ -423,6 +423,7 @@ impl Dataset {
             par_galaxies: Vec::new(),
             par_source: None,
             free_mass_galaxies: Vec::new(),
+            mass_galaxies: Vec::new(),
         });
         members.par_source = Some(name.clone());
         // Galaxies the catalogue lists already (a `best.par` writes every potfile member out
@@ -461,8 +462,11 @@ impl Dataset {
             }
             let index = members.members.len();
             members.note_par_galaxy(index);
-            if k >= with_mag && free_mass.contains(&g.line) {
-                members.free_mass_galaxies.push(index);
+            if k >= with_mag {
+                members.mass_galaxies.push(index);
+                if free_mass.contains(&g.line) {
+                    members.free_mass_galaxies.push(index);
+                }
             }
             members.members.push(g);
         }

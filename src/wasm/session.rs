@@ -363,9 +363,15 @@ impl AppSession {
             "summary": summary,
             "model_note": self.inner.model_note(r),
             "main_curve_arcsec": r.products().summary().main_curve_apart_arcsec(),
-            // What the verdict may offer to fit: `[{id, line, mag}]` of the loaded .par.
+            // What the verdict may offer to fit: `[{id, line, mag, mag_from_mass}]` of the
+            // loaded .par (`mag_from_mass`: the .par wrote no `mag`, see `ModelGalaxy`).
             "model_galaxies": self.inner.model_galaxies().iter()
-                .map(|g| serde_json::json!({"id": g.id, "line": g.line, "mag": g.mag}))
+                .map(|g| serde_json::json!({
+                    "id": g.member.id,
+                    "line": g.member.line,
+                    "mag": g.member.mag,
+                    "mag_from_mass": g.mag_from_mass,
+                }))
                 .collect::<Vec<_>>(),
         }))
     }

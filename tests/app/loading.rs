@@ -453,9 +453,10 @@ fn the_bcg_of_a_loaded_par_is_offered_then_fitted_as_a_member() {
     let offered: Vec<(String, usize, f64)> = s
         .model_galaxies()
         .into_iter()
-        .map(|g| (g.id, g.line, g.mag))
+        .map(|g| (g.member.id, g.member.line, g.member.mag))
         .collect();
     assert_eq!(offered, [("O3".to_string(), 55, 17.037)]);
+    assert!(!s.model_galaxies()[0].mag_from_mass);
     assert_eq!(s.parsed().unwrap().members.unwrap().members.len(), n);
     s.set_field("members_from_model", json!(true)).unwrap();
     let parsed = s.parsed().unwrap();
@@ -472,6 +473,37 @@ fn the_bcg_of_a_loaded_par_is_offered_then_fitted_as_a_member() {
     );
     // Fitted, it is no longer offered.
     assert!(s.model_galaxies().is_empty());
+}
+
+/// A starting `.par` whose BCG has no `mag` (MACS1931's `potentiel 3`): without a member
+/// catalogue its offer is the member of the magnitude its mass stands for, said to be so; with
+/// the catalogue that comments its row out, that row is its BCG and nothing is offered.
+#[cfg(not(target_arch = "wasm32"))]
+#[test]
+fn a_galaxy_without_a_magnitude_is_offered_as_its_mass_or_its_row() {
+    let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../shared/data/MACS1931/lenstool_cats");
+    let read = |name: &str| std::fs::read_to_string(dir.join(name)).unwrap();
+    let mut s = Session::new();
+    s.load_text(DataRole::Images, "m1931.cat", &read("immul_ongoing.cat"))
+        .unwrap();
+    s.load_text(DataRole::Model, "m1931.par", &read("m1931.par"))
+        .unwrap();
+    let offered = s.model_galaxies();
+    let [bcg] = &offered[..] else {
+        panic!("{offered:?}")
+    };
+    assert_eq!((bcg.member.id.as_str(), bcg.member.line), ("3", 66));
+    assert!(bcg.mag_from_mass);
+    s.load_text(DataRole::Members, "m1931.cat", &read("m1931.cat"))
+        .unwrap();
+    // The catalogue comments its row out (`#1009.0 ... 17.325`, line 10): that row is fitted
+    // as the BCG already (members.fit_commented_bcg), so the .par's galaxy is a member.
+    assert!(s.model_galaxies().is_empty());
+    let parsed = s.parsed().unwrap();
+    let members = parsed.members.unwrap();
+    let bcg = members.members.iter().find(|m| m.id == "1009.0").unwrap();
+    assert_eq!((bcg.line, bcg.mag), (10, 17.325));
 }
 
 /// The redshift priors of a loaded `.par` (AS1063 silver's starting model: uniform ranges for
@@ -553,7 +585,7 @@ fn a_best_par_offers_its_bcg_and_not_the_members_it_lists_again() {
     let offered: Vec<(String, usize, f64)> = s
         .model_galaxies()
         .into_iter()
-        .map(|g| (g.id, g.line, g.mag))
+        .map(|g| (g.member.id, g.member.line, g.member.mag))
         .collect();
     assert_eq!(offered, [("4".to_string(), 5, 18.8654)]);
     let n = s.parsed().unwrap().members.unwrap().members.len();

@@ -209,3 +209,41 @@ test('a typed coordinate reads out κ, μ and the counter-images without the mou
     await app.close();
   }
 });
+
+test('the offer to fit a .par galaxy names one without a magnitude by the mass it stands for', async () => {
+  const app = await openApp();
+  try {
+    const { page } = app;
+    await waitStatus(page, /^Ready/);
+    // A verdict that misses its BCG, and two galaxies of a .par: one with a `mag`, one (a
+    // starting .par's BCG, MACS1931's `potentiel 3`) with a velocity dispersion only.
+    const text = await page.evaluate(async () => {
+      const { showVerdict } = await import('./js/verdict.js');
+      const verdict = {
+        trust: 'usable_with_care', words: 'usable with care', reasons: 'No BCG.', systems: 3,
+        systems_matched: 3, members: 10, members_with_own_curves: 0, worst: [], bcg: { missing: true },
+      };
+      showVerdict(verdict, {
+        modelGalaxies: [
+          { id: 'O3', line: 55, mag: 17.037, mag_from_mass: false },
+          { id: '3', line: 66, mag: 16.8312, mag_from_mass: true },
+        ],
+        fitModel: () => {},
+      });
+      return document.getElementById('fit-model-galaxies').textContent;
+    });
+    assert.equal(text, "Fit the .par's galaxies (O3, mag 17.04; 3, as massive as a mag 16.83 member) and reconstruct again");
+    await page.locator('#verdict').screenshot({ path: join(ARTIFACTS, 'verdict-offer-by-mass.png') });
+    // The longer words wrap inside the box on a phone.
+    await page.setViewportSize({ width: 390, height: 844 });
+    const button = await page.locator('#fit-model-galaxies').boundingBox();
+    assert.ok(button.x >= 0 && button.x + button.width <= 390, JSON.stringify(button));
+    assert.equal(await page.evaluate(() => document.documentElement.scrollWidth), 390);
+    await page.locator('#verdict').screenshot({ path: join(ARTIFACTS, 'verdict-offer-by-mass-390.png') });
+    await page.evaluate(async () => (await import('./js/verdict.js')).showVerdict(null));
+    assert.equal(await page.isHidden('#verdict'), true);
+    assert.deepEqual(app.consoleErrors, []);
+  } finally {
+    await app.close();
+  }
+});

@@ -1119,6 +1119,8 @@ mod galaxies_of_a_par {
         let alone = data.members.as_ref().unwrap();
         assert_eq!(alone.ids(&alone.par_galaxies), ["3"]);
         assert_eq!(alone.ids(&alone.free_mass_galaxies), ["3"]);
+        // Its magnitude is the member law's for its mass, not one a file wrote.
+        assert_eq!(alone.ids(&alone.mass_galaxies), ["3"]);
         let dpie = 1.5 * std::f64::consts::PI * 100.0 * 100.0 * 100.0 / G_KPC;
         let mass = law_mass(&alone.members[0], &par);
         // Its ellipticity (0.273) lowers a dPIE's mass by 1 - eps^2 (eps the Kassiola-Kovner
@@ -1153,6 +1155,7 @@ mod galaxies_of_a_par {
             ),
             (&[1][..], &[1][..])
         );
+        assert_eq!(both.mass_galaxies, [1]);
         let config = wslap::MemberConfig {
             layers: "bcg".parse().unwrap(),
             ..wslap::MemberConfig::default()
@@ -1202,6 +1205,8 @@ mod galaxies_of_a_par {
         assert_eq!((bcg.id.as_str(), bcg.mag, bcg.line), ("1009.0", 17.325, 10));
         assert!(!members.commented.iter().any(|m| m.id == "1009.0"));
         assert_eq!(members.ids(&members.par_galaxies), ["1009.0"]);
+        // Its magnitude is the catalogue's.
+        assert!(members.mass_galaxies.is_empty());
         let notes = add_galaxies(&mut data, &par);
         assert!(
             notes[0].ends_with("`potentiel 3` (no `mag`) is member 1009.0 of m1931.cat already"),

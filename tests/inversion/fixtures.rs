@@ -98,5 +98,6 @@ pub fn members() -> MemberCatalog {
         par_galaxies: Vec::new(),
         par_source: None,
         free_mass_galaxies: Vec::new(),
+        mass_galaxies: Vec::new(),
     }
 }

@@ -185,6 +185,7 @@ fn layer_splits_partition_the_members() {
     let free_id = cat.members[2].id.clone();
     let mut freed = MemberCatalog {
         free_mass_galaxies: vec![2],
+        mass_galaxies: vec![2],
         ..members()
     };
     freed.members[3].id = free_id.clone();

@@ -59,6 +59,7 @@ fn member_galaxies_are_the_inversions_halos() {
         par_galaxies: Vec::new(),
         par_source: None,
         free_mass_galaxies: Vec::new(),
+        mass_galaxies: Vec::new(),
     };
     let grid = CellGrid::regular(DVec2::ZERO, 40.0, 8, 1.0).expect("grid");
     let members =

@@ -50,7 +50,7 @@ const andList = (items) => (items.length < 2 ? items.join('')
 /** Shows `verdict` (or hides the box for `null`: no result, or no reconstruction). When the
  * members lack their BCG, a button offers to fit it: the member catalogue's commented-out rows
  * (`bcg.commented`, one per core: `fitRows([{line, id}])`), else the galaxies of the loaded
- * Lenstool .par (`modelGalaxies`, `[{id, line, mag}]`: `fitModel()`). */
+ * Lenstool .par (`modelGalaxies`, `[{id, line, mag, mag_from_mass}]`: `fitModel()`). */
 export function showVerdict(verdict, { fitRows = null, modelGalaxies = [], fitModel = null } = {}) {
   last = verdict ?? null;
   const box = document.getElementById('verdict');
@@ -94,7 +94,10 @@ export function showVerdict(verdict, { fitRows = null, modelGalaxies = [], fitMo
       () => fitRows(rows));
   } else if (last.bcg?.missing && modelGalaxies.length && fitModel) {
     // A fitted .par may list hundreds of galaxies: name a few.
-    const named = modelGalaxies.slice(0, 3).map((g) => `${g.id}, mag ${g.mag.toFixed(2)}`).join('; ');
+    // A galaxy the .par writes without a magnitude is named by the one its mass stands for.
+    const named = modelGalaxies.slice(0, 3).map((g) => (g.mag_from_mass
+      ? `${g.id}, as massive as a mag ${g.mag.toFixed(2)} member`
+      : `${g.id}, mag ${g.mag.toFixed(2)}`)).join('; ');
     const which = modelGalaxies.length === 1 ? `galaxy (${named})`
       : modelGalaxies.length <= 3 ? `galaxies (${named})`
         : `${modelGalaxies.length} galaxies (${named}; …)`;
