@@ -1332,7 +1332,8 @@ fn reconstruct_from_a_ds9_region_file() {
 
 /// `wslap maps --lenstool` evaluates a published Lenstool model (AS1063's CATS gold bestopt.par
 /// with its potfile): the same Einstein radius as the library's model of the same files on the
-/// same map, maps in the .par's sky frame, and a clear error when a potfile is not found.
+/// same map, maps in the .par's sky frame, a potfile found where Lenstool would find it or
+/// beside the .par, and a clear error when it is not found.
 #[test]
 fn maps_of_a_lenstool_model_match_the_library_and_name_a_missing_potfile() {
     use wslap::load_lenstool_model;
@@ -1401,6 +1402,55 @@ fn maps_of_a_lenstool_model_match_the_library_and_name_a_missing_potfile() {
             && err.contains("give its member catalogue with --potfile"),
         "{err}"
     );
+    // A `filein` naming a folder of the modeller's machine: the catalogue is read where
+    // Lenstool run in the working folder would read it, else by its name beside the .par,
+    // with a warning each time; the model is the same.
+    let pkg = dir.join("pkg");
+    fs::create_dir_all(dir.join("model/as1063")).unwrap();
+    fs::create_dir_all(&pkg).unwrap();
+    let text = fs::read_to_string(&par).unwrap().replace(
+        "filein  1 ref_potential_w_clumpNE.cat",
+        "filein  1 model/as1063/members.cat",
+    );
+    fs::write(pkg.join("best.par"), text).unwrap();
+    fs::copy(&potfile, dir.join("model/as1063/members.cat")).unwrap();
+    let moved = |out: &str| {
+        Command::new(env!("CARGO_BIN_EXE_wslap"))
+            .current_dir(&dir.0)
+            .args(["maps", "--lenstool", "pkg/best.par", "--z-source", "2"])
+            .args(["--size", "160", "--pixels", "200", "--out", out])
+            .output()
+            .unwrap()
+    };
+    let out = moved("here");
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "{err}");
+    assert!(
+        err.contains(
+            "warning: pkg/best.par: line 87: the potfile's `filein model/as1063/members.cat` is \
+             not in the .par's folder (pkg/model/as1063/members.cat does not exist): \
+             model/as1063/members.cat is read instead"
+        ),
+        "{err}"
+    );
+    assert_eq!(
+        summary(&dir.join("here"))["einstein_radius_arcsec"].as_f64(),
+        Some(theta_e)
+    );
+    fs::rename(
+        dir.join("model/as1063/members.cat"),
+        pkg.join("members.cat"),
+    )
+    .unwrap();
+    let out = moved("beside");
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "{err}");
+    assert!(err.contains("pkg/members.cat is read instead"), "{err}");
+    assert_eq!(
+        summary(&dir.join("beside"))["einstein_radius_arcsec"].as_f64(),
+        Some(theta_e)
+    );
+
     // --potfile belongs to --lenstool.
     let out = wslap(&["maps", "--model", &par, "--potfile", &potfile, "--out", "x"]);
     assert!(!out.status.success());

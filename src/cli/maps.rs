@@ -32,7 +32,9 @@ pub struct MapsArgs {
     #[arg(long, value_name = "MODEL.par")]
     lenstool: Option<PathBuf>,
     /// Member catalogue of the --lenstool model's potfile blocks, one per block in order
-    /// (repeat the option); without it, each block's `filein`, next to the .par file.
+    /// (repeat the option); without it, each block's `filein` relative to the .par's folder,
+    /// else relative to the working folder, else its file name beside the .par (with a
+    /// warning).
     #[arg(long, value_name = "MEMBERS.cat", conflicts_with_all = ["model", "deflection"])]
     potfile: Vec<PathBuf>,
     /// Evaluate a --lenstool model with potentials at several redshifts (a foreground or
@@ -159,7 +161,8 @@ fn lenstool_products(
 }
 
 /// The Lenstool model `par_path` with the member catalogues `potfiles` (one per potfile block;
-/// when empty, each block's `filein` next to the .par file), read with `par_options`;
+/// when empty, each block's `filein` as [`wslap::LenstoolPar::potfile_paths`] finds it), read
+/// with `par_options`;
 /// warnings go to stderr.
 pub(super) fn load_lenstool(
     par_path: &Path,
@@ -173,7 +176,11 @@ pub(super) fn load_lenstool(
         eprintln!("warning: {w}");
     }
     let paths: Vec<PathBuf> = if potfiles.is_empty() {
-        par.potfile_paths(par_path)
+        let found = par.potfile_paths(par_path);
+        for note in found.iter().filter_map(|(_, note)| note.as_ref()) {
+            eprintln!("warning: {note}");
+        }
+        found.into_iter().map(|(path, _)| path).collect()
     } else {
         potfiles.to_vec()
     };

@@ -577,11 +577,50 @@ impl LenstoolPar {
     }
 
     /// Where the member catalogues of the `potfile` blocks are when the `.par` file is
-    /// `par_path`: each block's `filein`, relative to the `.par`'s folder (as Lenstool reads it
-    /// when run there).
-    pub fn potfile_paths(&self, par_path: &std::path::Path) -> Vec<std::path::PathBuf> {
+    /// `par_path`, one per block, each with a sentence when it is not where Lenstool run in the
+    /// `.par`'s folder would look. The first of these that exists: the block's `filein`
+    /// relative to the `.par`'s folder (as Lenstool reads it when run there); as written,
+    /// relative to the working folder (as Lenstool reads it when run here); its file name
+    /// alone in the `.par`'s folder (a package that keeps its files together, whose `.par`
+    /// names a folder of the modeller's machine, e.g. `../model/a2390/cgalVzK.cat`). When none
+    /// exists, the first, whose error then names it.
+    pub fn potfile_paths(
+        &self,
+        par_path: &std::path::Path,
+    ) -> Vec<(std::path::PathBuf, Option<String>)> {
         let dir = par_path.parent().unwrap_or(std::path::Path::new("."));
-        self.potfiles.iter().map(|p| dir.join(&p.filein)).collect()
+        self.potfiles
+            .iter()
+            .map(|p| {
+                let beside_par = dir.join(&p.filein);
+                if beside_par.exists() {
+                    return (beside_par, None);
+                }
+                let written = std::path::PathBuf::from(&p.filein);
+                let by_name = std::path::Path::new(&p.filein)
+                    .file_name()
+                    .map(|name| dir.join(name));
+                let found = [Some(written), by_name]
+                    .into_iter()
+                    .flatten()
+                    .find(|path| path.is_file());
+                match found {
+                    None => (beside_par, None),
+                    Some(path) => {
+                        let note = format!(
+                            "{}: line {}: the potfile's `filein {}` is not in the .par's folder \
+                             ({} does not exist): {} is read instead",
+                            self.source_name,
+                            p.line,
+                            p.filein,
+                            beside_par.display(),
+                            path.display()
+                        );
+                        (path, Some(note))
+                    }
+                }
+            })
+            .collect()
     }
 
     /// [`Self::build`] from the texts of the member catalogues, `(name, text)` one per
@@ -673,8 +712,8 @@ impl LenstoolPar {
 }
 
 /// Reads `par_path` and its member catalogues and builds the model. `member_paths` gives one
-/// catalogue per `potfile` block in order; when empty, each `filein` is taken relative to the
-/// directory of `par_path`.
+/// catalogue per `potfile` block in order; when empty, each `filein` is found as
+/// [`LenstoolPar::potfile_paths`] finds it.
 #[cfg(not(target_arch = "wasm32"))]
 pub fn load_lenstool_model(
     par_path: &std::path::Path,
@@ -689,6 +728,9 @@ pub fn load_lenstool_model(
     let par = parse_par(&read(par_path)?, &par_path.display().to_string())?;
     let paths: Vec<std::path::PathBuf> = if member_paths.is_empty() {
         par.potfile_paths(par_path)
+            .into_iter()
+            .map(|(path, _)| path)
+            .collect()
     } else {
         member_paths.iter().map(|p| p.to_path_buf()).collect()
     };
