@@ -131,13 +131,30 @@ def tnfw_kwargs(plane, mass, x, y):
             "r_trunc": rt / plane.mpc_per_arcsec, "center_x": x, "center_y": y}
 
 
+def dpie_kwargs(plane, law, l, factor, x, y):
+    """Total mass (Msun) and lenstronomy PJAFFE kwargs at D_ls/D_s = 1 of a circular Lenstool
+    dPIE (profile 81) for a galaxy of L/L* = l under the Lenstool scaling `law` (v_disp in km/s
+    and core, cut in kpc at L*; v_disp ~ L^(1/4), core and cut ~ L^(1/2)), its mass times
+    `factor`. Lenstool's b0 = 6 pi (v_disp / c)^2 gives kappa = (b0 / 2) s / (s - a)
+    [1/sqrt(a^2 + R^2) - 1/sqrt(s^2 + R^2)], PJAFFE's with sigma0 = b0 / (2 a) (as in
+    tests/data/dpie_reference.py); its total mass is (3/2) pi v_disp^2 s / G."""
+    sigma = law["v_disp"] * l**0.25 * np.sqrt(factor)
+    a_kpc, s_kpc = law["core_kpc"] * l**0.5, law["cut_kpc"] * l**0.5
+    c_km_s = const.c.to(u.km / u.s).value
+    b0 = 6 * np.pi * (sigma / c_km_s) ** 2 / ARCSEC_RAD
+    a, s = (r * 1e-3 / plane.mpc_per_arcsec for r in (a_kpc, s_kpc))
+    g = const.G.to(u.kpc * u.km**2 / u.s**2 / u.Msun).value
+    mass = 1.5 * np.pi * sigma**2 * s_kpc / g
+    return mass, {"sigma0": b0 / (2 * a), "Ra": a, "Rs": s, "center_x": x, "center_y": y}
+
+
 def scaled_kwargs(kwargs, f):
     """The kwargs for a source at D_ls/D_s = f (every profile here is linear in alpha_Rs, the
-    external shear in gamma1 and gamma2)."""
+    dPIE in sigma0, the external shear in gamma1 and gamma2)."""
     out = []
     for kw in kwargs:
         kw = dict(kw)
-        for key in ("alpha_Rs", "gamma1", "gamma2"):
+        for key in ("alpha_Rs", "sigma0", "gamma1", "gamma2"):
             if key in kw:
                 kw[key] *= f
         out.append(kw)
@@ -169,6 +186,18 @@ def check_conversions(plane, log):
         log(f"  TNFW M = {mass:.2e}: integral of lenstronomy kappa = {m_int:.5e} "
             f"(rel. err {rel:+.2e}); lenstronomy mass_2d(1e4 r_t) = {m2d:.5e}")
     assert worst < 1e-3, worst
+    # 1b. dPIE (PJAFFE): lenstronomy's projected mass to 1e4 cut radii against (3/2) pi
+    # v_disp^2 s / G (the mass beyond is (3/2) pi v^2 s / G times s / R, below 1e-4).
+    pjaffe = LensModel(["PJAFFE"]).lens_model.func_list[0]
+    law = dict(v_disp=100.0, core_kpc=0.15, cut_kpc=45.0)
+    for l in (0.1, 1.0, 8.0):
+        mass, kw = dpie_kwargs(plane, law, l, 1.0, 0.0, 0.0)
+        rho0 = pjaffe.sigma2rho(kw["sigma0"], kw["Ra"], kw["Rs"])
+        m2d = pjaffe.mass_2d(1e4 * kw["Rs"], rho0, kw["Ra"], kw["Rs"]) * plane.sigma_cr_ref_arcsec2
+        rel = m2d / mass - 1
+        log(f"  dPIE L = {l} L*: lenstronomy mass_2d(1e4 s) = {m2d:.5e} vs (3/2) pi v^2 s / G "
+            f"= {mass:.5e} (rel. err {rel:+.2e})")
+        assert abs(rel) < 1e-3, rel
     # 2. NFW: our alpha_Rs at D_ls/D_s = 1 times f equals lenstronomy's LensCosmo at z_s = 2.
     zs = 2.0
     lc = LensCosmo(z_lens=plane.z_l, z_source=zs, cosmo=COSMO)
@@ -257,6 +286,18 @@ CLUSTERS = [
          n_members=70, member_rc=22.0,
          what="(j) a distant lens (z_l = 0.55): elliptical NFW halo with a BCG, a dark clump "
               "39 arcsec SW, 70 members"),
+    # Members of another profile and law than the reconstruction assumes (added 2026-12-07,
+    # after every default was chosen): Lenstool's dPIE with the scaling of a published fit, the
+    # CATS model of AS1063 as its bestopt.par writes it (an L* galaxy of v_disp 100 km/s, core
+    # 0.15 kpc, cut 45 kpc; v_disp ~ L^(1/4), core and cut ~ L^(1/2)): steeper than the
+    # truncated NFW of the law inside a few kpc, a third of its mass inside 5 kpc, half in all.
+    dict(name="l_dpie_members", seed=1212, z_l=0.35, ra0=330.4703, dec0=-59.9439, n_sys=26,
+         halos=[dict(m200=1.3e15, c=6.0, x=0.0, y=0.0, q=0.72, phi=-25.0, bcg_l=8.0)],
+         clumps=[dict(m200=1.1e14, c=7.0, x=-35.0, y=-28.0)],
+         n_members=70, member_rc=30.0, member_dpie=dict(v_disp=100.0, core_kpc=0.15,
+                                                         cut_kpc=45.0),
+         what="(l) elliptical NFW halo with a BCG, a dark clump 45 arcsec SE, 70 members "
+              "that are Lenstool dPIEs scaled as the CATS model of AS1063 scales its galaxies"),
     # The tidal field of mass beyond the field (added with wslap's external shear, 2026-12-06):
     # a Lenstool fit of AS1063 finds gamma 0.10, so a cluster's own field is not always alone.
     dict(name="k_external_shear", seed=1111, z_l=0.36, ra0=44.7370, dec0=-8.5560, n_sys=25,
@@ -316,8 +357,15 @@ def build_lens(plane, spec, rng):
         mag = plane.mag_star - 2.5 * np.log10(m_cat / M_STAR)
         members.append(dict(id=k + 1, x=x, y=y, a=a, b=a * q, theta=theta, mag=mag, lum=l,
                             mass_catalogue_msun=m_cat, mass_true_msun=m_true))
-        models.append("TNFW")
-        kwargs.append(tnfw_kwargs(plane, m_true, x, y))
+        if "member_dpie" in spec:
+            # The law's scatter, as a factor on the dPIE's mass (v_disp^2, radii as written).
+            m_true, kw = dpie_kwargs(plane, spec["member_dpie"], l, m_true / m_cat, x, y)
+            models.append("PJAFFE")
+            kwargs.append(kw)
+            members[-1]["mass_true_msun"] = m_true
+        else:
+            models.append("TNFW")
+            kwargs.append(tnfw_kwargs(plane, m_true, x, y))
         roles.append("member")
     if "shear" in spec:
         two = np.deg2rad(2 * spec["shear"]["angle_deg"])
