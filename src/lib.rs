@@ -105,9 +105,9 @@ pub use arcs::{arcs_from_regions, parse_arcs, ArcCatalog, ArcSystem, ArcsError};
 pub use catalog::{
     arclet_ellipticity, galaxy_of_system, parse_arclet_catalog, parse_arclet_catalog_with,
     parse_image_catalog, parse_member_catalog, parse_potfile_catalog, system_of_image, Arclet,
-    ArcletCatalog, ArcletUnknownZ, CatalogError, CatalogRow, CommentedBcgs, Image, ImageCatalog,
-    ImageSystem, Member, MemberCatalog, DEGREE_LOOKALIKE, FIELD_ERROR_DEG, FIELD_WARN_DEG,
-    MAG_NO_MEASUREMENT, Z_AGREEMENT_TOL,
+    ArcletCatalog, ArcletUnknownZ, CatalogError, CatalogKind, CatalogRow, CommentedBcgs, Image,
+    ImageCatalog, ImageSystem, Member, MemberCatalog, DEGREE_LOOKALIKE, FIELD_ERROR_DEG,
+    FIELD_WARN_DEG, MAG_NO_MEASUREMENT, Z_AGREEMENT_TOL,
 };
 pub use ds9::{
     polyline_is_open, read_regions, write_marks, write_regions, Ds9Error, Ds9Frame, Mark, Region,

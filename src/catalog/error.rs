@@ -72,6 +72,28 @@ pub enum CatalogError {
         line: usize,
     },
 
+    /// A catalogue whose 7th column says it is the other kind: magnitudes in an image
+    /// catalogue (its redshift column), or redshifts in a member catalogue (its magnitudes).
+    #[error(
+        "{source_name}: column 7 ({}) holds {} to {} on {rows} rows (line {line}: {value}), \
+         which read as {}: this looks like {} ({}), not {}",
+        .read_as.column(), crate::error::number(*.low), crate::error::number(*.high),
+        .read_as.other_values(), .read_as.other().name(), .read_as.other().layout(),
+        .read_as.name()
+    )]
+    OtherKind {
+        source_name: String,
+        /// What the file was read as.
+        read_as: CatalogKind,
+        /// The column's least and greatest value, and on how many rows it was read.
+        low: f64,
+        high: f64,
+        rows: usize,
+        /// The first row with such a value, and that value as written.
+        line: usize,
+        value: String,
+    },
+
     /// Two images of one system whose redshifts differ by more than the agreement tolerance.
     #[error(
         "{source_name}: system '{system}': line {line_a} gives z = {z_a} but line {line_b} gives \
@@ -148,5 +170,55 @@ impl fmt::Display for CatalogWarning {
             "{}: line {}: {}",
             self.source_name, self.line, self.message
         )
+    }
+}
+
+/// The two kinds of Lenstool catalogue, which share their first six columns and differ in
+/// the 7th: a source redshift in an image catalogue, a magnitude in a member catalogue.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum CatalogKind {
+    Images,
+    Members,
+}
+
+impl CatalogKind {
+    /// "an image catalogue" or "a member catalogue".
+    pub fn name(self) -> &'static str {
+        match self {
+            Self::Images => "an image catalogue",
+            Self::Members => "a member catalogue",
+        }
+    }
+
+    /// The columns as Lenstool writes them.
+    pub fn layout(self) -> &'static str {
+        match self {
+            Self::Images => "id x y a b theta z mag",
+            Self::Members => "id x y a b theta mag lum",
+        }
+    }
+
+    /// The name of the 7th column.
+    pub fn column(self) -> &'static str {
+        match self {
+            Self::Images => "z",
+            Self::Members => "mag",
+        }
+    }
+
+    /// The other kind.
+    pub fn other(self) -> Self {
+        match self {
+            Self::Images => Self::Members,
+            Self::Members => Self::Images,
+        }
+    }
+
+    /// What the 7th column holds when the file is of the other kind.
+    fn other_values(self) -> &'static str {
+        match self {
+            Self::Images => "magnitudes, not source redshifts",
+            Self::Members => "redshifts, not magnitudes",
+        }
     }
 }

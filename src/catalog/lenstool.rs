@@ -15,7 +15,8 @@ use super::rows::{
 };
 use super::units::{check_field, RowPosition};
 use super::{
-    CatalogError, CatalogWarning, Image, ImageCatalog, ImageSystem, Member, MemberCatalog,
+    CatalogError, CatalogKind, CatalogWarning, Image, ImageCatalog, ImageSystem, Member,
+    MemberCatalog,
 };
 use crate::sky::SkyReference;
 
@@ -109,6 +110,7 @@ pub fn parse_image_catalog(
 ) -> Result<(ImageCatalog, Vec<CatalogWarning>), CatalogError> {
     let requested = frame::check_requested(reference, source_name)?;
     let table = read_table(text, source_name)?;
+    check_kind(&table, source_name, CatalogKind::Images)?;
     let [c0, c1] = table.coords.column_names();
     let names = ["id", c0, c1, "a", "b", "theta", "z", "mag"];
     let mut warnings = Vec::new();
@@ -230,6 +232,7 @@ fn parse_members(
 ) -> Result<(MemberCatalog, Vec<CatalogWarning>), CatalogError> {
     let requested = frame::check_requested(reference, source_name)?;
     let mut table = read_table(text, source_name)?;
+    check_kind(&table, source_name, CatalogKind::Members)?;
     let mut warnings = Vec::new();
     if let (true, false, Some(r)) = (headerless_relative, table.has_header, requested) {
         if let Some((line, x, y)) = row_not_in_degrees(&table) {
@@ -329,6 +332,60 @@ fn parse_members(
         mass_galaxies: Vec::new(),
     };
     Ok((catalog, warnings))
+}
+
+/// The 7th column below which a value reads as a source redshift and from which it reads as
+/// a magnitude: no lensed source is known beyond z ~ 13, no cluster member is brighter than
+/// magnitude 12 (a nearby BCG is 13 - 14), and the drop zone of the app sorts files so.
+const REDSHIFT_BELOW: f64 = 12.0;
+
+/// Refuses a catalogue of the other kind, told by its 7th column (given on at least 3 rows):
+/// an image catalogue whose median `z` is a magnitude (at least [`REDSHIFT_BELOW`]), or a
+/// member catalogue whose every `mag` is a redshift (in `[0, REDSHIFT_BELOW)`; absolute
+/// magnitudes are negative, and a `mag` of 99 that means none is left to the reader). A
+/// member catalogue read as images would otherwise give systems of one image each, or
+/// redshifts that disagree; an image catalogue read as members, halos of absurd mass.
+fn check_kind(table: &Table<'_>, source_name: &str, kind: CatalogKind) -> Result<(), CatalogError> {
+    let mut values: Vec<(usize, &str, f64)> = table
+        .rows
+        .iter()
+        .filter_map(|row| {
+            let text = *row.fields.get(6)?;
+            let v: f64 = text.parse().ok()?;
+            let measured = v.is_finite() && v.abs() < MAG_NO_MEASUREMENT;
+            measured.then_some((row.line, text, v))
+        })
+        .collect();
+    if values.len() < 3 {
+        return Ok(());
+    }
+    let first = values[0];
+    values.sort_by(|a, b| a.2.total_cmp(&b.2));
+    let (low, high) = (values[0].2, values[values.len() - 1].2);
+    let median = values[values.len() / 2].2;
+    let other = match kind {
+        CatalogKind::Images => median >= REDSHIFT_BELOW,
+        CatalogKind::Members => low >= 0.0 && high < REDSHIFT_BELOW,
+    };
+    if !other {
+        return Ok(());
+    }
+    // The first row (in the file's order) whose value shows it.
+    let shows = |v: &&(usize, &str, f64)| kind == CatalogKind::Members || v.2 >= REDSHIFT_BELOW;
+    let (line, value, _) = *values
+        .iter()
+        .filter(shows)
+        .min_by_key(|v| v.0)
+        .unwrap_or(&first);
+    Err(CatalogError::OtherKind {
+        source_name: source_name.into(),
+        read_as: kind,
+        low,
+        high,
+        rows: values.len(),
+        line,
+        value: value.to_string(),
+    })
 }
 
 /// The member of a row read as `shape`, `mag` and `lum`, at its position as written.

@@ -24,7 +24,7 @@ pub use arclets::{
     arclet_ellipticity, parse_arclet_catalog, parse_arclet_catalog_with, Arclet, ArcletCatalog,
     ArcletUnknownZ,
 };
-pub use error::{CatalogError, CatalogWarning};
+pub use error::{CatalogError, CatalogKind, CatalogWarning};
 pub(crate) use frame::{mean_position, reframe, sexagesimal};
 pub(crate) use lenstool::galaxy_indices;
 pub use lenstool::{

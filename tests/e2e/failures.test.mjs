@@ -5,7 +5,7 @@
 import { test } from 'node:test';
 import assert from 'node:assert/strict';
 import { join } from 'node:path';
-import { openApp, runToMap, setField, waitStatus, ROOT } from './browser.mjs';
+import { openApp, runToMap, setField, waitStatus, ROOT, ARTIFACTS } from './browser.mjs';
 
 const MEMBERS = join(ROOT, 'www', 'examples', 'a1689-sim', 'members.cat');
 
@@ -51,6 +51,28 @@ test('a rejected file keeps the one before, and says so at the top and in the ca
     await page.setInputFiles('#file-images', good);
     await waitStatus(page, /^Loaded images\.cat: .*; the map shown was made before it\.$/);
     assert.ok(await page.isHidden('#error'));
+    assert.deepEqual(app.consoleErrors, []);
+  } finally {
+    await app.close();
+  }
+});
+
+test('a member catalogue picked as the image catalogue is named as one, and the example stays', async () => {
+  const app = await openApp();
+  try {
+    const { page } = app;
+    await waitStatus(page, /^Ready/);
+    await teaching(page);
+    await page.setInputFiles('#file-images', MEMBERS);
+    await page.waitForSelector('#error:not([hidden])');
+    const error = await page.textContent('#error');
+    assert.match(error, /^members\.cat was not loaded: column 7 \(z\) holds [\d.]+ to [\d.]+ on \d+ rows \(line \d+: [\d.]+\), which read as magnitudes, not source redshifts: this looks like a member catalogue \(id x y a b theta mag lum\), not an image catalogue/);
+    assert.match(error, /The example "Teaching example: one halo, four sources" stays open as it was\.$/);
+    assert.match(await page.textContent('#status-images'), /looks like a member catalogue/);
+    await page.locator('#error').screenshot({ path: join(ARTIFACTS, 'error-members-as-images.png') });
+    await page.setViewportSize({ width: 390, height: 844 });
+    assert.equal(await page.evaluate(() => document.documentElement.scrollWidth), 390);
+    await page.locator('#error').screenshot({ path: join(ARTIFACTS, 'error-members-as-images-390.png') });
     assert.deepEqual(app.consoleErrors, []);
   } finally {
     await app.close();

@@ -158,6 +158,43 @@ mod real_files {
         assert_eq!(mag_range, (18.2961, 25.099));
     }
 
+    /// A catalogue given as the other kind is refused, told by its 7th column: MACS1931's and
+    /// AS1063's member catalogues as images (magnitudes where redshifts go), AS1063's images
+    /// as members (redshifts where magnitudes go).
+    #[test]
+    fn a_catalogue_of_the_other_kind_is_named() {
+        for (rel, first) in [
+            (
+                "MACS1931/lenstool_cats/m1931.cat",
+                "16.8822 to 28.859 on 198 rows (line 3",
+            ),
+            (
+                "AS1063/lenstool_cats/cats_gold_ref_potential_w_clumpNE.cat",
+                "18.2961 to 25.099 on 260 rows (line 2",
+            ),
+        ] {
+            let err = parse_image_catalog(&read(rel), rel, None).unwrap_err();
+            assert_contains(
+                &err.to_string(),
+                &[
+                    &format!("{rel}: column 7 (z) holds {first}"),
+                    "which read as magnitudes, not source redshifts: this looks like a member \
+                     catalogue (id x y a b theta mag lum), not an image catalogue",
+                ],
+            );
+        }
+        let rel = "AS1063/lenstool_cats/cats_gold_mul_gold.cat";
+        let err = parse_member_catalog(&read(rel), rel, None).unwrap_err();
+        assert_eq!(
+            err.to_string(),
+            format!(
+                "{rel}: column 7 (mag) holds 0.7287 to 6.107 on 50 rows (line 1: 1.2279), which \
+                 read as redshifts, not magnitudes: this looks like an image catalogue (id x y a \
+                 b theta z mag), not a member catalogue"
+            )
+        );
+    }
+
     #[test]
     fn macs1931_images() {
         let rel = "MACS1931/lenstool_cats/immul_ongoing.cat";
@@ -965,4 +1002,21 @@ fn absurd_offsets_are_said_in_readable_numbers() {
     let e = image_err("#REFERENCE 3 342.18 -44.53\n1.1 1e308 0 0.1 0.1 0 2 25\n");
     assert!(e.contains("is 2.778e304 deg from"), "{e}");
     assert!(!e.contains("inf"), "{e}");
+}
+
+/// The kind check needs three values in column 7 and leaves the ones it cannot judge alone:
+/// two members with magnitudes read as images are not refused by it; absolute (negative)
+/// magnitudes and a 99 that means none are read as members; one image at z = 13 among
+/// ordinary redshifts is an image catalogue.
+#[test]
+fn the_kind_check_leaves_what_it_cannot_judge() {
+    let two = "#REFERENCE 3 150.1 2.2\n1 0 0 1 1 0 18.5\n2 5 5 1 1 0 19.5\n";
+    assert!(!image_err(two).contains("column 7"), "{}", image_err(two));
+    let absolute = "#REFERENCE 3 150.1 2.2\n1 0 0 1 1 0 -22.1\n2 5 5 1 1 0 -20.3\n3 9 1 1 1 0 -19.0\n4 2 8 1 1 0 99\n";
+    let (members, _) = parse_member_catalog(absolute, "abs.cat", None).unwrap();
+    assert_eq!(members.members.len(), 3);
+    let high = "#REFERENCE 3 150.1 2.2\n1.1 0 0 1 1 0 13.0\n1.2 5 5 1 1 0 13.0\n2.1 9 1 1 1 0 2.1\n2.2 2 8 1 1 0 2.1\n\
+                3.1 -9 1 1 1 0 1.2\n3.2 -2 -8 1 1 0 1.2\n";
+    let (images, _) = parse_image_catalog(high, "high.cat", None).unwrap();
+    assert_eq!(images.systems.len(), 3);
 }

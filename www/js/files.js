@@ -31,7 +31,9 @@ export async function guessRole(file) {
 /** A Lenstool catalogue's role from its rows: the 7th column is a redshift in an image
  * catalogue (0 - 12) and a magnitude in a member catalogue (about 14 - 30, or 99 for none), so
  * the median over the first rows tells them apart whatever the file is called (SGAS J1152's
- * `source_ids_ref0.cat` was taken for members by its name). `null` without three such rows. */
+ * `source_ids_ref0.cat` was taken for members by its name). `null` without three such rows.
+ * The core's readers refuse a catalogue picked as the other kind by the same column and
+ * threshold (`check_kind` in src/catalog/lenstool.rs). */
 function catalogueRole(head) {
   const sevenths = head.split(/\r?\n/)
     .map((line) => line.trim())
