@@ -478,6 +478,10 @@ impl Reconstruction {
             crossval_holdout_median_arcsec: cv
                 .filter(|c| c.completed())
                 .and_then(|c| c.totals.holdout_image_offset_median_arcsec),
+            choice_holdout_median_arcsec: self
+                .strength_choice
+                .as_ref()
+                .and_then(StrengthChoice::chosen_holdout_median_arcsec),
         };
         Verdict::assess(&self.sources, inputs)
     }
@@ -1098,6 +1102,13 @@ impl StrengthChoice {
         c.regulariser == self.chosen_regulariser
             && c.strength == self.chosen
             && (c.cells.is_none() || self.chosen_cells.is_none() || c.cells == self.chosen_cells)
+    }
+
+    /// The chosen candidate's held-out median offset (arcsec) over the folds of this choice,
+    /// `None` when none of its held-out images was matched.
+    pub fn chosen_holdout_median_arcsec(&self) -> Option<f64> {
+        let chosen = self.candidates.iter().find(|c| self.is_chosen(c))?;
+        chosen.holdout_median_arcsec
     }
 
     /// The chosen candidate: what the reconstruction uses.

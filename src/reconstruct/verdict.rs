@@ -294,6 +294,12 @@ pub struct VerdictInputs<'a> {
     /// same data and settings (`wslap reconstruct --folds`): the held-out figure when the run
     /// holds no system out itself.
     pub crossval_holdout_median_arcsec: Option<f64>,
+    /// The chosen settings' held-out median offset (arcsec) in the cross-validation an
+    /// "auto" choice made them by ([`super::StrengthChoice::chosen_holdout_median_arcsec`]):
+    /// the held-out figure when there is no other (no system held out, no `--folds`). A
+    /// free-form map fits its own images to hundredths of an arcsec, so without a held-out
+    /// figure the verdict would judge a map on what says least about it.
+    pub choice_holdout_median_arcsec: Option<f64>,
 }
 
 /// `summary.json`'s `verdict`.
@@ -308,10 +314,15 @@ pub struct Verdict {
     /// images (arcsec).
     pub fit_offset_median_arcsec: Option<f64>,
     /// The same for the held-out systems, or for a cross-validation's held-out images
-    /// ([`VerdictInputs::crossval_holdout_median_arcsec`]).
+    /// ([`VerdictInputs::crossval_holdout_median_arcsec`]), or else for the chosen settings'
+    /// in an "auto" choice ([`VerdictInputs::choice_holdout_median_arcsec`]).
     pub holdout_offset_median_arcsec: Option<f64>,
     /// Whether that held-out figure is a cross-validation's.
     pub holdout_from_crossval: bool,
+    /// Whether it is the chosen settings' in the "auto" choice's cross-validation
+    /// ([`VerdictInputs::choice_holdout_median_arcsec`]).
+    #[serde(default)]
+    pub holdout_from_choice: bool,
     /// Systems judged.
     pub systems: usize,
     /// Systems with as many predicted images (shown ones) as observed, with fewer and with
@@ -406,9 +417,12 @@ impl Verdict {
         let own_holdout = median(true);
         let holdout_from_crossval =
             own_holdout.is_none() && inputs.crossval_holdout_median_arcsec.is_some();
+        let before_choice = own_holdout.or(inputs.crossval_holdout_median_arcsec);
+        let holdout_from_choice =
+            before_choice.is_none() && inputs.choice_holdout_median_arcsec.is_some();
         let (fit, holdout) = (
             median(false),
-            own_holdout.or(inputs.crossval_holdout_median_arcsec),
+            before_choice.or(inputs.choice_holdout_median_arcsec),
         );
         let n = checks.len();
         let count = |f: &dyn Fn(&SystemCheck) -> bool| checks.iter().filter(|c| f(c)).count();
@@ -601,6 +615,7 @@ impl Verdict {
             fit_offset_median_arcsec: fit,
             holdout_offset_median_arcsec: holdout,
             holdout_from_crossval,
+            holdout_from_choice,
             systems: n,
             systems_matched: n - fewer - more,
             systems_fewer_predicted: fewer,
@@ -968,6 +983,7 @@ mod tests {
             c_unmeasured,
             bcg: BcgFacts::default(),
             crossval_holdout_median_arcsec: None,
+            choice_holdout_median_arcsec: None,
         };
         let v = Verdict::assess(&sources, inputs(true));
         assert_eq!(v.trust, Trust::UsableWithCare);
@@ -1103,15 +1119,41 @@ mod tests {
             "{}",
             v.reasons
         );
+        // The "auto" choice's figure for the settings it chose counts when there is no
+        // other, and only then.
+        let chose = |m| VerdictInputs {
+            choice_holdout_median_arcsec: Some(m),
+            ..VerdictInputs::default()
+        };
+        let v = Verdict::assess(&two, chose(2.0));
+        assert_eq!(v.trust, Trust::UsableWithCare);
+        assert_eq!(v.holdout_offset_median_arcsec, Some(2.0));
+        assert!(v.holdout_from_choice && !v.holdout_from_crossval);
+        let v = Verdict::assess(
+            &two,
+            VerdictInputs {
+                choice_holdout_median_arcsec: Some(2.0),
+                ..after(0.6)
+            },
+        );
+        assert_eq!(v.holdout_offset_median_arcsec, Some(0.6));
+        assert!(v.holdout_from_crossval && !v.holdout_from_choice);
+        assert_eq!(v.trust, Trust::Good);
         // The run's own held-out system wins.
         let held = [
             fitted("1", &[0.2, 0.3]),
             fitted("2", &[0.3]),
             system("h", true, &[Some(0.5), Some(0.5)], 0),
         ];
-        let v = Verdict::assess(&held, after(2.0));
+        let v = Verdict::assess(
+            &held,
+            VerdictInputs {
+                choice_holdout_median_arcsec: Some(2.0),
+                ..after(2.0)
+            },
+        );
         assert_eq!(v.holdout_offset_median_arcsec, Some(0.5));
-        assert!(!v.holdout_from_crossval);
+        assert!(!v.holdout_from_crossval && !v.holdout_from_choice);
         assert_eq!(v.trust, Trust::Good, "{}", v.reasons);
     }
 

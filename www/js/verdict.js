@@ -15,7 +15,8 @@ export function worstSystems() {
 
 /** Text for the numbers behind the verdict, one per line. */
 function facts(v) {
-  const held = v.holdout_from_crossval ? 'held out in the cross-validation' : 'held out';
+  const held = v.holdout_from_crossval ? 'held out in the cross-validation'
+    : v.holdout_from_choice ? 'held out while choosing the settings' : 'held out';
   const out = [`Image offsets (median): fitted ${arcsec(v.fit_offset_median_arcsec)}${
     v.holdout_offset_median_arcsec == null ? '' : `, ${held} ${arcsec(v.holdout_offset_median_arcsec)}`}`];
   const parts = [`${v.systems_matched} as many as observed`];
