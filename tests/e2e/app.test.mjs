@@ -418,6 +418,12 @@ test('every field of the settings form is a setting of the core', async () => {
       await setField(page, `#${id}`, await page.inputValue(`#${id}`));
     }
     assert.deepEqual(await page.$$eval('#settings-form .field-error', (els) => els.map((e) => e.textContent).filter(Boolean)), []);
+    // The value each field shows is one the browser's own checks allow too (an input with no
+    // step took 1, and the shear prior's default 0.1, which the example leaves empty, read as
+    // invalid to them).
+    await setField(page, '#set-reconstruct-grid-external_shear_sigma', 0.1);
+    assert.deepEqual(await page.$$eval('#settings-form input', (els) => els.filter((el) => !el.checkValidity())
+      .map((el) => `${el.id} = ${el.value}: ${el.validationMessage}`)), []);
     assert.deepEqual(app.consoleErrors, []);
   } finally {
     await app.close();

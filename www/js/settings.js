@@ -125,7 +125,7 @@ export function buildSettings(form, apply) {
       : f.type === 'strength'
         ? `<input id="${id(f.path)}" type="text" inputmode="decimal" list="${id(f.path)}-list">
           <datalist id="${id(f.path)}-list">${f.options.map((o) => `<option value="${o}"></option>`).join('')}</datalist>`
-        : `<input id="${id(f.path)}" type="${['text', 'list'].includes(f.type) ? 'text' : 'number'}" ${f.step ? `step="${f.step}"` : ''}>`;
+        : `<input id="${id(f.path)}" type="${['text', 'list'].includes(f.type) ? 'text' : 'number'}" ${f.step ? `step="${f.step}"` : f.type === 'int' ? '' : 'step="any"'}>`;
     row.innerHTML = `<label for="${id(f.path)}">${f.label}</label>${control}
       ${f.hint ? `<small class="hint">${f.hint}</small>` : ''}
       <span class="field-error" id="${id(f.path)}-error" role="alert"></span>`;
