@@ -818,7 +818,8 @@ pub fn missing_bcg_warning(
     let cure = match (rows.is_empty(), par) {
         (true, None) => "If the cluster has one, add its row (id x y a b theta mag lum) to the \
                          member catalogue, or give the .par that models it (wslap reconstruct \
-                         --par; in the app, load it as the model file)"
+                         --par; in the app, load it as the model file with \"Galaxies and \
+                         redshift priors from the .par\" on)"
             .to_string(),
         (true, Some(par)) => format!(
             "The .par given ({par}) models no galaxy near the images either: if the cluster has a \
@@ -1039,7 +1040,8 @@ mod tests {
         let w = found.warning;
         assert!(w.ends_with(
             "add its row (id x y a b theta mag lum) to the member catalogue, or give the .par \
-             that models it (wslap reconstruct --par; in the app, load it as the model file)"
+             that models it (wslap reconstruct --par; in the app, load it as the model file \
+             with \"Galaxies and redshift priors from the .par\" on)"
         ));
     }
 

@@ -71,7 +71,7 @@ test('uploading the AS1063 catalogues reconstructs them', async () => {
     assert.equal(named.length + more, outsideCount);
     // The catalogue leaves the BCG out (it is in the .par): the run asks for it, before the
     // members left out one by one.
-    const bcg = items.findIndex((t) => /^cats_gold_ref_potential_w_clumpNE\.cat: no member within \d+ arcsec of the multiple images' centre is as bright as a brightest cluster galaxy \(4 L\* or more\): the brightest there is member \S+ at mag [\d.]+ \([\d.]+ L\*\)\..* add its row \(id x y a b theta mag lum\) to the member catalogue, or give the \.par that models it \(wslap reconstruct --par; in the app, load it as the model file\)$/.test(t));
+    const bcg = items.findIndex((t) => /^cats_gold_ref_potential_w_clumpNE\.cat: no member within \d+ arcsec of the multiple images' centre is as bright as a brightest cluster galaxy \(4 L\* or more\): the brightest there is member \S+ at mag [\d.]+ \([\d.]+ L\*\)\..* add its row \(id x y a b theta mag lum\) to the member catalogue, or give the \.par that models it \(wslap reconstruct --par; in the app, load it as the model file with "Galaxies and redshift priors from the \.par" on\)$/.test(t));
     assert.ok(bcg >= 0 && bcg < items.indexOf(outside[0]), items.slice(0, 3).join(' | '));
     // And the verdict beside the map says it among its (at most two) reasons.
     assert.match(await page.textContent('#verdict-reasons'), /(^|\. )No member near the images is bright enough to be the brightest cluster galaxy: if the catalogue leaves it out, add its row \(see the warnings\)\./);
