@@ -346,7 +346,7 @@ const REDSHIFT_BELOW: f64 = 12.0;
 /// member catalogue read as images would otherwise give systems of one image each, or
 /// redshifts that disagree; an image catalogue read as members, halos of absurd mass.
 fn check_kind(table: &Table<'_>, source_name: &str, kind: CatalogKind) -> Result<(), CatalogError> {
-    let mut values: Vec<(usize, &str, f64)> = table
+    let values: Vec<(usize, &str, f64)> = table
         .rows
         .iter()
         .filter_map(|row| {
@@ -359,12 +359,11 @@ fn check_kind(table: &Table<'_>, source_name: &str, kind: CatalogKind) -> Result
     if values.len() < 3 {
         return Ok(());
     }
-    let first = values[0];
-    values.sort_by(|a, b| a.2.total_cmp(&b.2));
-    let (low, high) = (values[0].2, values[values.len() - 1].2);
-    let median = values[values.len() / 2].2;
+    let mut sorted: Vec<f64> = values.iter().map(|v| v.2).collect();
+    sorted.sort_by(f64::total_cmp);
+    let (low, high) = (sorted[0], sorted[sorted.len() - 1]);
     let other = match kind {
-        CatalogKind::Images => median >= REDSHIFT_BELOW,
+        CatalogKind::Images => sorted[sorted.len() / 2] >= REDSHIFT_BELOW,
         CatalogKind::Members => low >= 0.0 && high < REDSHIFT_BELOW,
     };
     if !other {
@@ -372,11 +371,9 @@ fn check_kind(table: &Table<'_>, source_name: &str, kind: CatalogKind) -> Result
     }
     // The first row (in the file's order) whose value shows it.
     let shows = |v: &&(usize, &str, f64)| kind == CatalogKind::Members || v.2 >= REDSHIFT_BELOW;
-    let (line, value, _) = *values
-        .iter()
-        .filter(shows)
-        .min_by_key(|v| v.0)
-        .unwrap_or(&first);
+    let Some(&(line, value, _)) = values.iter().find(shows) else {
+        return Ok(());
+    };
     Err(CatalogError::OtherKind {
         source_name: source_name.into(),
         read_as: kind,
