@@ -379,6 +379,10 @@ fn reconstruct_writes_every_product_and_marks_held_out_systems() {
         .map(|s| s["id"].as_str().unwrap())
         .collect();
     assert_eq!(held, ["2", "7"]);
+    // The verdict judges the map by them, and says so.
+    let written = summary(&out_dir);
+    assert_eq!(written["verdict"]["holdout_from"], "held_out_systems");
+    assert!(written["verdict"]["holdout_offset_median_arcsec"].as_f64() > Some(0.0));
     // images.reg: a green circle on each catalogue image, at its RA and Dec (the catalogue is
     // in absolute degrees), and a dashed magenta one on each predicted image.
     let regions = wslap::read_regions(
@@ -794,6 +798,7 @@ fn reconstruct_folds_writes_crossval_json() {
         summary["verdict"]["holdout_offset_median_arcsec"].as_f64(),
         Some(held)
     );
+    assert_eq!(summary["verdict"]["holdout_from"], "crossval");
     // The folds' convergence, on the pixels of kappa.fits.
     let read = |file: &str| {
         let path = out_dir.join(file);

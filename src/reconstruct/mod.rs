@@ -47,8 +47,8 @@ pub use sources::{
 };
 pub use summary::{ReconstructSummary, Solved, WeakLensingFit};
 pub use verdict::{
-    members_with_own_curves, BcgFacts, Crowding, SystemCheck, Trust, Verdict, VerdictInputs,
-    FAR_MORE_PREDICTED_FACTOR, FLAG_OFFSET_ARCSEC, GOOD_FIT_OFFSET_ARCSEC,
+    members_with_own_curves, BcgFacts, Crowding, HoldoutSource, SystemCheck, Trust, Verdict,
+    VerdictInputs, FAR_MORE_PREDICTED_FACTOR, FLAG_OFFSET_ARCSEC, GOOD_FIT_OFFSET_ARCSEC,
     GOOD_HOLDOUT_OFFSET_ARCSEC, LOST_IMAGE_ARCSEC, LOST_SYSTEMS_SHARE, MAIN_CURVE_MIN_SHARE,
     ON_CURVE_MAGNIFICATION, ON_CURVE_SHARE, SMALL_SCALE_OFFSET_ARCSEC, WORST_SHOWN,
 };

@@ -302,6 +302,21 @@ pub struct VerdictInputs<'a> {
     pub choice_holdout_median_arcsec: Option<f64>,
 }
 
+/// Where the verdict's held-out figure comes from, in the order it is looked for: a run
+/// judges its map by images it was not given, and says which.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum HoldoutSource {
+    /// The run's own held-out systems (`wslap reconstruct --holdout`).
+    HeldOutSystems,
+    /// A cross-validation's held-out images ([`VerdictInputs::crossval_holdout_median_arcsec`]:
+    /// `wslap reconstruct --folds`, the app's Cross-validate).
+    Crossval,
+    /// The chosen settings' held-out images in the "auto" choice's cross-validation
+    /// ([`VerdictInputs::choice_holdout_median_arcsec`]).
+    Choice,
+}
+
 /// `summary.json`'s `verdict`.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct Verdict {
@@ -313,16 +328,10 @@ pub struct Verdict {
     /// Median offset of the fitted systems' observed images from their nearest predicted
     /// images (arcsec).
     pub fit_offset_median_arcsec: Option<f64>,
-    /// The same for the held-out systems, or for a cross-validation's held-out images
-    /// ([`VerdictInputs::crossval_holdout_median_arcsec`]), or else for the chosen settings'
-    /// in an "auto" choice ([`VerdictInputs::choice_holdout_median_arcsec`]).
+    /// The same for held-out images: the first of the [`HoldoutSource`]s that has them.
     pub holdout_offset_median_arcsec: Option<f64>,
-    /// Whether that held-out figure is a cross-validation's.
-    pub holdout_from_crossval: bool,
-    /// Whether it is the chosen settings' in the "auto" choice's cross-validation
-    /// ([`VerdictInputs::choice_holdout_median_arcsec`]).
-    #[serde(default)]
-    pub holdout_from_choice: bool,
+    /// Where that held-out figure comes from (none without one).
+    pub holdout_from: Option<HoldoutSource>,
     /// Systems judged.
     pub systems: usize,
     /// Systems with as many predicted images (shown ones) as observed, with fewer and with
@@ -414,16 +423,18 @@ impl Verdict {
                 sources.iter().filter(|s| s.held_out == held),
             ))
         };
-        let own_holdout = median(true);
-        let holdout_from_crossval =
-            own_holdout.is_none() && inputs.crossval_holdout_median_arcsec.is_some();
-        let before_choice = own_holdout.or(inputs.crossval_holdout_median_arcsec);
-        let holdout_from_choice =
-            before_choice.is_none() && inputs.choice_holdout_median_arcsec.is_some();
-        let (fit, holdout) = (
-            median(false),
-            before_choice.or(inputs.choice_holdout_median_arcsec),
-        );
+        let (holdout, holdout_from) = [
+            (median(true), HoldoutSource::HeldOutSystems),
+            (
+                inputs.crossval_holdout_median_arcsec,
+                HoldoutSource::Crossval,
+            ),
+            (inputs.choice_holdout_median_arcsec, HoldoutSource::Choice),
+        ]
+        .into_iter()
+        .find_map(|(m, from)| Some((Some(m?), Some(from))))
+        .unwrap_or((None, None));
+        let fit = median(false);
         let n = checks.len();
         let count = |f: &dyn Fn(&SystemCheck) -> bool| checks.iter().filter(|c| f(c)).count();
         let fewer = count(&|c| c.predicted < c.observed);
@@ -614,8 +625,7 @@ impl Verdict {
             reasons: reasons.into_iter().take(2).collect::<Vec<_>>().join(" "),
             fit_offset_median_arcsec: fit,
             holdout_offset_median_arcsec: holdout,
-            holdout_from_crossval,
-            holdout_from_choice,
+            holdout_from,
             systems: n,
             systems_matched: n - fewer - more,
             systems_fewer_predicted: fewer,
@@ -1098,6 +1108,11 @@ mod tests {
     #[test]
     fn a_cross_validation_s_held_out_images_count() {
         let two = [fitted("1", &[0.2, 0.3]), fitted("2", &[0.3])];
+        let alone = Verdict::assess(&two, VerdictInputs::default());
+        assert_eq!(
+            (alone.holdout_offset_median_arcsec, alone.holdout_from),
+            (None, None)
+        );
         let after = |m| VerdictInputs {
             crossval_holdout_median_arcsec: Some(m),
             ..VerdictInputs::default()
@@ -1105,7 +1120,7 @@ mod tests {
         let v = Verdict::assess(&two, after(2.0));
         assert_eq!(v.trust, Trust::UsableWithCare);
         assert_eq!(v.holdout_offset_median_arcsec, Some(2.0));
-        assert!(v.holdout_from_crossval);
+        assert_eq!(v.holdout_from, Some(HoldoutSource::Crossval));
         assert!(
             v.reasons
                 .starts_with("Held-out images are predicted 2.0″ off"),
@@ -1128,7 +1143,7 @@ mod tests {
         let v = Verdict::assess(&two, chose(2.0));
         assert_eq!(v.trust, Trust::UsableWithCare);
         assert_eq!(v.holdout_offset_median_arcsec, Some(2.0));
-        assert!(v.holdout_from_choice && !v.holdout_from_crossval);
+        assert_eq!(v.holdout_from, Some(HoldoutSource::Choice));
         let v = Verdict::assess(
             &two,
             VerdictInputs {
@@ -1137,7 +1152,7 @@ mod tests {
             },
         );
         assert_eq!(v.holdout_offset_median_arcsec, Some(0.6));
-        assert!(v.holdout_from_crossval && !v.holdout_from_choice);
+        assert_eq!(v.holdout_from, Some(HoldoutSource::Crossval));
         assert_eq!(v.trust, Trust::Good);
         // The run's own held-out system wins.
         let held = [
@@ -1153,7 +1168,7 @@ mod tests {
             },
         );
         assert_eq!(v.holdout_offset_median_arcsec, Some(0.5));
-        assert!(!v.holdout_from_crossval && !v.holdout_from_choice);
+        assert_eq!(v.holdout_from, Some(HoldoutSource::HeldOutSystems));
         assert_eq!(v.trust, Trust::Good, "{}", v.reasons);
     }
 

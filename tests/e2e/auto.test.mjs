@@ -96,7 +96,7 @@ test('AS1063 gold with the strength "auto": the candidates run in workers and th
     assert.equal(choice.chosen_cells, best.cells);
     // With no system held out and no folds, the verdict's held-out figure is the chosen
     // settings' in the choice's cross-validation, and says so.
-    assert.equal(summary.verdict.holdout_from_choice, true);
+    assert.equal(summary.verdict.holdout_from, 'choice');
     assert.equal(summary.verdict.holdout_offset_median_arcsec, best.holdout_median_arcsec);
     assert.match(await page.textContent('#verdict-facts li'),
       /^Image offsets \(median\): fitted \d+\.\d\d″, held out while choosing the settings \d+\.\d\d″$/);

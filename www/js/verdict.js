@@ -13,10 +13,16 @@ export function worstSystems() {
   return last?.worst ?? [];
 }
 
+// The held-out figure's words by where it comes from (summary.json's `verdict.holdout_from`).
+const HELD_OUT_FROM = {
+  held_out_systems: 'held out',
+  crossval: 'held out in the cross-validation',
+  choice: 'held out while choosing the settings',
+};
+
 /** Text for the numbers behind the verdict, one per line. */
 function facts(v) {
-  const held = v.holdout_from_crossval ? 'held out in the cross-validation'
-    : v.holdout_from_choice ? 'held out while choosing the settings' : 'held out';
+  const held = HELD_OUT_FROM[v.holdout_from] ?? 'held out';
   const out = [`Image offsets (median): fitted ${arcsec(v.fit_offset_median_arcsec)}${
     v.holdout_offset_median_arcsec == null ? '' : `, ${held} ${arcsec(v.holdout_offset_median_arcsec)}`}`];
   const parts = [`${v.systems_matched} as many as observed`];
