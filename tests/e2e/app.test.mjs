@@ -440,6 +440,23 @@ test('the page fits a phone-width screen', async () => {
     const overflow = await page.evaluate(() => document.documentElement.scrollWidth - window.innerWidth);
     assert.ok(overflow <= 0, `page is ${overflow}px wider than the screen`);
     await page.screenshot({ path: join(ARTIFACTS, 'app-phone.png'), fullPage: true });
+    // The systems table is wider than a phone: it scrolls in its own box, whose right edge
+    // is shaded while more columns lie beyond it, and the left edge once scrolled.
+    await page.click('#tab-systems');
+    const box = page.locator('#systems .table-scroll');
+    await box.waitFor();
+    const [scroll, client] = await box.evaluate((el) => [el.scrollWidth, el.clientWidth]);
+    assert.ok(scroll > client, `the table (${scroll}px) fits its box (${client}px)`);
+    assert.match(await box.evaluate((el) => getComputedStyle(el).backgroundAttachment), /^local, local, scroll, scroll$/);
+    // The table's first rows (the whole box is thousands of pixels tall).
+    await box.evaluate((el) => el.scrollIntoView({ block: 'start' }));
+    const top = async (name) => {
+      const at = await box.boundingBox();
+      await page.screenshot({ path: join(ARTIFACTS, name), clip: { ...at, height: 300 } });
+    };
+    await top('app-phone-systems.png');
+    await box.evaluate((el) => { el.scrollLeft = el.scrollWidth; });
+    await top('app-phone-systems-scrolled.png');
   } finally {
     await app.close();
   }
