@@ -771,28 +771,49 @@ function queueFile(role, file) { return enqueue(() => onFile(role, file)); }
 /** Starts over with nothing loaded and the default settings; the status line offers to undo
  * it (the project as it was is kept in memory until the page closes). */
 async function newProject() {
-  const before = lastProject;
+  let before = null;
   await enqueue(async () => {
+    before = lastProject;
     clearError();
     await ask('reset');
     await ask('setName', { name: NEW_PROJECT });
     describe(NEW_PROJECT, 'Nothing loaded yet: add your catalogues under "Files", or pick an example.');
     const loaded = await afterOpen(null);
     await persist();
-    setStatus(`${readyText(loaded)} `);
+    setStatus(readyText(loaded));
   });
+  offerUndo(before, 'undo-new-project', 'Undo New project');
+}
+
+/** Opens the example `ex` from the menu. When it replaces one's own project (not an example,
+ * which the menu gives back, nor an empty new project), the status line offers to go back to
+ * it: its files, settings and result are kept in memory until the page closes. */
+async function pickExample(ex) {
+  let before = null;
+  let name = '';
+  await enqueue(async () => {
+    name = $('project-name').textContent;
+    if (!openExample() && name !== NEW_PROJECT) before = lastProject;
+    await loadExample(ex);
+  });
+  offerUndo(before, 'undo-example', `Undo: back to "${name}"`);
+}
+
+/** Appends to the status line a button `id` that reopens `before` (a project.json), unless
+ * there was none. */
+function offerUndo(before, id, label) {
   if (!before) return;
   const undo = document.createElement('button');
   undo.type = 'button';
-  undo.id = 'undo-new-project';
+  undo.id = id;
   undo.className = 'link';
-  undo.textContent = 'Undo New project';
+  undo.textContent = label;
   undo.addEventListener('click', () => enqueue(async () => {
     const report = await openProject(before, 'the previous project');
     await persist();
     setStatus(`Back to the project as it was${report.message ? `: ${report.message}` : ''}.`);
   }));
-  $('status').append(undo);
+  $('status').append(' ', undo);
 }
 
 /** The verdict's offer: the member catalogue's commented-out rows `[{line, id}]` (the BCGs a
@@ -911,10 +932,7 @@ async function start() {
     showError(`could not read the examples: ${err.message}`);
   }
   fillExampleMenu();
-  $('example-select').addEventListener('change', () => {
-    const ex = examples[$('example-select').value];
-    enqueue(() => loadExample(ex));
-  });
+  $('example-select').addEventListener('change', () => pickExample(examples[$('example-select').value]));
   const { version, simd } = await client.ready;
   setStatus(`Worker ready (wslap ${version}).`);
   $('core-info').textContent = `Core: wslap ${version}, WebAssembly with ${

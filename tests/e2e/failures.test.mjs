@@ -1,11 +1,11 @@
 // End-to-end: the app's own failures found by using it as a new user would (issue #25): a
 // rejected file says which file is still in use, where the user looks and in the caption; a
 // result, clicked point and status never outlive the data they belong to; New project starts
-// over and can be undone.
+// over and can be undone, as can an example picked over your own files.
 import { test } from 'node:test';
 import assert from 'node:assert/strict';
 import { join } from 'node:path';
-import { openApp, runToMap, setField, waitStatus, ROOT, ARTIFACTS } from './browser.mjs';
+import { openApp, phoneShot, runToMap, setField, waitStatus, ROOT, ARTIFACTS } from './browser.mjs';
 
 const MEMBERS = join(ROOT, 'www', 'examples', 'a1689-sim', 'members.cat');
 
@@ -143,6 +143,42 @@ test('New project starts over and can be undone', async () => {
     assert.equal(await page.textContent('#project-name'), 'Teaching example: one halo, four sources');
     assert.match(await page.textContent('#status-images'), /images\.cat/);
     assert.ok(await page.isEnabled('#reconstruct'));
+    assert.deepEqual(app.consoleErrors, []);
+  } finally {
+    await app.close();
+  }
+});
+
+test('an example picked over your own files can be undone', async () => {
+  const app = await openApp();
+  try {
+    const { page } = app;
+    await waitStatus(page, /^Ready/);
+    await page.click('#new-project');
+    await waitStatus(page, /^Load an image catalogue or arcs/);
+    await page.setInputFiles('#file-images', join(ROOT, 'www', 'examples', 'teaching', 'images.cat'));
+    await waitStatus(page, /^Ready: press Reconstruct\.$/);
+    await setField(page, '#set-reconstruct-solver-iterations', 321);
+    assert.equal(await page.textContent('#project-name'), 'Your data');
+    // An example chosen from the menu replaces the files and settings; the status line offers
+    // the way back.
+    await page.selectOption('#example-select', { label: 'Teaching example: one halo, four sources' });
+    await page.waitForFunction(() => /Teaching/.test(document.getElementById('project-name').textContent));
+    await page.waitForSelector('#undo-example');
+    assert.match(await page.textContent('#status'), /^Ready: press Reconstruct\. Undo: back to "Your data"$/);
+    await page.evaluate(() => window.scrollTo(0, 0));
+    await page.screenshot({ path: join(ARTIFACTS, 'undo-example.png') });
+    await phoneShot(page, page.locator('#status'), 'undo-example-phone.png');
+    await page.setViewportSize({ width: 1280, height: 900 });
+    await page.click('#undo-example');
+    await waitStatus(page, /^Back to the project as it was/);
+    assert.equal(await page.textContent('#project-name'), 'Your data');
+    assert.match(await page.textContent('#status-images'), /images\.cat/);
+    assert.equal(await page.inputValue('#set-reconstruct-solver-iterations'), '321');
+    // Kept as the session: a reload opens one's own data again.
+    await page.reload();
+    await waitStatus(page, /^Restored your project/);
+    assert.equal(await page.textContent('#project-name'), 'Your data');
     assert.deepEqual(app.consoleErrors, []);
   } finally {
     await app.close();
