@@ -313,7 +313,20 @@ async function showResult(info) {
   locateExamples(await app.pointReadout([0, 0]).catch(() => null));
 }
 
+// A job that runs (its status words) is noted in the tab's sessionStorage until it ends: a
+// reload stops it, and the page that opens next says so (`sayInterrupted`).
+const RUNNING_KEY = 'wslap.running';
+const RUNNING_WORDS = {
+  'Reconstructing…': 'a reconstruction',
+  'Computing…': 'a computation',
+  'Cross-validating…': 'a cross-validation',
+};
+
 function showProgress(on) {
+  try {
+    if (on) sessionStorage.setItem(RUNNING_KEY, $('status').textContent);
+    else sessionStorage.removeItem(RUNNING_KEY);
+  } catch { /* storage refused: nothing to say after a reload */ }
   $('progress-box').hidden = !on;
   $('cancel').hidden = !on;
   for (const id of ['reconstruct', 'forward', 'lookup', 'crossval']) $(id).disabled = on || $(id).disabled;
@@ -332,10 +345,10 @@ function progressAt(elapsedMs, k, total, words) {
  * `position(p)` gives a progress report's `[done, total]` iterations and its words. */
 async function inWorker(status, job, position, done) {
   clearError();
+  setStatus(status);
   showProgress(true);
   $('progress').value = 0;
   $('progress-text').textContent = 'Building the linear system…';
-  setStatus(status);
   try {
     const answer = await job((p) => progressAt(p.elapsed_ms, ...position(p)));
     await done(answer);
@@ -953,13 +966,27 @@ async function start() {
     const link = linked ? ` (the link's example, "${linked.name}", is in the Example menu)` : '';
     setStatus(restored === 'current' ? `Restored your project from this browser${link}.`
       : `Restored the copy of your project saved before the last one, which did not open (it is kept, see below)${link}.`);
+    sayInterrupted();
     unknown();
     return;
   }
   const first = linked ?? examples[0];
   if (first) await loadExample(first);
   if (!$('set-aside').hidden) setStatus(`Your saved project did not open; it is kept (see below). Opened the example "${first?.name}".`);
+  sayInterrupted();
   unknown();
+}
+
+/** After a reload that stopped a job (`RUNNING_KEY`), adds to the status line what stopped. */
+function sayInterrupted() {
+  let words = null;
+  try {
+    words = sessionStorage.getItem(RUNNING_KEY);
+    sessionStorage.removeItem(RUNNING_KEY);
+  } catch { return; }
+  if (words == null) return;
+  const what = RUNNING_WORDS[words] ?? 'a run';
+  setStatus(`${$('status').textContent} The page was reloaded during ${what}, which stopped unfinished: start it again when you like.`);
 }
 
 /** Opens the project kept in this browser: its last copy, else the one saved before it. A copy

@@ -5,7 +5,7 @@
 import { test } from 'node:test';
 import assert from 'node:assert/strict';
 import { readFile } from 'node:fs/promises';
-import { idb, openApp, runToMap, savedProject, setField, waitStatus } from './browser.mjs';
+import { idb, openApp, phoneShot, runToMap, savedProject, setField, waitStatus } from './browser.mjs';
 
 /** The project text the app saved, once it matches `pattern`. */
 async function savedText(page, pattern = /wslap-project/) {
@@ -88,6 +88,33 @@ test('a last copy that does not open falls back to the one before; a cut save ne
     assert.match(await page.textContent('#project-name'), /Teaching/);
     assert.equal(await page.locator('.set-aside-entry').count(), 1);
     assert.match(await page.textContent('.set-aside-entry p'), /images\.cat: line 1/);
+    assert.deepEqual(app.consoleErrors, []);
+  } finally {
+    await app.close();
+  }
+});
+
+test('a reload during a run says the run stopped, once', async () => {
+  const app = await openApp();
+  try {
+    const { page } = app;
+    await waitStatus(page, /^Ready/);
+    await page.selectOption('#example-select', { label: 'Teaching example: one halo, four sources' });
+    await page.waitForFunction(() => /Teaching/.test(document.getElementById('project-name').textContent));
+    await waitStatus(page, /^Ready: press Reconstruct\.$/);
+    await setField(page, '#set-reconstruct-solver-iterations', 1000000);
+    await page.click('#reconstruct');
+    await page.waitForSelector('#progress-box:not([hidden])');
+    await page.reload();
+    await waitStatus(page, /^Restored your project from this browser\. The page was reloaded during a reconstruction, which stopped unfinished: start it again when you like\.$/);
+    assert.ok(await page.isEnabled('#reconstruct'));
+    assert.ok(await page.isHidden('#progress-box'));
+    assert.equal(await page.inputValue('#set-reconstruct-solver-iterations'), '1000000');
+    await page.screenshot({ path: 'test-artifacts/app-reload-mid-run.png' });
+    await phoneShot(page, page.locator('#status'), 'app-reload-mid-run-phone.png');
+    // Said once: the next reload has nothing to say about it.
+    await page.reload();
+    await waitStatus(page, /^Restored your project from this browser\.$/);
     assert.deepEqual(app.consoleErrors, []);
   } finally {
     await app.close();
