@@ -571,7 +571,8 @@ async function afterOpen(report) {
   const reports = new Map((report?.files ?? []).map((r) => [r.role, r]));
   for (const { role } of ROLES) {
     const r = reports.get(role);
-    setFileStatus(role, r && r.name === loaded[role] ? reportText(r) : loaded[role] ? `${loaded[role]}: loaded` : '');
+    if (r && r.name === loaded[role]) showFileReport(role, r);
+    else setFileStatus(role, loaded[role] ? `${loaded[role]}: loaded` : '');
   }
   rejected.clear();
   waitingForPar.clear();
@@ -680,11 +681,22 @@ async function leaveExample(ex, role) {
   $('z-curves').value = settings.reconstruct.products.z_source;
 }
 
-/** The status line of a loaded file: its LoadReport's summary and warnings. */
+// A file's warnings quoted in its line (and the status line); the rest are listed under a
+// "more" toggle beside the file, so that a file with hundreds does not make a page of them.
+const INLINE_WARNINGS = 3;
+
+/** The status line of a loaded file: its LoadReport's summary and its first warnings. */
 function reportText(report) {
   const n = report.warnings.length;
-  const warn = n ? ` (${n} warning${n === 1 ? '' : 's'}: ${report.warnings.join('; ')})` : '';
+  const rest = n - INLINE_WARNINGS;
+  const quoted = report.warnings.slice(0, INLINE_WARNINGS).join('; ');
+  const warn = n ? ` (${n} warning${n === 1 ? '' : 's'}: ${quoted}${rest > 0 ? `; ${rest} more listed below` : ''})` : '';
   return `${report.name}: ${report.summary}${warn}`;
+}
+
+/** Shows a loaded file's report beside it: `reportText`, then its other warnings folded. */
+function showFileReport(role, report) {
+  setFileStatus(role, reportText(report), false, report.warnings.slice(INLINE_WARNINGS));
 }
 
 async function onFile(role, file) {
@@ -704,7 +716,7 @@ async function onFile(role, file) {
     } else {
       report = await ask('loadText', { role, name: file.name, text: await file.text() });
     }
-    setFileStatus(role, reportText(report));
+    showFileReport(role, report);
     clearCrossval();
     if (example) {
       await leaveExample(example, role);
@@ -836,7 +848,7 @@ async function fitCommentedRows(rows) {
   const ids = rows.map((r) => r.id).join(', ');
   await changeThenReconstruct(`Member${rows.length > 1 ? 's' : ''} ${ids} ${rows.length > 1 ? 'were' : 'was'} not fitted`, async () => {
     const report = await ask('uncommentMembers', { lines: rows.map((r) => r.line) });
-    setFileStatus('members', reportText(report));
+    showFileReport('members', report);
     clearCrossval();
     await refreshLoaded();
     await persist();
@@ -875,14 +887,14 @@ async function applySetting(path, value) {
   // A DS9 region file's arc pixels follow the constraint pixel: say how many there are now.
   if (path === 'reconstruct.constraints.pixel_arcsec') {
     const report = await ask('reload', { role: 'arcs' });
-    if (report) setFileStatus('arcs', reportText(report));
+    if (report) showFileReport('arcs', report);
   }
   // A Lenstool model is read again with the single-plane setting (its warnings name the
   // blocks moved; turned off, a multi-plane model is refused and says so).
   if (path === 'lenstool_single_plane') {
     try {
       const report = await ask('reload', { role: 'model' });
-      if (report) setFileStatus('model', reportText(report));
+      if (report) showFileReport('model', report);
     } catch (err) {
       setFileStatus('model', err.message);
     }

@@ -1,9 +1,11 @@
 // End-to-end: the app's own failures found by using it as a new user would (issue #25): a
 // rejected file says which file is still in use, where the user looks and in the caption; a
 // result, clicked point and status never outlive the data they belong to; New project starts
-// over and can be undone, as can an example picked over your own files.
+// over and can be undone, as can an example picked over your own files; a file with many
+// warnings quotes a few and folds the rest.
 import { test } from 'node:test';
 import assert from 'node:assert/strict';
+import { readFile } from 'node:fs/promises';
 import { join } from 'node:path';
 import { openApp, phoneShot, runToMap, setField, waitStatus, ROOT, ARTIFACTS } from './browser.mjs';
 
@@ -179,6 +181,40 @@ test('an example picked over your own files can be undone', async () => {
     await page.reload();
     await waitStatus(page, /^Restored your project/);
     assert.equal(await page.textContent('#project-name'), 'Your data');
+    assert.deepEqual(app.consoleErrors, []);
+  } finally {
+    await app.close();
+  }
+});
+
+test('a file with many warnings quotes three and folds the rest beside it', async () => {
+  const app = await openApp();
+  try {
+    const { page } = app;
+    await waitStatus(page, /^Ready/);
+    await teaching(page);
+    // Seven rows written twice: seven warnings, each naming its line.
+    const text = await readFile(MEMBERS, 'utf8');
+    const rows = text.split('\n').filter((l) => /^\d/.test(l)).slice(0, 7);
+    await page.setInputFiles('#file-members', { name: 'twice.cat', mimeType: 'text/plain', buffer: Buffer.from(`${text.trimEnd()}\n${rows.join('\n')}\n`) });
+    await page.waitForSelector('#status-members .more-warnings');
+    const line = await page.evaluate(() => document.getElementById('status-members').firstChild.textContent);
+    assert.match(line, /^twice\.cat: 101 members \(7 warnings: (twice\.cat: line \d+: member '\d+' repeats line \d+ exactly.*?; ){3}4 more listed below\)$/);
+    assert.equal(await page.textContent('#status-members .more-warnings summary'), '4 more warnings');
+    assert.ok(await page.isHidden('#status-members .more-warnings li >> nth=0'));
+    await page.click('#status-members .more-warnings summary');
+    const more = await page.locator('#status-members .more-warnings li').allTextContents();
+    assert.equal(more.length, 4);
+    assert.ok(more.every((w) => /^twice\.cat: line \d+: member '\d+' repeats line \d+ exactly/.test(w)), more.join(' | '));
+    await page.locator('#status-members').scrollIntoViewIfNeeded();
+    await page.screenshot({ path: join(ARTIFACTS, 'file-more-warnings.png') });
+    await phoneShot(page, page.locator('#status-members'), 'file-more-warnings-phone.png');
+    // A reload shows the same line and list (the project keeps each file's report).
+    await page.setViewportSize({ width: 1280, height: 900 });
+    await page.reload();
+    await waitStatus(page, /^Restored your project/);
+    assert.equal(await page.evaluate(() => document.getElementById('status-members').firstChild.textContent), line);
+    assert.equal(await page.locator('#status-members .more-warnings li').count(), 4);
     assert.deepEqual(app.consoleErrors, []);
   } finally {
     await app.close();

@@ -52,7 +52,7 @@ export function buildFileRows(container, dropZone, onFile) {
     row.className = 'field file-row';
     row.innerHTML = `<label for="file-${role}">${label}</label>
       <input id="file-${role}" type="file" accept="${accept}">
-      <p id="status-${role}" class="file-status" role="status"></p>`;
+      <div id="status-${role}" class="file-status" role="status"></div>`;
     container.append(row);
     const input = row.querySelector('input');
     input.addEventListener('change', () => {
@@ -94,10 +94,24 @@ export function buildFileRows(container, dropZone, onFile) {
   });
 }
 
-/** Shows `text` next to the file of `role` (`bad` for an error). */
-export function setFileStatus(role, text, bad = false) {
+/** Shows `text` next to the file of `role` (`bad` for an error), and under it the warnings
+ * `more` in a list that opens on a click. */
+export function setFileStatus(role, text, bad = false, more = []) {
   const el = document.getElementById(`status-${role}`);
   if (!el) return;
   el.textContent = text;
   el.classList.toggle('bad', bad);
+  if (!more.length) return;
+  const box = document.createElement('details');
+  box.className = 'more-warnings';
+  const summary = document.createElement('summary');
+  summary.textContent = `${more.length} more warning${more.length === 1 ? '' : 's'}`;
+  const list = document.createElement('ul');
+  for (const w of more) {
+    const item = document.createElement('li');
+    item.textContent = w;
+    list.append(item);
+  }
+  box.append(summary, list);
+  el.append(box);
 }
