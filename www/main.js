@@ -4,7 +4,7 @@
 import { LensClient } from './lens-client.js';
 import { loadProject, loadPrevious, saveProject, hasSaved, setAside, setAsideList, deleteSetAside } from './js/store.js';
 import { buildFileRows, setFileStatus, ROLES } from './js/files.js';
-import { buildSettings, showSettings, fieldMessage } from './js/settings.js';
+import { buildSettings, showSettings, showChoiceNote, fieldMessage } from './js/settings.js';
 import { wireViews, showPng, showSystems, showCrossval, showStrengthChoice, viewOptions, currentView, refreshReadout, clearPin, pinAt } from './js/views.js';
 import { showDownloads, save } from './js/downloads.js';
 import { wireFigureDownload } from './js/figure-download.js';
@@ -140,6 +140,7 @@ function showNoResult() {
   locateExamples(null);
   runNotes(null);
   showStrengthChoice(null);
+  showChoiceNote(null);
   showIterates(null);
   showEnsemble(null, app);
   clearPin();
@@ -305,6 +306,7 @@ async function showResult(info) {
   showStrengthChoice(info.summary?.strength_choice,
     (info.summary?.free_redshifts?.systems ?? []).map(([id]) => id),
     info.summary?.settings?.grid?.external_shear_sigma != null);
+  showChoiceNote(info.summary?.strength_choice);
   showDownloads(info.kind, app);
   showIterates(info.kind === 'reconstruct' ? (await ask('iterates')).iterates : null);
   showEnsemble(info.summary?.ensemble_members ? await ask('ensembleInfo') : null, app);

@@ -104,10 +104,23 @@ test('AS1063 gold with the strength "auto": the candidates run in workers and th
     assert.ok(summary.maps.tangential_main_area_share > 0.8,
       `main tangential curve holds ${summary.maps.tangential_main_area_share} of the area`);
     await page.click('#downloads-panel summary');
+    // The settings keep the regulariser and grid as set; a note under the strength says what
+    // the choice used.
+    const note = page.locator('#settings-form .chosen-note');
+    assert.equal(await note.count(), 1);
+    const kindLabel = choice.chosen_regulariser === 'density' ? 'least concentrated'
+      : choice.chosen_regulariser === 'curvature' ? 'least curved' : 'smoothest mass';
+    assert.equal(await note.textContent(), `The last run's choice: ${kindLabel} (${choice.chosen_regulariser}), strength ${
+      choice.chosen}, ${choice.chosen_cells} × ${choice.chosen_cells} cells (the table under the map). The regulariser and grid fields keep the settings as set: "auto" starts from them again.`);
+    await page.$eval('#set-reconstruct-objective-strength', (el) => { el.closest('details').open = true; });
+    const field = page.locator('#set-reconstruct-objective-strength').locator('xpath=..');
+    await field.scrollIntoViewIfNeeded();
+    await field.screenshot({ path: join(ARTIFACTS, 'app-auto-choice-note.png') });
 
     await page.locator('#strength-box').scrollIntoViewIfNeeded();
     await page.screenshot({ path: join(ARTIFACTS, 'app-auto-result.png'), fullPage: true });
     await phoneShot(page, page.locator('#strength-box'), 'app-auto-result-phone.png');
+    await field.screenshot({ path: join(ARTIFACTS, 'app-auto-choice-note-phone.png') });
     assert.deepEqual(app.consoleErrors, []);
     console.log(`AS1063 gold, auto, ${candidates} candidates in ${workers} pool workers: ${seconds.toFixed(1)} s`);
   } finally {

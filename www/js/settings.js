@@ -193,3 +193,28 @@ export function showSettings(settings, { force = false } = {}) {
   }
   refresh(settings);
 }
+
+/** Under the regulariser's strength, what the last run's "auto" choice used (`choice`:
+ * summary.json's `strength_choice`), since the fields above keep the settings as set; nothing
+ * without one. */
+export function showChoiceNote(choice) {
+  const input = document.getElementById(id('reconstruct.objective.strength'));
+  if (!input) return;
+  const row = input.closest('.field');
+  let note = row.querySelector('.chosen-note');
+  if (!choice) {
+    note?.remove();
+    return;
+  }
+  if (!note) {
+    note = document.createElement('small');
+    note.className = 'hint chosen-note';
+    row.querySelector('.field-error').before(note);
+  }
+  const kinds = FIELDS.find((f) => f.path === 'reconstruct.objective.regulariser').options;
+  const kind = kinds.find(([k]) => k === choice.chosen_regulariser)?.[1];
+  const parts = [kind ? `${kind} (${choice.chosen_regulariser})` : null, `strength ${choice.chosen}`,
+    choice.chosen_cells != null ? `${choice.chosen_cells} × ${choice.chosen_cells} cells` : null];
+  note.textContent = `The last run's choice: ${parts.filter(Boolean).join(', ')} (the table under the map). `
+    + 'The regulariser and grid fields keep the settings as set: "auto" starts from them again.';
+}
