@@ -910,6 +910,62 @@ fn refused(dir: &Path, command: &str, args: &[&str]) -> String {
     String::from_utf8_lossy(&out.stderr).into_owned()
 }
 
+/// A negative value is the option's value, refused by the option's name (clap read `-70` as an
+/// unknown flag); a lens behind the maps' source redshift names --z-lens; an option `maps`
+/// would not use is refused, not ignored.
+#[test]
+fn negative_values_and_unused_options_name_the_option() {
+    let dir = temp_dir("negative");
+    let images = teaching_images(&dir);
+    let reconstruct = |extra: &[&str]| {
+        let mut args = vec!["--images", images.to_str().unwrap()];
+        args.extend(extra);
+        refused(&dir, "reconstruct", &args)
+    };
+    for (extra, expected) in [
+        (
+            &["--z-lens", "0.3", "--h0", "-70"][..],
+            "error: --h0: cosmology.h0 = -70 is not allowed",
+        ),
+        (
+            &["--z-lens", "0.3", "--omega-m", "-0.3"],
+            "error: --omega-m: cosmology.omega_m = -0.3 is not allowed",
+        ),
+        (
+            &["--z-lens", "-0.3"],
+            "error: --z-lens: cosmology.z_lens = -0.3 is not allowed",
+        ),
+        (
+            &["--z-lens", "0.3", "--default-z", "-2"],
+            "error: --default-z: constraints.default_z = -2 is not allowed",
+        ),
+        (
+            &["--z-lens", "0.3", "--z-prior", "-1", "8"],
+            "error: --z-prior: constraints.free_z_prior[0] = -1 is not allowed",
+        ),
+        (
+            &["--z-lens", "3"],
+            "error: --z-lens 3: the default settings: products.z_source = 2 is not allowed",
+        ),
+    ] {
+        let err = reconstruct(extra);
+        assert!(err.starts_with(expected), "{extra:?}: {err}");
+    }
+    let model = dir.join("model.json");
+    fs::write(&model, CLUSTER_MODEL_JSON).unwrap();
+    for flag in ["--z-lens", "--h0", "--omega-m"] {
+        let err = refused(
+            &dir,
+            "maps",
+            &["--model", model.to_str().unwrap(), flag, "1"],
+        );
+        assert!(
+            err.starts_with(&format!("error: {flag} is for --deflection maps only")),
+            "{err}"
+        );
+    }
+}
+
 #[test]
 fn config_errors_say_file_line_and_column_once() {
     let dir = temp_dir("config-once");

@@ -51,11 +51,11 @@ pub struct ImagesArgs {
     #[arg(long, num_args = 2, value_names = ["RA", "DEC"], allow_negative_numbers = true)]
     source_radec: Option<Vec<String>>,
     /// Source redshift.
-    #[arg(long)]
+    #[arg(long, allow_negative_numbers = true)]
     z_source: f64,
     /// Width in arcsec of the square searched for images, centred on (0, 0) (model files and
     /// Lenstool models; --maps searches the maps' own field).
-    #[arg(long, default_value_t = 200.0)]
+    #[arg(long, allow_negative_numbers = true, default_value_t = 200.0)]
     size: f64,
 }
 

@@ -39,7 +39,7 @@ pub struct LookupArgs {
     #[arg(long, value_name = "FILE")]
     positions: Option<PathBuf>,
     /// Source redshift.
-    #[arg(long)]
+    #[arg(long, allow_negative_numbers = true)]
     z_source: f64,
     /// Lens redshift (default: the maps' ZLENS card).
     #[arg(long, allow_negative_numbers = true)]

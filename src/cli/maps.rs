@@ -49,12 +49,12 @@ pub struct MapsArgs {
     /// Lens redshift (with --deflection, default the maps' ZLENS card; a model file has its own).
     #[arg(long, allow_negative_numbers = true)]
     z_lens: Option<f64>,
-    /// H0 in km/s/Mpc (with --deflection).
-    #[arg(long, default_value_t = 70.0)]
-    h0: f64,
-    /// Omega_m of flat LCDM (with --deflection).
-    #[arg(long, default_value_t = 0.3)]
-    omega_m: f64,
+    /// H0 in km/s/Mpc (with --deflection; default 70).
+    #[arg(long, allow_negative_numbers = true)]
+    h0: Option<f64>,
+    /// Omega_m of flat LCDM (with --deflection; default 0.3).
+    #[arg(long, allow_negative_numbers = true)]
+    omega_m: Option<f64>,
     /// Output folder (created if missing).
     #[arg(long, value_name = "DIR")]
     out: PathBuf,
@@ -89,6 +89,21 @@ impl From<Scale> for ColorScale {
 
 pub fn run(args: &MapsArgs) -> Result<(), String> {
     super::input::check_out_dir(&args.out)?;
+    // A model file and a .par carry their own distances: an option that would not be used is
+    // refused, not ignored.
+    if args.deflection.is_none() {
+        let given = [
+            ("--z-lens", args.z_lens.is_some()),
+            ("--h0", args.h0.is_some()),
+            ("--omega-m", args.omega_m.is_some()),
+        ];
+        if let Some((flag, _)) = given.iter().find(|(_, set)| *set) {
+            return Err(format!(
+                "{flag} is for --deflection maps only: a model file or a .par gives its own \
+                 lens redshift and cosmology"
+            ));
+        }
+    }
     let opts = ProductOptions {
         z_source: args.z_source,
         size_arcsec: args.size,
@@ -127,7 +142,8 @@ pub fn run(args: &MapsArgs) -> Result<(), String> {
                 .2?
                 .ok_or("--deflection needs --z-lens (the maps have no ZLENS card)")?,
         };
-        let cosmology = Cosmology::new(args.h0, args.omega_m).map_err(|e| e.to_string())?;
+        let cosmology = Cosmology::new(args.h0.unwrap_or(70.0), args.omega_m.unwrap_or(0.3))
+            .map_err(|e| e.to_string())?;
         let plane = LensPlane::new(cosmology, z_lens).map_err(|e| match args.z_lens {
             Some(_) => e.to_string(),
             None => format!("{}: its ZLENS card: {e}", paths[0].display()),

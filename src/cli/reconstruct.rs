@@ -8,9 +8,9 @@ use serde::Serialize;
 use wslap::{
     check_ensemble_size, check_memory, cross_validate, export_system, fold_groups,
     holdable_sources, image_regions, parse_par_with, reconstruct, run_ensemble, ColorScale,
-    Control, ConvergenceRecord, Cosmology, CrossValidation, Dataset, InputKind, InputText,
-    InputTexts, Inputs, LensPlane, LenstoolPar, ParOptions, ReconstructConfig, ReconstructError,
-    Reconstruction, SolverMethod,
+    Control, ConvergenceRecord, Cosmology, CosmologyError, CrossValidation, Dataset, InputKind,
+    InputText, InputTexts, Inputs, LensPlane, LenstoolPar, ParOptions, ReconstructConfig,
+    ReconstructError, Reconstruction, SolverMethod,
 };
 
 use super::input::read_text;
@@ -65,7 +65,12 @@ pub struct ReconstructArgs {
     shear: Option<PathBuf>,
     /// Shape noise of the arclets: the scatter of each ellipticity component (default 0.3;
     /// overrides shear.shape_noise of the configuration).
-    #[arg(long, value_name = "SIGMA", requires = "shear")]
+    #[arg(
+        long,
+        value_name = "SIGMA",
+        requires = "shear",
+        allow_negative_numbers = true
+    )]
     shape_noise: Option<f64>,
     /// Lens redshift.
     #[arg(long, allow_negative_numbers = true)]
@@ -79,7 +84,7 @@ pub struct ReconstructArgs {
     holdout: Vec<String>,
     /// Redshift for systems whose catalogue redshift is 0 (unknown); without it their redshift
     /// is estimated (see --free-z).
-    #[arg(long)]
+    #[arg(long, allow_negative_numbers = true)]
     default_z: Option<f64>,
     /// Systems whose redshift is estimated although the catalogue gives one, e.g. 3,7 (systems
     /// with z = 0 are estimated anyway). Each is left out of a first fit, its redshift found on
@@ -87,16 +92,22 @@ pub struct ReconstructArgs {
     #[arg(long, value_delimiter = ',', value_name = "IDS")]
     free_z: Vec<String>,
     /// The range an estimated redshift lies in, LOW,HIGH (default 0.5,8).
-    #[arg(long, value_delimiter = ',', num_args = 1..=2, value_name = "LOW,HIGH")]
+    #[arg(
+        long,
+        value_delimiter = ',',
+        num_args = 1..=2,
+        value_name = "LOW,HIGH",
+        allow_negative_numbers = true
+    )]
     z_prior: Option<Vec<f64>>,
     /// QADP iterations (overrides the configuration).
     #[arg(long)]
     iterations: Option<usize>,
     /// H0 in km/s/Mpc.
-    #[arg(long, default_value_t = 70.0)]
+    #[arg(long, allow_negative_numbers = true, default_value_t = 70.0)]
     h0: f64,
     /// Omega_m of flat LCDM.
-    #[arg(long, default_value_t = 0.3)]
+    #[arg(long, allow_negative_numbers = true, default_value_t = 0.3)]
     omega_m: f64,
     /// Also cross-validate (default 5 folds): reconstruct K more times, each time holding out
     /// one group of the fitted systems (every K-th in catalogue order) and predicting its
@@ -193,8 +204,20 @@ pub fn run(args: &ReconstructArgs) -> Result<(), String> {
             false => option("--default-z", &e),
         }
     })?;
-    let cosmology = Cosmology::new(args.h0, args.omega_m).map_err(|e| e.to_string())?;
-    let plane = LensPlane::new(cosmology, args.z_lens).map_err(|e| e.to_string())?;
+    // A value refused by the distances is named by the option that gave it.
+    let by_flag = |e: CosmologyError| match &e {
+        CosmologyError::BadFieldValue(bad) => option(
+            match bad.field.as_str() {
+                "cosmology.h0" => "--h0",
+                "cosmology.omega_m" => "--omega-m",
+                _ => "--z-lens",
+            },
+            &e,
+        ),
+        CosmologyError::SourceNotBehindLens { .. } => option("--z-lens", &e),
+    };
+    let cosmology = Cosmology::new(args.h0, args.omega_m).map_err(by_flag)?;
+    let plane = LensPlane::new(cosmology, args.z_lens).map_err(by_flag)?;
     // Known before any data is read: a source in front of the lens is refused at once.
     if let Err(e) = config.check_behind_lens(args.z_lens) {
         return Err(
@@ -202,6 +225,10 @@ pub fn run(args: &ReconstructArgs) -> Result<(), String> {
                 option("--default-z", &e)
             } else if e.field.starts_with("constraints.free_z_prior") && args.z_prior.is_some() {
                 option("--z-prior", &e)
+            } else if args.config.is_none() {
+                // The lens put behind a redshift the default settings use (the maps' z_s = 2):
+                // the option is what to change.
+                format!("--z-lens {}: {settings_name}: {e}", args.z_lens)
             } else {
                 format!("{settings_name}: {e}")
             },

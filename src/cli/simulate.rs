@@ -18,7 +18,7 @@ pub struct SimulateArgs {
     #[arg(long, default_value_t = 1)]
     seed: u64,
     /// Pixel of the ray-traced image in arcsec (0.2 to 1).
-    #[arg(long, default_value_t = 0.5)]
+    #[arg(long, allow_negative_numbers = true, default_value_t = 0.5)]
     pixel: f64,
     /// Output folder (created if missing).
     #[arg(long, value_name = "DIR")]
