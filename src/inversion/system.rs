@@ -509,8 +509,27 @@ impl LinearSystem {
                 true => ", external shear",
                 false => "",
             };
+            // The rows as `new` and `add_layer_prior` count them: the images' (or arc
+            // pixels'), the arclets' and one per layer prior (C's, the external shear's).
+            let images = 2 * self.constraints.pixels.len();
+            let priors = self
+                .layers
+                .iter()
+                .filter(|l| l.prior_sigma.is_some())
+                .count();
+            let arclets = rows.saturating_sub(images + priors);
+            let mut counted = vec![format!("{images} from the images or arc pixels, two each")];
+            if arclets > 0 {
+                counted.push(format!("{arclets} from the arclets"));
+            }
+            if priors > 0 {
+                counted.push(format!(
+                    "{priors} from the priors on the member factors and the external shear"
+                ));
+            }
+            let counted = counted.join(", ");
             return vec![format!(
-                "{rows} constraint rows (two per image or arc pixel) for {unknowns} unknowns \
+                "{rows} constraint rows ({counted}) for {unknowns} unknowns \
                  (cell masses, member factors{shear}, source positions): the data cannot fix the mass \
                  map on their own; {chooser}{members}. Arc pixels or ellipses, or a coarser \
                  grid, give the data more say"

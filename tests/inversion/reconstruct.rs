@@ -300,6 +300,26 @@ fn a_system_with_fewer_rows_than_unknowns_is_flagged() {
     let points = run(&config, ConstraintSource::Catalog(&catalog));
     assert!(points.system.n_rows < points.system.n_columns());
     assert!(flagged(&points), "{:?}", points.warnings);
+    // The rows it counts are the images' two each and one per prior (C's, the shear's).
+    let images = 2 * catalog.images().count();
+    let priors = points
+        .system
+        .layers
+        .iter()
+        .filter(|l| l.prior_sigma.is_some())
+        .count();
+    assert!(priors > 0, "the default holds an unmeasured C with a prior");
+    let counted = format!(
+        "{} constraint rows ({images} from the images or arc pixels, two each, {priors} from \
+         the priors",
+        images + priors
+    );
+    assert_eq!(points.system.n_rows, images + priors);
+    assert!(
+        points.warnings.iter().any(|w| w.starts_with(&counted)),
+        "{counted}: {:?}",
+        points.warnings
+    );
     // About the ridge of the computation (1e-10): none.
     let share = |r: &wslap::Reconstruction| r.system.layer_independence()[0].unwrap();
     assert!(share(&points) < 1e-8, "{}", share(&points));
