@@ -141,8 +141,10 @@ pub struct ReconstructArgs {
 ///
 /// The output is a complete CONFIG.json: save it, change what you need and pass it back with
 /// `--config` (fields left out keep these defaults; `null` means "not set", e.g. an automatic
-/// field width or no prior on C). What each field means and its allowed range: README.md and the
-/// `summary.json` of a run, which repeats the settings used.
+/// field width or no prior on C). What each field means and its allowed range: README.md. A
+/// run's `summary.json` repeats these settings as given (`settings`); with the strength "auto",
+/// what the choice used is in `strength_choice` (`chosen`, `chosen_regulariser`,
+/// `chosen_cells`).
 #[derive(Debug, Args)]
 pub struct ConfigArgs {}
 
