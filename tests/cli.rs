@@ -762,6 +762,19 @@ fn reconstruct_folds_writes_crossval_json() {
         stdout.contains("the folds' kappa spread: median"),
         "{stdout}"
     );
+    // The choice and the folds say they run (they are silent for minutes otherwise).
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        stderr.starts_with("choosing the regulariser, its strength and the grid: "),
+        "{stderr}"
+    );
+    assert!(
+        stderr.contains("cross-validating over 2 folds, side by side"),
+        "{stderr}"
+    );
+    for fold in ["fold 1/2: fitting", "fold 2/2: fitting"] {
+        assert_eq!(stderr.matches(fold).count(), 1, "{stderr}");
+    }
     assert!(out_dir.join("summary.json").exists());
     let cv: serde_json::Value =
         serde_json::from_str(&fs::read_to_string(out_dir.join("crossval.json")).unwrap()).unwrap();

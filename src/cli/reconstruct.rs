@@ -7,10 +7,10 @@ use clap::Args;
 use serde::Serialize;
 use wslap::{
     check_ensemble_size, check_memory, cross_validate, export_system, fold_groups,
-    holdable_sources, image_regions, parse_par_with, reconstruct, run_ensemble, ColorScale,
-    Control, ConvergenceRecord, Cosmology, CosmologyError, CrossValidation, Dataset, InputKind,
-    InputText, InputTexts, Inputs, LensPlane, LenstoolPar, ParOptions, ReconstructConfig,
-    ReconstructError, Reconstruction, SolverMethod,
+    holdable_sources, image_regions, parse_par_with, reconstruct, run_ensemble,
+    strength_candidates, ColorScale, Control, ConvergenceRecord, Cosmology, CosmologyError,
+    CrossValidation, Dataset, InputKind, InputText, InputTexts, Inputs, LensPlane, LenstoolPar,
+    ParOptions, ReconstructConfig, ReconstructError, Reconstruction, SolverMethod,
 };
 
 use super::input::read_text;
@@ -347,6 +347,16 @@ pub fn run(args: &ReconstructArgs) -> Result<(), String> {
         }
         Control::Continue
     };
+    // The choice's trials run side by side and report nothing until it is made.
+    if config.objective.strength.value().is_none() {
+        eprintln!(
+            "choosing the regulariser, its strength and the grid: {} candidates, each \
+             cross-validated over up to {} folds, side by side on the cores (AS1063's 50 images: \
+             about a minute); then the chosen map's passes",
+            strength_candidates(&config).len(),
+            config.objective.folds
+        );
+    }
     let result = reconstruct(&inputs, &config, &mut progress).map_err(|e| e.to_string())?;
     for w in &result.warnings {
         eprintln!("warning: {w}");
@@ -475,9 +485,24 @@ fn run_crossval(
     result: &Reconstruction,
     out: &Path,
 ) -> Result<CrossValidation, String> {
+    // A fold's first report says it fits (after its own choice of the settings, which reports
+    // nothing); QADP's last one too.
     let total = config.solver.iterations;
+    let qadp = config.solver.method != SolverMethod::Exact;
+    eprintln!(
+        "cross-validating over {folds} folds{}",
+        match config.objective.strength.value() {
+            None => ", side by side; each chooses its settings again (as above) before it fits",
+            Some(_) => ", side by side",
+        }
+    );
+    let mut started = vec![false; folds + 1];
     let mut progress = |fold: usize, r: &ConvergenceRecord| {
-        if r.iteration == total {
+        if let Some(seen @ false) = started.get_mut(fold) {
+            *seen = true;
+            eprintln!("fold {fold}/{folds}: fitting");
+        }
+        if qadp && r.iteration == total {
             eprintln!("fold {fold}/{folds}: {total} iterations");
         }
         Control::Continue
