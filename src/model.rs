@@ -260,6 +260,16 @@ impl ModelFile {
     /// error message; JSON errors carry line and column, component errors the component index.
     pub fn from_json_str(text: &str, source_name: &str) -> Result<Self, ModelError> {
         TooLarge::check_bytes(source_name, InputKind::Model, text.len() as u64)?;
+        if let Some(line) = lenstool_par_line(text) {
+            return Err(ModelError::Syntax {
+                source_name: source_name.to_string(),
+                line,
+                column: 1,
+                message: "this is a Lenstool parameter file (.par), not a JSON model: give it \
+                          with --lenstool (the app reads a .par as the model file)"
+                    .to_string(),
+            });
+        }
         if let Some((line, column, message)) = crate::limits::not_an_object(text) {
             return Err(ModelError::Syntax {
                 source_name: source_name.to_string(),
@@ -403,4 +413,25 @@ fn failing_component(text: &str) -> Option<(usize, String, serde_json::Error)> {
         let kind = c.get("type").and_then(|t| t.as_str()).unwrap_or("?");
         Some((index, kind.to_string(), err))
     })
+}
+
+/// The line (1-based) of a text's first word when that word opens a Lenstool `.par` block
+/// (`runmode`, `potentiel`, ...), so that a `.par` given as a JSON model is named as one.
+fn lenstool_par_line(text: &str) -> Option<usize> {
+    const BLOCKS: [&str; 8] = [
+        "runmode",
+        "cosmologie",
+        "potentiel",
+        "potfile",
+        "image",
+        "grille",
+        "champ",
+        "limit",
+    ];
+    let (k, line) = text
+        .lines()
+        .enumerate()
+        .find(|(_, l)| !l.trim().is_empty() && !l.trim_start().starts_with('#'))?;
+    let word = line.split_whitespace().next()?;
+    BLOCKS.iter().any(|b| word.starts_with(b)).then_some(k + 1)
 }

@@ -41,11 +41,13 @@ pub enum Ds9Error {
         line: usize,
         frame: String,
     },
-    #[error("{file} line {line}: region shape `{shape}` is not supported (polygon, point, circle, ellipse, box, line, segment)")]
+    #[error("{file} line {line}: region shape `{shape}` is not supported (polygon, point, circle, ellipse, box, line, segment){hint}")]
     UnsupportedShape {
         file: String,
         line: usize,
         shape: String,
+        /// What the file is instead, when that is plain (a Lenstool catalogue's row), or "".
+        hint: &'static str,
     },
     #[error("region on line {line} is in fk5: the frame needs a sky reference (RA, Dec of its origin) to use it")]
     NeedsReference { line: usize },

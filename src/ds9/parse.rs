@@ -238,10 +238,19 @@ fn parse_shape(
             }
         }
         _ => {
+            // A row that starts with a number is a catalogue's (`1.1 342.18 -44.53 ...`).
+            let hint = match name.parse::<f64>() {
+                Ok(_) => {
+                    "; this line reads as a Lenstool catalogue row (id x y a b theta z): give \
+                     the catalogue with --images (in the app, as the image catalogue)"
+                }
+                Err(_) => "",
+            };
             let e = Ds9Error::UnsupportedShape {
                 file: ctx.file.into(),
                 line: ctx.line,
                 shape: name.clone(),
+                hint,
             };
             return Err(e);
         }

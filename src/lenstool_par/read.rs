@@ -104,7 +104,8 @@ pub fn parse_par_with(
             p.free_mass = free_mass(b, &cx);
         }
     }
-    let cosmology = cosmology.ok_or_else(|| cx.model("no `cosmologie` block"))?;
+    let cosmology =
+        cosmology.ok_or_else(|| cx.model(&format!("no `cosmologie` block{}", other_kind(text))))?;
     let &(z_lens, main, _, _) = z_values
         .first()
         .ok_or_else(|| cx.model("no `potentiel` or `potfile` block"))?;
@@ -878,4 +879,27 @@ impl Ctx<'_> {
         };
         Ok((p, self.req(b, z_key, 0)?))
     }
+}
+
+/// What a text without a `cosmologie` block is instead, when it is plainly another kind of
+/// file the user has (a catalogue, a JSON model): a clause for the error, else "".
+fn other_kind(text: &str) -> &'static str {
+    let first = text
+        .lines()
+        .map(str::trim)
+        .find(|l| !l.is_empty() && !l.starts_with('#'));
+    let Some(first) = first else {
+        return "";
+    };
+    if first.starts_with('{') {
+        return ": this looks like a JSON model file, not a Lenstool .par (give it with --model)";
+    }
+    let fields: Vec<&str> = first.split_whitespace().collect();
+    let numbers = fields.iter().skip(1).take(6);
+    if fields.len() >= 7 && numbers.clone().all(|f| f.parse::<f64>().is_ok()) {
+        return ": this looks like a Lenstool catalogue (id x y a b theta z or mag ...), not a \
+                parameter file (.par): give it with --images or --members (in the app, as the \
+                image or member catalogue)";
+    }
+    ""
 }

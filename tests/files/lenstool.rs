@@ -1414,3 +1414,57 @@ fn a_galaxy_written_twice_is_fitted_twice_unless_catalogued() {
     );
     assert_eq!(data.members.unwrap().members.len(), 1);
 }
+
+/// A file given as another kind is named as what it is: a catalogue or a JSON model given as
+/// a `.par`, a `.par` given as a JSON model, a catalogue given as DS9 arcs (a newcomer's
+/// mistakes, each once answered with a parser's words: "no `cosmologie` block", "expected
+/// value", "region shape `1`").
+#[cfg_attr(not(target_arch = "wasm32"), test)]
+#[cfg_attr(target_arch = "wasm32", wasm_bindgen_test::wasm_bindgen_test)]
+fn a_file_of_another_kind_is_named_as_what_it_is() {
+    let catalogue = "#REFERENCE 0\n1.1 10.2 -3.1 0.1 0.1 0 2.0 25\n1.2 -8.0 4.0 0.1 0.1 0 2.0 25\n";
+    let err = refused(catalogue, "images.cat");
+    assert!(
+        err.starts_with("images.cat: no `cosmologie` block: this looks like a Lenstool catalogue")
+            && err.contains("give it with --images or --members"),
+        "{err}"
+    );
+    let json = "{\"z_lens\": 0.3, \"components\": []}";
+    let err = refused(json, "model.json");
+    assert!(
+        err.contains(
+            "this looks like a JSON model file, not a Lenstool .par (give it with --model)"
+        ),
+        "{err}"
+    );
+    // A .par without a cosmology block that is neither keeps the plain reason.
+    let err = refused("runmode\n  reference 3 10 20\n  end\n", "bare.par");
+    assert!(err.ends_with("no `cosmologie` block"), "{err}");
+
+    let err = wslap::ModelFile::from_json_str(IDENTITY, "identity.par")
+        .expect_err("a .par is no JSON model")
+        .to_string();
+    assert!(
+        err.contains(
+            "this is a Lenstool parameter file (.par), not a JSON model: give it with --lenstool"
+        ),
+        "{err}"
+    );
+    let first = IDENTITY
+        .lines()
+        .position(|l| !l.trim().is_empty() && !l.trim_start().starts_with('#'))
+        .unwrap();
+    assert!(
+        err.contains(&format!("line {}, column 1", first + 1)),
+        "{err}"
+    );
+
+    let err = wslap::read_regions(catalogue, "arcs.reg").expect_err("a catalogue is no DS9 file");
+    let err = err.to_string();
+    assert!(
+        err.starts_with("arcs.reg line 2: region shape `1` is not supported")
+            && err.contains("reads as a Lenstool catalogue row")
+            && err.contains("give the catalogue with --images"),
+        "{err}"
+    );
+}
