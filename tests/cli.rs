@@ -1074,6 +1074,18 @@ fn byte_order_marks_and_option_forms_as_people_write_them() {
         err.starts_with("error: --holdout: constraints: hold-out system \"999\""),
         "{err}"
     );
+    // So does --free-z (it had no prefix).
+    let err = refused(
+        &dir,
+        "reconstruct",
+        &[
+            "--images", &images, "--z-lens", "0.348", "--config", path, "--free-z", "999",
+        ],
+    );
+    assert!(
+        err.starts_with("error: --free-z: constraints: free_z_systems: system \"999\""),
+        "{err}"
+    );
     for prior in [&["1,2", "3,4"][..], &["1"][..]] {
         let mut args = vec!["--images", &images, "--z-lens", "0.348", "--z-prior"];
         args.extend(prior);

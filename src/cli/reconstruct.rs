@@ -315,7 +315,15 @@ pub fn run(args: &ReconstructArgs) -> Result<(), String> {
         ReconstructError::Memory(_) | ReconstructError::BadFieldValue(_) => {
             format!("{settings_name}: {e}")
         }
-        ReconstructError::Constraints(_) if !args.holdout.is_empty() => {
+        // A system the options name that the catalogue lacks: the option that named it.
+        ReconstructError::Constraints(_)
+            if !args.free_z.is_empty() && e.to_string().contains("free_z_systems") =>
+        {
+            format!("--free-z: {e}")
+        }
+        ReconstructError::Constraints(_)
+            if !args.holdout.is_empty() && e.to_string().contains("hold-out") =>
+        {
             format!("--holdout: {e}")
         }
         other => other.to_string(),
