@@ -3,7 +3,7 @@
 
 import { LensClient } from './lens-client.js';
 import { loadProject, loadPrevious, saveProject, hasSaved, setAside, setAsideList, deleteSetAside } from './js/store.js';
-import { buildFileRows, setFileStatus, ROLES } from './js/files.js';
+import { buildFileRows, foldedList, setFileStatus, ROLES } from './js/files.js';
 import { buildSettings, showSettings, showChoiceNote, fieldMessage } from './js/settings.js';
 import { wireViews, showPng, showSystems, showCrossval, showStrengthChoice, viewOptions, currentView, refreshReadout, clearPin, pinAt } from './js/views.js';
 import { showDownloads, save } from './js/downloads.js';
@@ -284,17 +284,8 @@ function runNotes(summary) {
   }
   const warnings = summary?.warnings ?? [];
   if (warnings.length) {
-    const details = document.createElement('details');
+    const details = foldedList(`${warnings.length} warning${warnings.length === 1 ? '' : 's'} from the run`, warnings);
     details.id = 'run-warnings';
-    const head = document.createElement('summary');
-    head.textContent = `${warnings.length} warning${warnings.length === 1 ? '' : 's'} from the run`;
-    const list = document.createElement('ul');
-    for (const w of warnings) {
-      const li = document.createElement('li');
-      li.textContent = w;
-      list.append(li);
-    }
-    details.append(head, list);
     box.append(details);
   }
 }

@@ -102,16 +102,23 @@ export function setFileStatus(role, text, bad = false, more = []) {
   el.textContent = text;
   el.classList.toggle('bad', bad);
   if (!more.length) return;
-  const box = document.createElement('details');
+  const box = foldedList(`${more.length} more warning${more.length === 1 ? '' : 's'}`, more);
   box.className = 'more-warnings';
-  const summary = document.createElement('summary');
-  summary.textContent = `${more.length} more warning${more.length === 1 ? '' : 's'}`;
+  el.append(box);
+}
+
+/** A closed `<details>` whose `<summary>` says `summary` and whose list holds `items` (text):
+ * a file's warnings past the first few, the run's warnings. */
+export function foldedList(summary, items) {
+  const box = document.createElement('details');
+  const head = document.createElement('summary');
+  head.textContent = summary;
   const list = document.createElement('ul');
-  for (const w of more) {
+  for (const text of items) {
     const item = document.createElement('li');
-    item.textContent = w;
+    item.textContent = text;
     list.append(item);
   }
-  box.append(summary, list);
-  el.append(box);
+  box.append(head, list);
+  return box;
 }
